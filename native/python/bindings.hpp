@@ -1,0 +1,9 @@
+#pragma once
+// Shared declarations of the thin pybind11 layer: each bind_*.cpp adds one concern's functions.
+#include <pybind11/pybind11.h>
+
+namespace wiresculpt::python {
+
+void bind_slicing(pybind11::module_& m);
+
+}  // namespace wiresculpt::python
