@@ -1,0 +1,19 @@
+"""Wire materials: the paper's Table 1 (3 mm wires) plus densities. SI units."""
+
+# k_b (N m^2), plastic-limit torque (N m), friction coefficient, density (kg/m^3).
+PRESETS = {
+    "steel": {"name": "steel", "wire_diameter": 0.003, "bending_stiffness": 0.73,
+              "max_torque": 1.77, "friction": 0.32, "density": 7850.0},
+    "brass": {"name": "brass", "wire_diameter": 0.003, "bending_stiffness": 0.42,
+              "max_torque": 1.30, "friction": 0.23, "density": 8500.0},
+}
+
+# key: (unit, lower bound exclusive, upper bound inclusive)
+FIELDS = {
+    "wire_diameter": ("m", 0.0, 0.05),
+    "bending_stiffness": ("N m^2", 0.0, 1e4),
+    "max_torque": ("N m", 0.0, 1e4),
+    "friction": ("", 0.0, 10.0),
+    "density": ("kg/m^3", 0.0, 1e5),
+}
+REQUIRED = ("wire_diameter", "bending_stiffness", "max_torque", "friction")

@@ -1,0 +1,161 @@
+"""The scene file of a headless run (FORMATS.md), read and validated.
+
+Every problem is one ValueError whose sentence names the key (as a path such as
+`planes[1].normal`) or the line at fault; nothing is guessed.
+"""
+import json
+import math
+import os
+from dataclasses import dataclass, field
+
+from . import materials, settings as settings_table
+
+TOP_KEYS = {"mesh", "size", "material", "planes", "settings"}
+PLANE_KEYS = {"name", "origin", "normal", "contours"}
+MAX_COORDINATE = 1e6  # metres (or mesh units): beyond this a number is a typo, not a sculpture
+MAX_SIZE = 100.0  # metres
+
+
+@dataclass
+class PlaneSpec:
+    name: str
+    origin: tuple
+    normal: tuple
+    contours: object = "largest"
+
+
+@dataclass
+class Scene:
+    path: str
+    mesh: str  # absolute path
+    size: object  # metres, or None: the mesh's units are metres
+    material: dict
+    planes: list
+    settings: dict = field(default_factory=settings_table.defaults)
+
+
+def _number(value, key, low=None, high=None, low_open=False):
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ValueError(f'scene key "{key}" must be a number, got {json.dumps(value)}')
+    value = float(value)
+    if not math.isfinite(value):
+        raise ValueError(f'scene key "{key}" must be a finite number, got {value}')
+    if low is not None and (value <= low if low_open else value < low):
+        raise ValueError(f'scene key "{key}" must be {"greater than" if low_open else "at least"} {low:g}, got {value:g}')
+    if high is not None and value > high:
+        raise ValueError(f'scene key "{key}" must be at most {high:g}, got {value:g}')
+    return value
+
+
+def _vector(value, key):
+    if not isinstance(value, list) or len(value) != 3:
+        raise ValueError(f'scene key "{key}" must be a list of three numbers, got {json.dumps(value)}')
+    return tuple(_number(x, f"{key}[{i}]", -MAX_COORDINATE, MAX_COORDINATE) for i, x in enumerate(value))
+
+
+def _unknown(keys, allowed, where):
+    extra = sorted(set(keys) - allowed)
+    if extra:
+        place = f" in {where}" if where else ""
+        raise ValueError(f'unknown scene key "{extra[0]}"{place}; expected one of: {", ".join(sorted(allowed))}')
+
+
+def _material(value):
+    if value is None:
+        return dict(materials.PRESETS["steel"])
+    if isinstance(value, str):
+        if value not in materials.PRESETS:
+            raise ValueError(f'scene key "material": unknown preset "{value}"; use one of: '
+                             f'{", ".join(sorted(materials.PRESETS))} or an object')
+        return dict(materials.PRESETS[value])
+    if not isinstance(value, dict):
+        raise ValueError('scene key "material" must be a preset name or an object')
+    _unknown(value, {"name", *materials.FIELDS}, "material")
+    out = {"name": str(value.get("name", "custom"))}
+    for key, (_unit, low, high) in materials.FIELDS.items():
+        if key in value:
+            out[key] = _number(value[key], f"material.{key}", low, high, low_open=True)
+        elif key in materials.REQUIRED:
+            raise ValueError(f'scene key "material.{key}" is missing')
+    return out
+
+
+def _plane(value, index, names):
+    key = f"planes[{index}]"
+    if not isinstance(value, dict):
+        raise ValueError(f'scene key "{key}" must be an object with "origin" and "normal"')
+    _unknown(value, PLANE_KEYS, key)
+    for required in ("origin", "normal"):
+        if required not in value:
+            raise ValueError(f'scene key "{key}.{required}" is missing')
+    name = value.get("name", chr(ord("A") + index) if index < 26 else f"P{index}")
+    if not isinstance(name, str) or not name.strip():
+        raise ValueError(f'scene key "{key}.name" must be a non-empty string')
+    if name in names:
+        raise ValueError(f'scene key "{key}.name": the name "{name}" is used by two planes')
+    names.add(name)
+    origin = _vector(value["origin"], f"{key}.origin")
+    normal = _vector(value["normal"], f"{key}.normal")
+    if math.sqrt(sum(c * c for c in normal)) < 1e-12:
+        raise ValueError(f'scene key "{key}.normal" (plane {name}) is zero; give a direction such as [0, 0, 1]')
+    contours = value.get("contours", "largest")
+    if isinstance(contours, list):
+        for i, k in enumerate(contours):
+            if isinstance(k, bool) or not isinstance(k, int) or k < 0:
+                raise ValueError(f'scene key "{key}.contours[{i}]" must be a contour index (0, 1, ...), got {json.dumps(k)}')
+    elif contours not in ("largest", "all"):
+        raise ValueError(f'scene key "{key}.contours" must be "largest", "all" or a list of indices, got {json.dumps(contours)}')
+    return PlaneSpec(name, origin, normal, contours)
+
+
+def _settings(value):
+    out = settings_table.defaults()
+    if value is None:
+        return out
+    if not isinstance(value, dict):
+        raise ValueError('scene key "settings" must be an object')
+    _unknown(value, set(settings_table.SETTINGS), "settings")
+    for key, raw in value.items():
+        _default, low, high, _unit, _text = settings_table.SETTINGS[key]
+        out[key] = None if raw is None and _default is None else _number(raw, f"settings.{key}", low, high)
+    if out["min_bend_deg"] >= out["max_bend_deg"]:
+        raise ValueError('scene key "settings.min_bend_deg" must be smaller than "settings.max_bend_deg"')
+    return out
+
+
+def parse_scene(data, path="scene.json"):
+    """A validated Scene from the decoded JSON `data` of the file at `path`."""
+    if not isinstance(data, dict):
+        raise ValueError(f"{path}: the scene must be a JSON object")
+    _unknown(data, TOP_KEYS, "")
+    if "mesh" not in data:
+        raise ValueError('scene key "mesh" is missing: give the path of an OBJ, STL or PLY file')
+    if not isinstance(data["mesh"], str) or not data["mesh"]:
+        raise ValueError('scene key "mesh" must be a file path')
+    mesh = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(path)), data["mesh"]))
+    if not os.path.isfile(mesh):
+        raise ValueError(f'scene key "mesh": file not found: {mesh}')
+    size = data.get("size")
+    if size is not None:
+        size = _number(size, "size", 0.0, MAX_SIZE, low_open=True)
+    planes = data.get("planes")
+    if not isinstance(planes, list) or not planes:
+        raise ValueError('scene key "planes" must be a non-empty list of planes')
+    names = set()
+    parsed = [_plane(p, i, names) for i, p in enumerate(planes)]
+    return Scene(os.path.abspath(path), mesh, size, _material(data.get("material")), parsed,
+                 _settings(data.get("settings")))
+
+
+def load_scene(path):
+    """Reads and validates the scene file at `path`."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+    except OSError as exc:
+        raise ValueError(f"cannot read scene file {path}: {exc.strerror}") from None
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{path} line {exc.lineno}: not valid JSON ({exc.msg})") from None
+    return parse_scene(data, path)

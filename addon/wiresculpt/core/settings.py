@@ -1,0 +1,18 @@
+"""The solver settings a scene file may give under "settings": one table with defaults, bounds
+and units, read by the scene loader and the add-on's properties alike."""
+
+# key: (default, minimum, maximum, unit, description)
+SETTINGS = {
+    "min_segment": (0.015, 0.001, 1.0, "m",
+                    "Shortest distance between two bends the machine can make (l_min)"),
+    "max_bend_deg": (120.0, 1.0, 180.0, "deg", "Largest bend the machine can make"),
+    "min_bend_deg": (1.0, 0.0, 45.0, "deg", "Smallest bend the machine makes reliably"),
+    "torque_fraction": (1.0, 0.01, 1.0, "",
+                        "Share of the wire's plastic-limit torque the design may use"),
+    "weld_tolerance": (None, 0.0, 0.01, "m",
+                       "Mesh vertices closer than this are merged (default: 1e-7 of the mesh size)"),
+}
+
+
+def defaults():
+    return {key: spec[0] for key, spec in SETTINGS.items()}

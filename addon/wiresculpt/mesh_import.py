@@ -1,0 +1,57 @@
+"""Mesh files into (V, F) arrays through Blender's own importers, coordinates exactly as written
+in the file (FORMATS.md: no axis conversion, every object of the file joined into one mesh)."""
+import os
+
+import bpy
+
+from .mesh_data import join_triangles, object_triangles
+
+FORMATS = (".obj", ".stl", ".ply")
+
+
+def _has_operator(group, name):
+    # bpy.ops resolves names lazily (hasattr is always true); dir() lists the real ones.
+    return name in dir(getattr(bpy.ops, group))
+
+
+def _import(path, ext):
+    same = {"forward_axis": "Y", "up_axis": "Z"}
+    if ext == ".obj":
+        if _has_operator("wm", "obj_import"):
+            return bpy.ops.wm.obj_import(filepath=path, **same)
+        return bpy.ops.import_scene.obj(filepath=path, axis_forward="Y", axis_up="Z", split_mode="OFF")
+    if ext == ".stl":
+        if _has_operator("wm", "stl_import"):  # Blender 4.2+
+            return bpy.ops.wm.stl_import(filepath=path, global_scale=1.0, use_scene_unit=False, **same)
+        return bpy.ops.import_mesh.stl(filepath=path, axis_forward="Y", axis_up="Z", global_scale=1.0,
+                                       use_scene_unit=False)
+    if ext == ".ply":
+        if _has_operator("wm", "ply_import"):  # Blender 4.0+
+            return bpy.ops.wm.ply_import(filepath=path, global_scale=1.0, use_scene_unit=False, **same)
+        return bpy.ops.import_mesh.ply(filepath=path)
+    raise ValueError(f"mesh file {path}: unsupported format {ext or '(none)'}; use OBJ, STL or PLY")
+
+
+def import_mesh(path):
+    """(V, F, objects): the file's meshes joined, world coordinates equal to the file's numbers.
+    ValueError for a missing, unreadable or empty file."""
+    if not os.path.isfile(path):
+        raise ValueError(f"mesh file not found: {path}")
+    ext = os.path.splitext(path)[1].lower()
+    if ext not in FORMATS:
+        raise ValueError(f"mesh file {path}: unsupported format {ext or '(none)'}; use OBJ, STL or PLY")
+    before = set(bpy.data.objects)
+    try:
+        result = _import(path, ext)
+    except RuntimeError as exc:
+        raise ValueError(f"mesh file {path}: Blender could not read it ({str(exc).strip()})") from None
+    if "FINISHED" not in result:
+        raise ValueError(f"mesh file {path}: Blender could not read it")
+    objects = [o for o in bpy.data.objects if o not in before and o.type == "MESH"]
+    if not objects:
+        raise ValueError(f"mesh file {path} holds no mesh")
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    V, F = join_triangles([object_triangles(o, depsgraph) for o in objects])
+    if len(V) == 0:
+        raise ValueError(f"mesh file {path} has no vertices")
+    return V, F, objects

@@ -1,0 +1,138 @@
+"""The headless batch run (FORMATS.md) as a user runs it: a separate Blender process per run."""
+import json
+import math
+import os
+import tempfile
+import unittest
+
+from helpers import (BATCH, ROOT, box_faces, box_vertices, polyline_length, run_blender,
+                     wiresculpt_lines, write_obj, write_ply, write_stl)
+
+GLOBE = os.path.join(ROOT, "scripts", "examples", "globe", "scene.json")
+# A box placed off-centre with unequal sides, so any axis swap or recentring shows.
+LO, HI = (0.1, -0.2, 0.02), (0.3, 0.05, 0.5)
+CORNERS = [(x, y, 0.2) for x in (0.1, 0.3) for y in (-0.2, 0.05)]
+
+
+class BatchTest(unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.TemporaryDirectory()
+        self.out = os.path.join(self.dir.name, "out")
+
+    def tearDown(self):
+        self.dir.cleanup()
+
+    def scene(self, **data):
+        path = os.path.join(self.dir.name, "scene.json")
+        with open(path, "w") as f:
+            f.write(data.pop("_text", None) or json.dumps(data))
+        return path
+
+    def batch(self, scene):
+        return run_blender(BATCH, scene, "--out", self.out)
+
+    def design(self):
+        with open(os.path.join(self.out, "design.json")) as f:
+            return json.load(f)
+
+    def assertFailsWith(self, fragment, scene):
+        r = self.batch(scene)
+        self.assertEqual(r.returncode, 1, r.stdout + r.stderr)
+        errors = wiresculpt_lines(r.stderr)
+        self.assertEqual(len(errors), 1, r.stderr)
+        self.assertTrue(errors[0].startswith("wiresculpt: error: "), errors[0])
+        self.assertIn(fragment, errors[0])
+        self.assertFalse(os.path.exists(self.out), "a failed run must leave no output behind")
+
+    def box_scene(self, writer, ext, **extra):
+        mesh = os.path.join(self.dir.name, "box" + ext)
+        writer(mesh, box_vertices(LO, HI), box_faces())
+        return self.scene(mesh="box" + ext, planes=[{"name": "Z", "origin": [0, 0, 0.2], "normal": [0, 0, 3]}],
+                          **extra)
+
+    def test_globe_example(self):
+        r = self.batch(GLOBE)
+        self.assertIn(r.returncode, (0, 2), r.stdout + r.stderr)
+        stages = [line.split(":")[1].strip() for line in wiresculpt_lines(r.stdout)]
+        self.assertIn("slicing", stages)
+        d = self.design()
+        self.assertEqual((d["format"], d["version"], d["units"]), ("wiresculpt-design", 1, "m"))
+        self.assertEqual(len(d["wires"]), 3)
+        for w in d["wires"]:
+            self.assertTrue(w["closed"])
+            # size 0.25 m: a great circle of radius 0.125 m, sampled by 48 points
+            expected = 2 * 0.125 * 48 * math.sin(math.pi / 48)
+            self.assertAlmostEqual(polyline_length(w["contour"], True), expected, delta=1e-4 * expected)
+            n, o = w["plane"]["normal"], w["plane"]["origin"]
+            for p in w["contour"]:
+                self.assertLess(abs(sum(n[k] * (p[k] - o[k]) for k in range(3))), 1e-9)
+            self.assertNotEqual(w["contour"][0], w["contour"][-1])
+        if r.returncode == 2:
+            self.assertFalse(d["stable"])
+            self.assertTrue(d["reason"])
+
+    def check_box(self, scene, scale=1.0):
+        r = self.batch(scene)
+        self.assertIn(r.returncode, (0, 2), r.stdout + r.stderr)
+        wires = self.design()["wires"]
+        self.assertEqual(len(wires), 1)
+        contour = wires[0]["contour"]
+        for corner in CORNERS:
+            nearest = min(math.dist(p, [scale * c for c in corner]) for p in contour)
+            self.assertLess(nearest, 1e-6 * scale, f"corner {corner} missing from {contour}")
+        self.assertAlmostEqual(polyline_length(contour, True), scale * 0.9, delta=1e-6 * scale)
+        self.assertEqual(wires[0]["plane"]["normal"], [0.0, 0.0, 1.0])
+
+    def test_obj_coordinates_are_used_as_written(self):
+        self.check_box(self.box_scene(write_obj, ".obj"))
+
+    def test_stl_coordinates_are_used_as_written(self):
+        self.check_box(self.box_scene(write_stl, ".stl"))
+
+    def test_ply_coordinates_are_used_as_written(self):
+        self.check_box(self.box_scene(write_ply, ".ply"))
+
+    def test_size_scales_mesh_and_plane_origins(self):
+        # The largest side is z (0.48); size 1.2 scales everything by 2.5 about the origin.
+        self.check_box(self.box_scene(write_obj, ".obj", size=1.2), scale=2.5)
+
+    def test_plane_that_misses_gives_no_wire(self):
+        write_obj(os.path.join(self.dir.name, "box.obj"), box_vertices(LO, HI), box_faces())
+        r = self.batch(self.scene(mesh="box.obj", planes=[{"origin": [0, 0, 3], "normal": [0, 0, 1]}]))
+        self.assertEqual(r.returncode, 2, r.stdout + r.stderr)
+        d = self.design()
+        self.assertEqual(d["wires"], [])
+        self.assertFalse(d["stable"])
+        self.assertIn("no plane cuts the mesh", d["reason"])
+
+    def test_bad_input(self):
+        write_obj(os.path.join(self.dir.name, "box.obj"), box_vertices(LO, HI), box_faces())
+        plane = {"origin": [0, 0, 0.2], "normal": [0, 0, 1]}
+        cases = [
+            ('unknown scene key "colour"', dict(mesh="box.obj", planes=[plane], colour="red")),
+            ("file not found", dict(mesh="nothere.obj", planes=[plane])),
+            ('"planes[0].normal" (plane A) is zero', dict(mesh="box.obj", planes=[{"origin": [0, 0, 0], "normal": [0, 0, 0]}])),
+            ('"planes[0].origin[1]" must be a finite number', dict(_text='{"mesh": "box.obj", "planes": [{"origin": [0, NaN, 0], "normal": [0, 0, 1]}]}')),
+            ("line 1: not valid JSON", dict(_text='{"mesh": "box.obj", "planes": [}')),
+            ('unknown scene key "speed" in settings', dict(mesh="box.obj", planes=[plane], settings={"speed": 2})),
+        ]
+        for fragment, data in cases:
+            with self.subTest(fragment):
+                self.assertFailsWith(fragment, self.scene(**data))
+
+    def test_bad_mesh_files(self):
+        for name, text, fragment in [("mesh.xyz", "1 2 3\n", "unsupported format .xyz"),
+                                     ("empty.obj", "# nothing\n", "holds no mesh")]:
+            with self.subTest(name):
+                with open(os.path.join(self.dir.name, name), "w") as f:
+                    f.write(text)
+                self.assertFailsWith(fragment, self.scene(mesh=name, planes=[{"origin": [0, 0, 0], "normal": [0, 0, 1]}]))
+
+    def test_missing_arguments(self):
+        r = run_blender(BATCH)
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("usage:", r.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,52 @@
+# Shared by the scripts: paths, package installation and the build. Source it, don't run it.
+set -euo pipefail
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+BUILD_DIR=${WIRESCULPT_BUILD_DIR:-$ROOT/build/release}
+# Blender 3.4 from Debian embeds Debian's Python 3.11; another python3 may come first on PATH.
+PYTHON=/usr/bin/python3.11
+BLENDER=${BLENDER:-blender}
+
+# Debian packages the build, the tests and the demo need.
+PACKAGES=(
+  cmake g++ make pkg-config
+  blender python3.11 python3-dev python3-numpy
+  libeigen3-dev pybind11-dev catch2
+  libglpk-dev libnlopt-cxx-dev libserialport-dev
+)
+
+say() { printf 'wiresculpt: %s\n' "$*" >&2; }
+
+as_root() {
+  if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi
+}
+
+# Installs whichever of the named Debian packages are missing; does nothing when all are there.
+ensure_packages() {
+  local missing=()
+  for p in "$@"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  say "installing ${missing[*]}"
+  as_root env DEBIAN_FRONTEND=noninteractive apt-get update -qq
+  as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+}
+
+# Configures (once) and builds the library, the Python module and the tests.
+build() {
+  if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
+    cmake -S "$ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE="$PYTHON" >/dev/null
+  fi
+  if ! cmake --build "$BUILD_DIR" -j"$(nproc)" >"$BUILD_DIR/build.log" 2>&1; then
+    cat "$BUILD_DIR/build.log" >&2
+    say "build failed (log: $BUILD_DIR/build.log)"
+    return 1
+  fi
+  grep -E 'warning:' "$BUILD_DIR/build.log" | grep -v 'lto-wrapper' >&2 || true
+}
+
+# Runs a Python file inside headless Blender; extra arguments follow "--".
+blender_run() {
+  local file=$1; shift
+  "$BLENDER" --background --factory-startup --python-exit-code 1 --python "$file" -- "$@"
+}
