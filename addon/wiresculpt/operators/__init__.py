@@ -1,0 +1,14 @@
+"""Operators, one module per concern, each with its own register/unregister."""
+from . import slicing
+
+_modules = (slicing,)
+
+
+def register():
+    for module in _modules:
+        module.register()
+
+
+def unregister():
+    for module in reversed(_modules):
+        module.unregister()

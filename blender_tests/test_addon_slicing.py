@@ -1,0 +1,383 @@
+"""The add-on's slicing stage inside Blender: handles, the Slice operator, the panel.
+
+    blender --background --factory-startup --python-exit-code 1 --python blender_tests/run.py -- addon_slicing
+"""
+import math
+import types
+import unittest
+
+import bmesh
+import bpy
+from mathutils import Matrix, Vector
+
+import wiresculpt
+from wiresculpt import native
+from wiresculpt.operators import slicing
+from wiresculpt.ui import panel
+
+
+def register_addon():
+    if wiresculpt._modules:  # registered already (by another suite or a previous run)
+        wiresculpt.unregister()
+    wiresculpt.register()
+
+
+def clear_scene():
+    for collection in (bpy.data.objects, bpy.data.meshes, bpy.data.curves, bpy.data.collections):
+        for block in list(collection):
+            collection.remove(block)
+    settings = bpy.context.scene.wiresculpt
+    settings.contours.clear()
+    settings.target = None
+
+
+def uv_sphere(radius=1.0, location=(0, 0, 0)):
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=128, ring_count=64, radius=radius,
+                                         location=location)
+    return bpy.context.object
+
+
+def run(operator_class, context=None):
+    """(result, reports) of the operator's execute, reports as [(type, message)]."""
+    reports = []
+    fake = types.SimpleNamespace(report=lambda kind, message: reports.append((kind, message)))
+    result = operator_class.execute(fake, context or bpy.context)
+    return result, reports
+
+
+def add_handle(location, rotation=(0, 0, 0)):
+    assert bpy.ops.wiresculpt.add_plane() == {'FINISHED'}
+    handle = bpy.context.view_layer.objects.active
+    handle.location = location
+    handle.rotation_euler = rotation
+    return handle
+
+
+def slice_scene():
+    assert bpy.ops.wiresculpt.slice() == {'FINISHED'}
+    bpy.context.view_layer.update()
+
+
+def plane_distance(handle, centre):
+    """Distance from `centre` to the handle's plane (world location, world Z axis)."""
+    bpy.context.view_layer.update()
+    M = handle.matrix_world
+    return M.col[2].xyz.normalized().dot(M.translation - Vector(centre))
+
+
+def circle_length(radius, distance):
+    return 2 * math.pi * math.sqrt(radius * radius - distance * distance)
+
+
+def items_of(plane):
+    return [item for item in bpy.context.scene.wiresculpt.contours if item.plane == plane]
+
+
+def contour_objects():
+    return [o for o in bpy.data.objects if slicing.CONTOUR_KEY in o]
+
+
+class AddonCase(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        register_addon()
+
+    @classmethod
+    def tearDownClass(cls):
+        clear_scene()
+        wiresculpt.unregister()
+
+    def setUp(self):
+        clear_scene()
+
+    def assertLengthNear(self, actual, expected, rel=0.01):
+        self.assertLess(abs(actual - expected), rel * expected,
+                        f"length {actual:.6f} differs from {expected:.6f} by more than {rel:.0%}")
+
+
+@unittest.skipUnless(native.available(), "the native module is not built")
+class SliceSphere(AddonCase):
+    R = 1.0
+    CENTRE = (0.3, -0.2, 0.5)
+
+    def three_planes(self):
+        sphere = uv_sphere(self.R, self.CENTRE)
+        bpy.context.scene.wiresculpt.target = sphere
+        c = Vector(self.CENTRE)
+        a = add_handle(c)
+        b = add_handle(c + Vector((0, 0, 0.5)))
+        tilt = Matrix.Rotation(0.4, 3, 'X') @ Matrix.Rotation(-0.7, 3, 'Y')
+        n = tilt.col[2]
+        d = add_handle(c + 0.6 * n + 0.2 * tilt.col[0], tilt.to_euler())
+        return sphere, (a, b, d)
+
+    def test_three_planes_three_circles(self):
+        _sphere, handles = self.three_planes()
+        self.assertEqual([h.name for h in handles], ["Slice A", "Slice B", "Slice C"])
+        slice_scene()
+        contours = bpy.context.scene.wiresculpt.contours
+        self.assertEqual(len(contours), 3)
+        for handle in handles:
+            (item,) = items_of(handle.name)
+            d = plane_distance(handle, self.CENTRE)
+            self.assertLengthNear(item.length, circle_length(self.R, d))
+            self.assertTrue(item.closed)
+            self.assertTrue(item.use)
+            curve = item.curve
+            self.assertIsNotNone(curve)
+            self.assertEqual(curve.type, 'CURVE')
+            self.assertIn(curve.name, bpy.data.collections[slicing.CONTOURS_COLLECTION].objects)
+            (spline,) = curve.data.splines
+            self.assertEqual(spline.type, 'POLY')
+            self.assertTrue(spline.use_cyclic_u)
+            n = handle.matrix_world.col[2].xyz.normalized()
+            for point in list(spline.points)[::17]:
+                p = curve.matrix_world @ point.co.xyz
+                self.assertAlmostEqual(n.dot(p - handle.matrix_world.translation), 0, places=4)
+                self.assertAlmostEqual((p - Vector(self.CENTRE)).length, self.R, delta=2e-3)
+        self.assertEqual(len(contour_objects()), 3)
+        for handle in handles:  # handles are never sliced themselves
+            self.assertNotIn(slicing.CONTOUR_KEY, handle)
+
+    def test_reslice_updates_same_objects(self):
+        _sphere, (a, b, c) = self.three_planes()
+        slice_scene()
+        before = {o.name: o.as_pointer() for o in contour_objects()}
+        b.location.z = self.CENTRE[2] - 0.8
+        slice_scene()
+        after = {o.name: o.as_pointer() for o in contour_objects()}
+        self.assertEqual(before, after)
+        self.assertEqual(len([o for o in bpy.data.objects if o.type == 'CURVE']), 3)
+        (item,) = items_of(b.name)
+        self.assertLengthNear(item.length, circle_length(self.R, 0.8))
+        self.assertEqual(item.curve.as_pointer(), before[item.curve.name])
+        length = sum((q.co.xyz - p.co.xyz).length for p, q in
+                     zip(item.curve.data.splines[0].points,
+                         list(item.curve.data.splines[0].points[1:]) +
+                         [item.curve.data.splines[0].points[0]]))
+        self.assertAlmostEqual(length, item.length, delta=1e-4)
+
+    def test_handle_off_mesh_removes_its_curve(self):
+        _sphere, (a, b, c) = self.three_planes()
+        slice_scene()
+        (old,) = items_of(b.name)
+        old_name = old.curve.name
+        b.location.z = self.CENTRE[2] + 5
+        result, reports = run(slicing.WIRESCULPT_OT_slice)
+        self.assertEqual(result, {'FINISHED'})
+        self.assertIn(b.name, reports[-1][1])
+        self.assertEqual(items_of(b.name), [])
+        self.assertNotIn(old_name, bpy.data.objects)
+        self.assertEqual(len(contour_objects()), 2)
+        self.assertEqual(len(items_of(a.name)), 1)
+
+    def test_modified_scaled_target_sliced_in_world_space(self):
+        sphere = uv_sphere(self.R, (1.0, 2.0, -1.0))
+        sphere.scale = (2, 2, 2)
+        displace = sphere.modifiers.new("Grow", 'DISPLACE')
+        displace.strength = 0.4  # no texture: every vertex moves 0.5 * strength along its normal
+        radius = 2 * (self.R + 0.2)
+        bpy.context.scene.wiresculpt.target = sphere
+        self.assertEqual(bpy.ops.wiresculpt.add_plane(), {'FINISHED'})
+        handle = bpy.context.view_layer.objects.active
+        self.assertLess((handle.location - Vector((1, 2, -1))).length, 1e-4)  # world centre
+        self.assertGreaterEqual(handle.dimensions.x, 2 * radius)  # covers the evaluated mesh
+        handle.location.z = -1.0 + 1.5
+        slice_scene()
+        (item,) = items_of(handle.name)
+        self.assertLengthNear(item.length, circle_length(radius, 1.5))
+
+    def test_add_plane_at_target_centre(self):
+        sphere = uv_sphere(0.5, (1, 2, 3))
+        bpy.context.scene.wiresculpt.target = sphere
+        result, _reports = run(slicing.WIRESCULPT_OT_add_plane)
+        self.assertEqual(result, {'FINISHED'})
+        handle = bpy.data.objects["Slice A"]
+        self.assertTrue(handle[wiresculpt.props.HANDLE_KEY])
+        self.assertIn(handle.name, bpy.data.collections[slicing.PLANES_COLLECTION].objects)
+        self.assertLess((handle.location - Vector((1, 2, 3))).length, 1e-5)
+        self.assertEqual(handle.display_type, 'WIRE')
+        self.assertEqual(handle.type, 'MESH')
+        self.assertGreaterEqual(min(handle.dimensions.x, handle.dimensions.y), 1.0)
+        self.assertEqual(bpy.context.view_layer.objects.active, handle)
+        run(slicing.WIRESCULPT_OT_add_plane)
+        self.assertIn("Slice B", bpy.data.objects)
+        self.assertFalse(wiresculpt.props._poll_target(None, handle))
+        self.assertTrue(wiresculpt.props._poll_target(None, sphere))
+
+
+@unittest.skipUnless(native.available(), "the native module is not built")
+class Ticks(AddonCase):
+    def two_spheres(self):
+        """One mesh of two spheres, radii 1 and 0.5, centres (0,0,0) and (3,0,0)."""
+        bm = bmesh.new()
+        bmesh.ops.create_uvsphere(bm, u_segments=128, v_segments=64, radius=1.0)
+        bmesh.ops.create_uvsphere(bm, u_segments=128, v_segments=64, radius=0.5,
+                                  matrix=Matrix.Translation((3, 0, 0)))
+        mesh = bpy.data.meshes.new("Pair")
+        bm.to_mesh(mesh)
+        bm.free()
+        obj = bpy.data.objects.new("Pair", mesh)
+        bpy.context.scene.collection.objects.link(obj)
+        bpy.context.scene.wiresculpt.target = obj
+        return obj
+
+    def test_longest_ticked_by_default(self):
+        self.two_spheres()
+        handle = add_handle((1.5, 0, 0))
+        slice_scene()
+        items = items_of(handle.name)
+        self.assertEqual([i.index for i in items], [0, 1])
+        self.assertLengthNear(items[0].length, 2 * math.pi)
+        self.assertLengthNear(items[1].length, math.pi)
+        self.assertEqual([i.use for i in items], [True, False])
+
+    def test_user_ticks_survive_reslice(self):
+        self.two_spheres()
+        handle = add_handle((1.5, 0, 0))
+        slice_scene()
+        items = items_of(handle.name)
+        items[0].use, items[1].use = False, True
+        handle.location.z = 0.2
+        slice_scene()
+        items = items_of(handle.name)
+        self.assertEqual([i.use for i in items], [False, True])
+        self.assertLengthNear(items[1].length, circle_length(0.5, 0.2))
+        self.assertEqual(len(contour_objects()), 2)
+
+
+class Refusals(AddonCase):
+    def test_no_target(self):
+        for operator in (slicing.WIRESCULPT_OT_slice, slicing.WIRESCULPT_OT_add_plane):
+            result, reports = run(operator)
+            self.assertEqual(result, {'CANCELLED'})
+            self.assertEqual(reports[-1][0], {'ERROR'})
+            self.assertIn("target", reports[-1][1].lower())
+        with self.assertRaisesRegex(RuntimeError, "target"):  # errors reach scripts, too
+            bpy.ops.wiresculpt.slice()
+
+    def test_no_handles(self):
+        bpy.context.scene.wiresculpt.target = uv_sphere()
+        result, reports = run(slicing.WIRESCULPT_OT_slice)
+        self.assertEqual(result, {'CANCELLED'})
+        self.assertIn("slicing plane", reports[-1][1].lower())
+
+    @unittest.skipUnless(native.available(), "the native module is not built")
+    def test_flat_handle_named(self):
+        bpy.context.scene.wiresculpt.target = uv_sphere()
+        add_handle((0, 0, 0))
+        flat = add_handle((0, 0, 0.3))
+        flat.scale.z = 0
+        result, reports = run(slicing.WIRESCULPT_OT_slice)
+        self.assertEqual(result, {'CANCELLED'})
+        self.assertIn(flat.name, reports[-1][1])
+        self.assertEqual(contour_objects(), [])
+
+    def test_solver_error_reported(self):
+        bpy.context.scene.wiresculpt.target = uv_sphere()
+        add_handle((0, 0, 0))
+        saved_module, saved_slice = native.module, native.slice_mesh
+
+        def failing(*_args, **_kwargs):
+            raise ValueError("plane Slice A: something the solver rejects")
+
+        native.module, native.slice_mesh = native.module or object(), failing
+        try:
+            result, reports = run(slicing.WIRESCULPT_OT_slice)
+        finally:
+            native.module, native.slice_mesh = saved_module, saved_slice
+        self.assertEqual(result, {'CANCELLED'})
+        self.assertIn("Slice A", reports[-1][1])
+
+
+class FakeLayout:
+    """Records what a draw function asks for; enough of UILayout to run panel code."""
+
+    def __init__(self, log):
+        self.log = log
+
+    def __getattr__(self, name):
+        def call(*args, **kwargs):
+            self.log.append((name, args, kwargs))
+            return FakeLayout(self.log)
+        return call
+
+
+def draw_panel():
+    log = []
+    fake = types.SimpleNamespace(layout=FakeLayout(log))
+    panel.VIEW3D_PT_wiresculpt.draw(fake, bpy.context)
+    return log
+
+
+class Registration(AddonCase):
+    def test_classes_and_settings(self):
+        for name in ("WIRESCULPT_OT_add_plane", "WIRESCULPT_OT_slice", "VIEW3D_PT_wiresculpt",
+                     "WIRESCULPT_UL_contours"):
+            self.assertTrue(hasattr(bpy.types, name), name)
+        self.assertTrue(hasattr(bpy.context.scene, "wiresculpt"))
+        self.assertEqual(panel.VIEW3D_PT_wiresculpt.bl_category, "Wire")
+        for cls in (slicing.WIRESCULPT_OT_add_plane, slicing.WIRESCULPT_OT_slice):
+            self.assertEqual(cls.bl_options, {'REGISTER', 'UNDO'})
+
+    def test_every_property_has_a_tooltip(self):
+        for cls in (wiresculpt.props.WiresculptSettings, wiresculpt.props.WiresculptContour):
+            for prop in cls.bl_rna.properties:
+                if prop.identifier in ("rna_type", "name"):
+                    continue
+                self.assertTrue(prop.description, f"{cls.__name__}.{prop.identifier}")
+        length = wiresculpt.props.WiresculptContour.bl_rna.properties["length"]
+        self.assertEqual((length.unit, length.subtype), ('LENGTH', 'DISTANCE'))
+
+    def test_panel_and_list_draw(self):
+        log = draw_panel()
+        operators = [args[0] for name, args, _kw in log if name == "operator"]
+        self.assertEqual(operators, ["wiresculpt.add_plane", "wiresculpt.slice"])
+        self.assertIn("template_list", [name for name, _a, _k in log])
+        settings = bpy.context.scene.wiresculpt
+        item = settings.contours.add()
+        item.plane, item.index, item.length, item.closed = "Slice A", 0, 1.25, True
+        log = []
+        panel.WIRESCULPT_UL_contours.draw_item(None, bpy.context, FakeLayout(log), settings,
+                                                item, 0, settings, "active_contour")
+        labels = [kw.get("text") for name, _a, kw in log if name == "label"]
+        self.assertEqual(labels[0], "Slice A #0")
+        self.assertIn("1.25", labels[1])
+        self.assertIn("m", labels[1])
+
+
+class WithoutNative(AddonCase):
+    """The add-on registers and explains itself when the compiled module is missing."""
+
+    REASON = "the solver was removed for this test (no _wiresculpt here)"
+
+    def setUp(self):
+        self.saved = native.module, native.LOAD_ERROR
+        native.module, native.LOAD_ERROR = None, self.REASON
+        register_addon()
+        clear_scene()
+
+    def tearDown(self):
+        native.module, native.LOAD_ERROR = self.saved
+
+    def test_registers_and_slice_cancels_with_reason(self):
+        self.assertTrue(hasattr(bpy.types, "WIRESCULPT_OT_slice"))
+        bpy.context.scene.wiresculpt.target = uv_sphere()
+        add_handle((0, 0, 0))
+        result, reports = run(slicing.WIRESCULPT_OT_slice)
+        self.assertEqual(result, {'CANCELLED'})
+        self.assertEqual(reports[-1], ({'ERROR'}, self.REASON))
+        with self.assertRaisesRegex(RuntimeError, "solver was removed"):
+            bpy.ops.wiresculpt.slice()
+        self.assertEqual(contour_objects(), [])
+
+    def test_panel_explains(self):
+        log = draw_panel()
+        texts = " ".join(kw.get("text", "") for name, _a, kw in log if name == "label")
+        self.assertIn("not loaded", texts)
+        self.assertIn("no _wiresculpt here", texts)
+        self.assertIn("box", [name for name, _a, _k in log])
+
+
+if __name__ == "__main__":
+    unittest.main()
