@@ -30,7 +30,7 @@ def main():
     result = unittest.TextTestRunner(stream=sys.stdout, verbosity=2).run(suite)
     failed = len(result.failures) + len(result.errors) + len(result.unexpectedSuccesses)
     skipped = len(result.skipped)
-    passed = result.testsRun - failed - skipped
+    passed = max(0, result.testsRun - failed - skipped)  # a failed setUpClass is not a test run
     sys.stdout.flush()
     print(f"blender: {passed} passed, {failed} failed, {skipped} skipped" if skipped
           else f"blender: {passed} passed, {failed} failed")

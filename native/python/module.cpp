@@ -29,4 +29,5 @@ PYBIND11_MODULE(_wiresculpt, m) {
   });
 
   wiresculpt::python::bind_slicing(m);
+  wiresculpt::python::bind_fab(m);
 }

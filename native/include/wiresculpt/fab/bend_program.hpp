@@ -1,0 +1,97 @@
+#pragma once
+// From a 2D rest polyline to the machine's program: feed, bend, feed, bend, ..., feed
+// (Sec. 5.1: "the feeder either pushes the wire forward into the bending head, or the bending
+// head rotates at a given angle"), with spring-back compensation from the calibration fit.
+//
+// Conventions
+//   points   #P by 2, metres, an OPEN polyline starting at the cut (a closed wire's rest shape
+//            already repeats the cut at both ends, FORMATS.md). The wire leaves the machine
+//            starting with points[0].
+//   feed     metres of wire pushed before a bend (the edge lengths between bend points).
+//   bend     radians, the signed turn of the wire's direction at a bend point, walking from the
+//            cut, in the polyline's own frame (x right, y up): positive = counter-clockwise =
+//            "left". |bend| < pi. How a sign becomes a head direction is
+//            MachineProfile::left_is_positive.
+//   commanded radians sent to the head after compensation, same sign as bend:
+//            |commanded| = (|bend| - b) / a, inverting the fit measured = a * commanded + b.
+//
+// The small-bend rule (turns under MachineProfile::min_bend, which the machine cannot make
+// reliably). The rebuilt wire's direction is kept within min_bend / 2 of the input's:
+//   1. Walk the interior points from the cut keeping a carried turn c (initially 0): the turn
+//      the rebuilt wire still owes the input.
+//   2. At point j with turn theta_j let t = theta_j + c.
+//      - |t| >= min_bend: a bend of t is made at j, c = 0. The small turns met since the last
+//        bend are ACCUMULATED into this bend, so the direction after it is exactly the input's.
+//        Exception: when |t| > max_bend but |theta_j| <= max_bend (the carry would push a legal
+//        bend over the limit) the bend is theta_j and c is carried on to the next point.
+//      - min_bend / 2 <= |t| < min_bend: the smallest reliable bend, min_bend * sign(t), is made
+//        at j and the overshoot c = t - min_bend * sign(t) is carried (|c| <= min_bend / 2).
+//      - |t| < min_bend / 2: no bend at j; the feeds on both sides MERGE into one and c = t.
+//      Rounding to the nearest of {0, +-min_bend} makes the direction error alternate in sign
+//      along a gentle arc instead of always lagging, so position errors do not add up.
+//   3. A carry left after the last interior point has no bend to join and is DROPPED
+//      (BendProgram::dropped_turn, |dropped_turn| < min_bend).
+//   Merging only lengthens feeds, so the rule never creates a feed shorter than the input's.
+//   The cost is reported as BendProgram::shape_error: the largest distance, over the wire's
+//   arc length s, between the input polyline and the rebuilt one (both start at the same point
+//   and direction; both are piecewise linear in s with kinks at input points, so the maximum is
+//   attained at an input point and computed exactly there).
+//
+// Refused (InputError, nothing returned): fewer than 2 points, non-finite coordinates, a
+// zero-length segment (naming the points), a bend over max_bend (naming the bend number, its
+// point and angle), a commanded angle beyond max_commanded or non-positive after compensation
+// (naming the bend and its angle), a feed shorter than min_feed (naming the step and its points).
+#include <cstddef>
+#include <vector>
+
+#include "wiresculpt/fab/machine.hpp"
+#include "wiresculpt/geometry.hpp"
+
+namespace wiresculpt::fab {
+
+/// One machine step: feed, then bend (the final step only feeds).
+struct BendStep {
+  double feed = 0.0;       ///< m of wire fed before the bend
+  double bend = 0.0;       ///< rad, signed target turn after the feed (0 on the final step)
+  double commanded = 0.0;  ///< rad, spring-back compensated head command (0 on the final step)
+  int vertex = -1;         ///< index in the input polyline of the bend point; -1 on the final step
+};
+
+struct BendProgram {
+  std::vector<BendStep> steps;   ///< in machine order, starting at the cut; last step has no bend
+  Vec2 start = Vec2::Zero();     ///< m, the input's first point (the cut)
+  double start_heading = 0.0;    ///< rad, direction of the input's first segment (atan2)
+  std::size_t input_points = 0;  ///< #P of the input polyline
+  double wire_length = 0.0;      ///< m, total wire (sum of feeds)
+  int bend_count = 0;            ///< bends made (steps.size() - 1)
+  int merged_points = 0;         ///< interior input points where no bend is made (rule step 2)
+  int rounded_bends = 0;         ///< bends rounded up to min_bend (rule step 2, second case)
+  int small_turns = 0;           ///< of those, points whose own turn was non-zero but < min_bend
+  double dropped_turn = 0.0;     ///< rad, carry dropped at the end of the wire (rule step 3)
+  double shape_error = 0.0;      ///< m, max over arc length of |input(s) - rebuilt(s)|
+  double machine_seconds = 0.0;  ///< s, estimate: sum over bend steps of
+                                 ///< max(seconds_per_bend, feed/feed_speed + 2|commanded|/bend_speed)
+                                 ///< plus the final feed / feed_speed
+};
+
+/// The program that bends `points` (#P by 2, metres, open, starting at the cut) on `profile`.
+/// Throws InputError as listed above; validates the profile first.
+BendProgram make_bend_program(const Polyline2& points, const MachineProfile& profile);
+
+/// The polyline the program makes (bend points only, #steps + 1 points), from the recorded start
+/// point and heading, or from the origin heading +x when `from_origin`. Uses the target bends
+/// (before compensation), so a program without merged points rebuilds its input exactly.
+Polyline2 rebuild_polyline(const BendProgram& program, bool from_origin = false);
+
+/// Input-polyline indices of the bend points, in order (for tick marks on templates).
+std::vector<std::size_t> bend_vertices(const BendProgram& program);
+
+/// Spring-back compensation of one target bend (rad): sign(target) * (|target| - b) / a.
+/// Throws InputError naming `bend_number` when the result is not positive or exceeds the head's range.
+double compensate(double target, const MachineProfile& profile, int bend_number = 0);
+
+/// The pointwise distance used for shape_error: max over arc length s of |a(s) - b(s)| where both
+/// polylines are walked from their first point (the shorter one is extended by its last point).
+double arclength_distance(const Polyline2& a, const Polyline2& b);
+
+}  // namespace wiresculpt::fab

@@ -1,0 +1,121 @@
+#pragma once
+// Streaming a program to a GRBL-based bender over a serial port (libserialport), with GRBL's
+// send-response protocol: one line is sent, then nothing more until GRBL answers that line with
+// "ok" (accepted) or "error:N" (rejected, not executed). "ALARM:N" at any time stops the stream.
+// Every read and write has a timeout, so nothing here can hang; the full protocol, the resume
+// semantics and the realtime characters are described in docs/machine-protocol.md.
+//
+// Resume: the caller keeps a StreamState between calls. state.next_line is the index (0-based)
+// of the first line GRBL has not acknowledged; lines before it were each acknowledged exactly
+// once. A stream starts at state.next_line and advances it on each "ok" only, so after an error,
+// alarm, timeout, disconnect or abort, calling again (on the same or a re-opened port) continues
+// with the first unacknowledged line: no acknowledged line is sent again, none is skipped.
+#include <atomic>
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "wiresculpt/fab/machine.hpp"
+#include "wiresculpt/progress.hpp"
+
+namespace wiresculpt::fab {
+
+struct PortInfo {
+  std::string name;         ///< e.g. "/dev/ttyUSB0"
+  std::string description;  ///< from the system, e.g. "USB2.0-Serial"
+};
+
+/// Serial ports the system reports (libserialport). Pseudo-terminals are not listed.
+std::vector<PortInfo> list_ports();
+
+/// An open serial link with timeouts. Opens through libserialport; a device libserialport does
+/// not know (a pseudo-terminal such as a socat or emulator port) is opened as a plain POSIX tty
+/// with the same settings.
+class SerialPort {
+ public:
+  /// Throws InputError naming the port when it cannot be opened or configured.
+  SerialPort(const std::string& name, const SerialSettings& settings);
+  ~SerialPort();
+  SerialPort(const SerialPort&) = delete;
+  SerialPort& operator=(const SerialPort&) = delete;
+
+  const std::string& name() const;
+  /// Writes all bytes within timeout_ms. Returns false when the link is lost or the time passed.
+  bool write(const std::string& bytes, int timeout_ms);
+  /// Reads what is available, waiting at most timeout_ms for the first byte.
+  /// Returns the number of bytes (0 = nothing in time), or -1 when the link is lost.
+  int read(char* buffer, int size, int timeout_ms);
+  /// Discards pending input, reading for at most timeout_ms.
+  void drain_input(int timeout_ms);
+
+  struct Impl;  // opaque: libserialport handle or POSIX descriptor
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+/// What the caller keeps between stream calls (see Resume above).
+struct StreamState {
+  std::size_t next_line = 0;  ///< first line not yet acknowledged (0-based)
+};
+
+/// Pause / resume / abort from another thread while a stream runs.
+struct StreamControl {
+  std::atomic<bool> pause{false};  ///< true: after the current line's answer, send '!' (feed hold)
+                                   ///< and send nothing more; back to false: send '~' and go on
+  std::atomic<bool> abort{false};  ///< true: send '!' then Ctrl-X (soft reset) and stop
+};
+
+struct StreamOptions {
+  double response_timeout = 30.0;  ///< s to wait for a line's answer; default 30 s (a full planner
+                                   ///< buffer answers only when a move ends)
+  double write_timeout = 2.0;      ///< s to hand a line to the port; default 2 s
+  double settle = 2.0;             ///< s to wait after opening (GRBL restarts when the port opens)
+                                   ///< before discarding its banner; default 2 s
+  bool dry_run = false;            ///< only validate the program; no port is opened
+  StreamControl* control = nullptr;  ///< optional pause/abort switches (not owned)
+};
+
+enum class StreamStatus {
+  completed,     ///< every line acknowledged
+  dry_run,       ///< validated only
+  error,         ///< GRBL answered error:N to failed_line (not executed)
+  alarm,         ///< GRBL raised ALARM:N while failed_line was in flight
+  disconnected,  ///< the link dropped (or GRBL restarted) with failed_line in flight (or next)
+  timeout,       ///< no answer to failed_line within response_timeout
+  aborted        ///< StreamControl::abort or the progress callback returned false
+};
+
+const char* to_string(StreamStatus status);
+
+struct StreamResult {
+  StreamStatus status = StreamStatus::completed;
+  std::size_t sent = 0;            ///< lines sent during this call
+  std::size_t acknowledged = 0;    ///< lines acknowledged during this call
+  long last_acknowledged = -1;     ///< index of the last acknowledged line overall (-1: none)
+  long failed_line = -1;           ///< index of the line the stream stopped at (-1: none)
+  int code = 0;                    ///< N of error:N or ALARM:N
+  std::string message;             ///< a sentence naming the line (1-based "line N") and what to do
+};
+
+/// Throws InputError naming the first bad line (1-based) and why: empty, longer than 79
+/// characters, non-printable or realtime characters ('!', '~', '?'), comments (strip them with
+/// stream_lines()), or a word letter that is neither a G-code command word (G M F S P N T) nor
+/// one of the profile's axis letters. Lines starting with '$' (GRBL settings) are allowed.
+void validate_program(const std::vector<std::string>& lines, const MachineProfile& profile);
+
+/// Streams lines[state.next_line ...] on an open port. Validates the whole program first.
+/// `progress` gets ("stream", acknowledged fraction) after each answer and while paused; it
+/// returning false aborts like StreamControl::abort. Never throws for machine or link trouble:
+/// that is the returned status; throws InputError for an invalid program or state.
+StreamResult stream_program(SerialPort& port, const std::vector<std::string>& lines, const MachineProfile& profile,
+                            StreamState& state, const StreamOptions& options = {}, const ProgressFn& progress = {});
+
+/// Opens `port_name` with the profile's serial settings (unless dry_run), waits options.settle,
+/// discards the controller's banner, then streams as above.
+StreamResult stream_program(const std::string& port_name, const std::vector<std::string>& lines,
+                            const MachineProfile& profile, StreamState& state, const StreamOptions& options = {},
+                            const ProgressFn& progress = {});
+
+}  // namespace wiresculpt::fab

@@ -1,0 +1,22 @@
+#pragma once
+// What a 1:1 template (SVG, DXF) shows of one wire.
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "wiresculpt/geometry.hpp"
+
+namespace wiresculpt::fab {
+
+struct TemplateWire {
+  std::string name;                           ///< label, e.g. "A/0"
+  Polyline2 points;                           ///< #P by 2, metres, in the wire's own 2D frame
+  std::vector<std::size_t> bend_points;       ///< indices into points: tick marks (see bend_vertices())
+  std::vector<std::size_t> crossing_points;   ///< indices into points: crossing marks
+};
+
+/// Throws InputError naming the wire (`index`, name) when it has no point, a non-finite point
+/// or a bend/crossing index outside 0..#P-1.
+void validate(const TemplateWire& wire, std::size_t index);
+
+}  // namespace wiresculpt::fab

@@ -1,0 +1,353 @@
+// Fabrication: bend programs, 1:1 templates (SVG, DXF), G-code, the bend table, serial streaming.
+// Degrees and millimetres are the edge units of the profile dict; they become SI right here
+// through fab/machine.hpp's helpers (the one conversion place) before anything reaches the core.
+#include <pybind11/eigen.h>
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <exception>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bindings.hpp"
+#include "wiresculpt/error.hpp"
+#include "wiresculpt/fab/atomic_file.hpp"
+#include "wiresculpt/fab/bend_program.hpp"
+#include "wiresculpt/fab/dxf.hpp"
+#include "wiresculpt/fab/gcode.hpp"
+#include "wiresculpt/fab/machine.hpp"
+#include "wiresculpt/fab/serial.hpp"
+#include "wiresculpt/fab/svg.hpp"
+
+namespace py = pybind11;
+
+namespace wiresculpt::python {
+namespace {
+
+using namespace wiresculpt::fab;
+using Points2 = Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>;
+
+Polyline2 to_polyline(const Points2& P) {
+  Polyline2 out;
+  out.reserve(static_cast<std::size_t>(P.rows()));
+  for (Eigen::Index i = 0; i < P.rows(); ++i) out.emplace_back(P(i, 0), P(i, 1));
+  return out;
+}
+
+py::array_t<double> to_array(const Polyline2& points) {
+  py::array_t<double> out({static_cast<py::ssize_t>(points.size()), py::ssize_t{2}});
+  auto w = out.mutable_unchecked<2>();
+  for (py::ssize_t i = 0; i < w.shape(0); ++i)
+    for (py::ssize_t k = 0; k < 2; ++k) w(i, k) = points[static_cast<std::size_t>(i)][k];
+  return out;
+}
+
+char axis_letter(const py::handle& v, const std::string& key) {
+  const std::string s = py::cast<std::string>(v);
+  if (s.size() > 1) throw InputError("machine profile: '" + key + "' must be one letter, got '" + s + "'");
+  return s.empty() ? '\0' : static_cast<char>(std::toupper(static_cast<unsigned char>(s[0])));
+}
+
+/// The profile dict (edge units, every key optional) -> MachineProfile (SI).
+MachineProfile to_profile(const py::dict& d) {
+  MachineProfile p;
+  for (const auto& [k, v] : d) {
+    const std::string key = py::cast<std::string>(k);
+    if (key == "name") p.name = py::cast<std::string>(v);
+    else if (key == "min_segment" || key == "min_feed") p.min_feed = py::cast<double>(v);  // metres, as design.json
+    else if (key == "max_bend_deg") p.max_bend = from_deg(py::cast<double>(v));
+    else if (key == "min_bend_deg") p.min_bend = from_deg(py::cast<double>(v));
+    else if (key == "max_commanded_deg") p.max_commanded = from_deg(py::cast<double>(v));
+    else if (key == "left_is_positive") p.left_is_positive = py::cast<bool>(v);
+    else if (key == "springback_a") p.springback_a = py::cast<double>(v);
+    else if (key == "springback_b_deg") p.springback_b = from_deg(py::cast<double>(v));
+    else if (key == "feed_speed_mm_s") p.feed_speed = from_mm(py::cast<double>(v));
+    else if (key == "bend_speed_deg_s") p.bend_speed = from_deg(py::cast<double>(v));
+    else if (key == "seconds_per_bend") p.seconds_per_bend = py::cast<double>(v);
+    else if (key == "feed_axis") p.axes.feed_axis = axis_letter(v, key);
+    else if (key == "bend_axis") p.axes.bend_axis = axis_letter(v, key);
+    else if (key == "pin_axis") p.axes.pin_axis = v.is_none() ? '\0' : axis_letter(v, key);
+    else if (key == "feed_units_per_mm") p.axes.feed_units_per_mm = py::cast<double>(v);
+    else if (key == "bend_units_per_deg") p.axes.bend_units_per_deg = py::cast<double>(v);
+    else if (key == "pin_travel") p.axes.pin_travel = py::cast<double>(v);
+    else if (key == "baud") p.serial.baud = py::cast<int>(v);
+    else if (key == "data_bits") p.serial.data_bits = py::cast<int>(v);
+    else if (key == "stop_bits") p.serial.stop_bits = py::cast<int>(v);
+    else if (key == "parity") {
+      const std::string s = py::cast<std::string>(v);
+      if (s == "none") p.serial.parity = SerialSettings::Parity::none;
+      else if (s == "odd") p.serial.parity = SerialSettings::Parity::odd;
+      else if (s == "even") p.serial.parity = SerialSettings::Parity::even;
+      else throw InputError("machine profile: parity must be 'none', 'odd' or 'even', got '" + s + "'");
+    } else if (key == "flow_control") {
+      const std::string s = py::cast<std::string>(v);
+      if (s == "none") p.serial.flow_control = SerialSettings::FlowControl::none;
+      else if (s == "xon_xoff") p.serial.flow_control = SerialSettings::FlowControl::xon_xoff;
+      else if (s == "rts_cts") p.serial.flow_control = SerialSettings::FlowControl::rts_cts;
+      else throw InputError("machine profile: flow_control must be 'none', 'xon_xoff' or 'rts_cts', got '" + s + "'");
+    } else {
+      throw InputError("machine profile: unknown key '" + key + "'");
+    }
+  }
+  validate(p);
+  return p;
+}
+
+py::dict from_profile(const MachineProfile& p) {
+  const char* parity[] = {"none", "odd", "even"};
+  const char* flow[] = {"none", "xon_xoff", "rts_cts"};
+  return py::dict(
+      py::arg("name") = p.name, py::arg("min_segment") = p.min_feed, py::arg("max_bend_deg") = to_deg(p.max_bend),
+      py::arg("min_bend_deg") = to_deg(p.min_bend), py::arg("max_commanded_deg") = to_deg(p.max_commanded),
+      py::arg("left_is_positive") = p.left_is_positive, py::arg("springback_a") = p.springback_a,
+      py::arg("springback_b_deg") = to_deg(p.springback_b), py::arg("feed_speed_mm_s") = to_mm(p.feed_speed),
+      py::arg("bend_speed_deg_s") = to_deg(p.bend_speed), py::arg("seconds_per_bend") = p.seconds_per_bend,
+      py::arg("feed_axis") = std::string(1, p.axes.feed_axis), py::arg("bend_axis") = std::string(1, p.axes.bend_axis),
+      py::arg("pin_axis") = p.axes.pin_axis ? std::string(1, p.axes.pin_axis) : std::string(),
+      py::arg("feed_units_per_mm") = p.axes.feed_units_per_mm, py::arg("bend_units_per_deg") = p.axes.bend_units_per_deg,
+      py::arg("pin_travel") = p.axes.pin_travel, py::arg("baud") = p.serial.baud,
+      py::arg("data_bits") = p.serial.data_bits, py::arg("stop_bits") = p.serial.stop_bits,
+      py::arg("parity") = parity[static_cast<int>(p.serial.parity)],
+      py::arg("flow_control") = flow[static_cast<int>(p.serial.flow_control)]);
+}
+
+/// {"name", "points" (n, 2) m, "bend_points", "crossing_points"} -> TemplateWire.
+TemplateWire to_template(const py::handle& h, std::size_t index) {
+  const py::dict d = py::cast<py::dict>(h);
+  TemplateWire w;
+  for (const auto& [k, v] : d) {
+    const std::string key = py::cast<std::string>(k);
+    if (key == "name") w.name = py::cast<std::string>(v);
+    else if (key == "points") w.points = to_polyline(py::cast<Points2>(v));
+    else if (key == "bend_points") w.bend_points = py::cast<std::vector<std::size_t>>(v);
+    else if (key == "crossing_points") w.crossing_points = py::cast<std::vector<std::size_t>>(v);
+    else throw InputError("wire " + std::to_string(index) + ": unknown key '" + key + "'");
+  }
+  return w;
+}
+
+std::vector<TemplateWire> to_templates(const py::list& wires) {
+  std::vector<TemplateWire> out;
+  for (std::size_t i = 0; i < wires.size(); ++i) out.push_back(to_template(wires[i], i));
+  return out;
+}
+
+SvgOptions to_svg_options(const py::dict& d) {
+  SvgOptions o;
+  for (const auto& [k, v] : d) {
+    const std::string key = py::cast<std::string>(k);
+    const double x = py::cast<double>(v);
+    if (key == "margin_mm") o.margin_mm = x;
+    else if (key == "stroke_mm") o.stroke_mm = x;
+    else if (key == "tick_mm") o.tick_mm = x;
+    else if (key == "crossing_radius_mm") o.crossing_radius_mm = x;
+    else if (key == "label_mm") o.label_mm = x;
+    else if (key == "sheet_width_mm") o.sheet_width_mm = x;
+    else throw InputError("SVG options: unknown key '" + key + "'");
+  }
+  return o;
+}
+
+void maybe_write(const std::optional<std::string>& path, const std::string& text) {
+  if (path && !path->empty()) write_file_atomic(*path, text);
+}
+
+py::dict program_dict(const BendProgram& p) {
+  py::list steps;
+  std::vector<double> feeds, bends, commanded;
+  for (const BendStep& s : p.steps) {
+    steps.append(py::dict(py::arg("feed_mm") = to_mm(s.feed), py::arg("bend_deg") = to_deg(s.bend),
+                          py::arg("commanded_deg") = to_deg(s.commanded), py::arg("vertex") = s.vertex));
+    feeds.push_back(to_mm(s.feed));
+    bends.push_back(to_deg(s.bend));
+    commanded.push_back(to_deg(s.commanded));
+  }
+  return py::dict(py::arg("steps") = steps, py::arg("feeds_mm") = feeds, py::arg("bends_deg") = bends,
+                  py::arg("commanded_deg") = commanded, py::arg("wire_length") = p.wire_length,
+                  py::arg("bend_count") = p.bend_count, py::arg("machine_seconds") = p.machine_seconds,
+                  py::arg("shape_error") = p.shape_error, py::arg("merged_points") = p.merged_points,
+                  py::arg("small_turns") = p.small_turns, py::arg("rounded_bends") = p.rounded_bends,
+                  py::arg("dropped_turn_deg") = to_deg(p.dropped_turn),
+                  py::arg("start") = std::vector<double>{p.start.x(), p.start.y()},
+                  py::arg("start_heading_deg") = to_deg(p.start_heading),
+                  py::arg("bend_vertices") = bend_vertices(p), py::arg("rebuilt") = to_array(rebuild_polyline(p)));
+}
+
+py::dict make_bend_program_py(const Points2& points, const py::dict& profile) {
+  const MachineProfile m = to_profile(profile);
+  const Polyline2 poly = to_polyline(points);
+  BendProgram p;
+  {
+    py::gil_scoped_release release;
+    p = make_bend_program(poly, m);
+  }
+  return program_dict(p);
+}
+
+std::string write_svg(const std::optional<std::string>& path, const py::list& wires, std::optional<bool> sheet,
+                      const py::dict& options) {
+  const std::vector<TemplateWire> w = to_templates(wires);
+  const SvgOptions o = to_svg_options(options);
+  const bool as_sheet = sheet.value_or(w.size() != 1);
+  std::string text;
+  {
+    py::gil_scoped_release release;
+    if (!as_sheet && w.size() != 1)
+      throw InputError("an SVG of one wire needs exactly one wire, got " + std::to_string(w.size()));
+    text = as_sheet ? svg_sheet(w, o) : svg_wire(w[0], o);
+    maybe_write(path, text);
+  }
+  return text;
+}
+
+std::string write_dxf(const std::optional<std::string>& path, const py::list& wires, bool labels) {
+  const std::vector<TemplateWire> w = to_templates(wires);
+  std::string text;
+  {
+    py::gil_scoped_release release;
+    DxfOptions o;
+    o.labels = labels;
+    text = dxf_document(w, o);
+    maybe_write(path, text);
+  }
+  return text;
+}
+
+std::string write_gcode(const std::optional<std::string>& path, const Points2& points, const py::dict& profile,
+                        const std::string& wire_name, const std::string& material, bool sync_each_step) {
+  const MachineProfile m = to_profile(profile);
+  const Polyline2 poly = to_polyline(points);
+  std::string text;
+  {
+    py::gil_scoped_release release;
+    text = gcode_program(make_bend_program(poly, m), m, GcodeInfo{wire_name, material, sync_each_step});
+    maybe_write(path, text);
+  }
+  return text;
+}
+
+std::string write_bend_table(const std::optional<std::string>& path, const Points2& points, const py::dict& profile) {
+  const MachineProfile m = to_profile(profile);
+  const Polyline2 poly = to_polyline(points);
+  std::string text;
+  {
+    py::gil_scoped_release release;
+    text = bend_table_csv(make_bend_program(poly, m));
+    maybe_write(path, text);
+  }
+  return text;
+}
+
+py::dict stream_program_py(const std::string& port, const std::vector<std::string>& lines, const py::dict& profile,
+                           py::dict state, const std::optional<py::function>& progress, StreamControl* control,
+                           bool dry_run, double response_timeout, double settle) {
+  const MachineProfile m = to_profile(profile);
+  StreamState s;
+  if (state.contains("next_line")) {
+    const long long next = py::cast<long long>(state["next_line"]);
+    if (next < 0) throw InputError("state['next_line'] must be >= 0, got " + std::to_string(next));
+    s.next_line = static_cast<std::size_t>(next);
+  }
+  StreamOptions o;
+  o.dry_run = dry_run;
+  o.response_timeout = response_timeout;
+  o.settle = settle;
+  o.control = control;
+  std::exception_ptr callback_error;
+  ProgressFn fn;
+  if (progress) {
+    const py::function* f = &*progress;  // lives in this frame; no refcounting without the GIL
+    fn = [f, &callback_error](std::string_view stage, double fraction) {
+      py::gil_scoped_acquire acquire;
+      try {
+        const py::object r = (*f)(std::string(stage), fraction);
+        return r.is_none() || py::cast<bool>(r);
+      } catch (...) {
+        callback_error = std::current_exception();
+        return false;  // stop the machine, then re-raise below
+      }
+    };
+  }
+  StreamResult r;
+  std::exception_ptr stream_error;
+  {
+    py::gil_scoped_release release;
+    try {
+      r = stream_program(port, lines, m, s, o, fn);
+    } catch (...) {
+      stream_error = std::current_exception();
+    }
+  }
+  state["next_line"] = s.next_line;
+  if (callback_error) std::rethrow_exception(callback_error);
+  if (stream_error) std::rethrow_exception(stream_error);
+  return py::dict(py::arg("status") = std::string(to_string(r.status)), py::arg("sent") = r.sent,
+                  py::arg("acknowledged") = r.acknowledged, py::arg("last_acknowledged") = r.last_acknowledged,
+                  py::arg("failed_line") = r.failed_line, py::arg("code") = r.code, py::arg("message") = r.message,
+                  py::arg("next_line") = s.next_line);
+}
+
+}  // namespace
+
+void bind_fab(py::module_& m) {
+  py::class_<StreamControl>(m, "StreamControl",
+                            "Pause / resume / abort switches for a running stream_program (thread-safe).")
+      .def(py::init<>())
+      .def("pause", [](StreamControl& c) { c.pause = true; })
+      .def("resume", [](StreamControl& c) { c.pause = false; })
+      .def("abort", [](StreamControl& c) { c.abort = true; })
+      .def_property_readonly("paused", [](const StreamControl& c) { return c.pause.load(); })
+      .def_property_readonly("aborted", [](const StreamControl& c) { return c.abort.load(); });
+
+  m.def("default_machine_profile", [] { return from_profile(MachineProfile{}); },
+        "The default (DIWire-class) machine profile as a dict of edge units (m, deg, mm/s, deg/s).");
+  m.def("make_bend_program", &make_bend_program_py, py::arg("points"), py::arg("profile") = py::dict(),
+        R"(Feeds and bends that make a 2D wire.
+
+points: (n, 2) metres, open, starting at the cut. profile: dict (see default_machine_profile()).
+Returns {"steps": [{"feed_mm", "bend_deg", "commanded_deg", "vertex"}], "feeds_mm", "bends_deg",
+"commanded_deg", "wire_length" (m), "bend_count", "machine_seconds", "shape_error" (m),
+"merged_points", "small_turns", "rounded_bends", "dropped_turn_deg", "start", "start_heading_deg",
+"bend_vertices", "rebuilt" (k, 2) m}. Raises ValueError naming the bend, step or point.)");
+  m.def("write_svg", &write_svg, py::arg("path"), py::arg("wires"), py::arg("sheet") = py::none(),
+        py::arg("options") = py::dict(),
+        R"(1:1 SVG template (mm). wires: [{"name", "points" (n, 2) m, "bend_points", "crossing_points"}].
+sheet: None = a sheet when more than one wire. Writes atomically when path is not None; returns the text.)");
+  m.def("write_dxf", &write_dxf, py::arg("path"), py::arg("wires"), py::arg("labels") = true,
+        "DXF R12, one layer per wire, mm. Writes atomically when path is not None; returns the text.");
+  m.def("write_gcode", &write_gcode, py::arg("path"), py::arg("points"), py::arg("profile") = py::dict(),
+        py::arg("wire_name") = "", py::arg("material") = "", py::arg("sync_each_step") = true,
+        "GRBL G-code for the wire. Writes atomically when path is not None; returns the text.");
+  m.def("write_bend_table", &write_bend_table, py::arg("path"), py::arg("points"), py::arg("profile") = py::dict(),
+        "CSV step,feed_mm,bend_deg,commanded_deg. Writes atomically when path is not None; returns the text.");
+  m.def("write_file_atomic", [](const std::string& path, const std::string& text) {
+    py::gil_scoped_release release;
+    write_file_atomic(path, text);
+  }, py::arg("path"), py::arg("text"), "Temporary file in the same folder, then rename.");
+  m.def("stream_lines", [](const std::string& gcode) { return stream_lines(gcode); }, py::arg("gcode"),
+        "The lines to stream: comments and blank lines removed.");
+  m.def("list_ports", [] {
+    std::vector<PortInfo> ports;
+    {
+      py::gil_scoped_release release;
+      ports = list_ports();
+    }
+    py::list out;
+    for (const PortInfo& p : ports) out.append(py::dict(py::arg("name") = p.name, py::arg("description") = p.description));
+    return out;
+  }, "Serial ports: [{'name', 'description'}].");
+  m.def("stream_program", &stream_program_py, py::arg("port"), py::arg("lines"), py::arg("profile") = py::dict(),
+        py::arg("state") = py::dict(), py::arg("progress") = py::none(), py::arg("control") = nullptr,
+        py::arg("dry_run") = false, py::arg("response_timeout") = 30.0, py::arg("settle") = 2.0,
+        R"(Stream G-code lines to a GRBL bender (send one line, wait for ok / error:N; ALARM stops).
+
+state: dict whose "next_line" (0-based, first unacknowledged line) is read and updated in place,
+so calling again after an error or a disconnect resumes without repeating or skipping a line.
+progress(stage, fraction) -> False aborts. control: a StreamControl to pause/resume/abort from
+another thread. Returns {"status": completed|dry_run|error|alarm|disconnected|timeout|aborted,
+"sent", "acknowledged", "last_acknowledged", "failed_line", "code", "message", "next_line"}.)");
+}
+
+}  // namespace wiresculpt::python

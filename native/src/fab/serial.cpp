@@ -1,0 +1,451 @@
+#include "wiresculpt/fab/serial.hpp"
+
+#include <fcntl.h>
+#include <libserialport.h>
+#include <poll.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <string>
+#include <thread>
+
+#include "wiresculpt/error.hpp"
+
+namespace wiresculpt::fab {
+
+// ---------------------------------------------------------------------------------------------
+// Listing
+// ---------------------------------------------------------------------------------------------
+
+std::vector<PortInfo> list_ports() {
+  std::vector<PortInfo> out;
+  sp_port** ports = nullptr;
+  if (sp_list_ports(&ports) != SP_OK) return out;  // no serial subsystem: no ports
+  for (int i = 0; ports[i]; ++i) {
+    PortInfo info;
+    if (const char* n = sp_get_port_name(ports[i])) info.name = n;
+    if (const char* d = sp_get_port_description(ports[i])) info.description = d;
+    out.push_back(info);
+  }
+  sp_free_port_list(ports);
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The port: libserialport, or a plain POSIX tty for devices libserialport does not know (ptys)
+// ---------------------------------------------------------------------------------------------
+
+struct SerialPort::Impl {
+  std::string name;
+  sp_port* sp = nullptr;
+  int fd = -1;
+
+  ~Impl() {
+    if (sp) {
+      sp_close(sp);
+      sp_free_port(sp);
+    }
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+namespace {
+
+[[noreturn]] void open_failed(const std::string& name, const std::string& why) {
+  throw InputError("could not open serial port '" + name + "': " + why);
+}
+
+speed_t posix_speed(int baud) {
+  switch (baud) {
+    case 9600: return B9600;
+    case 19200: return B19200;
+    case 38400: return B38400;
+    case 57600: return B57600;
+    case 115200: return B115200;
+    case 230400: return B230400;
+    case 460800: return B460800;
+    case 921600: return B921600;
+    default: return B0;
+  }
+}
+
+void open_posix(SerialPort::Impl& impl, const SerialSettings& s) {
+  impl.fd = ::open(impl.name.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+  if (impl.fd < 0) open_failed(impl.name, std::strerror(errno));
+  if (!::isatty(impl.fd)) open_failed(impl.name, "not a serial device");
+  termios t{};
+  if (::tcgetattr(impl.fd, &t) != 0) open_failed(impl.name, std::strerror(errno));
+  ::cfmakeraw(&t);
+  const speed_t speed = posix_speed(s.baud);
+  if (speed == B0) open_failed(impl.name, "baud rate " + std::to_string(s.baud) + " is not supported");
+  ::cfsetispeed(&t, speed);
+  ::cfsetospeed(&t, speed);
+  t.c_cflag &= ~static_cast<tcflag_t>(CSIZE | PARENB | PARODD | CSTOPB | CRTSCTS);
+  t.c_cflag |= CLOCAL | CREAD;
+  switch (s.data_bits) {
+    case 5: t.c_cflag |= CS5; break;
+    case 6: t.c_cflag |= CS6; break;
+    case 7: t.c_cflag |= CS7; break;
+    default: t.c_cflag |= CS8; break;
+  }
+  if (s.parity != SerialSettings::Parity::none) t.c_cflag |= PARENB;
+  if (s.parity == SerialSettings::Parity::odd) t.c_cflag |= PARODD;
+  if (s.stop_bits == 2) t.c_cflag |= CSTOPB;
+  t.c_iflag &= ~static_cast<tcflag_t>(IXON | IXOFF | IXANY);
+  if (s.flow_control == SerialSettings::FlowControl::rts_cts) t.c_cflag |= CRTSCTS;
+  if (s.flow_control == SerialSettings::FlowControl::xon_xoff) t.c_iflag |= IXON | IXOFF;
+  t.c_cc[VMIN] = 0;
+  t.c_cc[VTIME] = 0;
+  if (::tcsetattr(impl.fd, TCSANOW, &t) != 0) open_failed(impl.name, std::strerror(errno));
+}
+
+void open_libserialport(SerialPort::Impl& impl, const SerialSettings& s) {
+  auto check = [&](sp_return r, const char* what) {
+    if (r != SP_OK) {
+      char* msg = sp_last_error_message();
+      const std::string why = std::string(what) + (msg ? std::string(": ") + msg : std::string());
+      if (msg) sp_free_error_message(msg);
+      open_failed(impl.name, why);
+    }
+  };
+  check(sp_open(impl.sp, SP_MODE_READ_WRITE), "open failed");
+  check(sp_set_baudrate(impl.sp, s.baud), "baud rate not accepted");
+  check(sp_set_bits(impl.sp, s.data_bits), "data bits not accepted");
+  const sp_parity parity = s.parity == SerialSettings::Parity::odd    ? SP_PARITY_ODD
+                           : s.parity == SerialSettings::Parity::even ? SP_PARITY_EVEN
+                                                                      : SP_PARITY_NONE;
+  check(sp_set_parity(impl.sp, parity), "parity not accepted");
+  check(sp_set_stopbits(impl.sp, s.stop_bits), "stop bits not accepted");
+  const sp_flowcontrol flow = s.flow_control == SerialSettings::FlowControl::rts_cts    ? SP_FLOWCONTROL_RTSCTS
+                              : s.flow_control == SerialSettings::FlowControl::xon_xoff ? SP_FLOWCONTROL_XONXOFF
+                                                                                        : SP_FLOWCONTROL_NONE;
+  check(sp_set_flowcontrol(impl.sp, flow), "flow control not accepted");
+}
+
+}  // namespace
+
+SerialPort::SerialPort(const std::string& name, const SerialSettings& settings) : impl_(std::make_unique<Impl>()) {
+  impl_->name = name;
+  if (name.empty()) open_failed(name, "no port name given");
+  if (sp_get_port_by_name(name.c_str(), &impl_->sp) == SP_OK) {
+    open_libserialport(*impl_, settings);
+  } else {
+    impl_->sp = nullptr;
+    open_posix(*impl_, settings);
+  }
+}
+
+SerialPort::~SerialPort() = default;
+
+const std::string& SerialPort::name() const { return impl_->name; }
+
+bool SerialPort::write(const std::string& bytes, int timeout_ms) {
+  if (impl_->sp) {
+    // A zero timeout would mean "wait forever" to libserialport: never pass one.
+    const sp_return r = sp_blocking_write(impl_->sp, bytes.data(), bytes.size(),
+                                          static_cast<unsigned>(std::max(timeout_ms, 1)));
+    return r == static_cast<sp_return>(bytes.size());
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    if (left.count() <= 0) return false;
+    pollfd p{impl_->fd, POLLOUT, 0};
+    const int pr = ::poll(&p, 1, static_cast<int>(left.count()));
+    if (pr < 0 && errno == EINTR) continue;
+    if (pr <= 0) return false;
+    if (p.revents & (POLLERR | POLLHUP | POLLNVAL)) return false;
+    const ssize_t w = ::write(impl_->fd, bytes.data() + done, bytes.size() - done);
+    if (w < 0) {
+      if (errno == EAGAIN || errno == EINTR) continue;
+      return false;
+    }
+    done += static_cast<std::size_t>(w);
+  }
+  return true;
+}
+
+int SerialPort::read(char* buffer, int size, int timeout_ms) {
+  if (size <= 0) return 0;
+  if (impl_->sp) {
+    const sp_return r = sp_blocking_read_next(impl_->sp, buffer, static_cast<std::size_t>(size),
+                                              static_cast<unsigned>(std::max(timeout_ms, 1)));
+    return r < 0 ? -1 : static_cast<int>(r);
+  }
+  pollfd p{impl_->fd, POLLIN, 0};
+  int pr;
+  do pr = ::poll(&p, 1, std::max(timeout_ms, 0));
+  while (pr < 0 && errno == EINTR);
+  if (pr < 0) return -1;
+  if (pr == 0) return 0;
+  if (p.revents & POLLIN) {
+    const ssize_t n = ::read(impl_->fd, buffer, static_cast<std::size_t>(size));
+    if (n > 0) return static_cast<int>(n);
+    if (n < 0 && (errno == EAGAIN || errno == EINTR)) return 0;
+    return -1;  // 0 bytes on a readable tty, or EIO: the other end is gone
+  }
+  return -1;  // POLLHUP / POLLERR without data
+}
+
+void SerialPort::drain_input(int timeout_ms) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+  char buf[256];
+  while (std::chrono::steady_clock::now() < deadline)
+    if (read(buf, sizeof buf, 20) <= 0) break;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Program validation
+// ---------------------------------------------------------------------------------------------
+
+const char* to_string(StreamStatus status) {
+  switch (status) {
+    case StreamStatus::completed: return "completed";
+    case StreamStatus::dry_run: return "dry_run";
+    case StreamStatus::error: return "error";
+    case StreamStatus::alarm: return "alarm";
+    case StreamStatus::disconnected: return "disconnected";
+    case StreamStatus::timeout: return "timeout";
+    case StreamStatus::aborted: return "aborted";
+  }
+  return "unknown";
+}
+
+void validate_program(const std::vector<std::string>& lines, const MachineProfile& profile) {
+  const std::string allowed = std::string("GMFSPNT") + profile.axes.feed_axis + profile.axes.bend_axis +
+                              (profile.axes.pin_axis ? std::string(1, profile.axes.pin_axis) : std::string());
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const std::string& line = lines[i];
+    const std::string who = "line " + std::to_string(i + 1);
+    if (line.empty()) throw InputError(who + " is empty; remove blank lines (stream_lines() does)");
+    if (line.size() > 79)
+      throw InputError(who + " has " + std::to_string(line.size()) + " characters; GRBL accepts at most 79");
+    for (char c : line) {
+      const unsigned char u = static_cast<unsigned char>(c);
+      if (u < 0x20 || u >= 0x7f) throw InputError(who + " contains a non-printable character");
+      if (c == '!' || c == '~' || c == '?')
+        throw InputError(who + " contains '" + std::string(1, c) + "', which GRBL executes as a realtime command");
+      if (c == '(' || c == ';')
+        throw InputError(who + " contains a comment; strip comments with stream_lines() before streaming");
+    }
+    if (line[0] == '$') continue;
+    std::size_t k = 0;
+    while (k < line.size()) {
+      if (line[k] == ' ') { ++k; continue; }
+      const char letter = static_cast<char>(std::toupper(static_cast<unsigned char>(line[k])));
+      if (letter < 'A' || letter > 'Z' || allowed.find(letter) == std::string::npos)
+        throw InputError(who + " ('" + line + "'): '" + std::string(1, line[k]) +
+                         "' is not a G-code word this machine uses (allowed: " + allowed + ")");
+      ++k;
+      while (k < line.size() && line[k] == ' ') ++k;
+      const std::size_t start = k;
+      if (k < line.size() && (line[k] == '-' || line[k] == '+')) ++k;
+      bool digits = false;
+      while (k < line.size() && (std::isdigit(static_cast<unsigned char>(line[k])) || line[k] == '.')) {
+        digits = digits || line[k] != '.';
+        ++k;
+      }
+      if (!digits || k == start)
+        throw InputError(who + " ('" + line + "'): the word '" + std::string(1, letter) + "' has no number");
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Streaming
+// ---------------------------------------------------------------------------------------------
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+int to_ms(double seconds) { return static_cast<int>(std::clamp(seconds, 0.0, 1e6) * 1000.0); }
+
+std::string quoted(const std::vector<std::string>& lines, std::size_t i) {
+  return "line " + std::to_string(i + 1) + " ('" + lines[i] + "')";
+}
+
+// Splits the port's bytes into lines ("\n"-terminated, "\r" dropped).
+class LineReader {
+ public:
+  explicit LineReader(SerialPort& port) : port_(port) {}
+  enum class Got { line, nothing, lost };
+  // Waits at most timeout_ms for one complete line.
+  Got next(std::string& line, int timeout_ms) {
+    const auto deadline = Clock::now() + std::chrono::milliseconds(timeout_ms);
+    for (;;) {
+      const std::size_t nl = buffer_.find('\n');
+      if (nl != std::string::npos) {
+        line = buffer_.substr(0, nl);
+        buffer_.erase(0, nl + 1);
+        line.erase(std::remove(line.begin(), line.end(), '\r'), line.end());
+        return Got::line;
+      }
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+      if (left <= 0) return Got::nothing;
+      char buf[256];
+      const int n = port_.read(buf, sizeof buf, static_cast<int>(left));
+      if (n < 0) return Got::lost;
+      buffer_.append(buf, static_cast<std::size_t>(n));
+    }
+  }
+
+ private:
+  SerialPort& port_;
+  std::string buffer_;
+};
+
+bool starts_with(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
+
+int code_after_colon(const std::string& s) {
+  const std::size_t c = s.find(':');
+  if (c == std::string::npos) return 0;
+  try {
+    return std::stoi(s.substr(c + 1));
+  } catch (...) {
+    return 0;
+  }
+}
+
+}  // namespace
+
+StreamResult stream_program(SerialPort& port, const std::vector<std::string>& lines, const MachineProfile& profile,
+                            StreamState& state, const StreamOptions& options, const ProgressFn& progress) {
+  validate(profile);
+  validate_program(lines, profile);
+  if (state.next_line > lines.size())
+    throw InputError("the stream state's next line (" + std::to_string(state.next_line) +
+                     ") is past the program's " + std::to_string(lines.size()) + " lines");
+  StreamResult r;
+  r.last_acknowledged = static_cast<long>(state.next_line) - 1;
+  const std::size_t total = lines.size();
+  const int write_ms = std::max(1, to_ms(options.write_timeout));
+  const int answer_ms = std::max(1, to_ms(options.response_timeout));
+  constexpr int kSliceMs = 20;  // how often control switches are looked at while waiting
+  StreamControl* control = options.control;
+  LineReader reader(port);
+
+  auto fraction = [&] { return total ? static_cast<double>(state.next_line) / static_cast<double>(total) : 1.0; };
+  auto wants_abort = [&] { return control && control->abort.load(); };
+  auto stop = [&](StreamStatus status, long line, std::string message) {
+    r.status = status;
+    r.failed_line = line;
+    r.message = std::move(message);
+    return r;
+  };
+  auto abort_machine = [&](long line) {
+    port.write(std::string("!") + '\x18', write_ms);  // feed hold, then soft reset
+    return stop(StreamStatus::aborted, line,
+                "aborted by request before " + (line >= 0 ? quoted(lines, static_cast<std::size_t>(line)) : "the end") +
+                    " was acknowledged; the machine was stopped with a feed hold and a soft reset; " +
+                    std::to_string(state.next_line) + " lines are done and a resume starts at line " +
+                    std::to_string(state.next_line + 1));
+  };
+  auto report = [&] { return !progress || progress("stream", fraction()); };
+
+  if (!report()) return abort_machine(static_cast<long>(state.next_line));
+  while (state.next_line < total) {
+    const std::size_t i = state.next_line;
+    const long li = static_cast<long>(i);
+    if (wants_abort()) return abort_machine(li);
+    if (control && control->pause.load()) {
+      if (!port.write("!", write_ms))
+        return stop(StreamStatus::disconnected, li, "the link to " + port.name() + " dropped while pausing; resume starts at line " + std::to_string(i + 1));
+      while (control->pause.load()) {
+        if (wants_abort() || !report()) return abort_machine(li);
+        std::string ignored;
+        if (reader.next(ignored, kSliceMs * 5) == LineReader::Got::lost)
+          return stop(StreamStatus::disconnected, li, "the link to " + port.name() + " dropped while paused; resume starts at line " + std::to_string(i + 1));
+      }
+      if (!port.write("~", write_ms))
+        return stop(StreamStatus::disconnected, li, "the link to " + port.name() + " dropped on resuming; resume starts at line " + std::to_string(i + 1));
+    }
+
+    if (!port.write(lines[i] + "\n", write_ms))
+      return stop(StreamStatus::disconnected, li,
+                  "the link to " + port.name() + " dropped (or stopped accepting data) before " + quoted(lines, i) +
+                      " was sent; " + std::to_string(i) + " lines are done; reconnect and resume from line " +
+                      std::to_string(i + 1));
+    ++r.sent;
+
+    const auto deadline = Clock::now() + std::chrono::milliseconds(answer_ms);
+    bool acknowledged = false;
+    while (!acknowledged) {
+      if (wants_abort()) return abort_machine(li);
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+      if (left <= 0)
+        return stop(StreamStatus::timeout, li,
+                    "no answer to " + quoted(lines, i) + " within " + std::to_string(answer_ms) +
+                        " ms; it is not acknowledged, so a resume sends it again after you check the machine");
+      std::string answer;
+      const auto got = reader.next(answer, static_cast<int>(std::min<long long>(left, kSliceMs)));
+      if (got == LineReader::Got::nothing) continue;
+      if (got == LineReader::Got::lost)
+        return stop(StreamStatus::disconnected, li,
+                    "the link to " + port.name() + " dropped while " + quoted(lines, i) +
+                        " was waiting for its answer; the last acknowledged line is line " + std::to_string(i) +
+                        "; reconnect and resume from line " + std::to_string(i + 1));
+      if (answer == "ok") {
+        acknowledged = true;
+      } else if (starts_with(answer, "error:")) {
+        r.code = code_after_colon(answer);
+        return stop(StreamStatus::error, li,
+                    "GRBL rejected " + quoted(lines, i) + " with " + answer +
+                        " (the line was not executed); fix it and resume from line " + std::to_string(i + 1));
+      } else if (starts_with(answer, "ALARM")) {
+        r.code = code_after_colon(answer);
+        return stop(StreamStatus::alarm, li,
+                    "GRBL raised " + answer + " while " + quoted(lines, i) +
+                        " was in flight; the machine is locked: clear the alarm ($X or reset), check the wire, and "
+                        "resume from line " + std::to_string(i + 1));
+      } else if (starts_with(answer, "Grbl ")) {
+        return stop(StreamStatus::disconnected, li,
+                    "the controller restarted while " + quoted(lines, i) +
+                        " was in flight (its banner arrived); resume from line " + std::to_string(i + 1));
+      }
+      // Anything else ([MSG:...], <status>, blank) is informational.
+    }
+    ++state.next_line;
+    ++r.acknowledged;
+    r.last_acknowledged = li;
+    if (!report()) return abort_machine(state.next_line < total ? static_cast<long>(state.next_line) : -1);
+  }
+  r.status = StreamStatus::completed;
+  r.message = "all " + std::to_string(total) + " lines acknowledged";
+  return r;
+}
+
+StreamResult stream_program(const std::string& port_name, const std::vector<std::string>& lines,
+                            const MachineProfile& profile, StreamState& state, const StreamOptions& options,
+                            const ProgressFn& progress) {
+  validate(profile);
+  validate_program(lines, profile);
+  if (state.next_line > lines.size())
+    throw InputError("the stream state's next line (" + std::to_string(state.next_line) +
+                     ") is past the program's " + std::to_string(lines.size()) + " lines");
+  if (options.dry_run) {
+    StreamResult r;
+    r.status = StreamStatus::dry_run;
+    r.last_acknowledged = static_cast<long>(state.next_line) - 1;
+    r.message = "dry run: " + std::to_string(lines.size()) + " lines are valid for " + profile.name +
+                "; nothing was sent";
+    return r;
+  }
+  SerialPort port(port_name, profile.serial);
+  // GRBL restarts when the port opens (DTR); let it boot, then drop its banner.
+  const auto settle_end = Clock::now() + std::chrono::milliseconds(to_ms(options.settle));
+  while (Clock::now() < settle_end) {
+    if (options.control && options.control->abort.load()) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  port.drain_input(200);
+  return stream_program(port, lines, profile, state, options, progress);
+}
+
+}  // namespace wiresculpt::fab

@@ -1,0 +1,165 @@
+#include "wiresculpt/fab/svg.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "wiresculpt/error.hpp"
+#include "wiresculpt/fab/machine.hpp"
+
+namespace wiresculpt::fab {
+namespace {
+
+std::string num(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.4f", v);
+  return buf;
+}
+
+std::string xml_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default:
+        if (static_cast<unsigned char>(c) >= 0x20 || c == '\t') out += c;  // no control characters in XML
+    }
+  }
+  return out;
+}
+
+struct Box {
+  double min_x, min_y, max_x, max_y;  // mm
+  double width() const { return max_x - min_x; }
+  double height() const { return max_y - min_y; }
+};
+
+Box bbox_mm(const TemplateWire& w) {
+  Box b{to_mm(w.points[0].x()), to_mm(w.points[0].y()), to_mm(w.points[0].x()), to_mm(w.points[0].y())};
+  for (const Vec2& p : w.points) {
+    b.min_x = std::min(b.min_x, to_mm(p.x()));
+    b.max_x = std::max(b.max_x, to_mm(p.x()));
+    b.min_y = std::min(b.min_y, to_mm(p.y()));
+    b.max_y = std::max(b.max_y, to_mm(p.y()));
+  }
+  return b;
+}
+
+void check_options(const SvgOptions& o) {
+  auto ok = [](double v) { return std::isfinite(v) && v >= 0.0; };
+  if (!ok(o.margin_mm) || !ok(o.stroke_mm) || !ok(o.tick_mm) || !ok(o.crossing_radius_mm) ||
+      !ok(o.label_mm) || !ok(o.sheet_width_mm))
+    throw InputError("SVG options: every size must be a finite, non-negative number of millimetres");
+}
+
+double wire_length_mm(const TemplateWire& w) {
+  double s = 0.0;
+  for (std::size_t i = 1; i < w.points.size(); ++i) s += (w.points[i] - w.points[i - 1]).norm();
+  return to_mm(s);
+}
+
+// The wire's elements with its cell's top-left corner at (ox, oy) on the page.
+std::string wire_group(const TemplateWire& w, std::size_t index, double ox, double oy, const SvgOptions& o) {
+  const Box b = bbox_mm(w);
+  const double m = o.margin_mm;
+  std::vector<Vec2> q;  // page coordinates, mm, y down
+  q.reserve(w.points.size());
+  for (const Vec2& p : w.points) q.emplace_back(ox + m + to_mm(p.x()) - b.min_x, oy + m + b.max_y - to_mm(p.y()));
+
+  std::string s = "  <g class=\"wire\" id=\"wire-" + std::to_string(index) + "\" data-name=\"" +
+                  xml_escape(w.name) + "\">\n";
+  s += "    <polyline class=\"wire-path\" fill=\"none\" stroke=\"#000000\" stroke-width=\"" + num(o.stroke_mm) +
+       "\" stroke-linejoin=\"round\" points=\"";
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    if (i) s += ' ';
+    s += num(q[i].x());
+    s += ',';
+    s += num(q[i].y());
+  }
+  s += "\"/>\n";
+  for (std::size_t i : w.bend_points) {
+    Vec2 d = Vec2::Zero();
+    if (i > 0 && (q[i] - q[i - 1]).norm() > 0) d += (q[i] - q[i - 1]).normalized();
+    if (i + 1 < q.size() && (q[i + 1] - q[i]).norm() > 0) d += (q[i + 1] - q[i]).normalized();
+    if (d.norm() < 1e-9) d = (i > 0) ? (q[i] - q[i - 1]) : Vec2(1, 0);
+    if (d.norm() < 1e-12) d = Vec2(1, 0);
+    d.normalize();
+    const Vec2 nrm(-d.y(), d.x());
+    const Vec2 a = q[i] + o.tick_mm * nrm, c = q[i] - o.tick_mm * nrm;
+    s += "    <line class=\"bend\" data-point=\"" + std::to_string(i) + "\" x1=\"" + num(a.x()) + "\" y1=\"" +
+         num(a.y()) + "\" x2=\"" + num(c.x()) + "\" y2=\"" + num(c.y()) +
+         "\" stroke=\"#d00000\" stroke-width=\"" + num(o.stroke_mm * 0.6) + "\"/>\n";
+  }
+  for (std::size_t i : w.crossing_points)
+    s += "    <circle class=\"crossing\" data-point=\"" + std::to_string(i) + "\" cx=\"" + num(q[i].x()) +
+         "\" cy=\"" + num(q[i].y()) + "\" r=\"" + num(o.crossing_radius_mm) +
+         "\" fill=\"none\" stroke=\"#0050d0\" stroke-width=\"" + num(o.stroke_mm * 0.6) + "\"/>\n";
+  char len[64];
+  std::snprintf(len, sizeof len, "%.1f mm", wire_length_mm(w));
+  s += "    <text class=\"label\" x=\"" + num(ox + m) + "\" y=\"" + num(oy + 0.75 * m) +
+       "\" font-family=\"sans-serif\" font-size=\"" + num(o.label_mm) + "\">" + xml_escape(w.name) + "  (" + len +
+       ")</text>\n";
+  s += "  </g>\n";
+  return s;
+}
+
+std::string svg_open(double width, double height) {
+  return "<?xml version=\"1.0\" encoding=\"UTF-8\" standalone=\"no\"?>\n"
+         "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"" + num(width) + "mm\" height=\"" +
+         num(height) + "mm\" viewBox=\"0 0 " + num(width) + " " + num(height) + "\">\n"
+         "  <!-- wiresculpt 1:1 template: one user unit is one millimetre; print at 100% -->\n";
+}
+
+}  // namespace
+
+std::string svg_wire(const TemplateWire& wire, const SvgOptions& options) {
+  check_options(options);
+  validate(wire, 0);
+  const Box b = bbox_mm(wire);
+  const double w = b.width() + 2 * options.margin_mm, h = b.height() + 2 * options.margin_mm;
+  return svg_open(w, h) + wire_group(wire, 0, 0.0, 0.0, options) + "</svg>\n";
+}
+
+std::vector<SheetCell> sheet_layout(const std::vector<TemplateWire>& wires, const SvgOptions& options) {
+  check_options(options);
+  std::vector<SheetCell> cells;
+  double x = 0.0, y = 0.0, row_height = 0.0;
+  for (std::size_t k = 0; k < wires.size(); ++k) {
+    validate(wires[k], k);
+    const Box b = bbox_mm(wires[k]);
+    SheetCell c;
+    c.width_mm = b.width() + 2 * options.margin_mm;
+    c.height_mm = b.height() + 2 * options.margin_mm;
+    if (x > 0.0 && x + c.width_mm > options.sheet_width_mm) {  // new row
+      y += row_height;
+      x = 0.0;
+      row_height = 0.0;
+    }
+    c.x_mm = x;
+    c.y_mm = y;
+    x += c.width_mm;
+    row_height = std::max(row_height, c.height_mm);
+    cells.push_back(c);
+  }
+  return cells;
+}
+
+std::string svg_sheet(const std::vector<TemplateWire>& wires, const SvgOptions& options) {
+  if (wires.empty()) throw InputError("an SVG sheet needs at least one wire");
+  const std::vector<SheetCell> cells = sheet_layout(wires, options);
+  double width = 0.0, height = 0.0;
+  for (const SheetCell& c : cells) {
+    width = std::max(width, c.x_mm + c.width_mm);
+    height = std::max(height, c.y_mm + c.height_mm);
+  }
+  std::string s = svg_open(width, height);
+  for (std::size_t k = 0; k < wires.size(); ++k) s += wire_group(wires[k], k, cells[k].x_mm, cells[k].y_mm, options);
+  return s + "</svg>\n";
+}
+
+}  // namespace wiresculpt::fab

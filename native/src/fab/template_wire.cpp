@@ -1,0 +1,25 @@
+#include "wiresculpt/fab/template_wire.hpp"
+
+#include <string>
+
+#include "wiresculpt/error.hpp"
+
+namespace wiresculpt::fab {
+
+void validate(const TemplateWire& wire, std::size_t index) {
+  const std::string who = "wire " + std::to_string(index) + " ('" + wire.name + "')";
+  if (wire.points.empty()) throw InputError(who + " has no points");
+  for (std::size_t i = 0; i < wire.points.size(); ++i)
+    if (!wire.points[i].allFinite())
+      throw InputError(who + ": point " + std::to_string(i) + " has a non-finite coordinate");
+  const std::size_t n = wire.points.size();
+  for (std::size_t i : wire.bend_points)
+    if (i >= n)
+      throw InputError(who + ": bend point index " + std::to_string(i) + " is outside 0.." + std::to_string(n - 1));
+  for (std::size_t i : wire.crossing_points)
+    if (i >= n)
+      throw InputError(who + ": crossing point index " + std::to_string(i) + " is outside 0.." +
+                       std::to_string(n - 1));
+}
+
+}  // namespace wiresculpt::fab

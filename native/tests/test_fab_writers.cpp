@@ -1,0 +1,331 @@
+// The fabrication files: SVG (1:1, mm), DXF R12, G-code, the CSV bend table, and the atomic writer.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <regex>
+#include <sstream>
+#include <algorithm>
+#include <csignal>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include "wiresculpt/error.hpp"
+#include "wiresculpt/fab/atomic_file.hpp"
+#include "wiresculpt/fab/bend_program.hpp"
+#include "wiresculpt/fab/dxf.hpp"
+#include "wiresculpt/fab/gcode.hpp"
+#include "wiresculpt/fab/serial.hpp"
+#include "wiresculpt/fab/svg.hpp"
+
+using namespace wiresculpt;
+using namespace wiresculpt::fab;
+using Catch::Matchers::Contains;
+namespace fs = std::filesystem;
+
+namespace {
+constexpr double deg = std::numbers::pi / 180.0;
+
+std::vector<std::string> split_lines(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t pos = text.find(what); pos != std::string::npos; pos = text.find(what, pos + 1)) ++n;
+  return n;
+}
+
+double attribute(const std::string& text, const std::string& name) {
+  std::smatch m;
+  const std::regex re(" " + name + "=\"([-0-9.]+)(mm)?\"");
+  REQUIRE(std::regex_search(text, m, re));
+  return std::stod(m[1]);
+}
+
+// XML-ish: every tag opened is closed in order (self-closing tags stand alone).
+bool balanced_tags(const std::string& text) {
+  std::vector<std::string> stack;
+  const std::regex tag("<(/?)([a-zA-Z][a-zA-Z0-9]*)[^>]*?(/?)>");
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), tag); it != std::sregex_iterator(); ++it) {
+    const auto& m = *it;
+    if (m[3] == "/") continue;
+    if (m[1] == "/") {
+      if (stack.empty() || stack.back() != m[2]) return false;
+      stack.pop_back();
+    } else {
+      stack.push_back(m[2]);
+    }
+  }
+  return stack.empty();
+}
+
+std::vector<Vec2> polyline_points(const std::string& svg, std::size_t which = 0) {
+  const std::regex re("class=\"wire-path\"[^>]*points=\"([^\"]*)\"");
+  auto it = std::sregex_iterator(svg.begin(), svg.end(), re);
+  for (std::size_t k = 0; k < which; ++k) ++it;
+  REQUIRE(it != std::sregex_iterator());
+  std::vector<Vec2> out;
+  std::istringstream in((*it)[1].str());
+  for (std::string pair; in >> pair;) {
+    const auto comma = pair.find(',');
+    out.emplace_back(std::stod(pair.substr(0, comma)), std::stod(pair.substr(comma + 1)));
+  }
+  return out;
+}
+
+TemplateWire square_wire() {
+  TemplateWire w;
+  w.name = "A/0 <square>";
+  w.points = {{0, 0}, {0.08, 0}, {0.08, 0.05}, {0, 0.05}, {0, 0}};
+  w.bend_points = {1, 2, 3};
+  w.crossing_points = {0, 2};
+  return w;
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("wiresculpt_fab_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string read(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+bool has_temp_files(const fs::path& dir) {
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().filename().string().find(".tmp-") != std::string::npos) return true;
+  return false;
+}
+}  // namespace
+
+TEST_CASE("svg: one wire at 1:1 with width and height of the bounding box plus margins", "[fab][svg]") {
+  SvgOptions o;
+  o.margin_mm = 12.0;
+  const std::string svg = svg_wire(square_wire(), o);
+  CHECK(svg.rfind("<?xml", 0) == 0);
+  CHECK(balanced_tags(svg));
+  CHECK(attribute(svg, "width") == Approx(80 + 24));
+  CHECK(attribute(svg, "height") == Approx(50 + 24));
+  CHECK_THAT(svg, Contains("width=\"104.0000mm\"") && Contains("viewBox=\"0 0 104.0000 74.0000\""));
+  CHECK_THAT(svg, Contains("A/0 &lt;square&gt;"));
+  CHECK(count(svg, "class=\"bend\"") == 3);
+  CHECK(count(svg, "class=\"crossing\"") == 2);
+  const auto q = polyline_points(svg);
+  REQUIRE(q.size() == 5);
+  // 1:1 in mm, y up on paper: point (x, y) m -> (margin + 1000 x, margin + 50 - 1000 y).
+  CHECK(q[1].x() == Approx(12 + 80));
+  CHECK(q[1].y() == Approx(12 + 50));
+  CHECK(q[2].y() == Approx(12));
+  // A bend tick crosses the wire at its point: the tick at point 2 (the corner (80, 50) mm) is
+  // centred there.
+  std::smatch m;
+  REQUIRE(std::regex_search(svg, m, std::regex("data-point=\"2\" x1=\"([-0-9.]+)\" y1=\"([-0-9.]+)\" x2=\"([-0-9.]+)\" y2=\"([-0-9.]+)\"")));
+  CHECK((std::stod(m[1]) + std::stod(m[3])) / 2 == Approx(92.0));
+  CHECK((std::stod(m[2]) + std::stod(m[4])) / 2 == Approx(12.0));
+  CHECK(std::hypot(std::stod(m[1]) - std::stod(m[3]), std::stod(m[2]) - std::stod(m[4])) == Approx(2 * o.tick_mm));
+}
+
+TEST_CASE("svg: the sheet lays wires out without overlap", "[fab][svg]") {
+  std::vector<TemplateWire> wires;
+  for (int k = 0; k < 7; ++k) {
+    TemplateWire w = square_wire();
+    w.name = "W" + std::to_string(k);
+    for (auto& p : w.points) p = p * (1.0 + 0.5 * k) + Vec2(0.3 * k, -0.1 * k);  // anywhere in the plane
+    wires.push_back(w);
+  }
+  SvgOptions o;
+  o.sheet_width_mm = 400;
+  const auto cells = sheet_layout(wires, o);
+  REQUIRE(cells.size() == wires.size());
+  for (std::size_t a = 0; a < cells.size(); ++a)
+    for (std::size_t b = a + 1; b < cells.size(); ++b) {
+      const bool apart = cells[a].x_mm + cells[a].width_mm <= cells[b].x_mm + 1e-9 ||
+                         cells[b].x_mm + cells[b].width_mm <= cells[a].x_mm + 1e-9 ||
+                         cells[a].y_mm + cells[a].height_mm <= cells[b].y_mm + 1e-9 ||
+                         cells[b].y_mm + cells[b].height_mm <= cells[a].y_mm + 1e-9;
+      CHECK(apart);
+    }
+  const std::string svg = svg_sheet(wires, o);
+  CHECK(balanced_tags(svg));
+  CHECK(count(svg, "class=\"wire\"") == 7);
+  double width = 0, height = 0;
+  for (const auto& c : cells) {
+    width = std::max(width, c.x_mm + c.width_mm);
+    height = std::max(height, c.y_mm + c.height_mm);
+  }
+  CHECK(attribute(svg, "width") == Approx(width));
+  CHECK(attribute(svg, "height") == Approx(height));
+  for (std::size_t k = 0; k < wires.size(); ++k) {
+    const auto q = polyline_points(svg, k);
+    for (const Vec2& p : q) {
+      CHECK(p.x() >= cells[k].x_mm + o.margin_mm - 1e-3);
+      CHECK(p.x() <= cells[k].x_mm + cells[k].width_mm - o.margin_mm + 1e-3);
+      CHECK(p.y() >= cells[k].y_mm + o.margin_mm - 1e-3);
+      CHECK(p.y() <= cells[k].y_mm + cells[k].height_mm - o.margin_mm + 1e-3);
+    }
+    // The same shape at 1:1: edge lengths in mm equal the wire's in metres * 1000.
+    for (std::size_t i = 1; i < q.size(); ++i)
+      CHECK((q[i] - q[i - 1]).norm() == Approx(1000 * (wires[k].points[i] - wires[k].points[i - 1]).norm()).margin(1e-3));
+  }
+  TemplateWire bad = square_wire();
+  bad.crossing_points = {9};
+  CHECK_THROWS_WITH(svg_sheet({square_wire(), bad}), Contains("wire 1") && Contains("crossing point index 9"));
+}
+
+TEST_CASE("dxf: R12 structure, one layer per wire, polylines in mm", "[fab][dxf]") {
+  std::vector<TemplateWire> wires{square_wire(), square_wire()};
+  wires[1].name = "B/1";
+  for (auto& p : wires[1].points) p += Vec2(0.2, 0.0);
+  const std::string dxf = dxf_document(wires);
+  const auto lines = split_lines(dxf);
+  REQUIRE(lines.size() % 2 == 0);
+  for (std::size_t i = 0; i < lines.size(); i += 2) {
+    INFO("group code line " << i + 1 << ": '" << lines[i] << "'");
+    CHECK(std::regex_match(lines[i], std::regex(" *-?[0-9]+")));
+  }
+  CHECK(lines[lines.size() - 2] == "  0");
+  CHECK(lines.back() == "EOF");
+  CHECK_THAT(dxf, Contains("$ACADVER\n  1\nAC1009\n"));
+  CHECK(count(dxf, "\nPOLYLINE\n") == 2);
+  CHECK(count(dxf, "\nSEQEND\n") == 2);
+  CHECK(count(dxf, "\nVERTEX\n") == 10);
+  CHECK(dxf_layer_name(0, "A/0 <square>") == "WIRE_0_A_0__SQUARE_");
+  CHECK(dxf_layer_name(1, "B/1") == "WIRE_1_B_1");
+  CHECK(dxf_layer_name(3, std::string(60, 'x')).size() == 31);
+  CHECK(count(dxf, "\n  2\nWIRE_1_B_1\n") == 1);                 // the layer table entry
+  CHECK(count(dxf, "\n  8\nWIRE_1_B_1\n") == 1 + 5 + 1 + 1);    // polyline, vertices, seqend, text
+  CHECK_THAT(dxf, Contains(" 10\n280.000000\n 20\n50.000000\n"));  // (0.28, 0.05) m of wire B
+}
+
+TEST_CASE("gcode: header, axis mapping, units and the bend table", "[fab][gcode]") {
+  MachineProfile m;
+  m.springback_a = 0.9;
+  m.springback_b = -2 * deg;
+  const double a = 0.05;
+  const BendProgram prog = make_bend_program(Polyline2{{0, 0}, {a, 0}, {a, a}, {2 * a, a}}, m);  // +90, -90
+  REQUIRE(prog.bend_count == 2);
+  GcodeInfo info{"A/0", "steel 3 mm", true};
+  const std::string g = gcode_program(prog, m, info);
+  CHECK_THAT(g, Contains("; wire: A/0\n") && Contains("; material: steel 3 mm\n") && Contains("; length: 150.000 mm"));
+  const auto lines = stream_lines(g);
+  CHECK_NOTHROW(validate_program(lines, m));
+  const double c = (90.0 + 2.0) / 0.9;
+  char plus[64], minus[64];
+  std::snprintf(plus, sizeof plus, "G1 Y%.4f F5400.0", c);
+  std::snprintf(minus, sizeof minus, "G1 Y-%.4f F5400.0", c);
+  const std::vector<std::string> expected{"G21", "G91", "G94",
+                                          "G1 X50.0000 F1200.0", plus, minus, "G4 P0",
+                                          "G1 X50.0000 F1200.0", minus, plus, "G4 P0",
+                                          "G1 X50.0000 F1200.0", "G4 P0", "M2"};
+  CHECK(lines == expected);
+
+  // Another mapping: feed on A in 0.5 units/mm, bend on B in 2 units/deg, left = negative, a pin on Z.
+  m.axes.feed_axis = 'A';
+  m.axes.bend_axis = 'B';
+  m.axes.pin_axis = 'Z';
+  m.axes.feed_units_per_mm = 0.5;
+  m.axes.bend_units_per_deg = 2.0;
+  m.left_is_positive = false;
+  info.sync_each_step = false;
+  const auto l2 = stream_lines(gcode_program(prog, m, info));
+  CHECK_NOTHROW(validate_program(l2, m));
+  CHECK(l2[3] == "G1 A25.0000 F600.0");
+  std::snprintf(minus, sizeof minus, "G1 B-%.4f F10800.0", 2 * c);  // left bend, left = negative
+  CHECK(l2[4] == "G0 Z-5.0000");  // the pin starts on the positive side: change sides first
+  CHECK(l2[5] == "G0 Z5.0000");
+  CHECK(l2[6] == minus);
+  CHECK(std::count_if(l2.begin(), l2.end(), [](const std::string& s) { return s.rfind("G0 Z", 0) == 0; }) == 4);
+  CHECK_THROWS_WITH(validate_program({"G1 X5"}, m), Contains("line 1") && Contains("'X'"));
+  CHECK_THROWS_WITH(validate_program({"G1 A5", "G1 A5 ; note"}, m), Contains("line 2") && Contains("comment"));
+  CHECK_THROWS_WITH(validate_program({"G1 A5", "G1 A5", "G1 A!"}, m), Contains("line 3") && Contains("realtime"));
+  CHECK_THROWS_WITH(validate_program({std::string(80, 'G')}, m), Contains("line 1") && Contains("79"));
+
+  const std::string csv = bend_table_csv(prog);
+  const auto rows = split_lines(csv);
+  REQUIRE(rows.size() == 4);
+  CHECK(rows[0] == "step,feed_mm,bend_deg,commanded_deg");
+  char row[128];
+  std::snprintf(row, sizeof row, "1,50.0000,90.0000,%.4f", c);
+  CHECK(rows[1] == row);
+  std::snprintf(row, sizeof row, "2,50.0000,-90.0000,-%.4f", c);
+  CHECK(rows[2] == row);
+  CHECK(rows[3] == "3,50.0000,0.0000,0.0000");
+}
+
+TEST_CASE("gcode: stream_lines strips comments and blank lines", "[fab][gcode]") {
+  const auto l = stream_lines("; header\n\nG21 (mm)\n  G1 X5 ; feed\r\n(only a comment)\nM2");
+  CHECK(l == std::vector<std::string>{"G21", "G1 X5", "M2"});
+}
+
+TEST_CASE("atomic file: complete files only, no temporary left behind", "[fab][atomic]") {
+  const fs::path dir = fresh_dir("atomic");
+  const fs::path target = dir / "wire.svg";
+  write_file_atomic(target, "first version\n");
+  CHECK(read(target) == "first version\n");
+  const std::string big(1 << 20, 'x');
+  write_file_atomic(target, big);
+  CHECK(read(target) == big);
+  CHECK_FALSE(has_temp_files(dir));
+
+  SECTION("a folder that does not exist") {
+    CHECK_THROWS_AS(write_file_atomic(dir / "missing" / "a.dxf", "x"), InputError);
+    CHECK_THROWS_WITH(write_file_atomic(dir / "missing" / "a.dxf", "x"), Contains("missing/a.dxf"));
+    CHECK_FALSE(fs::exists(dir / "missing"));
+  }
+  SECTION("a 'folder' that is a file") {
+    write_file_atomic(dir / "plain", "not a folder");
+    CHECK_THROWS_WITH(write_file_atomic(dir / "plain" / "a.dxf", "x"), Contains("plain/a.dxf"));
+    CHECK(read(dir / "plain") == "not a folder");
+  }
+  SECTION("the rename fails: the target is a folder; the temporary file is removed") {
+    fs::create_directories(dir / "occupied" / "inner");
+    CHECK_THROWS_WITH(write_file_atomic(dir / "occupied", "text"), Contains("occupied"));
+    CHECK(fs::is_directory(dir / "occupied" / "inner"));
+    CHECK_FALSE(has_temp_files(dir));
+    CHECK(read(target) == big);  // other files untouched
+  }
+  SECTION("a folder nobody may create files in, not even root") {
+    CHECK_THROWS_WITH(write_file_atomic("/proc/self/wiresculpt.svg", "x"), Contains("/proc/self/wiresculpt.svg"));
+  }
+  SECTION("the disk fills up mid-write: no partial file, the old one kept") {
+    write_file_atomic(dir / "kept.dxf", "old\n");
+    rlimit old{};
+    REQUIRE(::getrlimit(RLIMIT_FSIZE, &old) == 0);
+    const auto previous = std::signal(SIGXFSZ, SIG_IGN);  // writes past the limit fail with EFBIG
+    rlimit small = old;
+    small.rlim_cur = 64 * 1024;
+    REQUIRE(::setrlimit(RLIMIT_FSIZE, &small) == 0);
+    bool threw = false;
+    try {
+      write_file_atomic(dir / "kept.dxf", big);
+    } catch (const InputError& e) {
+      threw = std::string(e.what()).find("kept.dxf") != std::string::npos;
+    }
+    ::setrlimit(RLIMIT_FSIZE, &old);
+    std::signal(SIGXFSZ, previous);
+    CHECK(threw);
+    CHECK(read(dir / "kept.dxf") == "old\n");
+    CHECK_FALSE(has_temp_files(dir));
+  }
+  SECTION("a read-only folder (only meaningful when not running as root)") {
+    const fs::path ro = dir / "readonly";
+    fs::create_directories(ro);
+    write_file_atomic(ro / "kept.csv", "old\n");
+    fs::permissions(ro, fs::perms::owner_read | fs::perms::owner_exec);
+    if (::geteuid() != 0) {
+      CHECK_THROWS_WITH(write_file_atomic(ro / "kept.csv", "new\n"), Contains("kept.csv"));
+      CHECK(read(ro / "kept.csv") == "old\n");
+    }
+    fs::permissions(ro, fs::perms::owner_all);
+    CHECK_FALSE(has_temp_files(ro));
+  }
+  fs::remove_all(dir);
+}

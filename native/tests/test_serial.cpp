@@ -1,0 +1,302 @@
+// GRBL streaming against an emulator inside the test: a pseudo-terminal pair whose master end is
+// answered by a thread that behaves like GRBL (normal, error at line k, alarm, slow, disconnect).
+// Every wait is bounded; each case runs well under a second.
+#include <catch2/catch.hpp>
+#include <pty.h>
+#include <poll.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <mutex>
+#include <thread>
+
+#include "wiresculpt/error.hpp"
+#include "wiresculpt/fab/bend_program.hpp"
+#include "wiresculpt/fab/gcode.hpp"
+#include "wiresculpt/fab/serial.hpp"
+
+using namespace wiresculpt;
+using namespace wiresculpt::fab;
+using Catch::Matchers::Contains;
+
+namespace {
+
+class GrblEmulator {
+ public:
+  enum class Mode { normal, error_at, alarm_at, slow, disconnect_after };
+
+  explicit GrblEmulator(Mode mode, std::size_t k = 0, int delay_ms = 0) : mode_(mode), k_(k), delay_ms_(delay_ms) {
+    termios raw{};
+    ::cfmakeraw(&raw);
+    char name[256] = {};
+    REQUIRE(::openpty(&master_, &slave_, name, &raw, nullptr) == 0);
+    path_ = name;
+    send("\r\nGrbl 1.1h ['$' for help]\r\n");  // what GRBL prints when the port opens
+    thread_ = std::thread([this] { run(); });
+  }
+  ~GrblEmulator() {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+    if (master_ >= 0) ::close(master_);
+    if (slave_ >= 0) ::close(slave_);
+  }
+  const std::string& path() const { return path_; }
+  std::vector<std::string> received() { std::lock_guard<std::mutex> g(mu_); return received_; }
+  std::vector<std::string> acknowledged() { std::lock_guard<std::mutex> g(mu_); return acknowledged_; }
+  std::string realtime() { std::lock_guard<std::mutex> g(mu_); return realtime_; }
+
+ private:
+  void send(const std::string& s) {
+    if (master_ >= 0 && ::write(master_, s.data(), s.size()) < 0) { /* the test sees the missing answer */ }
+  }
+
+  void answer(const std::string& line) {
+    std::size_t index;
+    {
+      std::lock_guard<std::mutex> g(mu_);
+      index = received_.size();
+      received_.push_back(line);
+    }
+    if (locked_) return send("error:9\r\n");  // GRBL refuses everything while in alarm
+    if (mode_ == Mode::error_at && index == k_) return send("error:20\r\n");
+    if (mode_ == Mode::alarm_at && index == k_) {
+      locked_ = true;
+      return send("ALARM:1\r\n");
+    }
+    if (mode_ == Mode::slow) std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms_));
+    {
+      std::lock_guard<std::mutex> g(mu_);
+      acknowledged_.push_back(line);
+    }
+    send("[MSG:busy]\r\nok\r\n");  // an informational line first: the streamer must skip it
+    if (mode_ == Mode::disconnect_after && index + 1 == k_) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));  // the ok reaches the streamer
+      ::close(master_);  // the cable is pulled: the slave end hangs up
+      master_ = -1;
+      stop_ = true;
+    }
+  }
+
+  void run() {
+    std::string buffer;
+    while (!stop_) {
+      pollfd p{master_, POLLIN, 0};
+      if (::poll(&p, 1, 10) <= 0 || !(p.revents & POLLIN)) continue;
+      char buf[256];
+      const ssize_t n = ::read(master_, buf, sizeof buf);
+      if (n <= 0) continue;
+      for (ssize_t i = 0; i < n && !stop_; ++i) {
+        const char c = buf[i];
+        if (c == '!' || c == '~' || c == '?' || c == '\x18') {
+          std::lock_guard<std::mutex> g(mu_);
+          realtime_ += c;
+        } else if (c == '\n') {
+          if (!buffer.empty() && buffer.back() == '\r') buffer.pop_back();
+          answer(buffer);
+          buffer.clear();
+        } else {
+          buffer += c;
+        }
+      }
+    }
+  }
+
+  Mode mode_;
+  std::size_t k_;
+  int delay_ms_;
+  int master_ = -1, slave_ = -1;
+  std::string path_;
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+  bool locked_ = false;
+  std::mutex mu_;
+  std::vector<std::string> received_, acknowledged_;
+  std::string realtime_;
+};
+
+std::vector<std::string> program_lines() {
+  const double a = 0.04;
+  const BendProgram p = make_bend_program(Polyline2{{0, 0}, {a, 0}, {a, a}, {0, a}, {0, 0}}, MachineProfile{});
+  return stream_lines(gcode_program(p, MachineProfile{}, GcodeInfo{"test", "steel", true}));
+}
+
+StreamOptions quick() {
+  StreamOptions o;
+  o.settle = 0.05;
+  o.response_timeout = 1.0;
+  o.write_timeout = 0.5;
+  return o;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+TEST_CASE("serial: a full program is streamed, each line acknowledged once", "[fab][serial]") {
+  const auto lines = program_lines();
+  REQUIRE(lines.size() > 10);
+  GrblEmulator grbl(GrblEmulator::Mode::normal);
+  StreamState state;
+  std::vector<double> fractions;
+  const auto r = stream_program(grbl.path(), lines, MachineProfile{}, state, quick(),
+                                [&](std::string_view, double f) { fractions.push_back(f); return true; });
+  CHECK(r.status == StreamStatus::completed);
+  CHECK(r.sent == lines.size());
+  CHECK(r.acknowledged == lines.size());
+  CHECK(r.last_acknowledged == static_cast<long>(lines.size()) - 1);
+  CHECK(state.next_line == lines.size());
+  CHECK(grbl.received() == lines);
+  CHECK(grbl.acknowledged() == lines);
+  REQUIRE(fractions.size() == lines.size() + 1);
+  CHECK(fractions.front() == 0.0);
+  CHECK(fractions.back() == 1.0);
+}
+
+TEST_CASE("serial: error:N at line k stops at k", "[fab][serial]") {
+  const auto lines = program_lines();
+  const std::size_t k = 4;
+  GrblEmulator grbl(GrblEmulator::Mode::error_at, k);
+  StreamState state;
+  const auto r = stream_program(grbl.path(), lines, MachineProfile{}, state, quick());
+  CHECK(r.status == StreamStatus::error);
+  CHECK(r.code == 20);
+  CHECK(r.failed_line == static_cast<long>(k));
+  CHECK(r.last_acknowledged == static_cast<long>(k) - 1);
+  CHECK(state.next_line == k);
+  CHECK(grbl.received().size() == k + 1);  // nothing was sent after the rejected line
+  CHECK_THAT(r.message, Contains("line 5") && Contains("error:20"));
+}
+
+TEST_CASE("serial: ALARM stops the stream", "[fab][serial]") {
+  const auto lines = program_lines();
+  GrblEmulator grbl(GrblEmulator::Mode::alarm_at, 2);
+  StreamState state;
+  const auto r = stream_program(grbl.path(), lines, MachineProfile{}, state, quick());
+  CHECK(r.status == StreamStatus::alarm);
+  CHECK(r.code == 1);
+  CHECK(r.failed_line == 2);
+  CHECK(state.next_line == 2);
+  CHECK(grbl.received().size() == 3);
+  CHECK_THAT(r.message, Contains("ALARM:1") && Contains("line 3"));
+}
+
+TEST_CASE("serial: slow answers are waited for, missing answers time out", "[fab][serial]") {
+  const auto lines = program_lines();
+  SECTION("slow but within the timeout") {
+    GrblEmulator grbl(GrblEmulator::Mode::slow, 0, 15);
+    StreamState state;
+    const auto r = stream_program(grbl.path(), std::vector<std::string>(lines.begin(), lines.begin() + 6),
+                                  MachineProfile{}, state, quick());
+    CHECK(r.status == StreamStatus::completed);
+    CHECK(state.next_line == 6);
+  }
+  SECTION("slower than the timeout") {
+    GrblEmulator grbl(GrblEmulator::Mode::slow, 0, 400);
+    StreamState state;
+    StreamOptions o = quick();
+    o.response_timeout = 0.1;
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto r = stream_program(grbl.path(), lines, MachineProfile{}, state, o);
+    CHECK(seconds_since(t0) < 1.0);
+    CHECK(r.status == StreamStatus::timeout);
+    CHECK(r.failed_line == 0);
+    CHECK(state.next_line == 0);
+    CHECK_THAT(r.message, Contains("line 1"));
+  }
+}
+
+TEST_CASE("serial: after a disconnect, a resume finishes with every line acknowledged exactly once", "[fab][serial]") {
+  const auto lines = program_lines();
+  const std::size_t k = 5;
+  StreamState state;
+  std::vector<std::string> received, acknowledged;
+  {
+    GrblEmulator grbl(GrblEmulator::Mode::disconnect_after, k);
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto r = stream_program(grbl.path(), lines, MachineProfile{}, state, quick());
+    CHECK(seconds_since(t0) < 1.5);
+    CHECK(r.status == StreamStatus::disconnected);
+    CHECK(r.last_acknowledged == static_cast<long>(k) - 1);
+    CHECK(r.failed_line == static_cast<long>(k));
+    CHECK(state.next_line == k);
+    CHECK_THAT(r.message, Contains("resume from line 6"));
+    received = grbl.received();
+    acknowledged = grbl.acknowledged();
+  }
+  CHECK(acknowledged.size() == k);
+  {
+    GrblEmulator grbl(GrblEmulator::Mode::normal);  // the machine again, on a new device name
+    const auto r = stream_program(grbl.path(), lines, MachineProfile{}, state, quick());
+    CHECK(r.status == StreamStatus::completed);
+    CHECK(r.sent == lines.size() - k);
+    const auto more_received = grbl.received(), more_acknowledged = grbl.acknowledged();
+    received.insert(received.end(), more_received.begin(), more_received.end());
+    acknowledged.insert(acknowledged.end(), more_acknowledged.begin(), more_acknowledged.end());
+  }
+  CHECK(state.next_line == lines.size());
+  CHECK(acknowledged == lines);  // in order, none twice, none skipped
+  CHECK(received == lines);      // and none sent twice
+}
+
+TEST_CASE("serial: pause, resume and abort", "[fab][serial]") {
+  const auto lines = program_lines();
+  SECTION("pause holds the stream, resume continues it") {
+    GrblEmulator grbl(GrblEmulator::Mode::normal);
+    StreamControl control;
+    StreamState state;
+    StreamOptions o = quick();
+    o.control = &control;
+    std::thread releaser;
+    std::size_t received_while_paused = 0;
+    const auto r = stream_program(grbl.path(), lines, MachineProfile{}, state, o, [&](std::string_view, double) {
+      if (state.next_line == 3 && !releaser.joinable()) {
+        control.pause = true;
+        releaser = std::thread([&] {
+          std::this_thread::sleep_for(std::chrono::milliseconds(150));
+          received_while_paused = grbl.received().size();
+          control.pause = false;
+        });
+      }
+      return true;
+    });
+    releaser.join();
+    CHECK(r.status == StreamStatus::completed);
+    CHECK(received_while_paused == 3);
+    CHECK(grbl.realtime() == "!~");
+    CHECK(grbl.acknowledged() == lines);
+  }
+  SECTION("the progress callback aborts") {
+    GrblEmulator grbl(GrblEmulator::Mode::normal);
+    StreamState state;
+    const auto r = stream_program(grbl.path(), lines, MachineProfile{}, state, quick(),
+                                  [&](std::string_view, double f) { return f < 0.5; });
+    CHECK(r.status == StreamStatus::aborted);
+    CHECK(state.next_line == grbl.acknowledged().size());
+    CHECK(state.next_line >= lines.size() / 2);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    CHECK(grbl.realtime() == "!\x18");
+  }
+}
+
+TEST_CASE("serial: dry run, bad programs and bad ports", "[fab][serial]") {
+  const auto lines = program_lines();
+  StreamState state;
+  StreamOptions o = quick();
+  o.dry_run = true;
+  const auto r = stream_program("/dev/does-not-exist", lines, MachineProfile{}, state, o);
+  CHECK(r.status == StreamStatus::dry_run);
+  CHECK(state.next_line == 0);
+  auto bad = lines;
+  bad[6] = "G1 Q3";
+  CHECK_THROWS_WITH(stream_program("/dev/does-not-exist", bad, MachineProfile{}, state, o), Contains("line 7"));
+  o.dry_run = false;
+  CHECK_THROWS_WITH(stream_program("/dev/does-not-exist", lines, MachineProfile{}, state, o),
+                    Contains("/dev/does-not-exist"));
+  state.next_line = lines.size() + 1;
+  CHECK_THROWS_WITH(stream_program("/dev/does-not-exist", lines, MachineProfile{}, state, o), Contains("past"));
+  CHECK_NOTHROW(list_ports());
+}
