@@ -52,24 +52,42 @@ class BatchTest(unittest.TestCase):
 
     def test_globe_example(self):
         r = self.batch(GLOBE)
-        self.assertIn(r.returncode, (0, 2), r.stdout + r.stderr)
+        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
         stages = [line.split(":")[1].strip() for line in wiresculpt_lines(r.stdout)]
         self.assertIn("slicing", stages)
+        self.assertIn("layering", stages)
         d = self.design()
         self.assertEqual((d["format"], d["version"], d["units"]), ("wiresculpt-design", 1, "m"))
         self.assertEqual(len(d["wires"]), 3)
         for w in d["wires"]:
             self.assertTrue(w["closed"])
-            # size 0.25 m: a great circle of radius 0.125 m, sampled by 48 points
+            # size 0.25 m: a great circle of radius 0.125 m sampled by 48 points, plus the
+            # crossing points inserted on its chords (which leave the length unchanged)
             expected = 2 * 0.125 * 48 * math.sin(math.pi / 48)
-            self.assertAlmostEqual(polyline_length(w["contour"], True), expected, delta=1e-4 * expected)
+            self.assertAlmostEqual(polyline_length(w["contour"], True), expected, delta=1e-6)
             n, o = w["plane"]["normal"], w["plane"]["origin"]
             for p in w["contour"]:
                 self.assertLess(abs(sum(n[k] * (p[k] - o[k]) for k in range(3))), 1e-9)
             self.assertNotEqual(w["contour"][0], w["contour"][-1])
-        if r.returncode == 2:
-            self.assertFalse(d["stable"])
-            self.assertTrue(d["reason"])
+        # Three great circles meet pairwise at two antipodal points: six crossings, each on the
+        # common line of its two planes at distance 0.125 from the centre.
+        self.assertEqual(len(d["crossings"]), 6)
+        for c in d["crossings"]:
+            self.assertIn(c["hook"], (-1, 1))
+            self.assertAlmostEqual(math.dist(c["point"], (0, 0, 0)), 0.125, delta=1e-9)
+            for k in (0, 1):
+                wire = d["wires"][c["wires"][k]]
+                self.assertEqual(wire["contour"][c["contour_vertices"][k]], c["point"])
+        self.assertEqual(sorted(d["assembly_order"]), [0, 1, 2])
+        self.assertTrue(d["stable"])
+        self.assertEqual(d["reason"], "")
+        for key in ("seconds", "lp_solves", "nodes"):
+            self.assertIn(key, d["stages"]["layering"])
+        self.assertGreater(d["stages"]["layering"]["lp_solves"], 0)
+        self.assertEqual(d["pending_stages"], ["target_shape", "forces", "rest_shape"])
+        for absent in ("target", "rest", "cut"):
+            self.assertNotIn(absent, d["wires"][0])
+        self.assertNotIn("force", d["crossings"][0])
 
     def check_box(self, scene, scale=1.0):
         r = self.batch(scene)

@@ -1,7 +1,7 @@
 """The design document (`design.json`, FORMATS.md): built as a plain dict, written atomically.
 
 Only stages that ran put values in it: a key a stage owns is absent until that stage exists, and
-`stable` stays false with a `reason` saying what was not computed.
+`pending_stages` names the stages that did not run.
 """
 import json
 import re

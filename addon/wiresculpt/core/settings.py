@@ -7,6 +7,8 @@ SETTINGS = {
                     "Shortest distance between two bends the machine can make (l_min)"),
     "max_bend_deg": (120.0, 1.0, 180.0, "deg", "Largest bend the machine can make"),
     "min_bend_deg": (1.0, 0.0, 45.0, "deg", "Smallest bend the machine makes reliably"),
+    "contact_angle_deg": (120.0, 30.0, 175.0, "deg",
+                          "Angle between a wire's two edges at an interlocked crossing (the kink)"),
     "torque_fraction": (1.0, 0.01, 1.0, "",
                         "Share of the wire's plastic-limit torque the design may use"),
     "weld_tolerance": (None, 0.0, 0.01, "m",

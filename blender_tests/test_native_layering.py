@@ -1,0 +1,66 @@
+"""The layering binding from Python: results by hand on great circles, errors and cancellation."""
+import math
+import unittest
+
+import numpy as np
+
+from wiresculpt import native
+
+
+def circle(normal, radius=0.1, n=64):
+    normal = np.asarray(normal, float)
+    u = np.cross(normal, [0.0, 0.0, 1.0] if abs(normal[2]) < 0.9 else [1.0, 0.0, 0.0])
+    u /= np.linalg.norm(u)
+    v = np.cross(normal, u)
+    t = np.linspace(0, 2 * math.pi, n, endpoint=False)
+    return radius * (np.outer(np.cos(t), u) + np.outer(np.sin(t), v))
+
+
+def wire(name, normal, **kw):
+    return {"name": name, "origin": [0, 0, 0], "normal": normal, "points": circle(normal, **kw), "closed": True}
+
+
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class LayeringBinding(unittest.TestCase):
+    def test_three_great_circles(self):
+        r = native.module.layering([wire("X", [1, 0, 0]), wire("Y", [0, 1, 0]), wire("Z", [0, 0, 1])])
+        crossings = r["network"]["crossings"]
+        self.assertEqual(len(crossings), 6)
+        self.assertTrue(r["stable"])
+        self.assertEqual(sorted(r["assembly_order"]), [0, 1, 2])
+        self.assertEqual(len(r["steps"][0]), 2)  # the first step is a pair
+        for c in crossings:
+            # on the common line of the two planes, on the circle
+            n0 = np.eye(3)[c["wires"][0]]
+            n1 = np.eye(3)[c["wires"][1]]
+            p = np.asarray(c["point"])
+            self.assertAlmostEqual(float(p @ n0), 0.0, places=12)
+            self.assertAlmostEqual(float(p @ n1), 0.0, places=12)
+            self.assertAlmostEqual(float(np.linalg.norm(p)), 0.1, places=12)
+
+    def test_two_circles_need_a_third(self):
+        # Two wires are held under forces only; the verdict for the pair is stable (Sec. 4.2).
+        r = native.module.layering([wire("X", [1, 0, 0]), wire("Y", [0, 1, 0])])
+        self.assertTrue(r["stable"])
+        self.assertEqual(len(r["network"]["crossings"]), 2)
+
+    def test_bad_input_names_the_wire_or_key(self):
+        with self.assertRaises(ValueError) as ctx:
+            native.module.layering([wire("X", [1, 0, 0]), wire("Y", [0, 1, 0])], {"frictoin": 0.3})
+        self.assertIn("frictoin", str(ctx.exception))
+        same = [wire("A", [0, 0, 1]), wire("B", [0, 0, 1], radius=0.1)]
+        with self.assertRaises(ValueError) as ctx:
+            native.module.layering(same)
+        self.assertIn("A", str(ctx.exception))
+        self.assertIn("B", str(ctx.exception))
+
+    def test_cancel(self):
+        wires = [wire("X", [1, 0, 0]), wire("Y", [0, 1, 0]), wire("Z", [0, 0, 1])]
+        with self.assertRaises(native.module.Cancelled):
+            native.module.layering(wires, {}, lambda stage, fraction: False)
+        with self.assertRaises(RuntimeError):  # Cancelled is a RuntimeError for callers that don't know it
+            native.module.layering(wires, {}, lambda stage, fraction: False)
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,101 @@
+#pragma once
+// Layering and assembly order (Sec. 4.2, Fig. 7 of Miguel, Lepoutre, Bickel 2016): a hook
+// configuration per crossing (n_p = 3: null, +1, -1; see contact.hpp for the sign convention)
+// and an order of adding wires such that every intermediate assembly is stable (Eq. 1; the first
+// pair under forces only, every later prefix under forces and torques), found by depth-first
+// branch and bound over the assembly tree. Method notes: docs/method-layering.md.
+//
+// Objective (lexicographic, minimised; e_c of Eq. 2 with e_c = 0 for a null crossing):
+//   1. max_c e_c                       the paper's "smallest maximum deviation"
+//   2. number of null crossings        ties prefer more interlocked crossings (more stability)
+//   3. Σ_c e_c                         then the smallest total modification
+//   4. number of two-hand steps        (only when single-wire steps cannot work, see below)
+// Floating-point keys are equal when within 1e-9. Among configurations equal in all four keys
+// the first one found is returned (deterministic).
+//
+// Exactness: the search returns a configuration and order whose objective is the minimum over
+// every hook configuration (3^C) and every order of single-wire steps whose prefixes are all
+// stable. Prunings used, all exact: (a) lower bound against the best complete structure;
+// (b) dominance: a null crossing whose cheaper hook costs no more than the current maximum is
+// never optimal (hooking it keeps every prefix stable, as pyramids only add columns, and lowers
+// key 2), so such children are skipped; (c) an assembly state (wire set + hooks) reached again
+// by another order is not expanded twice; (d) a step with 16 or more hook choices is skipped at
+// once when even both hooks' pyramids together at all its new crossings leave it unstable (for
+// fewer choices trying them one by one is cheaper); (e) before searching, the
+// finished sculpture with both pyramids at every crossing must be stable, else no configuration
+// is (the reason then names the wire that cannot be held); (f) a hook dearer than the best
+// structure's maximum is never enumerated. The search first follows the cheapest child of each
+// step to reach a complete structure (and so a bound) quickly, then tries every other child
+// that can still improve on the best.
+//
+// Beyond the paper (Sec. 6, the torus): when no single-wire order exists and
+// LayeringOptions::two_wire_steps is set, the search is repeated allowing steps that add two
+// wires at once (the prefix in between need not be stable); those steps are listed in
+// LayeringResult::two_hand_steps. (A three-wire start never helps: if no pair has two crossings,
+// three wires have at most three, 12 columns, fewer than the 13 needed to span the 12
+// self-equilibrated loads of three wires; and, for 0 < contact_angle/2 - atan μ < π/2, any pair
+// with two crossings is stable under forces only with opposite hooks.)
+#include <string>
+#include <vector>
+
+#include "wiresculpt/contact.hpp"
+#include "wiresculpt/network.hpp"
+#include "wiresculpt/progress.hpp"
+
+namespace wiresculpt {
+
+struct LayeringOptions {
+  ContactOptions contact;       ///< friction, contact angle, metric settings (contact.hpp)
+  /// When no single-wire assembly order exists, search again allowing steps that add two wires
+  /// at once (a second pair of hands). Needs at least 4 wires. Default true.
+  bool two_wire_steps = true;
+  /// Stop after this many search nodes (stability checks of candidate assemblies) and return the
+  /// best found so far with a warning (LayeringResult::complete_search = false); 0 = no limit.
+  /// The search is exponential in the worst case (a network whose finished form is stable but
+  /// that has no stable order explores every order); the default bounds it to some seconds.
+  /// Default 200000.
+  long max_nodes = 200000;
+  /// Steps with more new crossings than this are not enumerated (2^n hook choices each); a
+  /// warning names the skipped wire. Default 20.
+  int max_step_crossings = 20;
+};
+
+struct LayeringStats {
+  long lp_solves = 0;  ///< GLPK simplex calls
+  long nodes = 0;      ///< candidate assemblies whose stability was checked
+  double seconds = 0.0;
+};
+
+struct LayeringResult {
+  /// Per crossing: -1, 0 or 1 (FORMATS.md `hook`). When unstable: the hooks of the largest stable
+  /// partial assembly found, 0 elsewhere.
+  std::vector<int> hooks;
+  std::vector<double> metric;               ///< per crossing: e_c of the chosen hook (0 if null)
+  std::vector<int> assembly_order;          ///< wire ids in the order a person adds them
+  /// The same, grouped: steps[0] is the first pair, every later step one wire (or, with two
+  /// hands, two).
+  std::vector<std::vector<int>> steps;
+  /// Indices into `steps` (never 0) of the steps that add two wires at once and need two hands.
+  std::vector<int> two_hand_steps;
+  bool stable = false;
+  /// Empty when stable; otherwise a sentence naming the wire that cannot be added stably and
+  /// the crossings involved.
+  std::string reason;
+  std::vector<std::string> warnings;
+  // The objective keys of the returned hooks (when unstable: max and sum over the partial
+  // assembly's hooks, null_crossings 0).
+  double max_metric = 0.0;  ///< objective key 1
+  int null_crossings = 0;   ///< objective key 2
+  double sum_metric = 0.0;  ///< objective key 3
+  bool complete_search = true;  ///< false when max_nodes stopped the search
+  LayeringStats stats;
+};
+
+/// Layering and assembly order of `net`. A two-wire network is its own first pair and is judged
+/// under forces only (with a warning that it can turn about the planes' common line); a
+/// one-wire network is trivially stable. Reports progress as stage "layering" and honours
+/// cancellation (throws Cancelled). Throws InputError for an empty network, more than 64 wires or
+/// invalid options.
+LayeringResult layering(const Network& net, const LayeringOptions& options = {}, const ProgressFn& progress = {});
+
+}  // namespace wiresculpt

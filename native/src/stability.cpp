@@ -1,0 +1,283 @@
+#include "wiresculpt/stability.hpp"
+
+#include <glpk.h>
+
+#include <cmath>
+#include <csetjmp>
+#include <string>
+
+#include "wiresculpt/error.hpp"
+
+namespace wiresculpt {
+namespace {
+
+// --- GLPK guard -------------------------------------------------------------------------------
+// GLPK reports internal errors through a hook and aborts the process if the hook returns. The
+// hook jumps back to guarded_simplex, which frees GLPK's (per-thread) environment as GLPK
+// requires; every problem object of that environment is then gone, which the generation counter
+// tells the Lp wrapper. Only GLPK's own C frames lie between setjmp and longjmp.
+thread_local std::jmp_buf* t_jump = nullptr;
+thread_local unsigned t_generation = 0;
+thread_local unsigned t_configured = ~0u;
+
+void on_glpk_error(void*) {
+  if (t_jump) std::longjmp(*t_jump, 1);
+}
+
+void configure_glpk() {
+  if (t_configured == t_generation) return;
+  glp_term_out(GLP_OFF);
+  t_configured = t_generation;
+}
+
+int guarded_simplex(glp_prob* lp, const glp_smcp* parm) {
+  std::jmp_buf buf;
+  t_jump = &buf;
+  glp_error_hook(on_glpk_error, nullptr);
+  if (setjmp(buf) != 0) {
+    t_jump = nullptr;
+    glp_free_env();
+    ++t_generation;
+    return -1;
+  }
+  const int ret = glp_simplex(lp, parm);
+  glp_error_hook(nullptr, nullptr);
+  t_jump = nullptr;
+  return ret;
+}
+
+struct Lp {
+  glp_prob* p = nullptr;
+  unsigned generation = 0;
+  Lp() : p(glp_create_prob()), generation(t_generation) {}
+  ~Lp() {
+    if (p && generation == t_generation) glp_delete_prob(p);
+  }
+  Lp(const Lp&) = delete;
+  Lp& operator=(const Lp&) = delete;
+  bool alive() const { return generation == t_generation; }
+};
+
+std::string wire_name(const Network& net, int w) { return "'" + net.wires[w].name + "'"; }
+
+void validate_set(const Network& net, const std::vector<int>& wires, const std::vector<int>& hooks,
+                  bool allow_both = false) {
+  const int P = static_cast<int>(net.wires.size());
+  if (hooks.size() != net.crossings.size())
+    throw InputError("stability: expected one hook per crossing (" + std::to_string(net.crossings.size()) +
+                     "), got " + std::to_string(hooks.size()));
+  for (std::size_t c = 0; c < hooks.size(); ++c)
+    if (hooks[c] < -1 || hooks[c] > (allow_both ? 2 : 1))
+      throw InputError("crossing " + std::to_string(c) + ": hook must be -1, 0 or 1, not " + std::to_string(hooks[c]));
+  std::vector<char> seen(P, 0);
+  for (int w : wires) {
+    if (w < 0 || w >= P) throw InputError("stability: wire id " + std::to_string(w) + " does not exist");
+    if (seen[w]) throw InputError("stability: wire " + wire_name(net, w) + " is listed twice");
+    seen[w] = 1;
+  }
+}
+
+Vec3 crossing_centroid(const Network& net) {
+  Vec3 s = Vec3::Zero();
+  for (const auto& c : net.crossings) s += c.point;
+  return net.crossings.empty() ? s : Vec3(s / static_cast<double>(net.crossings.size()));
+}
+
+}  // namespace
+
+Eigen::MatrixXd load_basis(int P) {
+  if (P < 2) throw InputError("load_basis needs at least two polylines");
+  Eigen::MatrixXd L = Eigen::MatrixXd::Zero(6 * P, 6 * (P - 1));
+  for (int i = 0; i < 6 * P; ++i)
+    for (int j = 0; j < 6 * (P - 1); ++j) {
+      if (i == j) L(i, j) = 1.0;
+      else if (i % 6 == j % 6 && i >= 6 * (P - 1)) L(i, j) = -1.0;
+    }
+  return L;
+}
+
+WrenchMatrix wrench_matrix(const Network& net, const std::vector<int>& wires, const std::vector<int>& hooks,
+                           const ContactOptions& contact, bool forces_only) {
+  validate(contact);
+  validate_set(net, wires, hooks);
+  const int q = forces_only ? 3 : 6;
+  std::vector<int> pos(net.wires.size(), -1);
+  for (std::size_t k = 0; k < wires.size(); ++k) pos[wires[k]] = static_cast<int>(k);
+  WrenchMatrix out;
+  out.reference = crossing_centroid(net);
+  std::vector<int> used;
+  for (int c = 0; c < static_cast<int>(net.crossings.size()); ++c) {
+    const auto& x = net.crossings[c];
+    if (hooks[c] != 0 && pos[x.wires[0]] >= 0 && pos[x.wires[1]] >= 0) used.push_back(c);
+  }
+  out.M = Eigen::MatrixXd::Zero(q * static_cast<Eigen::Index>(wires.size()), 4 * static_cast<Eigen::Index>(used.size()));
+  Eigen::Index col = 0;
+  for (int c : used) {
+    const auto& x = net.crossings[c];
+    const auto pyr = contact_pyramid(net, c, hooks[c], contact);
+    for (const Vec3& b : pyr) {
+      Eigen::Matrix<double, 6, 1> w;
+      w << b, (x.point - out.reference).cross(b);
+      out.M.block(q * pos[x.wires[0]], col, q, 1) = w.head(q);
+      out.M.block(q * pos[x.wires[1]], col, q, 1) = -w.head(q);
+      out.column_crossing.push_back(c);
+      ++col;
+    }
+  }
+  return out;
+}
+
+StabilityChecker::StabilityChecker(const Network& net, const ContactOptions& contact, bool minimise_sum)
+    : net_(&net), minimise_sum_(minimise_sum) {
+  validate(contact);
+  reference_ = crossing_centroid(net);
+  double ss = 0.0;
+  for (const auto& c : net.crossings) ss += (c.point - reference_).squaredNorm();
+  length_scale_ = net.crossings.empty() ? 1.0 : std::sqrt(ss / static_cast<double>(net.crossings.size()));
+  if (!(length_scale_ > 1e-12)) length_scale_ = 1.0;
+  for (int c = 0; c < static_cast<int>(net.crossings.size()); ++c) {
+    const auto& x = net.crossings[c];
+    const int P = static_cast<int>(net.wires.size());
+    if (x.wires[0] < 0 || x.wires[0] >= P || x.wires[1] < 0 || x.wires[1] >= P || x.wires[0] == x.wires[1] ||
+        !x.point.allFinite())
+      throw InputError("crossing " + std::to_string(c) + " is malformed (wire ids or point); build the network "
+                       "with build_network");
+  }
+  columns_.resize(net.crossings.size());
+  for (int c = 0; c < static_cast<int>(net.crossings.size()); ++c)
+    for (int h = 0; h < 2; ++h) {
+      const auto pyr = contact_pyramid(net, c, h == 0 ? -1 : 1, contact);
+      for (int k = 0; k < 4; ++k) {
+        columns_[c][h][k].head<3>() = pyr[k];
+        columns_[c][h][k].tail<3>() = (net.crossings[c].point - reference_).cross(pyr[k]) / length_scale_;
+        if (!columns_[c][h][k].allFinite())
+          throw InputError("crossing " + std::to_string(c) + ": its wires' planes give no finite contact direction "
+                           "(parallel planes?)");
+      }
+    }
+}
+
+StabilityResult StabilityChecker::check(const std::vector<int>& wires, const std::vector<int>& hooks,
+                                        bool forces_only) {
+  const Network& net = *net_;
+  validate_set(net, wires, hooks, true);
+  StabilityResult result;
+  const int P = static_cast<int>(wires.size());
+  if (P <= 1) {
+    result.stable = true;  // a single body: the only self-equilibrated load is zero
+    return result;
+  }
+  const int q = forces_only ? 3 : 6;
+  const int R = q * (P - 1);
+  std::vector<int> pos(net.wires.size(), -1);
+  for (int k = 0; k < P; ++k) pos[wires[k]] = k;
+
+  // Sparse columns; rows of wires[0] (the reference) are dropped.
+  std::vector<int> ia{0}, ja{0};
+  std::vector<double> ar{0.0};
+  int K = 0;
+  for (int c = 0; c < static_cast<int>(net.crossings.size()); ++c) {
+    const auto& x = net.crossings[c];
+    const int p0 = pos[x.wires[0]], p1 = pos[x.wires[1]];
+    if (hooks[c] == 0 || p0 < 0 || p1 < 0) continue;
+    const bool both = hooks[c] == 2;
+    for (int k = 0; k < (both ? 8 : 4); ++k) {
+      const auto& column = columns_[c][both ? k / 4 : (hooks[c] > 0 ? 1 : 0)][k % 4];
+      ++K;
+      for (int side = 0; side < 2; ++side) {
+        const int p = side == 0 ? p0 : p1;
+        if (p == 0) continue;
+        const double sign = side == 0 ? 1.0 : -1.0;
+        for (int r = 0; r < q; ++r) {
+          const double v = sign * column[r];
+          if (v == 0.0) continue;
+          ia.push_back((p - 1) * q + r + 1);
+          ja.push_back(K);
+          ar.push_back(v);
+        }
+      }
+    }
+  }
+  if (K == 0) {  // nothing holds the wires together: no load but zero can be balanced
+    result.failed_wire = wires.back();
+    result.failed_component = 0;
+    return result;
+  }
+
+  configure_glpk();
+  Lp lp;
+  glp_set_obj_dir(lp.p, GLP_MIN);
+  glp_add_rows(lp.p, R);
+  glp_add_cols(lp.p, K);
+  for (int r = 1; r <= R; ++r) glp_set_row_bnds(lp.p, r, GLP_FX, 0.0, 0.0);
+  for (int j = 1; j <= K; ++j) {
+    glp_set_col_bnds(lp.p, j, GLP_LO, 0.0, 0.0);
+    // Eq. 1 minimises Σ a; the verdict only needs feasibility (see stability.hpp).
+    glp_set_obj_coef(lp.p, j, minimise_sum_ ? 1.0 : 0.0);
+  }
+  glp_load_matrix(lp.p, static_cast<int>(ar.size()) - 1, ia.data(), ja.data(), ar.data());
+
+  glp_smcp parm;
+  glp_init_smcp(&parm);
+  parm.msg_lev = GLP_MSG_OFF;
+  parm.presolve = GLP_OFF;
+  parm.pricing = GLP_PT_STD;  // textbook pricing: these LPs are small, steepest edge does not pay
+  parm.meth = GLP_DUALP;  // costs >= 0: the slack basis and every optimal basis stay dual feasible
+                          // when the right-hand side changes
+
+  std::vector<double> rhs(R, 0.0);
+  auto solve = [&](const std::vector<double>& want) -> bool {
+    parm.meth = GLP_DUALP;
+    for (int r = 0; r < R; ++r)
+      if (want[r] != rhs[r]) {
+        glp_set_row_bnds(lp.p, r + 1, GLP_FX, want[r], want[r]);
+        rhs[r] = want[r];
+      }
+    for (int attempt = 0; attempt < 2; ++attempt) {
+      ++result.lp_solves;
+      ++lp_solves_;
+      const int ret = guarded_simplex(lp.p, &parm);
+      if (ret == -1 || !lp.alive())
+        throw SolverError("GLPK stopped with an internal error while checking the stability of wire " +
+                          wire_name(net, wires.back()) + "; please report this input");
+      if (ret == 0) {
+        const int status = glp_get_status(lp.p);
+        if (status == GLP_OPT || status == GLP_FEAS) return true;
+        if (status == GLP_NOFEAS || glp_get_prim_stat(lp.p) == GLP_NOFEAS) return false;
+      }
+      // A singular or ill-conditioned basis: restart from the slack basis with the primal simplex.
+      glp_std_basis(lp.p);
+      parm.meth = GLP_PRIMAL;
+    }
+    throw SolverError("the stability LP could not be solved (GLPK failed twice) while checking wire " +
+                      wire_name(net, wires.back()));
+  };
+
+  // Eq. 1 has M a = -l: a basis load e_r asks for -1 in row r; the negative sum -Σ e_r for +1.
+  std::vector<double> want(R, 0.0);
+  for (int k = P - 1; k >= 1; --k)
+    for (int comp = 0; comp < q; ++comp) {
+      const int r = (k - 1) * q + comp;
+      want[r] = -1.0;
+      const bool ok = solve(want);
+      want[r] = 0.0;
+      if (!ok) {
+        result.failed_wire = wires[k];
+        result.failed_component = comp;
+        return result;
+      }
+    }
+  std::fill(want.begin(), want.end(), 1.0);
+  if (!solve(want)) return result;
+  result.stable = true;
+  return result;
+}
+
+StabilityResult check_stability(const Network& net, const std::vector<int>& wires, const std::vector<int>& hooks,
+                                const ContactOptions& contact, const StabilityOptions& options) {
+  validate_set(net, wires, hooks);  // hooks = 2 (both pyramids) is for the search only
+  StabilityChecker checker(net, contact, options.minimise_sum);
+  return checker.check(wires, hooks, options.forces_only);
+}
+
+}  // namespace wiresculpt

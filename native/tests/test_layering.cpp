@@ -1,0 +1,367 @@
+// The layering search against hand-known verdicts and against brute-force enumeration of every
+// hook configuration and every assembly order.
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <numeric>
+#include <random>
+
+#include "wiresculpt/contact.hpp"
+#include "wiresculpt/error.hpp"
+#include "wiresculpt/layering.hpp"
+#include "wiresculpt/stability.hpp"
+#include "wire_fixtures.hpp"
+
+using namespace wiresculpt;
+using Catch::Matchers::Contains;
+using fixtures::Cut;
+
+namespace {
+constexpr double R = 0.1;
+
+// Every prefix of the result's order is stable (first pair forces only), checked afresh; a
+// complete order holds every wire once.
+void check_prefixes(const Network& net, const LayeringResult& r, bool complete = true, const ContactOptions& co = {}) {
+  std::vector<int> prefix;
+  for (std::size_t s = 0; s < r.steps.size(); ++s) {
+    for (int w : r.steps[s]) prefix.push_back(w);
+    StabilityOptions o;
+    o.forces_only = s == 0;
+    INFO("step " << s);
+    CHECK(check_stability(net, prefix, r.hooks, co, o).stable);
+  }
+  if (!complete) return;
+  std::vector<int> sorted = r.assembly_order;
+  std::sort(sorted.begin(), sorted.end());
+  std::vector<int> all(net.wires.size());
+  std::iota(all.begin(), all.end(), 0);
+  CHECK(sorted == all);
+}
+
+// The objective of layering.hpp, recomputed from the hooks.
+struct Objective {
+  bool found = false;
+  double max = 0.0;
+  int nulls = 0;
+  double sum = 0.0;
+};
+
+Objective objective_of(const Network& net, const std::vector<int>& hooks, const ContactOptions& co = {}) {
+  Objective o;
+  o.found = true;
+  for (int c = 0; c < static_cast<int>(hooks.size()); ++c) {
+    const double e = hook_metric(net, c, hooks[c], co);
+    o.max = std::max(o.max, e);
+    o.sum += e;
+    o.nulls += hooks[c] == 0;
+  }
+  return o;
+}
+
+bool better(const Objective& a, const Objective& b) {
+  if (!b.found) return a.found;
+  if (!a.found) return false;
+  if (std::abs(a.max - b.max) > 1e-9) return a.max < b.max;
+  if (a.nulls != b.nulls) return a.nulls < b.nulls;
+  if (std::abs(a.sum - b.sum) > 1e-9) return a.sum < b.sum;
+  return false;
+}
+
+// Every configuration (3^C) and every order (P!), single-wire steps.
+Objective brute_force(const Network& net, const ContactOptions& co) {
+  const int P = static_cast<int>(net.wires.size());
+  const int C = static_cast<int>(net.crossings.size());
+  StabilityChecker checker(net, co);
+  std::map<std::string, bool> memo;
+  auto stable = [&](const std::vector<int>& wires, const std::vector<int>& hooks) {
+    std::string key(static_cast<std::size_t>(P + C), '.');
+    for (int w : wires) key[w] = 'w';
+    for (int c = 0; c < C; ++c) {
+      const bool inside = key[net.crossings[c].wires[0]] == 'w' && key[net.crossings[c].wires[1]] == 'w';
+      key[P + c] = inside ? static_cast<char>('1' + hooks[c]) : '.';
+    }
+    auto it = memo.find(key);
+    if (it != memo.end()) return it->second;
+    const bool ok = checker.check(wires, hooks, wires.size() == 2).stable;
+    memo[key] = ok;
+    return ok;
+  };
+  int configs = 1;
+  for (int c = 0; c < C; ++c) configs *= 3;
+  Objective best;
+  std::vector<int> hooks(C);
+  for (int code = 0; code < configs; ++code) {
+    int rest = code;
+    for (int c = 0; c < C; ++c) {
+      hooks[c] = rest % 3 - 1;
+      rest /= 3;
+    }
+    const Objective here = objective_of(net, hooks, co);
+    if (best.found && !better(here, best)) continue;  // cannot improve the best value
+    std::vector<int> all(P);
+    std::iota(all.begin(), all.end(), 0);
+    if (!stable(all, hooks)) continue;
+    std::vector<int> order = all;
+    bool ok = false;
+    do {
+      ok = true;
+      for (int k = 2; k <= P && ok; ++k) ok = stable(std::vector<int>(order.begin(), order.begin() + k), hooks);
+    } while (!ok && std::next_permutation(order.begin(), order.end()));
+    if (ok) best = here;
+  }
+  return best;
+}
+
+// A random network whose crossings are chosen first: random planes near the origin, two points
+// on the common line of (most) pairs, and each wire a closed polygon through its points (in angle
+// order about their centroid) with a randomly pushed point between consecutive ones, so the
+// input bends, and with them the costs e_c, vary widely. Where a polygon only touches the other
+// plane at a chosen point, build_network makes no crossing there.
+std::vector<WireSpec> random_polygons(std::mt19937& rng, int P) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), push(0.5, 1.6);
+  std::vector<Plane> planes;
+  for (int k = 0; k < P; ++k) {
+    Vec3 n(unit(rng), unit(rng), unit(rng));
+    if (n.norm() < 0.2) n = Vec3::UnitZ();
+    planes.push_back(Plane::make(0.02 * Vec3(unit(rng), unit(rng), unit(rng)), n));
+  }
+  std::vector<std::vector<Vec3>> pts(P);
+  for (int i = 0; i < P; ++i)
+    for (int j = i + 1; j < P; ++j) {
+      const Vec3 d = planes[i].normal.cross(planes[j].normal).normalized();
+      Eigen::Matrix3d A;
+      A.row(0) = planes[i].normal.transpose();
+      A.row(1) = planes[j].normal.transpose();
+      A.row(2) = d.transpose();
+      const Vec3 p0 = A.fullPivLu().solve(
+          Vec3(planes[i].normal.dot(planes[i].origin), planes[j].normal.dot(planes[j].origin), 0.0));
+      // Two points per pair (one could never hold a pair, Sec. 4.2); with four wires, some pairs
+      // get none so that the network stays within eight crossings.
+      const int count = (P > 3 && rng() % 3 == 0) ? 0 : 2;
+      if (count == 0) continue;
+      for (int k = 0; k < count; ++k) {
+        const Vec3 p = p0 + 0.08 * unit(rng) * d;
+        pts[i].push_back(p);
+        pts[j].push_back(p);
+      }
+    }
+  std::vector<WireSpec> wires;
+  for (int i = 0; i < P; ++i) {
+    const Plane& pl = planes[i];
+    Vec3 centre = Vec3::Zero();
+    for (const Vec3& p : pts[i]) centre += p;
+    centre /= static_cast<double>(pts[i].size());
+    // A wire through fewer than three points gets two extra ones around the centre.
+    std::vector<Vec3> ring = pts[i];
+    while (ring.size() < 3) ring.push_back(centre + 0.05 * (ring.size() == 1 ? pl.u : pl.v));
+    auto angle = [&](const Vec3& p) { return std::atan2((p - centre).dot(pl.v), (p - centre).dot(pl.u)); };
+    std::sort(ring.begin(), ring.end(), [&](const Vec3& a, const Vec3& b) { return angle(a) < angle(b); });
+    WireSpec w;
+    w.name = std::string(1, static_cast<char>('A' + i));
+    w.plane = pl;
+    for (std::size_t k = 0; k < ring.size(); ++k) {
+      const Vec3& a = ring[k];
+      const Vec3& b = ring[(k + 1) % ring.size()];
+      w.points.push_back(a);
+      const Vec3 mid = 0.5 * (a + b);
+      Vec3 mid_point = centre + push(rng) * (mid - centre);
+      mid_point -= pl.signed_distance(mid_point) * pl.normal;
+      w.points.push_back(mid_point);
+    }
+    wires.push_back(w);
+  }
+  return wires;
+}
+
+Network great_circles(int count) {
+  auto cuts = fixtures::great_circle_cuts();
+  cuts.resize(count);
+  return build_network(fixtures::sphere_wires(cuts, R));
+}
+}  // namespace
+
+TEST_CASE("layering: two interlocked wires hook in opposite directions at their two crossings") {
+  // Same hooks push one wire the same way at both crossings (unstable, see test_stability);
+  // both hooks cost 2 on great circles, so the optimum hooks both crossings, oppositely.
+  const Network net = great_circles(2);
+  const LayeringResult r = layering(net);
+  REQUIRE(r.stable);
+  CHECK(r.reason.empty());
+  CHECK(r.hooks[0] == -r.hooks[1]);
+  CHECK(r.hooks[0] != 0);
+  CHECK(r.max_metric == Approx(2.0));
+  CHECK(r.null_crossings == 0);
+  CHECK(r.steps.size() == 1);
+  CHECK(r.two_hand_steps.empty());
+  REQUIRE_FALSE(r.warnings.empty());
+  CHECK_THAT(r.warnings.back(), Contains("forces only"));
+  check_prefixes(net, r);
+}
+
+TEST_CASE("layering: three great circles") {
+  const Network net = great_circles(3);
+  const LayeringResult r = layering(net);
+  REQUIRE(r.stable);
+  // Every hook costs 2 here (test_contact), so all six interlock: max 2, no null, sum 12.
+  CHECK(r.max_metric == Approx(2.0));
+  CHECK(r.null_crossings == 0);
+  CHECK(r.sum_metric == Approx(12.0));
+  for (int h : r.hooks) CHECK(h != 0);
+  CHECK(r.assembly_order.size() == 3);
+  CHECK(r.steps.size() == 2);
+  CHECK(r.stats.nodes >= 2);
+  CHECK(r.stats.lp_solves > 0);
+  check_prefixes(net, r);
+  // The same with four crossings forced null is not stable (test_stability): the search never
+  // returns such a design.
+  CHECK(r.null_crossings < 4);
+}
+
+TEST_CASE("layering: an unstable network names the wire that cannot be added and its crossings") {
+  // Great circles X and Y, plus an open straight wire W in the plane z = 0 crossing X once at
+  // (0, R, 0). One crossing gives four columns, too few to hold W against six loads.
+  auto wires = fixtures::sphere_wires({{"X", Vec3::UnitX(), 0.0}, {"Y", Vec3::UnitY(), 0.0}}, R);
+  WireSpec w;
+  w.name = "W";
+  w.plane = Plane::make({0, 0, 0}, Vec3::UnitZ());
+  w.closed = false;
+  for (int k = -3; k <= 3; ++k) w.points.push_back(Vec3(0.01 * k + 0.002, R, 0));
+  wires.push_back(w);
+  const Network net = build_network(wires);
+  REQUIRE(net.crossings.size() == 3);
+  int wc = -1;
+  for (int c = 0; c < 3; ++c)
+    if (net.crossings[c].wires[1] == 2) wc = c;
+  REQUIRE(wc >= 0);
+  const LayeringResult r = layering(net);
+  CHECK_FALSE(r.stable);
+  // Caught before the search: not even both hooks at once can hold W.
+  CHECK_THAT(r.reason, Contains("'W'") && Contains("crossing " + std::to_string(wc)) &&
+                           Contains("no hook configuration"));
+  CHECK(r.assembly_order.empty());
+  for (int h : r.hooks) CHECK(h == 0);
+}
+
+TEST_CASE("layering: a wire that crosses nothing cannot be held") {
+  auto wires = fixtures::sphere_wires(fixtures::great_circle_cuts(), R);
+  wires.push_back(fixtures::circle_wire({"far", Vec3::UnitZ(), 0.0}, 0.02, 16));
+  for (auto& p : wires.back().points) p.z() += 0.5;
+  wires.back().plane = Plane::make({0, 0, 0.5}, Vec3::UnitZ());
+  const Network net = build_network(wires);
+  const LayeringResult r = layering(net);
+  CHECK_FALSE(r.stable);
+  CHECK_THAT(r.reason, Contains("'far'") && Contains("crosses no other wire"));
+}
+
+TEST_CASE("layering: a four-wire cage needs a step with two hands") {
+  // Four circles of one sphere, E and W from nearly parallel planes (their common line misses
+  // the sphere), N and S likewise, so they form a ring E-N-W-S: each meets its two neighbours at
+  // two points of one line. Any three wires form a chain whose end wire touches the middle one
+  // only on one line and can turn about it: no single-wire order exists. All four form a closed
+  // loop of four hinges; the planes are tilted by different amounts so the hinge axes are not
+  // parallel (with parallel axes the loop would be a planar four-bar linkage, a mechanism).
+  const std::vector<Cut> cuts{{"E", Vec3(1, 0, 0.3).normalized(), R / 2},
+                              {"N", Vec3(0, 1, 0.25).normalized(), R / 2},
+                              {"W", Vec3(1, 0, -0.2).normalized(), -R / 2},
+                              {"S", Vec3(0, 1, -0.15).normalized(), -R / 2}};
+  const Network net = build_network(fixtures::sphere_wires(cuts, R));
+  REQUIRE(net.crossings.size() == 8);
+  LayeringOptions single;
+  single.two_wire_steps = false;
+  const LayeringResult one = layering(net, single);
+  CHECK_FALSE(one.stable);
+  // The search got as far as a stable pair; the reason names a wire that could not follow and
+  // its crossings with the pair.
+  REQUIRE(one.assembly_order.size() == 2);
+  CHECK_THAT(one.reason, Contains("cannot be added stably") && Contains("crossings"));
+  check_prefixes(net, one, false);
+
+  const LayeringResult two = layering(net);
+  REQUIRE(two.stable);
+  REQUIRE(two.steps.size() == 2);
+  CHECK(two.steps[1].size() == 2);
+  CHECK(two.two_hand_steps == std::vector<int>{1});
+  CHECK_THAT(two.warnings.back(), Contains("two hands"));
+  check_prefixes(net, two);
+}
+
+TEST_CASE("layering: branch and bound finds the brute-force optimum on random small networks") {
+  // Two contact settings: the default, and a grippy one (more friction, sharper kinks) under
+  // which many configurations are stable, so the first structure found is often not the best.
+  ContactOptions grippy;
+  grippy.friction = 0.8;
+  grippy.contact_angle = 80.0 * std::numbers::pi / 180.0;
+  for (const ContactOptions& co : {ContactOptions{}, grippy}) {
+    std::mt19937 rng(20160724);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    int tested = 0, stable = 0;
+    for (int attempt = 0; attempt < 1500 && tested < 30; ++attempt) {
+      const int P = 3 + attempt % 2;
+      std::vector<Cut> cuts;
+      for (int k = 0; k < P; ++k) {
+        Vec3 n(unit(rng), unit(rng), unit(rng));
+        if (n.norm() < 0.2) n = Vec3::UnitZ();
+        cuts.push_back({std::string(1, static_cast<char>('A' + k)), n.normalized(), 0.7 * R * unit(rng)});
+      }
+      Network net;
+      try {
+        net = build_network(attempt % 3 == 2 ? random_polygons(rng, P) : fixtures::sphere_wires(cuts, R, 48));
+      } catch (const InputError&) {
+        continue;
+      }
+      const int C = static_cast<int>(net.crossings.size());
+      if (C < 2 || C > 8) continue;
+      ++tested;
+      INFO("friction " << co.friction << ", attempt " << attempt << ", " << P << " wires, " << C << " crossings");
+      const Objective expect = brute_force(net, co);
+      LayeringOptions lo;
+      lo.contact = co;
+      lo.two_wire_steps = false;  // the brute force adds one wire at a time
+      const LayeringResult r = layering(net, lo);
+      REQUIRE(r.stable == expect.found);
+      if (!expect.found) continue;
+      ++stable;
+      CHECK(r.max_metric == Approx(expect.max).margin(1e-9));
+      CHECK(r.null_crossings == expect.nulls);
+      CHECK(r.sum_metric == Approx(expect.sum).margin(1e-9));
+      // The reported keys are those of the returned hooks, and the order is valid.
+      const Objective mine = objective_of(net, r.hooks, co);
+      CHECK(mine.max == Approx(r.max_metric).margin(1e-12));
+      CHECK(mine.nulls == r.null_crossings);
+      CHECK(mine.sum == Approx(r.sum_metric).margin(1e-12));
+      check_prefixes(net, r, true, co);
+    }
+    CHECK(tested >= 20);
+    CHECK(stable >= 4);
+  }
+}
+
+TEST_CASE("layering: progress is reported and cancellation stops the search") {
+  const Network net = great_circles(3);
+  int calls = 0;
+  double last = -1;
+  layering(net, {}, [&](std::string_view stage, double f) {
+    CHECK(stage == "layering");
+    CHECK(f >= 0.0);
+    CHECK(f <= 1.0);
+    last = f;
+    ++calls;
+    return true;
+  });
+  CHECK(calls >= 2);
+  CHECK(last == 1.0);
+  CHECK_THROWS_AS(layering(net, {}, [](std::string_view, double) { return false; }), Cancelled);
+}
+
+TEST_CASE("layering: options and inputs are validated") {
+  CHECK_THROWS_AS(layering(Network{}), InputError);
+  const Network net = great_circles(2);
+  LayeringOptions o;
+  o.max_nodes = -1;
+  CHECK_THROWS_AS(layering(net, o), InputError);
+  o = LayeringOptions{};
+  o.contact.friction = -0.1;
+  CHECK_THROWS_AS(layering(net, o), InputError);
+}

@@ -1,0 +1,104 @@
+#pragma once
+// Wire networks whose geometry is known exactly: circles cut from one sphere by planes, built as
+// polylines directly (no mesh), with the exact points where two circles meet inserted as
+// vertices, so the crossings are known by hand.
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "wiresculpt/geometry.hpp"
+#include "wiresculpt/network.hpp"
+
+namespace fixtures {
+
+using wiresculpt::Plane;
+using wiresculpt::Polyline3;
+using wiresculpt::Vec3;
+using wiresculpt::WireSpec;
+
+/// A cut of the sphere of radius R about the origin by the plane {x : n·x = h} (n unit).
+struct Cut {
+  std::string name;
+  Vec3 normal;
+  double offset;
+};
+
+/// Where two cuts' circles meet: the points of the planes' common line on the sphere (0 or 2).
+inline std::vector<Vec3> circle_meets(const Cut& a, const Cut& b, double R) {
+  const Vec3 cr = a.normal.cross(b.normal);
+  if (cr.norm() < 1e-12) return {};
+  const Vec3 d = cr.normalized();
+  Eigen::Matrix3d A;
+  A.row(0) = a.normal.transpose();
+  A.row(1) = b.normal.transpose();
+  A.row(2) = d.transpose();
+  const Vec3 p0 = A.fullPivLu().solve(Vec3(a.offset, b.offset, 0.0));  // closest point to the origin
+  const double rest = R * R - p0.squaredNorm();
+  if (rest <= 0) return {};
+  const double t = std::sqrt(rest);
+  return {p0 - t * d, p0 + t * d};
+}
+
+/// The circle of `cut` on the sphere as a closed polyline of n uniform angles (starting at
+/// `phase`), plus the given extra points (which must lie on the circle) inserted in angle order.
+inline WireSpec circle_wire(const Cut& cut, double R, int n, const std::vector<Vec3>& extra = {},
+                            double phase = 0.0) {
+  const Plane plane = Plane::make(cut.offset * cut.normal, cut.normal);
+  const double rho = std::sqrt(R * R - cut.offset * cut.offset);
+  const Vec3 centre = cut.offset * cut.normal;
+  struct Item {
+    double phi;
+    Vec3 p;
+    bool extra;
+  };
+  std::vector<Item> pts;
+  const double two_pi = 2.0 * std::numbers::pi;
+  for (int k = 0; k < n; ++k) {
+    const double phi = phase + two_pi * k / n;
+    pts.push_back({std::fmod(phi, two_pi), centre + rho * (std::cos(phi) * plane.u + std::sin(phi) * plane.v), false});
+  }
+  for (const Vec3& p : extra) {
+    double phi = std::atan2((p - centre).dot(plane.v), (p - centre).dot(plane.u));
+    if (phi < 0) phi += two_pi;
+    pts.push_back({phi, p, true});
+  }
+  std::sort(pts.begin(), pts.end(), [](const Item& x, const Item& y) { return x.phi < y.phi; });
+  // Grid points within 20 µm of a meeting point are dropped (and repeated meeting points kept once).
+  std::vector<char> keep(pts.size(), 1);
+  const std::size_t m = pts.size();
+  for (std::size_t k = 0; k < m; ++k) {
+    if (!pts[k].extra) continue;
+    for (std::size_t q = 0; q < m; ++q)
+      if (q != k && keep[q] && (pts[q].p - pts[k].p).norm() < 2e-5 && (!pts[q].extra || q > k)) keep[q] = 0;
+  }
+  WireSpec w;
+  w.name = cut.name;
+  w.plane = plane;
+  w.closed = true;
+  for (std::size_t k = 0; k < m; ++k)
+    if (keep[k]) w.points.push_back(pts[k].p);
+  return w;
+}
+
+/// Circles of every cut on one sphere, each with all its meeting points inserted exactly.
+inline std::vector<WireSpec> sphere_wires(const std::vector<Cut>& cuts, double R, int n = 64) {
+  std::vector<WireSpec> out;
+  for (std::size_t i = 0; i < cuts.size(); ++i) {
+    std::vector<Vec3> extra;
+    for (std::size_t j = 0; j < cuts.size(); ++j)
+      if (j != i)
+        for (const Vec3& p : circle_meets(cuts[i], cuts[j], R)) extra.push_back(p);
+    out.push_back(circle_wire(cuts[i], R, n, extra));
+  }
+  return out;
+}
+
+/// Three orthogonal great circles: planes x = 0 ("X"), y = 0 ("Y"), z = 0 ("Z").
+inline std::vector<Cut> great_circle_cuts() {
+  return {{"X", Vec3::UnitX(), 0.0}, {"Y", Vec3::UnitY(), 0.0}, {"Z", Vec3::UnitZ(), 0.0}};
+}
+
+}  // namespace fixtures
