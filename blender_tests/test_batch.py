@@ -84,10 +84,46 @@ class BatchTest(unittest.TestCase):
         for key in ("seconds", "lp_solves", "nodes"):
             self.assertIn(key, d["stages"]["layering"])
         self.assertGreater(d["stages"]["layering"]["lp_solves"], 0)
-        self.assertEqual(d["pending_stages"], ["target_shape", "forces", "rest_shape"])
-        for absent in ("target", "rest", "cut"):
+        self.assertEqual(d["pending_stages"], ["forces", "rest_shape"])
+        for absent in ("rest", "cut"):
             self.assertNotIn(absent, d["wires"][0])
         self.assertNotIn("force", d["crossings"][0])
+        self.check_targets(d)
+
+    def check_targets(self, d):
+        """The target shapes against FORMATS.md and the machine, computed from the points alone."""
+        l_min, max_bend = d["machine"]["min_segment"], math.radians(d["machine"]["max_bend_deg"])
+        for w in d["wires"]:
+            t, n, o = w["target"], w["plane"]["normal"], w["plane"]["origin"]
+            for p in t:
+                self.assertLess(abs(sum(n[k] * (p[k] - o[k]) for k in range(3))), 1e-9)
+            m = len(t)
+            for i in range(m):
+                a, b, c = t[i - 1], t[i], t[(i + 1) % m]
+                self.assertGreaterEqual(math.dist(b, c), l_min - 1e-6, f"short segment on {w['name']}")
+                e0 = [b[k] - a[k] for k in range(3)]
+                e1 = [c[k] - b[k] for k in range(3)]
+                cos = sum(e0[k] * e1[k] for k in range(3)) / (math.hypot(*e0) * math.hypot(*e1))
+                self.assertLessEqual(math.acos(max(-1.0, min(1.0, cos))), max_bend + 1e-6)
+            self.assertAlmostEqual(w["length"], polyline_length(t, True), delta=1e-9)
+            self.assertLess(w["target_max_distance"], 0.02)
+        for c in d["crossings"]:
+            w0, w1 = (d["wires"][k] for k in c["wires"])
+            n0, n1 = w0["plane"]["normal"], w1["plane"]["normal"]
+            dvec = [n0[1] * n1[2] - n0[2] * n1[1], n0[2] * n1[0] - n0[0] * n1[2], n0[0] * n1[1] - n0[1] * n1[0]]
+            for k, wire in enumerate((w0, w1)):
+                t = wire["target"]
+                r = c["vertices"][k]
+                self.assertLess(math.dist(t[r], c["point"]), 1e-9)
+                prev, here, nxt = t[r - 1], t[r], t[(r + 1) % len(t)]
+                def unit(a, b):
+                    e = [b[i] - a[i] for i in range(3)]
+                    return [x / math.hypot(*e) for x in e]
+                h = [x - y for x, y in zip(unit(here, nxt), unit(prev, here))]  # Sec. 4.1 bisector
+                side = sum(h[i] * dvec[i] for i in range(3))
+                expected = c["hook"] if k == 0 else -c["hook"]
+                if expected:
+                    self.assertGreater(side * expected, 0, f"crossing {c['id']}: wire {wire['name']} opens the wrong way")
 
     def check_box(self, scene, scale=1.0):
         r = self.batch(scene)

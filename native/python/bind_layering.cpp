@@ -13,6 +13,7 @@
 #include "wiresculpt/error.hpp"
 #include "wiresculpt/layering.hpp"
 #include "wiresculpt/network.hpp"
+#include "wiresculpt/stability.hpp"
 
 namespace py = pybind11;
 
@@ -158,9 +159,53 @@ py::dict layering_py(const py::list& wire_list, const py::dict& settings, const 
                                   py::arg("nodes") = r.stats.nodes));
 }
 
+// Eq. 1 for every prefix of a given assembly: the check after a later stage changed hooks.
+py::dict check_assembly_py(const py::list& wire_list, const std::vector<int>& hooks,
+                           const std::vector<std::vector<int>>& steps, const py::dict& settings) {
+  std::vector<WireSpec> wires;
+  for (std::size_t i = 0; i < wire_list.size(); ++i) wires.push_back(to_wire(wire_list[i], i));
+  NetworkOptions net_options;
+  LayeringOptions options;
+  read_settings(settings, net_options, options);
+  int failed_step = -1, failed_wire = -1, lp_solves = 0;
+  std::size_t crossings = 0;
+  {
+    py::gil_scoped_release release;
+    const Network net = build_network(wires, net_options);
+    crossings = net.crossings.size();
+    if (hooks.size() != crossings)
+      throw InputError("check_assembly: " + std::to_string(hooks.size()) + " hooks given for " +
+                       std::to_string(crossings) + " crossings");
+    std::vector<int> prefix;
+    for (std::size_t k = 0; k < steps.size() && failed_step < 0; ++k) {
+      prefix.insert(prefix.end(), steps[k].begin(), steps[k].end());
+      StabilityOptions check;
+      check.forces_only = k == 0 && prefix.size() == 2;  // the first pair: forces only (Sec. 4.2)
+      const StabilityResult r = check_stability(net, prefix, hooks, options.contact, check);
+      lp_solves += r.lp_solves;
+      if (!r.stable) {
+        failed_step = static_cast<int>(k);
+        failed_wire = r.failed_wire;
+      }
+    }
+  }
+  return py::dict(py::arg("stable") = failed_step < 0, py::arg("failed_step") = failed_step,
+                  py::arg("failed_wire") = failed_wire, py::arg("lp_solves") = lp_solves,
+                  py::arg("crossings") = crossings);
+}
+
 }  // namespace
 
 void bind_layering(py::module_& m) {
+  m.def("check_assembly", &check_assembly_py, py::arg("wires"), py::arg("hooks"), py::arg("steps"),
+        py::arg("settings") = py::dict(),
+        R"(Stability (Eq. 1) of every prefix of an assembly with the given hooks.
+
+wires and settings as for layering(); hooks: -1, 0 or 1 per crossing of the network those wires
+form; steps: lists of wire ids added together (the first pair is judged under forces only).
+Returns {"stable", "failed_step" (-1 when stable), "failed_wire" (the wire whose unit load could
+not be balanced, -1 for the negative-sum load), "lp_solves", "crossings"}.)");
+
   m.def("layering", &layering_py, py::arg("wires"), py::arg("settings") = py::dict(),
         py::arg("progress") = py::none(),
         R"(Crossings, layering and assembly order of planar wires (Sec. 4.1-4.2).

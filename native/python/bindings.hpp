@@ -7,5 +7,6 @@ namespace wiresculpt::python {
 void bind_slicing(pybind11::module_& m);
 void bind_fab(pybind11::module_& m);
 void bind_layering(pybind11::module_& m);
+void bind_target_shape(pybind11::module_& m);
 
 }  // namespace wiresculpt::python

@@ -31,4 +31,5 @@ PYBIND11_MODULE(_wiresculpt, m) {
   wiresculpt::python::bind_slicing(m);
   wiresculpt::python::bind_fab(m);
   wiresculpt::python::bind_layering(m);
+  wiresculpt::python::bind_target_shape(m);
 }

@@ -1,0 +1,60 @@
+"""Layering and assembly order (Sec. 4.1-4.2): crossings, a hook per crossing, the order."""
+import math
+
+import numpy as np
+
+from .. import native
+
+
+def settings_for(material, settings):
+    """The native layering settings from the design's material and settings."""
+    return {
+        "min_segment": settings["min_segment"],
+        "friction": material["friction"],
+        "contact_angle": math.radians(settings["contact_angle_deg"]),
+    }
+
+
+def wire_specs(design, key="contour"):
+    """The design's wires as the native network functions take them."""
+    return [{"name": w["name"], "origin": w["plane"]["origin"], "normal": w["plane"]["normal"],
+             "points": np.asarray(w[key], dtype=np.float64), "closed": w["closed"]}
+            for w in design["wires"]]
+
+
+def run(design, material, settings, progress=None):
+    """Fills crossings, assembly order, stable/reason and stages.layering. Returns a progress line."""
+    result = native.require().layering(wire_specs(design), settings_for(material, settings), progress)
+    net = result["network"]
+    for wire, solved in zip(design["wires"], net["wires"]):
+        wire["contour"] = solved["points"].tolist()  # the sliced contour with its crossing points inserted
+    design["crossings"] = [
+        {"id": c["id"], "wires": list(c["wires"]), "contour_vertices": list(c["vertices"]),
+         "point": list(c["point"]), "hook": c["hook"], "metric": result["metric"][c["id"]]}
+        for c in net["crossings"]
+    ]
+    design["assembly_order"] = list(result["assembly_order"])
+    design["assembly_steps"] = [list(s) for s in result["steps"]]
+    design["two_hand_steps"] = list(result["two_hand_steps"])
+    design["stable"] = bool(result["stable"])
+    design["reason"] = result["reason"]
+    design.setdefault("warnings", []).extend(result["warnings"])
+    if net["close_crossings"]:
+        design["close_crossings"] = [g["message"] for g in net["close_crossings"]]
+        design["required_size"] = net["required_size"]
+    stats = result["stats"]
+    design["stages"]["layering"] = {
+        "seconds": stats["seconds"], "lp_solves": stats["lp_solves"], "nodes": stats["nodes"],
+        "complete_search": result["complete_search"], **result["objective"],
+    }
+    return (f"{len(design['crossings'])} crossings, {'stable' if design['stable'] else 'not stable'}, "
+            f"order {design['assembly_order']}, {stats['lp_solves']} LPs, {stats['nodes']} nodes "
+            f"({stats['seconds']:.3f} s)")
+
+
+def recheck(design, material, settings):
+    """Eq. 1 for every prefix of the design's assembly with its current hooks (after a later
+    stage nulled crossings). Returns the native verdict dict."""
+    hooks = [c["hook"] for c in design["crossings"]]
+    return native.require().check_assembly(wire_specs(design), hooks, design["assembly_steps"],
+                                            settings_for(material, settings))

@@ -1,0 +1,122 @@
+"""Target shape (Sec. 4.3): per wire, a fabricable polyline through its fixed crossings whose
+kinks open the way the layering's hooks say (FORMATS.md `hook`).
+
+Contact angle: the layering stage assumes each kink's edges lie exactly contact_angle/2 from the
+bisector, with friction widening its pyramid by atan(mu). The paper's constraint is
+angle(edge, h*) + atan(mu) <= alpha*/2, so alpha* = contact_angle + 2 atan(mu) keeps every edge
+within contact_angle/2 of h*: the realised kink is at least as sharp as the one the layering
+judged stable.
+"""
+import math
+import time
+
+import numpy as np
+
+from .. import native
+from ..core.frames import plane_frame, to_2d, to_3d
+from . import layering
+
+FAILED = ("too_close", "infeasible", "open_end")
+MAX_ROUNDS = 4  # solve, null what cannot be realised, solve again (each round nulls at least one)
+
+
+def crossing_direction(design, crossing):
+    """d = normalize(n0 x n1), n0 and n1 the plane normals of the crossing's wires."""
+    n0, n1 = (np.asarray(design["wires"][w]["plane"]["normal"], dtype=np.float64) for w in crossing["wires"])
+    d = np.cross(n0, n1)
+    return d / np.linalg.norm(d)
+
+
+def desired_bisector(design, crossing, k):
+    """The 3D direction wire k (0 or 1) of `crossing` must open towards: hook * d for wires[0],
+    -hook * d for wires[1] (d itself for a null crossing, which is not constrained)."""
+    sign = crossing["hook"] if k == 0 else -crossing["hook"]
+    return (sign or 1) * crossing_direction(design, crossing)
+
+
+def model_size(design):
+    points = np.concatenate([np.asarray(w["contour"]) for w in design["wires"]])
+    return float(np.max(points.max(axis=0) - points.min(axis=0)))
+
+
+def solve_wire(design, wire, material, settings, size):
+    """(result, [(crossing, k)]) of the native optimisation of one wire."""
+    _n, u, v = plane_frame(wire["plane"]["normal"])
+    origin = wire["plane"]["origin"]
+    contact = math.radians(settings["contact_angle_deg"]) + 2 * math.atan(material["friction"])
+    specs, refs = [], []
+    for c in design["crossings"]:
+        if wire["id"] not in c["wires"]:
+            continue
+        k = c["wires"].index(wire["id"])
+        h = desired_bisector(design, c, k)
+        specs.append({"vertex": c["contour_vertices"][k], "bisector": (float(h @ u), float(h @ v)),
+                      "contact_angle": contact, "active": c["hook"] != 0})
+        refs.append((c, k))
+    options = {"min_segment": settings["min_segment"], "max_bend": math.radians(settings["max_bend_deg"]),
+               "friction": material["friction"], "model_size": size, "wire_name": wire["name"]}
+    result = native.require().optimize_target_shape(to_2d(wire["contour"], origin, u, v), wire["closed"],
+                                                    specs, options)
+    return result, refs, (origin, u, v)
+
+
+def run(design, material, settings):
+    """Fills each wire's target, length and distances, each crossing's vertices, stages.target_shape;
+    nulls crossings that cannot be realised and re-checks stability. Returns a progress line."""
+    start = time.perf_counter()
+    size = model_size(design)
+    nulled, iterations = [], 0
+    for _round in range(MAX_ROUNDS):
+        solved = [solve_wire(design, w, material, settings, size) for w in design["wires"]]
+        iterations += sum(r["iterations"] for r, _refs, _frame in solved)
+        failing = {}
+        for wire, (r, refs, _frame) in zip(design["wires"], solved):
+            for (c, _k), status in zip(refs, r["crossings"]):
+                if c["hook"] != 0 and status["status"] in FAILED:
+                    failing.setdefault(c["id"], f"crossing {c['id']} on wire {wire['name']}: {status['message']}")
+        if not failing:
+            break
+        for cid, message in failing.items():
+            design["crossings"][cid]["hook"] = 0
+            nulled.append({"crossing": cid, "message": message})
+    else:
+        raise RuntimeError("target shape: crossings kept failing after nulling; this is a solver bug")
+
+    per_wire = []
+    for wire, (r, refs, frame) in zip(design["wires"], solved):
+        target = to_3d(r["points"], *frame)
+        wire["target"] = target.tolist()
+        wire["length"] = float(np.sum(np.linalg.norm(np.diff(target, axis=0, append=target[:1] if wire["closed"]
+                                                               else None), axis=1)))
+        wire["target_max_distance"] = r["max_distance"]
+        wire["target_rms_distance"] = r["rms_distance"]
+        for (c, k), vertex in zip(refs, r["crossing_vertices"]):
+            c.setdefault("vertices", [None, None])[k] = int(vertex)
+        per_wire.append({"id": wire["id"], "seconds": r["seconds"], "iterations": r["iterations"],
+                         "max_distance": r["max_distance"], "rms_distance": r["rms_distance"],
+                         "feasible": r["feasible"], "nlopt_result": r["nlopt_result"]})
+        design.setdefault("warnings", []).extend(f"wire {wire['name']}: {w}" for w in r["warnings"])
+        if not r["feasible"]:
+            design["warnings"].append(f"wire {wire['name']}: the target shape violates a machine limit "
+                                      f"(segments {r['max_length_violation'] * 1000:.3f} mm short, bends "
+                                      f"{math.degrees(r['max_angle_violation']):.3f} deg over)")
+    for c in design["crossings"]:
+        if c["hook"] == 0:
+            c["metric"] = 0.0
+    seconds = time.perf_counter() - start
+    design["stages"]["target_shape"] = {"seconds": seconds, "iterations": iterations, "wires": per_wire,
+                                        "nulled_crossings": nulled}
+    if nulled:
+        verdict = layering.recheck(design, material, settings)
+        design["stages"]["target_shape"]["recheck_lp_solves"] = verdict["lp_solves"]
+        if not verdict["stable"] and design["stable"]:
+            step = design["assembly_steps"][verdict["failed_step"]]
+            names = ", ".join(design["wires"][w]["name"] for w in step)
+            design["stable"] = False
+            design["reason"] = (f"the target shape cannot realise {len(nulled)} crossing"
+                                f"{'s' if len(nulled) > 1 else ''} ({'; '.join(n['message'] for n in nulled)}); "
+                                f"without {'them' if len(nulled) > 1 else 'it'} the assembly is no longer "
+                                f"stable when adding {names}")
+    worst = max(w["max_distance"] for w in per_wire)
+    return (f"{len(per_wire)} wires, largest distance to the contour {worst * 1000:.2f} mm, "
+            f"{len(nulled)} crossings nulled, {iterations} iterations ({seconds:.3f} s)")

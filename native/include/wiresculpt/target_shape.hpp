@@ -1,0 +1,241 @@
+#pragma once
+// Per-wire target-shape optimisation (Sec. 4.3 of Miguel, Lepoutre, Bickel 2016, Eq. 3-5): turn a
+// wire's dense sliced contour into a fabricable polyline that stays close to it, keeps every
+// crossing point fixed, respects the bending machine (segments >= l_min, bends <= max) and opens
+// each active crossing's kink towards the bisector the layering chose (contact constraints).
+// The method, its choices and the measurements behind them are in docs/method-target-shape.md.
+//
+// Everything is in the wire's own 2D plane frame (Plane::to_2d), metres and radians.
+//
+//   minimise    E(p) = E_d(p) + w_r E_r(p)
+//   subject to  |p_{i+1} - p_i| >= l_min                      every segment with a free end
+//               bend(p_i) <= max_bend                          every vertex with a free neighbour
+//               angle(p_{r±1} - p_r, h*) + atan(μ) <= α*/2     both edges of every active crossing r
+//               p_r = contour point of crossing r              (crossings are not variables)
+//
+// E_d is the IMLS distance of Eq. 4 (point-to-tangent-line distances of the target points,
+// blended with a compact kernel of support h = 2 × the average target sampling distance, each
+// optimised point weighted by the length of its incident segments). Where a point has too little
+// kernel mass (no target point within h, typically a neighbour of a kink moved off the contour)
+// E_d blends smoothly into the squared distance to the nearest point of the target polyline, so
+// the energy is defined everywhere and continuously differentiable except on the medial axis of
+// the target (where it stays continuous). E_r is Eq. 5 read as a sum of squared norms:
+// Σ_i |u_i - (u_{i-1} + u_{i+1})/2|² over the interior vertices, u = p - p_initial.
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "wiresculpt/geometry.hpp"
+#include "wiresculpt/progress.hpp"
+
+namespace wiresculpt {
+
+/// One crossing on the wire, as the layering stage hands it over (FORMATS.md, `hook`).
+struct TargetCrossing {
+  /// Index into the input contour of the vertex that IS the crossing point (exactly on it).
+  int vertex = -1;
+  /// Desired unit bisector h* in the plane frame: the direction the kink must open to (Sec. 4.1,
+  /// h = (ê_r - ê_{r-1}) / |…|). Normalised here; must be non-zero when `active`.
+  Vec2 bisector = Vec2::Zero();
+  /// Desired contact angle α* in radians, (0, π]: the angle between the two edges at the kink
+  /// (Sec. 4.1, the angle between e_r and -e_{r-1}; π is straight).
+  double contact_angle = 2.0 * std::numbers::pi / 3.0;
+  /// false for the null hook: the crossing point stays fixed, no contact constraint.
+  bool active = true;
+};
+
+enum class TargetShapeAlgorithm {
+  slsqp,         ///< NLopt LD_SLSQP (default: see docs/method-target-shape.md)
+  auglag_lbfgs,  ///< NLopt AUGLAG with LD_LBFGS as the local solver
+  ccsaq,         ///< NLopt LD_CCSAQ
+  mma,           ///< NLopt LD_MMA
+};
+
+struct TargetShapeOptions {
+  /// Metres. The machine's minimum distance between bending points (Sec. 5.1). Default 0.015.
+  double min_segment = 0.015;
+  /// Radians, in (0, π]. The largest bend (turning angle, π minus the kink's opening) the machine
+  /// makes at one point (Sec. 4.3, c_f,angle). Default 2π/3 (120°).
+  double max_bend = 2.0 * std::numbers::pi / 3.0;
+  /// Metres. Arc-length spacing of the initial resampling between consecutive crossings; 0 means
+  /// 1.5 × min_segment. Should not be below min_segment. Default 0.
+  double spacing = 0.0;
+  /// w_r of Eq. 3, in metres (E_d is in m³, E_r in m²). Default 1e-3 m: a one-point bump of
+  /// height a costs about 2·spacing·a² in E_d and 1.5·w_r·a² in E_r, so at the default spacing the
+  /// regulariser weighs about 1/30 of the distance term: it smooths the displacement field near
+  /// kinks without pulling the wire off the contour.
+  double regularization = 1e-3;
+  /// Coulomb friction coefficient μ (Table 1: steel 0.32, brass 0.23). The contact constraint
+  /// adds α(μ) = atan(μ), the friction angle, to each edge's angle from h* (Sec. 4.3), the same
+  /// α(μ) as ContactOptions::friction in contact.hpp. 0 gives the purely geometric constraint.
+  double friction = 0.32;
+  TargetShapeAlgorithm algorithm = TargetShapeAlgorithm::slsqp;
+  /// NLopt's relative tolerance on the energy. Default 1e-12.
+  double ftol_rel = 1e-12;
+  /// NLopt's relative tolerance on the variables (scaled by min_segment). Default 1e-10.
+  double xtol_rel = 1e-10;
+  /// Tolerance on each constraint in its solver form (dimensionless: 1 - |e|²/l_min² for lengths,
+  /// cosines for angles). Default 1e-10.
+  double constraint_tol = 1e-10;
+  /// Maximum number of energy evaluations over all blocks (SLSQP uses about one per iteration).
+  /// Default 20000.
+  int max_iterations = 20000;
+  /// Points per block. 0, or a wire of at most 4 × window points, is solved as one NLopt
+  /// problem; otherwise windows of `window` points centred on each active crossing, then
+  /// overlapping windows of `window` consecutive points (every window/2 points), are solved in
+  /// turn, each with the rest of the wire held, until no window moves a point by more than
+  /// sweep_tol (multiplicative Schwarz / block coordinate descent). Dense SLSQP costs O(n³) per
+  /// iteration, so windows make long wires fast; see docs/method-target-shape.md. Default 8.
+  int window = 8;
+  /// Metres. A window is solved again when a point its energy terms read moved by more than this
+  /// since its last solve. Default 1e-9 (1 nm).
+  double sweep_tol = 1e-9;
+  /// Maximum number of sweeps over the windows. Default 200.
+  int max_sweeps = 200;
+  /// Metres: the model's current size (largest bounding-box side), used to say how large it must
+  /// be scaled when two crossings are too close. 0: only the scale factor is reported.
+  double model_size = 0.0;
+  /// Radians. A contact or bend constraint violated by more than this after the solve marks the
+  /// result (and the crossing) as not realised. Default 1e-6.
+  double angle_tolerance = 1e-6;
+  /// Metres. Same for segment lengths. Default 1e-6.
+  double length_tolerance = 1e-6;
+  /// Shown in every message about this wire.
+  std::string wire_name = "wire";
+};
+
+/// What happened to one input crossing.
+struct TargetCrossingStatus {
+  /// "ok" (realised), "inactive" (null hook, point kept), "too_close" (no free point towards a
+  /// neighbouring crossing and the fixed edge cannot satisfy the constraints), "infeasible" (the
+  /// constraints cannot hold: contact angle vs friction or max bend, or the solver could not meet
+  /// them), "open_end" (an active crossing at an end of an open wire has no kink).
+  std::string status = "ok";
+  bool realised = true;   ///< false: the caller should make it null and re-check stability
+  int vertex = -1;        ///< index of the crossing in TargetShapeResult::points
+  /// Achieved unit bisector (ê_r - ê_{r-1})/|…| and opening angle (radians, π straight) at the
+  /// crossing; bisector is zero at an open end or where the wire is straight.
+  Vec2 bisector = Vec2::Zero();
+  double contact_angle = 0.0;
+  /// Radians: max over both edges of angle(edge, h*) + atan(μ) - α*/2 (<= 0 when satisfied);
+  /// 0 for inactive crossings.
+  double contact_violation = 0.0;
+  /// For "too_close": the factor (>= 1) by which the model must grow so that the closer
+  /// neighbouring crossing is 2 × min_segment away along the wire (room for one free point);
+  /// 1 otherwise.
+  double scale = 1.0;
+  std::string message;  ///< a sentence naming the wire and crossing; empty when "ok"/"inactive"
+};
+
+struct TargetShapeResult {
+  Polyline2 points;                 ///< #m optimised points (closed: first not repeated), metres
+  std::vector<int> crossing_vertices;  ///< per input crossing, its index into `points`
+  std::vector<TargetCrossingStatus> crossings;  ///< per input crossing
+  double max_distance = 0.0;  ///< metres: largest distance of a point to the input contour
+  double rms_distance = 0.0;  ///< metres: RMS of those distances
+  double min_segment = 0.0;   ///< metres: shortest segment of `points`
+  double max_bend = 0.0;      ///< radians: largest bend of `points`
+  /// Metres: max(0, l_min - |e|) over all segments. Radians: the largest excess of a bend over
+  /// max_bend or of a contact constraint (angle(edge, h*) + atan μ - α*/2) of an active crossing
+  /// that was not reported unrealisable before solving.
+  double max_length_violation = 0.0;
+  double max_angle_violation = 0.0;
+  int iterations = 0;         ///< NLopt energy evaluations, all blocks together
+  int sweeps = 0;             ///< passes over the windows (1 for a single block)
+  double seconds = 0.0;       ///< wall-clock time of the whole call
+  /// NLopt's result as text, e.g. "NLOPT_FTOL_REACHED": the first failure code of any block, else
+  /// the last block's code; "NLOPT_MAXEVAL_REACHED" when max_iterations ran out across windows;
+  /// "none" when nothing was free.
+  std::string nlopt_result;
+  double energy = 0.0;        ///< E at the result (m³)
+  /// Every segment, bend and solved contact constraint within its tolerance (segments between
+  /// too-close crossings count; contact constraints dropped before solving do not).
+  bool feasible = true;
+  std::vector<std::string> warnings;  ///< sentences about violated constraints, naming vertices
+};
+
+/// Optimises one wire.
+///   contour   #n 2D points in the wire's plane frame, metres (n >= 2 open, n >= 3 closed)
+///   closed    true: the last point connects back to the first (not repeated)
+///   crossings as above; vertices distinct and in [0, n)
+/// Throws InputError (non-finite input, bad index, duplicate crossing, zero bisector of an active
+/// crossing, bad option) naming the wire and crossing; Cancelled when `progress` asks to stop.
+/// Unrealisable crossings are not errors: they are reported in the result.
+TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
+                                        const std::vector<TargetCrossing>& crossings,
+                                        const TargetShapeOptions& options = {},
+                                        const ProgressFn& progress = {});
+
+/// The optimisation problem of one wire, exposed for tests and diagnostics: the initial
+/// resampled polyline and every term with its analytic gradient with respect to ALL points
+/// (fixed ones included). optimize_target_shape builds one of these.
+class TargetShapeProblem {
+ public:
+  TargetShapeProblem(const Polyline2& contour, bool closed, const std::vector<TargetCrossing>& crossings,
+                     const TargetShapeOptions& options = {});
+
+  enum class Kind { length, bend, contact };
+  /// One inequality constraint in solver form, c(p) <= 0 (dimensionless):
+  ///   length  at edge i (p_i -> p_{i+1}):   1 - |e_i|² / l_min²
+  ///   bend    at vertex i:                   cos(max_bend) - ê_{i-1}·ê_i
+  ///   contact at crossing vertex r, side ±:  cos(α*/2 - atan μ) - û·h*, u = p_{r±1} - p_r
+  struct Constraint {
+    Kind kind = Kind::length;
+    int vertex = -1;    ///< edge start (length), vertex (bend), crossing vertex (contact)
+    int neighbour = -1; ///< contact: the incident vertex r±1
+    int crossing = -1;  ///< contact: index into the input crossings
+  };
+
+  const Polyline2& initial() const { return initial_; }
+  bool closed() const { return closed_; }
+  const std::vector<char>& fixed() const { return fixed_; }  ///< per point: a crossing
+  const std::vector<int>& crossing_vertices() const { return crossing_vertices_; }
+  /// Constraints that depend on at least one free point (the solver's constraints).
+  const std::vector<Constraint>& constraints() const { return constraints_; }
+  const std::vector<TargetCrossingStatus>& statuses() const { return statuses_; }
+  double kernel_support() const { return h_; }  ///< metres, h of Eq. 4
+
+  /// E_d of Eq. 4 (m³); adds dE_d/dp to `grad` when non-null (resized to #points).
+  double distance_energy(const Polyline2& p, Polyline2* grad = nullptr) const;
+  /// E_r of Eq. 5 (m²); adds dE_r/dp to `grad` when non-null.
+  double regularization_energy(const Polyline2& p, Polyline2* grad = nullptr) const;
+  /// E = E_d + w_r E_r; adds the gradient when non-null.
+  double energy(const Polyline2& p, Polyline2* grad = nullptr) const;
+  /// Σ over `terms` (vertex indices) of w_i D(p_i) + w_r |Δu_i|²: the part of E that a block of
+  /// points changes. Adds the gradient when non-null (grad must already have #points entries).
+  double energy_terms(const Polyline2& p, const std::vector<int>& terms, Polyline2* grad = nullptr) const;
+  /// Value of constraint k; adds its gradient to `grad` when non-null.
+  double constraint(std::size_t k, const Polyline2& p, Polyline2* grad = nullptr) const;
+  /// Distance (metres) from q to the input contour polyline.
+  double distance_to_contour(const Vec2& q) const;
+  /// The IMLS squared distance D(q) of Eq. 4 for one point (m²) with its gradient.
+  double imls(const Vec2& q, Vec2* grad = nullptr) const;
+
+ private:
+  friend TargetShapeResult optimize_target_shape(const Polyline2&, bool, const std::vector<TargetCrossing>&,
+                                                 const TargetShapeOptions&, const ProgressFn&);
+  double nearest_squared(const Vec2& q, Vec2* grad) const;
+  // Term i of E_d (w_i D(p_i)) and of w_r E_r (weight |Δu_i|²); gradients added to grad.
+  double distance_term(const Polyline2& p, int i, Polyline2* grad) const;
+  double regularization_term(const Polyline2& p, int i, double weight, Polyline2* grad) const;
+
+  TargetShapeOptions options_;
+  std::vector<TargetCrossing> crossings_;
+  bool closed_ = true;
+  Polyline2 target_;          // densified input contour
+  std::vector<Vec2> normals_; // unit normals at target points
+  double h_ = 0.0;
+  double cell_ = 0.0;
+  double max_edge_ = 0.0;     // longest target edge
+  Vec2 grid_origin_ = Vec2::Zero();
+  int grid_nx_ = 0, grid_ny_ = 0;
+  std::vector<int> grid_start_, grid_items_;  // CSR buckets of target points
+  Polyline2 initial_;
+  std::vector<char> fixed_;
+  std::vector<int> crossing_vertices_;
+  std::vector<Constraint> constraints_;
+  std::vector<TargetCrossingStatus> statuses_;
+  std::vector<double> beta_;  // per crossing: α*/2 - atan μ
+};
+
+}  // namespace wiresculpt

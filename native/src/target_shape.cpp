@@ -1,0 +1,958 @@
+#include "wiresculpt/target_shape.hpp"
+
+#include <nlopt.hpp>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "wiresculpt/error.hpp"
+
+namespace wiresculpt {
+namespace {
+
+constexpr double pi = std::numbers::pi;
+// Kernel mass below which E_d blends from the IMLS into the nearest-point distance. A point on a
+// densely sampled target has Φ ≈ 1.63 (h = 2 × spacing); Φ = 0.5 is reached about 0.45 h off it.
+constexpr double kernel_mass_full = 0.5;
+
+std::string fmt(double v, int precision = 3) {
+  std::ostringstream s;
+  s.precision(precision);
+  s << v;
+  return s.str();
+}
+std::string mm(double metres) { return fmt(metres * 1000.0, 3) + " mm"; }
+std::string deg(double radians) { return fmt(radians * 180.0 / pi, 3) + "°"; }
+
+double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+// Angle in [0, π] between two non-zero vectors.
+double angle_between(const Vec2& a, const Vec2& b) { return std::atan2(std::abs(cross2(a, b)), a.dot(b)); }
+
+std::string result_text(nlopt::result r) {
+  switch (r) {
+    case nlopt::FAILURE: return "NLOPT_FAILURE";
+    case nlopt::INVALID_ARGS: return "NLOPT_INVALID_ARGS";
+    case nlopt::OUT_OF_MEMORY: return "NLOPT_OUT_OF_MEMORY";
+    case nlopt::ROUNDOFF_LIMITED: return "NLOPT_ROUNDOFF_LIMITED";
+    case nlopt::FORCED_STOP: return "NLOPT_FORCED_STOP";
+    case nlopt::SUCCESS: return "NLOPT_SUCCESS";
+    case nlopt::STOPVAL_REACHED: return "NLOPT_STOPVAL_REACHED";
+    case nlopt::FTOL_REACHED: return "NLOPT_FTOL_REACHED";
+    case nlopt::XTOL_REACHED: return "NLOPT_XTOL_REACHED";
+    case nlopt::MAXEVAL_REACHED: return "NLOPT_MAXEVAL_REACHED";
+    case nlopt::MAXTIME_REACHED: return "NLOPT_MAXTIME_REACHED";
+    default: return "NLOPT_UNKNOWN";
+  }
+}
+
+void validate(const Polyline2& contour, bool closed, const std::vector<TargetCrossing>& crossings,
+              const TargetShapeOptions& o) {
+  const std::string& w = o.wire_name;
+  auto bad = [&](const std::string& what) { throw InputError("target shape of wire " + w + ": " + what); };
+  auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  if (!positive(o.min_segment)) bad("min_segment must be a positive number of metres");
+  if (!(positive(o.max_bend) && o.max_bend <= pi)) bad("max_bend must be in (0, π] radians");
+  if (!(std::isfinite(o.spacing) && o.spacing >= 0.0)) bad("spacing must be >= 0 metres");
+  if (!(std::isfinite(o.regularization) && o.regularization >= 0.0)) bad("regularization must be >= 0");
+  if (!(std::isfinite(o.friction) && o.friction >= 0.0)) bad("friction must be >= 0");
+  if (!positive(o.ftol_rel) || !positive(o.xtol_rel) || !positive(o.constraint_tol))
+    bad("the solver tolerances must be positive");
+  if (!positive(o.angle_tolerance) || !positive(o.length_tolerance)) bad("the check tolerances must be positive");
+  if (o.max_iterations <= 0) bad("max_iterations must be positive");
+  if (o.window < 0) bad("window must be >= 0 points");
+  if (o.window > 0 && o.window < 4) bad("window must be 0 (one block) or at least 4 points");
+  if (o.max_sweeps <= 0) bad("max_sweeps must be positive");
+  if (!positive(o.sweep_tol)) bad("sweep_tol must be a positive number of metres");
+  if (!(std::isfinite(o.model_size) && o.model_size >= 0.0)) bad("model_size must be >= 0 metres");
+  const std::size_t n = contour.size();
+  if (n < (closed ? 3u : 2u))
+    bad("the contour has " + std::to_string(n) + " points; a " + (closed ? "closed" : "open") + " wire needs at least " +
+        (closed ? "3" : "2"));
+  for (std::size_t i = 0; i < n; ++i)
+    if (!contour[i].allFinite()) bad("contour point " + std::to_string(i) + " is not finite");
+  std::vector<char> used(n, 0);
+  for (std::size_t c = 0; c < crossings.size(); ++c) {
+    const TargetCrossing& x = crossings[c];
+    const std::string name = "crossing " + std::to_string(c);
+    if (x.vertex < 0 || static_cast<std::size_t>(x.vertex) >= n)
+      bad(name + " names contour vertex " + std::to_string(x.vertex) + ", outside [0, " + std::to_string(n) + ")");
+    if (used[x.vertex]) bad(name + " is at contour vertex " + std::to_string(x.vertex) + ", which another crossing already uses");
+    used[x.vertex] = 1;
+    if (x.active) {
+      if (!x.bisector.allFinite() || x.bisector.norm() < 1e-12) bad(name + " is active but its bisector h* is zero or not finite");
+      if (!(std::isfinite(x.contact_angle) && x.contact_angle > 0.0 && x.contact_angle <= pi))
+        bad(name + " has contact angle " + fmt(x.contact_angle) + " rad, outside (0, π]");
+    }
+  }
+}
+
+// Closest point of segment [a, b] to q.
+Vec2 closest_on_segment(const Vec2& q, const Vec2& a, const Vec2& b) {
+  const Vec2 d = b - a;
+  const double l2 = d.squaredNorm();
+  if (l2 <= 0.0) return a;
+  const double t = std::clamp((q - a).dot(d) / l2, 0.0, 1.0);
+  return a + t * d;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Problem set-up: target, resampling, constraints.
+
+TargetShapeProblem::TargetShapeProblem(const Polyline2& contour, bool closed,
+                                       const std::vector<TargetCrossing>& crossings, const TargetShapeOptions& options)
+    : options_(options), crossings_(crossings), closed_(closed) {
+  validate(contour, closed, crossings, options);
+  const TargetShapeOptions& o = options_;
+  const std::string& w = o.wire_name;
+  if (o.spacing == 0.0) options_.spacing = 1.5 * o.min_segment;
+  for (TargetCrossing& c : crossings_)
+    if (c.active) c.bisector.normalize();
+  const double spacing = options_.spacing, lmin = o.min_segment;
+  const int n = static_cast<int>(contour.size());
+  const int n_edges = closed ? n : n - 1;
+
+  // Cumulative arc length of the input contour (closed: cum[n] is the total length).
+  std::vector<double> cum(static_cast<std::size_t>(n_edges) + 1, 0.0);
+  for (int i = 0; i < n_edges; ++i) cum[i + 1] = cum[i] + (contour[(i + 1) % n] - contour[i]).norm();
+  const double total = cum[n_edges];
+  if (!(total > 0.0)) throw InputError("target shape of wire " + w + ": the contour has zero length");
+  auto point_at = [&](double s) -> Vec2 {
+    if (closed) s = std::fmod(std::fmod(s, total) + total, total);
+    s = std::clamp(s, 0.0, total);
+    int j = static_cast<int>(std::upper_bound(cum.begin(), cum.end(), s) - cum.begin()) - 1;
+    j = std::clamp(j, 0, n_edges - 1);
+    const double len = cum[j + 1] - cum[j];
+    const double t = len > 0.0 ? (s - cum[j]) / len : 0.0;
+    return contour[j] + std::clamp(t, 0.0, 1.0) * (contour[(j + 1) % n] - contour[j]);
+  };
+
+  // The target: the input contour with long edges subdivided (at most spacing/4), so that the
+  // IMLS kernel never blends normals of distant parts of a coarse polygon.
+  {
+    const double max_edge = spacing / 4.0;
+    for (int i = 0; i < n_edges; ++i) {
+      const Vec2 a = contour[i], b = contour[(i + 1) % n];
+      const double len = (b - a).norm();
+      if (len <= 0.0) continue;
+      if (target_.empty() || (target_.back() - a).norm() > 0.0) target_.push_back(a);
+      const int pieces = std::max(1, static_cast<int>(std::ceil(len / max_edge)));
+      for (int k = 1; k < pieces; ++k) target_.push_back(a + (static_cast<double>(k) / pieces) * (b - a));
+    }
+    if (!closed) target_.push_back(contour[n - 1]);
+    if (closed && target_.size() > 1 && (target_.back() - target_.front()).norm() == 0.0) target_.pop_back();
+    const int m = static_cast<int>(target_.size());
+    const int m_edges = closed ? m : m - 1;
+    normals_.resize(m);
+    double length = 0.0;
+    for (int k = 0; k < m_edges; ++k) length += (target_[(k + 1) % m] - target_[k]).norm();
+    for (int k = 0; k < m; ++k) {
+      Vec2 t = Vec2::Zero();
+      if (closed || k > 0) t += (target_[k] - target_[(k + m - 1) % m]).normalized();
+      if (closed || k < m - 1) t += (target_[(k + 1) % m] - target_[k]).normalized();
+      if (t.norm() < 1e-9) t = (target_[(k + 1) % m] - target_[k]).normalized();  // a cusp
+      t.normalize();
+      normals_[k] = Vec2(-t.y(), t.x());
+    }
+    h_ = 2.0 * length / std::max(1, m_edges);
+    for (int k = 0; k < m_edges; ++k) max_edge_ = std::max(max_edge_, (target_[(k + 1) % m] - target_[k]).norm());
+    // Uniform grid of cell >= h over the target's bounding box (at most ~512 cells a side).
+    Vec2 lo = target_[0], hi = target_[0];
+    for (const Vec2& p : target_) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    const double extent = std::max((hi - lo).maxCoeff(), h_);
+    cell_ = std::max(h_, extent / 512.0);
+    grid_origin_ = lo;
+    grid_nx_ = static_cast<int>((hi.x() - lo.x()) / cell_) + 1;
+    grid_ny_ = static_cast<int>((hi.y() - lo.y()) / cell_) + 1;
+    grid_start_.assign(static_cast<std::size_t>(grid_nx_) * grid_ny_ + 1, 0);
+    auto cell_of = [&](const Vec2& p) {
+      const int ix = std::clamp(static_cast<int>((p.x() - lo.x()) / cell_), 0, grid_nx_ - 1);
+      const int iy = std::clamp(static_cast<int>((p.y() - lo.y()) / cell_), 0, grid_ny_ - 1);
+      return iy * grid_nx_ + ix;
+    };
+    for (const Vec2& p : target_) ++grid_start_[cell_of(p) + 1];
+    for (std::size_t c = 1; c < grid_start_.size(); ++c) grid_start_[c] += grid_start_[c - 1];
+    grid_items_.assign(target_.size(), 0);
+    std::vector<int> fill(grid_start_.begin(), grid_start_.end() - 1);
+    for (int k = 0; k < m; ++k) grid_items_[fill[cell_of(target_[k])]++] = k;
+  }
+
+  // Knots: the crossings in contour order (plus the ends of an open wire, or one canonical vertex
+  // of a closed wire without crossings, the lexicographically smallest, so that the result does
+  // not depend on where the contour starts or which way it runs).
+  struct Knot {
+    int vertex;
+    int crossing;  // -1 for an end / anchor
+  };
+  std::vector<Knot> knots;
+  {
+    std::vector<int> order(crossings_.size());
+    for (std::size_t c = 0; c < order.size(); ++c) order[c] = static_cast<int>(c);
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return crossings_[a].vertex < crossings_[b].vertex; });
+    if (!closed && (order.empty() || crossings_[order.front()].vertex != 0)) knots.push_back({0, -1});
+    for (int c : order) knots.push_back({crossings_[c].vertex, c});
+    if (!closed && (order.empty() || crossings_[order.back()].vertex != n - 1)) knots.push_back({n - 1, -1});
+    if (closed && knots.empty()) {
+      int best = 0;
+      for (int i = 1; i < n; ++i)
+        if (contour[i].x() < contour[best].x() || (contour[i].x() == contour[best].x() && contour[i].y() < contour[best].y()))
+          best = i;
+      knots.push_back({best, -1});
+    }
+  }
+  crossing_vertices_.assign(crossings_.size(), -1);
+  statuses_.assign(crossings_.size(), TargetCrossingStatus{});
+  struct Gap {
+    int a, b;  // crossings
+    double arc, chord;
+  };
+  std::vector<Gap> gaps;  // consecutive crossings without a free point between them
+  const int pieces = closed ? static_cast<int>(knots.size()) : static_cast<int>(knots.size()) - 1;
+  for (int k = 0; k < pieces; ++k) {
+    const Knot& ka = knots[k];
+    const Knot& kb = knots[(k + 1) % knots.size()];
+    const double s0 = cum[ka.vertex];
+    double s1 = cum[kb.vertex];
+    if (closed && s1 <= s0) s1 += total;  // wraps (or the single-knot loop)
+    const double arc = s1 - s0;
+    const bool between_crossings = ka.crossing >= 0 && kb.crossing >= 0;
+    if (between_crossings && arc <= 0.0 && knots.size() > 1)
+      throw InputError("target shape of wire " + w + ": crossings " + std::to_string(ka.crossing) + " and " +
+                       std::to_string(kb.crossing) + " are at the same point of the contour");
+    int segments = std::max(1, static_cast<int>(std::lround(arc / spacing)));
+    if (closed && knots.size() == 1) segments = std::max(3, segments);
+    if (between_crossings && knots.size() > 1) {
+      if (arc >= 2.0 * lmin)
+        segments = std::max(2, segments);
+      else {
+        segments = 1;
+        gaps.push_back({ka.crossing, kb.crossing, arc, (contour[kb.vertex] - contour[ka.vertex]).norm()});
+      }
+    }
+    if (ka.crossing >= 0) crossing_vertices_[ka.crossing] = static_cast<int>(initial_.size());
+    initial_.push_back(contour[ka.vertex]);
+    fixed_.push_back(ka.crossing >= 0 ? 1 : 0);
+    for (int j = 1; j < segments; ++j) {
+      initial_.push_back(point_at(s0 + arc * j / segments));
+      fixed_.push_back(0);
+    }
+  }
+  if (!closed) {
+    const Knot& last = knots.back();
+    if (last.crossing >= 0) crossing_vertices_[last.crossing] = static_cast<int>(initial_.size());
+    initial_.push_back(contour[last.vertex]);
+    fixed_.push_back(last.crossing >= 0 ? 1 : 0);
+  }
+  const int m = static_cast<int>(initial_.size());
+
+  // Per-crossing feasibility before solving.
+  const double friction_angle = std::atan(o.friction);
+  beta_.assign(crossings_.size(), 0.0);
+  auto crossing_name = [&](int c) { return "crossing " + std::to_string(c) + " on wire " + w; };
+  auto mark = [&](int c, const std::string& status, const std::string& message, double scale = 1.0) {
+    TargetCrossingStatus& s = statuses_[c];
+    if (!s.realised) return;  // keep the first reason
+    s.status = status;
+    s.realised = false;
+    s.message = message;
+    s.scale = scale;
+  };
+  for (std::size_t c = 0; c < crossings_.size(); ++c) {
+    const TargetCrossing& x = crossings_[c];
+    TargetCrossingStatus& s = statuses_[c];
+    s.vertex = crossing_vertices_[c];
+    if (!x.active) {
+      s.status = "inactive";
+      continue;
+    }
+    beta_[c] = x.contact_angle / 2.0 - friction_angle;
+    const int v = s.vertex;
+    const int ci = static_cast<int>(c);
+    if (!closed && (v == 0 || v == m - 1))
+      mark(ci, "open_end", crossing_name(ci) + " is at an end of the open wire, where the wire has no kink to open");
+    else if (beta_[c] <= 0.0)
+      mark(ci, "infeasible",
+           crossing_name(ci) + " asks for contact angle " + deg(x.contact_angle) +
+               ", which is not wider than twice the friction angle atan(μ) = " + deg(friction_angle));
+    else if (pi - 2.0 * beta_[c] > o.max_bend + 1e-12)
+      mark(ci, "infeasible",
+           crossing_name(ci) + " needs a bend of at least " + deg(pi - 2.0 * beta_[c]) + " (contact angle " +
+               deg(x.contact_angle) + " minus twice the friction angle) but the machine bends at most " + deg(o.max_bend));
+  }
+  auto scale_message = [&](const Gap& g) {
+    const double scale = 2.0 * lmin / std::max(g.arc, 1e-300);
+    std::string msg = "crossings " + std::to_string(g.a) + " and " + std::to_string(g.b) + " on wire " + w + " are " +
+                      mm(g.arc) + " apart along the wire; a free bending point between them needs " + mm(2.0 * lmin) +
+                      ": scale the model up by " + fmt(scale) + "x";
+    if (o.model_size > 0.0) msg += ", to at least " + fmt(o.model_size * scale) + " m";
+    return std::make_pair(scale, msg);
+  };
+  for (const Gap& g : gaps) {
+    const auto [scale, msg] = scale_message(g);
+    if (g.chord < lmin) {
+      // The direct segment is too short to bend: a fabrication problem whatever the hooks.
+      mark(g.a, "too_close", msg + " (the straight piece is shorter than the minimum segment)", scale);
+      mark(g.b, "too_close", msg + " (the straight piece is shorter than the minimum segment)", scale);
+      continue;
+    }
+    // A fixed edge: its contact constraint is a constant that either holds or cannot be met.
+    for (int c : {g.a, g.b}) {
+      if (!crossings_[c].active || !statuses_[c].realised) continue;
+      const int v = crossing_vertices_[c];
+      const int other = crossing_vertices_[c == g.a ? g.b : g.a];
+      const double a = angle_between(initial_[other] - initial_[v], crossings_[c].bisector);
+      if (a > beta_[c] + o.angle_tolerance) mark(c, "too_close", msg, scale);
+    }
+  }
+
+  // The solver's constraints: those touching at least one free point.
+  const int edges = closed ? m : m - 1;
+  for (int i = 0; i < edges; ++i)
+    if (!fixed_[i] || !fixed_[(i + 1) % m]) constraints_.push_back({Kind::length, i, -1, -1});
+  for (int i = 0; i < m; ++i) {
+    if (!closed && (i == 0 || i == m - 1)) continue;
+    const int a = (i + m - 1) % m, b = (i + 1) % m;
+    if (m < 3) continue;
+    if (!fixed_[a] || !fixed_[i] || !fixed_[b]) constraints_.push_back({Kind::bend, i, -1, -1});
+  }
+  for (std::size_t c = 0; c < crossings_.size(); ++c) {
+    if (!crossings_[c].active || !statuses_[c].realised) continue;
+    const int v = crossing_vertices_[c];
+    for (int nb : {(v + m - 1) % m, (v + 1) % m})
+      if (!fixed_[nb]) constraints_.push_back({Kind::contact, v, nb, static_cast<int>(c)});
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Energy terms.
+
+double TargetShapeProblem::nearest_squared(const Vec2& q, Vec2* grad) const {
+  const int m = static_cast<int>(target_.size());
+  const int m_edges = closed_ ? m : m - 1;
+  double best = std::numeric_limits<double>::infinity();
+  Vec2 best_point = target_[0];
+  auto try_edge = [&](int k) {
+    const Vec2 c = closest_on_segment(q, target_[k], target_[(k + 1) % m]);
+    const double d2 = (q - c).squaredNorm();
+    if (d2 < best) best = d2, best_point = c;
+  };
+  if (m_edges == 0) {
+    best = (q - target_[0]).squaredNorm();
+  } else {
+    const double fx = (q.x() - grid_origin_.x()) / cell_, fy = (q.y() - grid_origin_.y()) / cell_;
+    if (fx < 0 || fy < 0 || fx >= grid_nx_ || fy >= grid_ny_) {
+      for (int k = 0; k < m_edges; ++k) try_edge(k);  // outside the target's box: rare, brute force
+    } else {
+      // Rings of grid cells around q; the nearest point of the polyline lies on an edge with an
+      // end within (distance + longest edge), so stop once the ring is farther than that.
+      const int cx = static_cast<int>(fx), cy = static_cast<int>(fy);
+      const int max_ring = std::max(grid_nx_, grid_ny_);
+      for (int ring = 0; ring <= max_ring; ++ring) {
+        if (std::isfinite(best) && (ring - 1) * cell_ > std::sqrt(best) + max_edge_) break;
+        for (int iy = cy - ring; iy <= cy + ring; ++iy) {
+          if (iy < 0 || iy >= grid_ny_) continue;
+          const bool edge_row = iy == cy - ring || iy == cy + ring;
+          for (int ix = cx - ring; ix <= cx + ring; ix += (edge_row ? 1 : 2 * ring)) {
+            if (ix >= 0 && ix < grid_nx_) {
+              const int cell = iy * grid_nx_ + ix;
+              for (int it = grid_start_[cell]; it < grid_start_[cell + 1]; ++it) {
+                const int k = grid_items_[it];
+                if (k < m_edges) try_edge(k);
+                if (closed_ || k > 0) try_edge((k + m - 1) % m);
+              }
+            }
+            if (ring == 0) break;
+          }
+        }
+      }
+    }
+  }
+  if (grad) *grad = 2.0 * (q - best_point);
+  return best;
+}
+
+double TargetShapeProblem::distance_to_contour(const Vec2& q) const { return std::sqrt(nearest_squared(q, nullptr)); }
+
+double TargetShapeProblem::imls(const Vec2& q, Vec2* grad) const {
+  const double h2 = h_ * h_;
+  double Phi = 0.0, N = 0.0;
+  Vec2 dPhi = Vec2::Zero(), dN = Vec2::Zero();
+  const int cx = static_cast<int>(std::floor((q.x() - grid_origin_.x()) / cell_));
+  const int cy = static_cast<int>(std::floor((q.y() - grid_origin_.y()) / cell_));
+  for (int iy = std::max(cy - 1, 0); iy <= std::min(cy + 1, grid_ny_ - 1); ++iy)
+    for (int ix = std::max(cx - 1, 0); ix <= std::min(cx + 1, grid_nx_ - 1); ++ix) {
+      const int cell = iy * grid_nx_ + ix;
+      for (int it = grid_start_[cell]; it < grid_start_[cell + 1]; ++it) {
+        const int k = grid_items_[it];
+        const Vec2 d = q - target_[k];
+        const double r2 = d.squaredNorm();
+        if (r2 >= h2) continue;
+        const double a = 1.0 - r2 / h2;
+        const double a3 = a * a * a;
+        const double phi = a3 * a;
+        const double nd = normals_[k].dot(d);
+        const double f = nd * nd;
+        Phi += phi;
+        N += phi * f;
+        if (grad) {
+          const Vec2 dphi = (-8.0 * a3 / h2) * d;
+          dPhi += dphi;
+          dN += f * dphi + (2.0 * phi * nd) * normals_[k];
+        }
+      }
+    }
+  if (Phi >= kernel_mass_full) {
+    const double I = N / Phi;
+    if (grad) *grad = (dN - I * dPhi) / Phi;
+    return I;
+  }
+  // Blend into the squared distance to the nearest target point: D = s I + (1 - s) g, with the
+  // C¹ smoothstep s(Φ/Φ0) that vanishes (with its derivative) where no kernel reaches q.
+  Vec2 dg;
+  const double g = nearest_squared(q, grad ? &dg : nullptr);
+  if (Phi <= 0.0) {
+    if (grad) *grad = dg;
+    return g;
+  }
+  const double t = Phi / kernel_mass_full;
+  const double s = t * t * (3.0 - 2.0 * t);
+  const double ds = 6.0 * t * (1.0 - t) / kernel_mass_full;
+  const double I = N / Phi;
+  if (grad) {
+    const Vec2 dI = (dN - I * dPhi) / Phi;
+    *grad = ds * (I - g) * dPhi + s * dI + (1.0 - s) * dg;
+  }
+  return s * I + (1.0 - s) * g;
+}
+
+double TargetShapeProblem::distance_term(const Polyline2& p, int i, Polyline2* grad) const {
+  const int m = static_cast<int>(p.size());
+  Vec2 dD;
+  const double D = imls(p[i], grad ? &dD : nullptr);
+  // w_i = |p_i - p_{i-1}| + |p_{i+1} - p_i| (one term at an open end).
+  double wi = 0.0;
+  for (int side : {-1, 1}) {
+    const int j = i + side;
+    if (!closed_ && (j < 0 || j >= m)) continue;
+    const int jj = (j + m) % m;
+    const Vec2 e = p[i] - p[jj];
+    const double len = e.norm();
+    wi += len;
+    if (grad && len > 0.0) {
+      const Vec2 de = (D / len) * e;
+      (*grad)[i] += de;
+      (*grad)[jj] -= de;
+    }
+  }
+  if (grad) (*grad)[i] += wi * dD;
+  return wi * D;
+}
+
+double TargetShapeProblem::regularization_term(const Polyline2& p, int i, double weight, Polyline2* grad) const {
+  const int m = static_cast<int>(p.size());
+  if (!closed_ && (i == 0 || i == m - 1)) return 0.0;
+  const int a = (i + m - 1) % m, b = (i + 1) % m;
+  const Vec2 L = (p[i] - initial_[i]) - 0.5 * ((p[a] - initial_[a]) + (p[b] - initial_[b]));
+  if (grad) {
+    (*grad)[i] += (2.0 * weight) * L;
+    (*grad)[a] -= weight * L;
+    (*grad)[b] -= weight * L;
+  }
+  return weight * L.squaredNorm();
+}
+
+double TargetShapeProblem::distance_energy(const Polyline2& p, Polyline2* grad) const {
+  if (grad) grad->resize(p.size(), Vec2::Zero());
+  double E = 0.0;
+  for (int i = 0; i < static_cast<int>(p.size()); ++i) E += distance_term(p, i, grad);
+  return E;
+}
+
+double TargetShapeProblem::regularization_energy(const Polyline2& p, Polyline2* grad) const {
+  if (grad) grad->resize(p.size(), Vec2::Zero());
+  double E = 0.0;
+  for (int i = 0; i < static_cast<int>(p.size()); ++i) E += regularization_term(p, i, 1.0, grad);
+  return E;
+}
+
+double TargetShapeProblem::energy(const Polyline2& p, Polyline2* grad) const {
+  if (grad) grad->resize(p.size(), Vec2::Zero());
+  double E = 0.0;
+  for (int i = 0; i < static_cast<int>(p.size()); ++i)
+    E += distance_term(p, i, grad) + regularization_term(p, i, options_.regularization, grad);
+  return E;
+}
+
+double TargetShapeProblem::energy_terms(const Polyline2& p, const std::vector<int>& terms, Polyline2* grad) const {
+  double E = 0.0;
+  for (int i : terms) E += distance_term(p, i, grad) + regularization_term(p, i, options_.regularization, grad);
+  return E;
+}
+
+namespace {
+// d(û·v̂)/du for non-zero u.
+Vec2 d_unit_dot(const Vec2& u, const Vec2& vhat) {
+  const double len = u.norm();
+  const Vec2 uhat = u / len;
+  return (vhat - uhat.dot(vhat) * uhat) / len;
+}
+}  // namespace
+
+double TargetShapeProblem::constraint(std::size_t k, const Polyline2& p, Polyline2* grad) const {
+  const Constraint& c = constraints_.at(k);
+  const int m = static_cast<int>(p.size());
+  if (grad) grad->resize(m, Vec2::Zero());
+  const double lmin2 = options_.min_segment * options_.min_segment;
+  switch (c.kind) {
+    case Kind::length: {
+      const int a = c.vertex, b = (c.vertex + 1) % m;
+      const Vec2 e = p[b] - p[a];
+      if (grad) {
+        (*grad)[b] -= (2.0 / lmin2) * e;
+        (*grad)[a] += (2.0 / lmin2) * e;
+      }
+      return 1.0 - e.squaredNorm() / lmin2;
+    }
+    case Kind::bend: {
+      const int i = c.vertex, a = (i + m - 1) % m, b = (i + 1) % m;
+      const Vec2 u = p[i] - p[a], v = p[b] - p[i];
+      const Vec2 uh = u.normalized(), vh = v.normalized();
+      if (grad) {
+        const Vec2 du = d_unit_dot(u, vh), dv = d_unit_dot(v, uh);  // of û·v̂
+        (*grad)[a] += du;
+        (*grad)[i] -= du;
+        (*grad)[i] += dv;
+        (*grad)[b] -= dv;
+      }
+      return std::cos(options_.max_bend) - uh.dot(vh);
+    }
+    case Kind::contact: {
+      const Vec2& h = crossings_[c.crossing].bisector;
+      const Vec2 u = p[c.neighbour] - p[c.vertex];
+      if (grad) {
+        const Vec2 du = d_unit_dot(u, h);
+        (*grad)[c.neighbour] -= du;
+        (*grad)[c.vertex] += du;
+      }
+      return std::cos(beta_[c.crossing]) - u.normalized().dot(h);
+    }
+  }
+  return 0.0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The solve.
+
+namespace {
+
+// One block of the problem handed to NLopt: some free points as variables (the others held at
+// their current positions), the energy terms they change and the constraints they touch.
+struct Block {
+  std::vector<int> points;       // variables, 2 per point
+  std::vector<int> terms;        // energy terms depending on them
+  std::vector<int> constraints;  // indices into TargetShapeProblem::constraints()
+};
+
+struct SolverData {
+  const TargetShapeProblem* problem = nullptr;
+  const Block* block = nullptr;
+  std::vector<int> var_of;  // point -> first variable index in the current block, -1 otherwise
+  double scale_x = 1.0;     // p = scale_x * x
+  double scale_f = 1.0;     // f = E / scale_f
+  Polyline2 p, grad, cgrad;
+  const ProgressFn* progress = nullptr;
+  int evaluations = 0;
+  int max_evaluations = 1;
+  bool cancelled = false;
+
+  void unpack(const double* x) {
+    for (std::size_t k = 0; k < block->points.size(); ++k) p[block->points[k]] = scale_x * Vec2(x[2 * k], x[2 * k + 1]);
+  }
+};
+
+std::array<int, 3> constraint_points(const TargetShapeProblem::Constraint& c, int np) {
+  switch (c.kind) {
+    case TargetShapeProblem::Kind::length: return {c.vertex, (c.vertex + 1) % np, -1};
+    case TargetShapeProblem::Kind::bend: return {(c.vertex + np - 1) % np, c.vertex, (c.vertex + 1) % np};
+    case TargetShapeProblem::Kind::contact: return {c.vertex, c.neighbour, -1};
+  }
+  return {-1, -1, -1};
+}
+
+double objective(unsigned, const double* x, double* g, void* data) {
+  auto* d = static_cast<SolverData*>(data);
+  ++d->evaluations;
+  if (d->progress && *d->progress) {
+    try {
+      report_progress(*d->progress, "target_shape",
+                      std::min(1.0, static_cast<double>(d->evaluations) / d->max_evaluations));
+    } catch (const Cancelled&) {
+      d->cancelled = true;
+      throw nlopt::forced_stop();
+    }
+  }
+  d->unpack(x);
+  if (!g) return d->problem->energy_terms(d->p, d->block->terms, nullptr) / d->scale_f;
+  std::fill(d->grad.begin(), d->grad.end(), Vec2::Zero());
+  const double E = d->problem->energy_terms(d->p, d->block->terms, &d->grad);
+  const double gs = d->scale_x / d->scale_f;
+  for (std::size_t k = 0; k < d->block->points.size(); ++k) {
+    g[2 * k] = gs * d->grad[d->block->points[k]].x();
+    g[2 * k + 1] = gs * d->grad[d->block->points[k]].y();
+  }
+  return E / d->scale_f;
+}
+
+void constraints_fn(unsigned m, double* result, unsigned n, const double* x, double* g, void* data) {
+  auto* d = static_cast<SolverData*>(data);
+  d->unpack(x);
+  const auto& all = d->problem->constraints();
+  const int np = static_cast<int>(d->p.size());
+  if (g) std::fill(g, g + static_cast<std::size_t>(m) * n, 0.0);
+  for (unsigned k = 0; k < m; ++k) {
+    const int ck = d->block->constraints[k];
+    if (!g) {
+      result[k] = d->problem->constraint(ck, d->p);
+      continue;
+    }
+    // A constraint touches at most three points: clear them, evaluate, scatter.
+    const auto pts = constraint_points(all[ck], np);
+    for (int q : pts)
+      if (q >= 0) d->cgrad[q] = Vec2::Zero();
+    result[k] = d->problem->constraint(ck, d->p, &d->cgrad);
+    double* row = g + static_cast<std::size_t>(k) * n;
+    for (int q : pts) {
+      if (q < 0 || d->var_of[q] < 0) continue;
+      row[d->var_of[q]] = d->scale_x * d->cgrad[q].x();
+      row[d->var_of[q] + 1] = d->scale_x * d->cgrad[q].y();
+    }
+  }
+}
+
+nlopt::algorithm nlopt_algorithm(TargetShapeAlgorithm a) {
+  switch (a) {
+    case TargetShapeAlgorithm::slsqp: return nlopt::LD_SLSQP;
+    case TargetShapeAlgorithm::auglag_lbfgs: return nlopt::AUGLAG;
+    case TargetShapeAlgorithm::ccsaq: return nlopt::LD_CCSAQ;
+    case TargetShapeAlgorithm::mma: return nlopt::LD_MMA;
+  }
+  return nlopt::LD_SLSQP;
+}
+
+// Builds the block of the points in `range` (free ones only).
+Block make_block(const TargetShapeProblem& problem, const std::vector<int>& range) {
+  const int m = static_cast<int>(problem.initial().size());
+  const bool closed = problem.closed();
+  Block b;
+  std::vector<char> in(m, 0), term(m, 0);
+  for (int i : range)
+    if (!problem.fixed()[i]) {
+      b.points.push_back(i);
+      in[i] = 1;
+      for (int s : {-1, 0, 1}) {
+        const int j = i + s;
+        if (!closed && (j < 0 || j >= m)) continue;
+        term[(j + m) % m] = 1;
+      }
+    }
+  for (int i = 0; i < m; ++i)
+    if (term[i]) b.terms.push_back(i);
+  const auto& cons = problem.constraints();
+  for (std::size_t k = 0; k < cons.size(); ++k)
+    for (int q : constraint_points(cons[k], m))
+      if (q >= 0 && in[q]) {
+        b.constraints.push_back(static_cast<int>(k));
+        break;
+      }
+  return b;
+}
+
+}  // namespace
+
+TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
+                                        const std::vector<TargetCrossing>& crossings,
+                                        const TargetShapeOptions& options, const ProgressFn& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  report_progress(progress, "target_shape", 0.0);
+  const TargetShapeProblem problem(contour, closed, crossings, options);
+  const TargetShapeOptions& o = problem.options_;
+  const std::string& w = o.wire_name;
+  TargetShapeResult result;
+  Polyline2 p = problem.initial();
+  const int m = static_cast<int>(p.size());
+
+  // Start: each free neighbour of an active crossing that lies outside the contact cone is turned
+  // about the crossing point onto the cone (keeping its distance and its side of h*), so that
+  // the kinks start open the right way. The regulariser still measures from initial().
+  for (std::size_t c = 0; c < crossings.size(); ++c) {
+    const TargetCrossingStatus& s = problem.statuses_[c];
+    if (!problem.crossings_[c].active || !s.realised) continue;
+    const Vec2 h = problem.crossings_[c].bisector;
+    const double cone = problem.beta_[c] * (1.0 - 1e-3);
+    const int v = s.vertex;
+    int side_used = 0;
+    for (int nb : {(v + m - 1) % m, (v + 1) % m}) {
+      const Vec2 u = p[nb] - p[v];
+      int side = cross2(h, u) >= 0.0 ? 1 : -1;
+      if (side == side_used) side = -side;  // both edges on one side would close the kink
+      side_used = side;
+      const bool inside = angle_between(u, h) <= cone && side == (cross2(h, u) >= 0.0 ? 1 : -1);
+      if (problem.fixed()[nb] || inside) continue;
+      const double a = side * cone;
+      p[nb] = p[v] + u.norm() * Vec2(std::cos(a) * h.x() - std::sin(a) * h.y(), std::sin(a) * h.x() + std::cos(a) * h.y());
+    }
+  }
+
+  // The blocks: one for the whole wire (window 0 or at most 4 × window points), or overlapping
+  // windows of `window` points every window/2 points (every constraint, spanning at most three
+  // consecutive points, lies inside one window), solved in turn until no window moves (see
+  // docs/method-target-shape.md).
+  std::vector<Block> blocks;
+  const int window = o.window;
+  if (window <= 0 || m <= 4 * window) {  // small wires: one block is as cheap
+    std::vector<int> all(m);
+    for (int i = 0; i < m; ++i) all[i] = i;
+    blocks.push_back(make_block(problem, all));
+  } else {
+    // First a window of `window` points centred on each active crossing (both sides of the kink
+    // move together), then the uniform tiling.
+    for (std::size_t c = 0; c < crossings.size(); ++c) {
+      const TargetCrossingStatus& s = problem.statuses_[c];
+      if (!problem.crossings_[c].active || !s.realised) continue;
+      std::vector<int> range;
+      const int half = window / 2;
+      for (int j = -half; j < half; ++j) {
+        const int q = s.vertex + j;
+        if (closed || (q >= 0 && q < m)) range.push_back((q + m) % m);
+      }
+      blocks.push_back(make_block(problem, range));
+    }
+    const int stride = window / 2;
+    const int count = closed ? (m + stride - 1) / stride : std::max(1, (m - window + stride - 1) / stride + 1);
+    for (int k = 0; k < count; ++k) {
+      std::vector<int> range;
+      const int start = closed ? k * stride : std::min(k * stride, m - window);
+      for (int j = 0; j < window; ++j) range.push_back(closed ? (start + j) % m : start + j);
+      blocks.push_back(make_block(problem, range));
+    }
+  }
+  std::erase_if(blocks, [](const Block& b) { return b.points.empty(); });
+
+  SolverData data;
+  data.problem = &problem;
+  data.var_of.assign(m, -1);
+  data.scale_x = o.min_segment;
+  // E_d ≈ Σ 2·spacing·d_i²: this scale makes the energy's curvature across the contour O(1)
+  // per point in the scaled variables, which is where SLSQP's initial Hessian guess is I.
+  data.scale_f = 2.0 * o.spacing * o.min_segment * o.min_segment;
+  data.p = p;
+  data.grad.assign(m, Vec2::Zero());
+  data.cgrad.assign(m, Vec2::Zero());
+  data.progress = &progress;
+  data.max_evaluations = o.max_iterations;
+  result.nlopt_result = "none";
+  std::string worst_result;
+  auto solve_block = [&](const Block& b) {
+    const unsigned nvar = static_cast<unsigned>(2 * b.points.size());
+    data.block = &b;
+    for (std::size_t k = 0; k < b.points.size(); ++k) data.var_of[b.points[k]] = static_cast<int>(2 * k);
+    nlopt::opt opt(nlopt_algorithm(o.algorithm), nvar);
+    if (o.algorithm == TargetShapeAlgorithm::auglag_lbfgs) {
+      nlopt::opt local(nlopt::LD_LBFGS, nvar);
+      local.set_ftol_rel(o.ftol_rel);
+      local.set_xtol_rel(o.xtol_rel);
+      local.set_maxeval(o.max_iterations);
+      opt.set_local_optimizer(local);
+    }
+    opt.set_min_objective(objective, &data);
+    if (!b.constraints.empty())
+      opt.add_inequality_mconstraint(constraints_fn, &data, std::vector<double>(b.constraints.size(), o.constraint_tol));
+    opt.set_ftol_rel(o.ftol_rel);
+    opt.set_xtol_rel(o.xtol_rel);
+    opt.set_maxeval(std::max(1, o.max_iterations - data.evaluations));
+    std::vector<double> x(nvar);
+    for (std::size_t k = 0; k < b.points.size(); ++k) {
+      x[2 * k] = data.p[b.points[k]].x() / data.scale_x;
+      x[2 * k + 1] = data.p[b.points[k]].y() / data.scale_x;
+    }
+    const Polyline2 before = data.p;
+    double f = 0.0;
+    nlopt::result r = nlopt::FAILURE;
+    try {
+      r = opt.optimize(x, f);
+    } catch (const nlopt::roundoff_limited&) {
+      r = nlopt::ROUNDOFF_LIMITED;
+    } catch (const nlopt::forced_stop&) {
+      r = nlopt::FORCED_STOP;
+    } catch (const std::invalid_argument& e) {
+      throw SolverError("target shape of wire " + w + ": NLopt rejected the problem (" + e.what() + ")");
+    } catch (const std::bad_alloc&) {
+      throw;
+    } catch (const std::runtime_error&) {
+      r = nlopt::FAILURE;
+    }
+    if (data.cancelled) throw Cancelled();
+    bool finite = true;
+    for (double v : x) finite = finite && std::isfinite(v);
+    // Keep the block's answer only if it is no worse than where it started (SLSQP can stop with
+    // NLOPT_FAILURE at a poor point, e.g. when its line search fails): less violation, or as
+    // feasible and no more energy.
+    auto merit = [&](const Polyline2& q) {
+      double viol = 0.0;
+      for (int k : b.constraints) viol = std::max(viol, problem.constraint(k, q));
+      return std::make_pair(viol, problem.energy_terms(q, b.terms));
+    };
+    const auto [viol0, e0] = merit(before);
+    data.p = before;
+    if (finite) {
+      Polyline2 after = before;
+      for (std::size_t k = 0; k < b.points.size(); ++k) after[b.points[k]] = data.scale_x * Vec2(x[2 * k], x[2 * k + 1]);
+      const auto [viol1, e1] = merit(after);
+      const double tol = o.constraint_tol;
+      const bool feasible_and_lower = viol1 <= tol && (viol0 > tol || e1 <= e0 + 1e-14 * std::abs(e0));
+      const bool less_infeasible = r > 0 && viol0 > tol && viol1 < viol0;
+      const bool better = feasible_and_lower || less_infeasible;
+      if (better) data.p = after;
+    }
+    double moved = 0.0;
+    for (int q : b.points) moved = std::max(moved, (data.p[q] - before[q]).norm());
+    for (int q : b.points) data.var_of[q] = -1;
+    // Keep the first non-success code (a failure in any block is the one worth reporting).
+    const std::string text = result_text(r);
+    if (r < 0 && worst_result.empty()) worst_result = text;
+    result.nlopt_result = worst_result.empty() ? text : worst_result;
+    if (!finite) result.warnings.push_back("the solver diverged on part of wire " + w + "; that part keeps its previous shape");
+    return moved;
+  };
+
+  if (blocks.size() == 1) {
+    solve_block(blocks[0]);
+    result.sweeps = 1;
+  } else if (!blocks.empty()) {
+    // Multiplicative Schwarz sweeps: a window is solved again only when a point it depends on
+    // moved by more than move_tol since it was last solved.
+    const double move_tol = o.sweep_tol;
+    std::vector<char> dirty(blocks.size(), 1);
+    std::vector<std::vector<int>> watchers(m);  // point -> blocks whose terms read it
+    for (std::size_t k = 0; k < blocks.size(); ++k)
+      for (int t : blocks[k].terms)
+        for (int s : {-1, 0, 1}) {
+          const int j = t + s;
+          if (!closed && (j < 0 || j >= m)) continue;
+          auto& wv = watchers[(j + m) % m];
+          if (wv.empty() || wv.back() != static_cast<int>(k)) wv.push_back(static_cast<int>(k));
+        }
+    for (int sweep = 0; sweep < o.max_sweeps; ++sweep) {
+      bool any = false;
+      for (std::size_t k = 0; k < blocks.size(); ++k) {
+        if (!dirty[k]) continue;
+        any = true;
+        dirty[k] = 0;
+        const Polyline2 before = data.p;
+        solve_block(blocks[k]);
+        for (int q : blocks[k].points)
+          if ((data.p[q] - before[q]).norm() > move_tol)
+            for (int other : watchers[q])
+              if (other != static_cast<int>(k)) dirty[other] = 1;
+        if (data.evaluations >= o.max_iterations) break;
+      }
+      if (!any) break;
+      result.sweeps = sweep + 1;
+      if (data.evaluations >= o.max_iterations) {
+        result.nlopt_result = "NLOPT_MAXEVAL_REACHED";
+        break;
+      }
+    }
+  }
+  result.iterations = data.evaluations;
+  p = data.p;
+
+  // Measure the result.
+  result.points = p;
+  result.crossing_vertices = problem.crossing_vertices();
+  result.crossings = problem.statuses();
+  result.energy = problem.energy(p);
+  const double friction_angle = std::atan(o.friction);
+  double sum2 = 0.0;
+  for (const Vec2& q : p) {
+    const double d = problem.distance_to_contour(q);
+    result.max_distance = std::max(result.max_distance, d);
+    sum2 += d * d;
+  }
+  result.rms_distance = std::sqrt(sum2 / std::max(m, 1));
+  const int edges = closed ? m : m - 1;
+  result.min_segment = std::numeric_limits<double>::infinity();
+  std::vector<int> short_edges, sharp_bends;
+  for (int i = 0; i < edges; ++i) {
+    const double len = (p[(i + 1) % m] - p[i]).norm();
+    result.min_segment = std::min(result.min_segment, len);
+    const double v = o.min_segment - len;
+    if (v > 0.0) result.max_length_violation = std::max(result.max_length_violation, v);
+    if (v > o.length_tolerance) short_edges.push_back(i);
+  }
+  if (edges == 0) result.min_segment = 0.0;
+  for (int i = 0; i < m; ++i) {
+    if ((!closed && (i == 0 || i == m - 1)) || m < 3) continue;
+    const Vec2 u = p[i] - p[(i + m - 1) % m], v = p[(i + 1) % m] - p[i];
+    const double bend = angle_between(u, v);
+    result.max_bend = std::max(result.max_bend, bend);
+    if (bend - o.max_bend > 0.0) result.max_angle_violation = std::max(result.max_angle_violation, bend - o.max_bend);
+    if (bend - o.max_bend > o.angle_tolerance) sharp_bends.push_back(i);
+  }
+  for (std::size_t c = 0; c < crossings.size(); ++c) {
+    TargetCrossingStatus& s = result.crossings[c];
+    const int v = s.vertex;
+    const bool has_prev = closed || v > 0, has_next = closed || v < m - 1;
+    if (has_prev && has_next) {
+      const Vec2 en = (p[(v + 1) % m] - p[v]).normalized(), ep = (p[v] - p[(v + m - 1) % m]).normalized();
+      const Vec2 b = en - ep;
+      s.bisector = b.norm() > 1e-12 ? Vec2(b.normalized()) : Vec2::Zero();
+      s.contact_angle = angle_between(en, -ep);
+    }
+    if (!crossings[c].active) continue;
+    const Vec2 h = crossings[c].bisector.normalized();
+    double worst = -std::numeric_limits<double>::infinity();
+    for (int nb : {v - 1, v + 1}) {
+      if (!closed && (nb < 0 || nb >= m)) continue;
+      const double a = angle_between(p[(nb + m) % m] - p[v], h) + friction_angle - crossings[c].contact_angle / 2.0;
+      worst = std::max(worst, a);
+    }
+    s.contact_violation = std::isfinite(worst) ? worst : 0.0;
+    if (!s.realised) continue;
+    result.max_angle_violation = std::max(result.max_angle_violation, s.contact_violation);
+    if (s.contact_violation > o.angle_tolerance) {
+      result.feasible = false;
+      s.status = "infeasible";
+      s.realised = false;
+      s.message = "crossing " + std::to_string(c) + " on wire " + w +
+                  ": the kink could not be opened towards the desired bisector within the fabrication limits (an edge is " +
+                  deg(s.contact_violation) + " outside the contact cone)";
+    }
+  }
+  auto list = [](const std::vector<int>& v) {
+    std::string s;
+    for (std::size_t k = 0; k < v.size() && k < 8; ++k) s += (k ? ", " : "") + std::to_string(v[k]);
+    if (v.size() > 8) s += ", ...";
+    return s;
+  };
+  if (!short_edges.empty())
+    result.warnings.push_back("wire " + w + ": segments starting at points " + list(short_edges) + " are shorter than " +
+                              mm(o.min_segment) + " (by up to " + mm(result.max_length_violation) + ")");
+  if (!sharp_bends.empty())
+    result.warnings.push_back("wire " + w + ": bends at points " + list(sharp_bends) + " exceed " + deg(o.max_bend));
+  result.feasible = result.feasible && short_edges.empty() && sharp_bends.empty();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  report_progress(progress, "target_shape", 1.0);
+  return result;
+}
+
+}  // namespace wiresculpt
