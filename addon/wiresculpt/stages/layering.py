@@ -22,9 +22,10 @@ def wire_specs(design, key="contour"):
             for w in design["wires"]]
 
 
-def run(design, material, settings, progress=None):
-    """Fills crossings, assembly order, stable/reason and stages.layering. Returns a progress line."""
-    result = native.require().layering(wire_specs(design), settings_for(material, settings), progress)
+def run(design, material, settings, native_progress=None):
+    """Fills crossings, assembly order, stable/reason and stages.layering. Returns a progress line.
+    `native_progress(stage, fraction) -> bool` (False cancels) is handed to the solver."""
+    result = native.require().layering(wire_specs(design), settings_for(material, settings), native_progress)
     net = result["network"]
     for wire, solved in zip(design["wires"], net["wires"]):
         wire["contour"] = solved["points"].tolist()  # the sliced contour with its crossing points inserted

@@ -39,7 +39,7 @@ def model_size(design):
     return float(np.max(points.max(axis=0) - points.min(axis=0)))
 
 
-def solve_wire(design, wire, material, settings, size):
+def solve_wire(design, wire, material, settings, size, native_progress=None):
     """(result, [(crossing, k)]) of the native optimisation of one wire."""
     _n, u, v = plane_frame(wire["plane"]["normal"])
     origin = wire["plane"]["origin"]
@@ -56,18 +56,18 @@ def solve_wire(design, wire, material, settings, size):
     options = {"min_segment": settings["min_segment"], "max_bend": math.radians(settings["max_bend_deg"]),
                "friction": material["friction"], "model_size": size, "wire_name": wire["name"]}
     result = native.require().optimize_target_shape(to_2d(wire["contour"], origin, u, v), wire["closed"],
-                                                    specs, options)
+                                                    specs, options, native_progress)
     return result, refs, (origin, u, v)
 
 
-def run(design, material, settings):
+def run(design, material, settings, native_progress=None):
     """Fills each wire's target, length and distances, each crossing's vertices, stages.target_shape;
     nulls crossings that cannot be realised and re-checks stability. Returns a progress line."""
     start = time.perf_counter()
     size = model_size(design)
     nulled, iterations = [], 0
     for _round in range(MAX_ROUNDS):
-        solved = [solve_wire(design, w, material, settings, size) for w in design["wires"]]
+        solved = [solve_wire(design, w, material, settings, size, native_progress) for w in design["wires"]]
         iterations += sum(r["iterations"] for r, _refs, _frame in solved)
         failing = {}
         for wire, (r, refs, _frame) in zip(design["wires"], solved):
