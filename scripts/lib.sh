@@ -14,6 +14,9 @@ PACKAGES=(
   libglpk-dev libnlopt-cxx-dev libserialport-dev
 )
 
+# The sanitizer and fuzz builds (scripts/test, scripts/fuzz).
+FUZZ_PACKAGES=(clang libclang-rt-14-dev)
+
 say() { printf 'wiresculpt: %s\n' "$*" >&2; }
 
 as_root() {
@@ -43,6 +46,24 @@ build() {
     return 1
   fi
   grep -E 'warning:' "$BUILD_DIR/build.log" | grep -v 'lto-wrapper' >&2 || true
+}
+
+# The native tests built with AddressSanitizer and UBSan (no Python module).
+build_sanitize() {
+  if [ ! -f "$ROOT/build/sanitize/CMakeCache.txt" ]; then
+    cmake --preset sanitize -S "$ROOT" >/dev/null
+  fi
+  cmake --build "$ROOT/build/sanitize" -j"$(nproc)" >"$ROOT/build/sanitize/build.log" 2>&1 ||
+    { cat "$ROOT/build/sanitize/build.log" >&2; say "sanitizer build failed"; return 1; }
+}
+
+# The libFuzzer targets, built with clang.
+build_fuzz() {
+  if [ ! -f "$ROOT/build/fuzz/CMakeCache.txt" ]; then
+    cmake --preset fuzz -S "$ROOT" >/dev/null
+  fi
+  cmake --build "$ROOT/build/fuzz" -j"$(nproc)" >"$ROOT/build/fuzz/build.log" 2>&1 ||
+    { cat "$ROOT/build/fuzz/build.log" >&2; say "fuzz build failed"; return 1; }
 }
 
 # Runs a Python file inside headless Blender; extra arguments follow "--".
