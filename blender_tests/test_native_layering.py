@@ -62,5 +62,40 @@ class LayeringBinding(unittest.TestCase):
             native.module.layering(wires, {}, lambda stage, fraction: False)
 
 
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class ProgressCallbacks(unittest.TestCase):
+    """One adapter serves every binding: None continues, False cancels, an exception in the
+    callback is re-raised as itself."""
+
+    def calls(self, progress):
+        wires = [wire("X", [1, 0, 0]), wire("Y", [0, 1, 0]), wire("Z", [0, 0, 1])]
+        line = np.stack([np.linspace(0, 0.3, 40), np.zeros(40)], axis=1)
+        yield lambda: native.module.layering(wires, {}, progress)
+        yield lambda: native.module.optimize_target_shape(line, False, [], {}, progress)
+
+    def test_none_continues(self):
+        seen = []
+        for call in self.calls(lambda stage, fraction: seen.append(stage)):
+            call()
+        self.assertIn("layering", seen)
+        self.assertTrue(len(set(seen)) >= 2, seen)
+
+    def test_false_cancels(self):
+        for call in self.calls(lambda stage, fraction: False):
+            with self.assertRaises(native.module.Cancelled):
+                call()
+
+    def test_exception_is_reraised(self):
+        class Boom(Exception):
+            pass
+
+        def explode(stage, fraction):
+            raise Boom(stage)
+
+        for call in self.calls(explode):
+            with self.assertRaises(Boom):
+                call()
+
+
 if __name__ == "__main__":
     unittest.main()

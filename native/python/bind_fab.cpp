@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "bindings.hpp"
+#include "progress.hpp"
 #include "wiresculpt/error.hpp"
 #include "wiresculpt/fab/atomic_file.hpp"
 #include "wiresculpt/fab/bend_program.hpp"
@@ -241,7 +242,7 @@ std::string write_bend_table(const std::optional<std::string>& path, const Point
 }
 
 py::dict stream_program_py(const std::string& port, const std::vector<std::string>& lines, const py::dict& profile,
-                           py::dict state, const std::optional<py::function>& progress, StreamControl* control,
+                           py::dict state, const py::object& progress, StreamControl* control,
                            bool dry_run, double response_timeout, double settle) {
   const MachineProfile m = to_profile(profile);
   StreamState s;
@@ -255,34 +256,16 @@ py::dict stream_program_py(const std::string& port, const std::vector<std::strin
   o.response_timeout = response_timeout;
   o.settle = settle;
   o.control = control;
-  std::exception_ptr callback_error;
-  ProgressFn fn;
-  if (progress) {
-    const py::function* f = &*progress;  // lives in this frame; no refcounting without the GIL
-    fn = [f, &callback_error](std::string_view stage, double fraction) {
-      py::gil_scoped_acquire acquire;
-      try {
-        const py::object r = (*f)(std::string(stage), fraction);
-        return r.is_none() || py::cast<bool>(r);
-      } catch (...) {
-        callback_error = std::current_exception();
-        return false;  // stop the machine, then re-raise below
-      }
-    };
-  }
+  PythonProgress reporter(progress);
+  const ProgressFn fn = reporter.fn();
   StreamResult r;
-  std::exception_ptr stream_error;
-  {
-    py::gil_scoped_release release;
-    try {
-      r = stream_program(port, lines, m, s, o, fn);
-    } catch (...) {
-      stream_error = std::current_exception();
-    }
+  try {
+    r = reporter.run([&] { return stream_program(port, lines, m, s, o, fn); });
+  } catch (...) {
+    state["next_line"] = s.next_line;  // what was acknowledged stays acknowledged: resume from here
+    throw;
   }
   state["next_line"] = s.next_line;
-  if (callback_error) std::rethrow_exception(callback_error);
-  if (stream_error) std::rethrow_exception(stream_error);
   return py::dict(py::arg("status") = std::string(to_string(r.status)), py::arg("sent") = r.sent,
                   py::arg("acknowledged") = r.acknowledged, py::arg("last_acknowledged") = r.last_acknowledged,
                   py::arg("failed_line") = r.failed_line, py::arg("code") = r.code, py::arg("message") = r.message,

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "bindings.hpp"
+#include "progress.hpp"
 #include "wiresculpt/error.hpp"
 #include "wiresculpt/layering.hpp"
 #include "wiresculpt/network.hpp"
@@ -106,42 +107,20 @@ py::dict network_dict(const Network& net, const std::vector<int>& hooks) {
                   py::arg("required_size") = net.required_size);
 }
 
-py::dict layering_py(const py::list& wire_list, const py::dict& settings, const std::optional<py::function>& progress) {
+py::dict layering_py(const py::list& wire_list, const py::dict& settings, const py::object& progress) {
   std::vector<WireSpec> wires;
   for (std::size_t i = 0; i < wire_list.size(); ++i) wires.push_back(to_wire(wire_list[i], i));
   NetworkOptions net_options;
   LayeringOptions options;
   read_settings(settings, net_options, options);
 
-  std::exception_ptr callback_error;
-  ProgressFn fn;
-  if (progress) {
-    const py::function* f = &*progress;  // lives in this frame; no refcounting without the GIL
-    fn = [f, &callback_error](std::string_view stage, double fraction) {
-      py::gil_scoped_acquire acquire;
-      try {
-        const py::object r = (*f)(std::string(stage), fraction);
-        return r.is_none() || py::cast<bool>(r);
-      } catch (...) {
-        callback_error = std::current_exception();
-        return false;  // stop the search, then re-raise below
-      }
-    };
-  }
+  PythonProgress reporter(progress);
+  const ProgressFn fn = reporter.fn();
   Network net;
-  LayeringResult r;
-  std::exception_ptr core_error;
-  {
-    py::gil_scoped_release release;
-    try {
-      net = build_network(wires, net_options);
-      r = layering(net, options, fn);
-    } catch (...) {
-      core_error = std::current_exception();
-    }
-  }
-  if (callback_error) std::rethrow_exception(callback_error);
-  if (core_error) std::rethrow_exception(core_error);
+  const LayeringResult r = reporter.run([&] {
+    net = build_network(wires, net_options);
+    return layering(net, options, fn);
+  });
 
   py::list warnings;
   for (const auto& w : net.warnings) warnings.append(w);

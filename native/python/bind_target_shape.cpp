@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "bindings.hpp"
+#include "progress.hpp"
 #include "wiresculpt/target_shape.hpp"
 
 namespace py = pybind11;
@@ -87,21 +88,9 @@ py::dict optimize(const py::array_t<double, py::array::c_style | py::array::forc
   const Polyline2 contour = to_points(points);
   const std::vector<TargetCrossing> xs = to_crossings(crossings);
   const TargetShapeOptions o = to_options(options);
-  ProgressFn fn;
-  if (!progress.is_none())
-    fn = [progress](std::string_view stage, double fraction) {
-      py::gil_scoped_acquire gil;
-      try {
-        return py::cast<bool>(progress(std::string(stage), fraction));
-      } catch (py::error_already_set&) {
-        return false;  // an exception in the callback cancels the run
-      }
-    };
-  TargetShapeResult r;
-  {
-    py::gil_scoped_release release;
-    r = optimize_target_shape(contour, closed, xs, o, fn);
-  }
+  PythonProgress reporter(progress);
+  const ProgressFn fn = reporter.fn();
+  const TargetShapeResult r = reporter.run([&] { return optimize_target_shape(contour, closed, xs, o, fn); });
   py::array_t<double> pts({static_cast<py::ssize_t>(r.points.size()), py::ssize_t{2}});
   auto w = pts.mutable_unchecked<2>();
   for (py::ssize_t i = 0; i < w.shape(0); ++i)
