@@ -5,7 +5,7 @@ GIL) with `cancel` wired to its Esc key.
 """
 from . import native
 from .core.design import new_design
-from .stages import layering, slicing, target_shape
+from .stages import forces, layering, slicing, target_shape
 
 ALL_STAGES = ["layering", "target_shape", "forces", "rest_shape"]
 
@@ -55,10 +55,14 @@ def solve(design, material, settings, progress=None, cancel=None):
         checkpoint()
         say("target_shape", target_shape.run(design, material, settings, native_progress))
         design["pending_stages"].remove("target_shape")
+        if design["stable"]:  # forces need the hooks of a complete stable assembly
+            checkpoint()
+            say("forces", forces.run(design, material, settings, native_progress))
+            design["pending_stages"].remove("forces")
+            say("rest_shape", forces.rest_summary(design))
+            design["pending_stages"].remove("rest_shape")
     except native.module.Cancelled:
         raise Cancelled() from None
-    if design["stable"]:
-        say("pending", "forces and rest shape are not computed by this version")
     return design
 
 

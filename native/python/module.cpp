@@ -32,4 +32,5 @@ PYBIND11_MODULE(_wiresculpt, m) {
   wiresculpt::python::bind_fab(m);
   wiresculpt::python::bind_layering(m);
   wiresculpt::python::bind_target_shape(m);
+  wiresculpt::python::bind_forces(m);
 }

@@ -1,0 +1,108 @@
+"""Internal forces, cuts, rest shapes and load capacity (Sec. 4.4, Eq. 6-12, and beyond the paper):
+one native call on the target shapes (docs/method-forces.md).
+
+Fills, per crossing, `force` (N, on wires[0] by wires[1], FORMATS.md), `normal_force` and
+`out_of_plane` (|f.n|/|f| for the plane of wires[0] and of wires[1]); per wire `cut`, `rest`
+(2D, metres, in the wire's plane frame, from the cut in the direction of increasing target index),
+`rest_angles` and `target_angles` (radians, one per rest point), `closure_gap` (m),
+`max_torque` (N m) and `max_torque_vertex`, `max_out_of_plane_torque`, `rest_over_bend`;
+`load_capacity` (weight_N and the multiple of it the sculpture holds with gravity along each
+axis direction; absent when the material has no density), `out_of_plane` statistics,
+`stages.forces` and `stages.rest_shape`. Only computed values are written.
+
+A user's cut for a closed wire may be given as the wire's `cut_override` (index into `target`);
+it is validated by the solver (a ValueError names the wire).
+"""
+import math
+
+import numpy as np
+
+from .. import native
+
+AXES = ("+x", "-x", "+y", "-y", "+z", "-z")
+
+
+def _inputs(design):
+    wires = [{"name": w["name"], "origin": w["plane"]["origin"], "normal": w["plane"]["normal"],
+              "target": np.asarray(w["target"], dtype=np.float64), "closed": w["closed"],
+              "cut": int(w.get("cut_override", -1))}
+             for w in design["wires"]]
+    crossings = [{"wires": list(c["wires"]), "vertices": list(c["vertices"]), "hook": int(c["hook"])}
+                 for c in design["crossings"]]
+    return wires, crossings
+
+
+def run(design, material, settings, native_progress=None):
+    """Computes forces, rest shapes and load capacity into `design`. Returns the forces stage's
+    progress line; rest_summary(design) gives the rest-shape stage's."""
+    wires, crossings = _inputs(design)
+    mat = {k: material[k] for k in ("bending_stiffness", "max_torque", "friction", "wire_diameter", "density")
+           if k in material}
+    options = {"torque_fraction": settings["torque_fraction"], "max_bend": math.radians(settings["max_bend_deg"])}
+    steps = [list(s) for s in design.get("assembly_steps", [])]
+    r = native.require().forces_and_rest(wires, crossings, steps, mat, options, native_progress)
+
+    for c, out in zip(design["crossings"], r["crossings"]):
+        c["force"] = [float(x) for x in out["force"]]
+        c["normal_force"] = float(out["normal"])
+        c["out_of_plane"] = [float(x) for x in out["out_of_plane"]]
+    for w, out in zip(design["wires"], r["wires"]):
+        w["cut"] = int(out["cut"])
+        w["rest"] = np.asarray(out["rest"]).tolist()
+        w["rest_angles"] = [float(a) for a in out["rest_angles"]]
+        w["target_angles"] = [float(a) for a in out["target_angles"]]
+        w["closure_gap"] = float(out["closure_gap"])
+        w["max_torque"] = float(out["max_torque"])
+        w["max_torque_vertex"] = int(out["max_torque_vertex"])
+        w["max_out_of_plane_torque"] = float(out["max_out_of_plane_torque"])
+        w["rest_over_bend"] = [{"vertex": int(o["vertex"]), "angle_deg": math.degrees(o["angle"])}
+                               for o in out["over_bend"]]
+        for o in out["over_bend"]:
+            design.setdefault("warnings", []).append(
+                f"wire {w['name']}: the rest shape bends {math.degrees(abs(o['angle'])):.1f} deg at vertex "
+                f"{o['vertex']}, more than the machine's {settings['max_bend_deg']:g} deg; lower the torque "
+                "fraction or the maximum bend of the target shape and solve again")
+    summary, stats = r["forces"], r["stats"]
+    hooked = [c for c in design["crossings"] if c["hook"] != 0]
+    design["out_of_plane"] = {"mean": summary["mean_out_of_plane"], "max": summary["max_out_of_plane"],
+                              "crossings": len(hooked)}
+    if r["load_capacity"] is not None:
+        lc = r["load_capacity"]
+        design["load_capacity"] = {"weight_N": lc["weight_N"], "length": lc["length"],
+                                   **{axis: lc[axis] for axis in AXES},
+                                   "base": {axis: [design["wires"][i]["name"] for i in lc["base"][axis]]
+                                            for axis in AXES},
+                                   "status": dict(lc["status"])}
+    design.setdefault("warnings", []).extend(r["warnings"])
+    design["stages"]["forces"] = {
+        "seconds": stats["forces_seconds"], "lp_seconds": stats["lp_seconds"], "nlp_seconds": stats["nlp_seconds"],
+        "lp_iterations": stats["lp_iterations"], "iterations": stats["iterations"], "method": summary["method"],
+        "nlopt_result": summary["nlopt_result"], "g_stb": summary["g_stb"], "g_asm": summary["g_asm"],
+        "assembly_residual": summary["assembly_residual"], "equilibrium_residual": summary["equilibrium_residual"],
+        "t_max": summary["t_max"], "torque_active": summary["torque_active"],
+        "load_capacity_seconds": r["load_capacity"]["seconds"] if r["load_capacity"] is not None else None,
+    }
+    gaps = [w["closure_gap"] for w in design["wires"] if w["closed"]]
+    design["stages"]["rest_shape"] = {
+        "seconds": stats["rest_seconds"],
+        "max_closure_gap": max(gaps) if gaps else 0.0,
+        "over_bend": sum(len(w["rest_over_bend"]) for w in design["wires"]),
+    }
+    normals = [c["normal_force"] for c in hooked]
+    line = (f"{len(hooked)} loaded crossings, normal forces {min(normals, default=0):.2f}-"
+            f"{max(normals, default=0):.2f} N (sum {summary['g_stb'] / 2:.2f} N), out of plane "
+            f"{100 * summary['mean_out_of_plane']:.1f}% mean, {100 * summary['max_out_of_plane']:.1f}% max, "
+            f"{summary['method']} ({stats['forces_seconds']:.3f} s)")
+    if "load_capacity" in design:
+        lc = design["load_capacity"]
+        held = [lc[a] for a in AXES if lc[a] is not None]
+        line += (f"; holds {min(held):.1f}x its weight ({lc['weight_N']:.2f} N) in the weakest direction"
+                 if held else "")
+    return line
+
+
+def rest_summary(design):
+    """The rest-shape stage's progress line (after run)."""
+    stage = design["stages"]["rest_shape"]
+    return (f"{len(design['wires'])} rest shapes, largest closure gap {stage['max_closure_gap'] * 1000:.2f} mm, "
+            f"{stage['over_bend']} bends over the machine limit ({stage['seconds']:.4f} s)")

@@ -1,0 +1,605 @@
+#include "wiresculpt/forces.hpp"
+
+#include <glpk.h>
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <csetjmp>
+#include <limits>
+#include <nlopt.hpp>
+#include <string>
+
+#include "wiresculpt/error.hpp"
+
+namespace wiresculpt {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// --- GLPK guard (as in stability.cpp) ----------------------------------------------------------
+// GLPK reports internal errors through a hook and aborts the process if the hook returns; the
+// hook jumps back here, GLPK's environment is freed as GLPK requires, and the solve reports
+// failure. Only GLPK's own C frames lie between setjmp and longjmp.
+thread_local std::jmp_buf* t_jump = nullptr;
+
+void on_glpk_error(void*) {
+  if (t_jump) std::longjmp(*t_jump, 1);
+}
+
+// glp_simplex with GLPK's error hook unwinding here; -1 when GLPK hit an internal error (its
+// environment is then freed, with every problem object in it).
+int guarded_simplex(glp_prob* lp, const glp_smcp* parm) {
+  std::jmp_buf buf;
+  t_jump = &buf;
+  glp_error_hook(on_glpk_error, nullptr);
+  if (setjmp(buf) != 0) {
+    t_jump = nullptr;
+    glp_free_env();
+    return -1;
+  }
+  const int ret = glp_simplex(lp, parm);
+  glp_error_hook(nullptr, nullptr);
+  t_jump = nullptr;
+  return ret;
+}
+
+std::string wname(const Network& net, int w) { return "wire '" + net.wires[w].name + "'"; }
+
+std::string result_text(nlopt::result r) {
+  switch (r) {
+    case nlopt::FAILURE: return "NLOPT_FAILURE";
+    case nlopt::INVALID_ARGS: return "NLOPT_INVALID_ARGS";
+    case nlopt::OUT_OF_MEMORY: return "NLOPT_OUT_OF_MEMORY";
+    case nlopt::ROUNDOFF_LIMITED: return "NLOPT_ROUNDOFF_LIMITED";
+    case nlopt::FORCED_STOP: return "NLOPT_FORCED_STOP";
+    case nlopt::SUCCESS: return "NLOPT_SUCCESS";
+    case nlopt::STOPVAL_REACHED: return "NLOPT_STOPVAL_REACHED";
+    case nlopt::FTOL_REACHED: return "NLOPT_FTOL_REACHED";
+    case nlopt::XTOL_REACHED: return "NLOPT_XTOL_REACHED";
+    case nlopt::MAXEVAL_REACHED: return "NLOPT_MAXEVAL_REACHED";
+    case nlopt::MAXTIME_REACHED: return "NLOPT_MAXTIME_REACHED";
+    default: return "NLOPT_UNKNOWN";
+  }
+}
+
+void validate(const ForceOptions& o) {
+  auto finite_pos = [](double v) { return std::isfinite(v) && v > 0; };
+  if (!std::isfinite(o.friction) || o.friction < 0) throw InputError("friction must be a finite number >= 0");
+  if (!finite_pos(o.max_torque)) throw InputError("max_torque must be a finite number of N m > 0");
+  if (!finite_pos(o.torque_fraction) || o.torque_fraction > 1.0)
+    throw InputError("torque_fraction must be in (0, 1], not " + std::to_string(o.torque_fraction));
+  if (!std::isfinite(o.assembly_weight) || o.assembly_weight < 0)
+    throw InputError("assembly_weight must be a finite number >= 0");
+  if (o.max_iterations < 1) throw InputError("max_iterations must be at least 1");
+  if (!finite_pos(o.ftol_rel) || !finite_pos(o.xtol_rel) || !finite_pos(o.constraint_tol))
+    throw InputError("ftol_rel, xtol_rel and constraint_tol must be finite numbers > 0");
+}
+
+void validate_network(const Network& net, const std::vector<int>& hooks) {
+  const int P = static_cast<int>(net.wires.size());
+  if (hooks.size() != net.crossings.size())
+    throw InputError("forces: expected one hook per crossing (" + std::to_string(net.crossings.size()) + "), got " +
+                     std::to_string(hooks.size()));
+  for (int w = 0; w < P; ++w) {
+    const WireSpec& s = net.wires[w];
+    for (const Vec3& p : s.points)
+      if (!p.allFinite()) throw InputError(wname(net, w) + " has a non-finite target point");
+  }
+  for (std::size_t c = 0; c < net.crossings.size(); ++c) {
+    const Crossing& x = net.crossings[c];
+    const std::string who = "crossing " + std::to_string(c);
+    if (hooks[c] < -1 || hooks[c] > 1) throw InputError(who + ": hook must be -1, 0 or 1, not " + std::to_string(hooks[c]));
+    for (int k = 0; k < 2; ++k)
+      if (x.wires[k] < 0 || x.wires[k] >= P) throw InputError(who + ": wire id " + std::to_string(x.wires[k]) + " does not exist");
+    if (x.wires[0] == x.wires[1]) throw InputError(who + " joins a wire to itself");
+    for (int k = 0; k < 2; ++k) {
+      const WireSpec& s = net.wires[x.wires[k]];
+      if (x.vertices[k] < 0 || x.vertices[k] >= static_cast<int>(s.points.size()))
+        throw InputError(who + ": vertex " + std::to_string(x.vertices[k]) + " is outside " + wname(net, x.wires[k]) +
+                         "'s " + std::to_string(s.points.size()) + " target points");
+    }
+    const Vec3 d = net.wires[x.wires[0]].plane.normal.cross(net.wires[x.wires[1]].plane.normal);
+    if (hooks[c] != 0 && !(d.norm() > 1e-9))
+      throw InputError(who + ": the planes of " + wname(net, x.wires[0]) + " and " + wname(net, x.wires[1]) +
+                       " are parallel, so they cannot hook");
+  }
+}
+
+}  // namespace
+
+namespace detail {
+
+LpSolution solve_lp(const LinearProgram& in) {
+  LpSolution out;
+  const int K = static_cast<int>(in.obj.size());
+  const int R = static_cast<int>(in.row_lo.size());
+  auto bound_type = [](double lo, double hi) {
+    const bool l = std::isfinite(lo), h = std::isfinite(hi);
+    if (l && h) return lo == hi ? GLP_FX : GLP_DB;
+    if (l) return GLP_LO;
+    if (h) return GLP_UP;
+    return GLP_FR;
+  };
+  // Entries below 1e-13 of their column's largest are rounding noise of cross products (a
+  // structural zero computed as 1e-19 would otherwise pin a variable); rows left empty become
+  // free when their bounds admit 0 up to rounding, else the LP is infeasible.
+  std::vector<double> col_max(K, 0.0);
+  for (std::size_t t = 0; t < in.tri_val.size(); ++t)
+    col_max[in.tri_col[t]] = std::max(col_max[in.tri_col[t]], std::abs(in.tri_val[t]));
+  std::vector<int> ia{0}, ja{0};
+  std::vector<double> ar{0.0};
+  std::vector<char> row_used(R, 0);
+  for (std::size_t t = 0; t < in.tri_val.size(); ++t) {
+    if (!(std::abs(in.tri_val[t]) > 1e-13 * col_max[in.tri_col[t]])) continue;
+    ia.push_back(in.tri_row[t] + 1);
+    ja.push_back(in.tri_col[t] + 1);
+    ar.push_back(in.tri_val[t]);
+    row_used[in.tri_row[t]] = 1;
+  }
+  for (int r = 0; r < R; ++r)
+    if (!row_used[r] && (in.row_lo[r] > 1e-9 * (1.0 + std::abs(in.row_lo[r])) ||
+                         in.row_hi[r] < -1e-9 * (1.0 + std::abs(in.row_hi[r])))) {
+      out.status = LpSolution::infeasible;
+      return out;
+    }
+  glp_term_out(GLP_OFF);
+  glp_prob* lp = glp_create_prob();
+  glp_set_obj_dir(lp, in.maximise ? GLP_MAX : GLP_MIN);
+  if (R > 0) glp_add_rows(lp, R);
+  if (K > 0) glp_add_cols(lp, K);
+  for (int r = 0; r < R; ++r)
+    glp_set_row_bnds(lp, r + 1, row_used[r] ? bound_type(in.row_lo[r], in.row_hi[r]) : GLP_FR, std::isfinite(in.row_lo[r]) ? in.row_lo[r] : 0.0,
+                     std::isfinite(in.row_hi[r]) ? in.row_hi[r] : 0.0);
+  for (int j = 0; j < K; ++j) {
+    glp_set_col_bnds(lp, j + 1, bound_type(in.col_lo[j], in.col_hi[j]), std::isfinite(in.col_lo[j]) ? in.col_lo[j] : 0.0,
+                     std::isfinite(in.col_hi[j]) ? in.col_hi[j] : 0.0);
+    glp_set_obj_coef(lp, j + 1, in.obj[j]);
+  }
+  glp_load_matrix(lp, static_cast<int>(ar.size()) - 1, ia.data(), ja.data(), ar.data());
+  glp_scale_prob(lp, GLP_SF_AUTO);
+  glp_smcp parm;
+  glp_init_smcp(&parm);
+  parm.msg_lev = GLP_MSG_OFF;
+  parm.presolve = GLP_ON;
+  int ret = guarded_simplex(lp, &parm);
+  if (ret == -1) {  // GLPK's environment (and with it `lp`) is gone
+    out.status = LpSolution::failed;
+    return out;
+  }
+  if (ret != 0 && ret != GLP_ENOPFS && ret != GLP_ENODFS) {  // retry without presolve
+    parm.presolve = GLP_OFF;
+    glp_adv_basis(lp, 0);
+    ret = guarded_simplex(lp, &parm);
+    if (ret == -1) {
+      out.status = LpSolution::failed;
+      return out;
+    }
+  }
+  if (ret == 0 || ret == GLP_ENOPFS || ret == GLP_ENODFS) {
+    const int status = glp_get_status(lp);
+    if (ret == GLP_ENOPFS || status == GLP_NOFEAS) out.status = LpSolution::infeasible;
+    else if (ret == GLP_ENODFS || status == GLP_UNBND) out.status = LpSolution::unbounded;
+    else if (status == GLP_OPT) out.status = LpSolution::optimal;
+    else out.status = LpSolution::failed;
+  }
+  if (out.status == LpSolution::optimal) {
+    out.x.resize(K);
+    for (int j = 0; j < K; ++j) out.x[j] = glp_get_col_prim(lp, j + 1);
+    out.objective = glp_get_obj_val(lp);
+  }
+  out.iterations = glp_get_it_cnt(lp);
+  glp_delete_prob(lp);
+  return out;
+}
+
+}  // namespace detail
+
+std::array<Vec3, 4> target_pyramid(const Network& net, int c, int hook, double friction) {
+  if (c < 0 || c >= static_cast<int>(net.crossings.size()))
+    throw InputError("crossing " + std::to_string(c) + " does not exist");
+  if (hook != 1 && hook != -1)
+    throw InputError("crossing " + std::to_string(c) + ": only hooks -1 and 1 have a contact pyramid");
+  const Crossing& x = net.crossings[c];
+  const Vec3 d = net.wires[x.wires[0]].plane.normal.cross(net.wires[x.wires[1]].plane.normal).normalized();
+  const double s = static_cast<double>(hook);
+  std::array<Vec3, 4> out;
+  for (int k = 0; k < 2; ++k) {
+    const WireSpec& w = net.wires[x.wires[k]];
+    const int n = static_cast<int>(w.points.size());
+    const int v = x.vertices[k];
+    int prev = v - 1, next = v + 1;
+    if (w.closed) {
+      prev = (v + n - 1) % n;
+      next = (v + 1) % n;
+    } else if (prev < 0 || next >= n) {
+      throw InputError("crossing " + std::to_string(c) + " is at an end of open " + wname(net, x.wires[k]) +
+                       ", which has no kink to hook");
+    }
+    const Vec3& p = w.points[v];
+    const Vec3 h = (k == 0 ? s : -s) * d;
+    const Vec3& nrm = w.plane.normal;
+    const Vec3 arms[2] = {(w.points[prev] - p).normalized(), (w.points[next] - p).normalized()};
+    for (int e = 0; e < 2; ++e) {
+      const Vec3& a = arms[e];
+      const Vec3& other = arms[1 - e];
+      Vec3 m = nrm.cross(a);
+      m -= m.dot(nrm) * nrm;  // in plane (a is, up to rounding)
+      m.normalize();
+      const double side = m.dot(h);
+      if (std::abs(side) > 1e-9) {
+        if (side > 0) m = -m;
+      } else if (m.dot(other) > 0) {
+        m = -m;
+      }
+      if (!m.allFinite() || !a.allFinite())
+        throw InputError("crossing " + std::to_string(c) + ": " + wname(net, x.wires[k]) +
+                         " has coincident points at the crossing");
+      const Vec3 q = (m + friction * a).normalized();
+      out[2 * k + e] = k == 0 ? q : Vec3(-q);
+    }
+  }
+  return out;
+}
+
+std::vector<WireLoad> wire_loads(const Network& net, const std::vector<int>& hooks, const std::vector<Vec3>& forces,
+                                 int wire) {
+  std::vector<WireLoad> out;
+  for (std::size_t c = 0; c < net.crossings.size(); ++c) {
+    if (hooks[c] == 0) continue;
+    const Crossing& x = net.crossings[c];
+    for (int k = 0; k < 2; ++k)
+      if (x.wires[k] == wire) out.push_back({x.vertices[k], k == 0 ? forces[c] : Vec3(-forces[c])});
+  }
+  return out;
+}
+
+ForceProblem::ForceProblem(const Network& net, const std::vector<int>& hooks,
+                           const std::vector<std::vector<int>>& steps, const std::vector<int>& cuts,
+                           const ForceOptions& options)
+    : net_(&net), hooks_(hooks) {
+  validate(options);
+  validate_network(net, hooks);
+  const int P = static_cast<int>(net.wires.size());
+  if (cuts.size() != static_cast<std::size_t>(P))
+    throw InputError("forces: expected one cut per wire (" + std::to_string(P) + "), got " + std::to_string(cuts.size()));
+  const int C = static_cast<int>(net.crossings.size());
+  pyramid_.resize(C);
+  std::vector<int> hooked;
+  for (int c = 0; c < C; ++c)
+    if (hooks[c] != 0) {
+      pyramid_[c] = target_pyramid(net, c, hooks[c], options.friction);
+      hooked.push_back(c);
+      for (int j = 0; j < 4; ++j) column_crossing_.push_back(c);
+    }
+  const int K = static_cast<int>(column_crossing_.size());
+  // Reference and length scale: centroid and RMS distance of all crossings.
+  for (const Crossing& x : net.crossings) reference_ += x.point;
+  if (C > 0) reference_ /= static_cast<double>(C);
+  double ss = 0.0;
+  for (const Crossing& x : net.crossings) ss += (x.point - reference_).squaredNorm();
+  L_ = C > 0 ? std::sqrt(ss / C) : 1.0;
+  if (!(L_ > 1e-9)) L_ = 1.0;
+  t_max_ = options.max_torque * options.torque_fraction;
+  w_ = options.assembly_weight * L_ / t_max_;
+
+  // M (6P × K) and the normal weights.
+  M_ = Eigen::MatrixXd::Zero(6 * P, K);
+  c_ = Eigen::VectorXd::Zero(K);
+  Nk_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(hooked.size()), K);
+  for (int j = 0; j < K; ++j) {
+    const int c = column_crossing_[j];
+    const Crossing& x = net.crossings[c];
+    const Vec3& b = pyramid_[c][j % 4];
+    const Vec3 t = (x.point - reference_).cross(b);
+    M_.block<3, 1>(6 * x.wires[0], j) = b;
+    M_.block<3, 1>(6 * x.wires[0] + 3, j) = t;
+    M_.block<3, 1>(6 * x.wires[1], j) = -b;
+    M_.block<3, 1>(6 * x.wires[1] + 3, j) = -t;
+    const Vec3 d = net.wires[x.wires[0]].plane.normal.cross(net.wires[x.wires[1]].plane.normal).normalized();
+    const double nk = -static_cast<double>(hooks[c]) * b.dot(d);
+    Nk_(j / 4, j) = nk;
+    c_(j) = 2.0 * nk;
+  }
+
+  // Torque rows: walk each wire from its cut; row v holds n·Σ_{k after v} (x_v - x_k) × b_j.
+  std::vector<std::vector<std::array<int, 2>>> on_wire(P);  // (column start, side) per hooked crossing
+  for (int h = 0; h < static_cast<int>(hooked.size()); ++h)
+    for (int k = 0; k < 2; ++k) on_wire[net.crossings[hooked[h]].wires[k]].push_back({4 * h, k});
+  std::vector<Eigen::RowVectorXd> rows;
+  for (int w = 0; w < P; ++w) {
+    const WireSpec& s = net.wires[w];
+    const int n = static_cast<int>(s.points.size());
+    const std::vector<int> walk = wire_walk(n, s.closed, cuts[w], s.name);
+    std::vector<int> pos(n, -1);
+    for (int k = static_cast<int>(walk.size()) - 1; k >= 0; --k) pos[walk[k]] = k;
+    const int last = static_cast<int>(walk.size()) - (s.closed ? 1 : 0);  // the repeated cut has no tail
+    for (int v = 0; v < last; ++v) {
+      Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(K);
+      const Vec3& xv = s.points[walk[v]];
+      for (const auto& [col, side] : on_wire[w]) {
+        const int c = column_crossing_[col];
+        const int vk = net.crossings[c].vertices[side];
+        if (pos[vk] <= v) continue;
+        const Vec3 lever = xv - s.points[vk];
+        for (int j = 0; j < 4; ++j) {
+          const Vec3 f = side == 0 ? pyramid_[c][j] : Vec3(-pyramid_[c][j]);
+          row(col + j) = lever.cross(f).dot(s.plane.normal);
+        }
+      }
+      rows.push_back(row);
+      torque_vertex_.push_back({w, walk[v]});
+    }
+  }
+  T_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), K);
+  for (std::size_t r = 0; r < rows.size(); ++r) T_.row(static_cast<Eigen::Index>(r)) = rows[r];
+
+  // Q = Σ_s R_sᵀ R_s over assembly prefixes (torque rows scaled by 1/L).
+  Q_ = Eigen::MatrixXd::Zero(K, K);
+  std::vector<char> in(P, 0), seen(P, 0);
+  for (const auto& step : steps) {
+    for (int w : step) {
+      if (w < 0 || w >= P) throw InputError("forces: assembly step names wire id " + std::to_string(w) + ", which does not exist");
+      if (seen[w]) throw InputError("forces: " + wname(net, w) + " appears twice in the assembly steps");
+      seen[w] = in[w] = 1;
+    }
+    Eigen::MatrixXd R = Eigen::MatrixXd::Zero(6 * P, K);
+    for (int j = 0; j < K; ++j) {
+      const Crossing& x = net.crossings[column_crossing_[j]];
+      if (!in[x.wires[0]] || !in[x.wires[1]]) continue;
+      R.col(j) = M_.col(j);
+      for (int w = 0; w < P; ++w) R.block<3, 1>(6 * w + 3, j) /= L_;
+    }
+    Q_.noalias() += R.transpose() * R;
+  }
+}
+
+double ForceProblem::objective(const Eigen::VectorXd& a, Eigen::VectorXd* grad) const {
+  const Eigen::VectorXd Qa = Q_ * a;
+  if (grad) *grad = c_ - 2.0 * w_ * Qa;
+  return c_.dot(a) - w_ * a.dot(Qa);
+}
+
+std::vector<Vec3> ForceProblem::forces(const Eigen::VectorXd& a) const {
+  std::vector<Vec3> out(net_->crossings.size(), Vec3::Zero());
+  for (int j = 0; j < columns(); ++j) out[column_crossing_[j]] += a(j) * pyramid_[column_crossing_[j]][j % 4];
+  return out;
+}
+
+namespace {
+
+struct SlsqpData {
+  const ForceProblem* problem;
+  const Eigen::MatrixXd* N;  // K × k null-space basis
+  Eigen::MatrixXd G;         // constraint rows in z, m × k (c(z) = G z - h <= 0)
+  Eigen::VectorXd h;
+  const ProgressFn* progress;
+  int evaluations = 0;
+  bool cancelled = false;
+};
+
+double slsqp_objective(unsigned n, const double* z, double* grad, void* data) {
+  auto* s = static_cast<SlsqpData*>(data);
+  if (++s->evaluations % 20 == 0 && s->progress && *s->progress && !(*s->progress)("forces", 0.6)) {
+    s->cancelled = true;
+    throw nlopt::forced_stop();
+  }
+  const Eigen::Map<const Eigen::VectorXd> zv(z, n);
+  const Eigen::VectorXd a = *s->N * zv;
+  Eigen::VectorXd ga;
+  const double g = s->problem->objective(a, grad ? &ga : nullptr);
+  if (grad) Eigen::Map<Eigen::VectorXd>(grad, n) = s->N->transpose() * ga;
+  return g;
+}
+
+void slsqp_constraints(unsigned m, double* result, unsigned n, const double* z, double* grad, void* data) {
+  auto* s = static_cast<SlsqpData*>(data);
+  const Eigen::Map<const Eigen::VectorXd> zv(z, n);
+  Eigen::Map<Eigen::VectorXd>(result, m) = s->G * zv - s->h;
+  if (grad) Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(grad, m, n) = s->G;
+}
+
+// Largest violation of a's constraints, relative: torque / t_max, sign and normal / scale.
+double violation(const ForceProblem& p, const Eigen::VectorXd& a, double force_scale) {
+  double v = 0.0;
+  if (a.size() == 0) return 0.0;
+  v = std::max(v, -a.minCoeff() / force_scale);
+  if (p.torque_rows().rows() > 0) v = std::max(v, ((p.torque_rows() * a).cwiseAbs().maxCoeff() - p.t_max()) / p.t_max());
+  if (p.normal_rows().rows() > 0) v = std::max(v, -(p.normal_rows() * a).minCoeff() / force_scale);
+  return v;
+}
+
+}  // namespace
+
+ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, const std::vector<std::vector<int>>& steps,
+                            const std::vector<int>& cuts, const ForceOptions& options, const ProgressFn& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  auto since = [](std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+  report_progress(progress, "forces", 0.0);
+  const ForceProblem problem(net, hooks, steps, cuts, options);
+  const int K = problem.columns();
+  const double F_ref = problem.t_max() / problem.length_scale();
+  ForceResult r;
+  r.cuts = cuts;
+  r.t_max = problem.t_max();
+  r.column_crossing = problem.column_crossing();
+  Eigen::VectorXd a = Eigen::VectorXd::Zero(K);
+  const Eigen::MatrixXd& M = problem.equilibrium();
+  const Eigen::MatrixXd& T = problem.torque_rows();
+  const Eigen::MatrixXd& Nk = problem.normal_rows();
+
+  const bool use_lp = options.algorithm != ForceAlgorithm::slsqp;
+  const bool use_nlp = options.algorithm == ForceAlgorithm::slsqp ||
+                       (options.algorithm == ForceAlgorithm::lp_then_slsqp && problem.weight() > 0 &&
+                        problem.assembly_matrix().squaredNorm() > 0);
+  if (K > 0 && use_lp) {
+    const auto t0 = std::chrono::steady_clock::now();
+    detail::LinearProgram lp;
+    lp.maximise = true;
+    lp.obj.assign(problem.normal_weights().data(), problem.normal_weights().data() + K);
+    lp.col_lo.assign(K, 0.0);
+    lp.col_hi.assign(K, kInf);
+    int row = 0;
+    auto add_rows = [&](const Eigen::MatrixXd& A, double lo, double hi) {
+      for (Eigen::Index i = 0; i < A.rows(); ++i, ++row) {
+        lp.row_lo.push_back(lo);
+        lp.row_hi.push_back(hi);
+        for (Eigen::Index j = 0; j < A.cols(); ++j)
+          if (A(i, j) != 0.0) {
+            lp.tri_row.push_back(row);
+            lp.tri_col.push_back(static_cast<int>(j));
+            lp.tri_val.push_back(A(i, j));
+          }
+      }
+    };
+    add_rows(M, 0.0, 0.0);
+    add_rows(T, -problem.t_max(), problem.t_max());
+    add_rows(Nk, 0.0, kInf);
+    detail::LpSolution sol = detail::solve_lp(lp);
+    r.lp_iterations = sol.iterations;
+    if (sol.status == detail::LpSolution::unbounded) {
+      // Name the crossings whose force no torque limits: bound every coefficient and look.
+      const double cap = 1e6 * F_ref;
+      lp.col_hi.assign(K, cap);
+      const detail::LpSolution capped = detail::solve_lp(lp);
+      std::string names;
+      if (capped.status == detail::LpSolution::optimal)
+        for (int j = 0; j < K; ++j)
+          if (capped.x[j] > 0.5 * cap && names.find(" " + std::to_string(r.column_crossing[j]) + ",") == std::string::npos)
+            names += " " + std::to_string(r.column_crossing[j]) + ",";
+      if (!names.empty()) names.pop_back();
+      throw SolverError("the contact forces are unbounded: no wire's bending torque limits the force at crossing" +
+                        (names.empty() ? std::string("s") : names) +
+                        "; check the cuts and that every wire has more than one crossing");
+    }
+    if (sol.status != detail::LpSolution::optimal)
+      throw SolverError("the force LP could not be solved (GLPK " +
+                        std::string(sol.status == detail::LpSolution::infeasible ? "found it infeasible" : "failed") +
+                        "); please report this input");
+    for (int j = 0; j < K; ++j) a(j) = std::max(0.0, sol.x[j]);
+    r.method = "lp";
+    r.lp_seconds = since(t0);
+  }
+  report_progress(progress, "forces", 0.5);
+
+  if (K > 0 && use_nlp) {
+    const auto t0 = std::chrono::steady_clock::now();
+    // Null space of M: a = N z keeps M a = 0 to rounding.
+    Eigen::BDCSVD<Eigen::MatrixXd> svd(M, Eigen::ComputeFullV);
+    const Eigen::VectorXd& sv = svd.singularValues();
+    const double tol = 1e-10 * std::max(1.0, sv.size() ? sv(0) : 1.0);
+    int rank = 0;
+    for (Eigen::Index i = 0; i < sv.size(); ++i)
+      if (sv(i) > tol) ++rank;
+    const Eigen::MatrixXd N = svd.matrixV().rightCols(K - rank);
+    const int k = static_cast<int>(N.cols());
+    if (k > 0) {
+      SlsqpData data{&problem, &N, {}, {}, &progress};
+      const Eigen::Index m = K + 2 * T.rows() + Nk.rows();
+      data.G.resize(m, k);
+      data.h.resize(m);
+      // Rows scaled to O(1): signs by F_ref, torques by t_max.
+      data.G.topRows(K) = -N / F_ref;
+      data.h.head(K).setZero();
+      const Eigen::MatrixXd TN = T * N / problem.t_max();
+      data.G.middleRows(K, T.rows()) = TN;
+      data.G.middleRows(K + T.rows(), T.rows()) = -TN;
+      data.h.segment(K, 2 * T.rows()).setOnes();
+      data.G.bottomRows(Nk.rows()) = -Nk * N / F_ref;
+      data.h.tail(Nk.rows()).setZero();
+      nlopt::opt opt(nlopt::LD_SLSQP, static_cast<unsigned>(k));
+      opt.set_max_objective(slsqp_objective, &data);
+      opt.add_inequality_mconstraint(slsqp_constraints, &data,
+                                     std::vector<double>(static_cast<std::size_t>(m), options.constraint_tol));
+      opt.set_ftol_rel(options.ftol_rel);
+      opt.set_xtol_rel(options.xtol_rel);
+      opt.set_maxeval(options.max_iterations);
+      std::vector<double> z(static_cast<std::size_t>(k));
+      Eigen::Map<Eigen::VectorXd>(z.data(), k) = N.transpose() * a;
+      const Eigen::VectorXd a_start = a;
+      const double g_start = problem.objective(a_start);
+      double g = 0.0;
+      nlopt::result res = nlopt::FAILURE;
+      try {
+        res = opt.optimize(z, g);
+        r.nlopt_result = result_text(res);
+      } catch (const nlopt::forced_stop&) {
+        if (data.cancelled) throw Cancelled();
+        r.nlopt_result = "NLOPT_FORCED_STOP";
+      } catch (const std::exception& e) {
+        if (data.cancelled) throw Cancelled();
+        r.nlopt_result = std::string("NLOPT_FAILURE (") + e.what() + ")";
+      }
+      if (data.cancelled) throw Cancelled();
+      r.iterations = data.evaluations;
+      Eigen::VectorXd a_nlp = N * Eigen::Map<const Eigen::VectorXd>(z.data(), k);
+      // Rounding-level negatives (SLSQP's constraint tolerance) are set to zero.
+      for (int j = 0; j < K; ++j)
+        if (a_nlp(j) < 0 && a_nlp(j) > -1e-7 * F_ref) a_nlp(j) = 0.0;
+      const double v = violation(problem, a_nlp, F_ref);
+      const double g_nlp = problem.objective(a_nlp);
+      const bool from_lp = use_lp;
+      if (v <= 1e-7 && (!from_lp || g_nlp >= g_start - 1e-9 * std::max(1.0, std::abs(g_start)))) {
+        a = a_nlp;
+        r.method = from_lp ? "lp+slsqp" : "slsqp";
+      } else if (from_lp) {
+        r.warnings.push_back("the assembly term could not be improved by SLSQP (" + r.nlopt_result +
+                             "); the forces maximise the normal-force sum alone");
+      } else {
+        throw SolverError("SLSQP found no feasible contact forces (" + r.nlopt_result +
+                          "); use the default algorithm");
+      }
+    } else if (!use_lp) {
+      r.method = "slsqp";
+    }
+    r.nlp_seconds = since(t0);
+  }
+  if (r.method.empty()) r.method = use_lp ? "lp" : "slsqp";
+  report_progress(progress, "forces", 0.9);
+
+  // Results.
+  r.coefficients = a;
+  r.forces = problem.forces(a);
+  const int C = static_cast<int>(net.crossings.size());
+  r.normal.assign(C, 0.0);
+  r.out_of_plane.assign(C, {0.0, 0.0});
+  int counted = 0;
+  for (int c = 0; c < C; ++c) {
+    if (hooks[c] == 0) continue;
+    const Crossing& x = net.crossings[c];
+    const Vec3 d = net.wires[x.wires[0]].plane.normal.cross(net.wires[x.wires[1]].plane.normal).normalized();
+    const Vec3& f = r.forces[c];
+    r.normal[c] = -static_cast<double>(hooks[c]) * f.dot(d);
+    const double fn = f.norm();
+    for (int k = 0; k < 2; ++k) {
+      r.out_of_plane[c][k] = fn > 0 ? std::abs(f.dot(net.wires[x.wires[k]].plane.normal)) / fn : 0.0;
+      r.mean_out_of_plane += r.out_of_plane[c][k];
+      r.max_out_of_plane = std::max(r.max_out_of_plane, r.out_of_plane[c][k]);
+      ++counted;
+    }
+  }
+  if (counted) r.mean_out_of_plane /= counted;
+  r.g_stb = problem.normal_weights().dot(a);
+  r.assembly_residual = a.dot(problem.assembly_matrix() * a);
+  r.g_asm = -problem.weight() * r.assembly_residual;
+  double scale = 0.0;
+  for (int j = 0; j < K; ++j) scale += std::abs(a(j)) * M.col(j).norm();
+  r.equilibrium_residual = scale > 0 ? (M * a).norm() / scale : 0.0;
+  // Per-wire torques, from the 3D sums (the out-of-plane part is reported too).
+  r.wires.resize(net.wires.size());
+  for (int w = 0; w < static_cast<int>(net.wires.size()); ++w) {
+    const RestShapeResult rs = rest_shape(net.wires[w], cuts[w], wire_loads(net, hooks, r.forces, w), RestShapeOptions{});
+    r.wires[w].max_torque = rs.max_torque;
+    r.wires[w].max_torque_vertex = rs.max_torque_vertex;
+    for (double t : rs.out_of_plane_torque) r.wires[w].max_out_of_plane = std::max(r.wires[w].max_out_of_plane, t);
+    if (rs.max_torque >= (1.0 - 1e-6) * r.t_max) r.torque_active = true;
+  }
+  r.seconds = since(start);
+  report_progress(progress, "forces", 1.0);
+  return r;
+}
+
+}  // namespace wiresculpt

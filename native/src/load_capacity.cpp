@@ -1,0 +1,157 @@
+#include "wiresculpt/load_capacity.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+
+#include "wiresculpt/error.hpp"
+
+namespace wiresculpt {
+
+LoadCapacityResult load_capacity(const Network& net, const std::vector<int>& cuts, const ForceProblem& problem,
+                                 const Eigen::VectorXd& a0, const LoadCapacityOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  auto positive = [](double v) { return std::isfinite(v) && v > 0; };
+  if (!positive(options.wire_diameter)) throw InputError("wire_diameter must be a finite number of metres > 0");
+  if (!positive(options.density)) throw InputError("density must be a finite number of kg/m^3 > 0");
+  if (!positive(options.gravity)) throw InputError("gravity must be a finite number of m/s^2 > 0");
+  if (!std::isfinite(options.tie_tolerance) || options.tie_tolerance < 0)
+    throw InputError("tie_tolerance must be a finite number of metres >= 0");
+  const int K = problem.columns();
+  if (a0.size() != K)
+    throw InputError("load capacity: expected " + std::to_string(K) + " pre-stress coefficients, got " +
+                     std::to_string(a0.size()));
+  const int P = static_cast<int>(net.wires.size());
+  if (cuts.size() != static_cast<std::size_t>(P)) throw InputError("load capacity: expected one cut per wire");
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  const double per_metre = std::numbers::pi * 0.25 * options.wire_diameter * options.wire_diameter * options.density *
+                           options.gravity;  // N/m
+  LoadCapacityResult out;
+  // Walks and edges (weights at midpoints) per wire.
+  struct Edge {
+    Vec3 mid;
+    double weight;
+  };
+  std::vector<std::vector<int>> walks(P);
+  std::vector<std::vector<Edge>> edges(P);
+  for (int w = 0; w < P; ++w) {
+    const WireSpec& s = net.wires[w];
+    walks[w] = wire_walk(static_cast<int>(s.points.size()), s.closed, cuts[w], s.name);
+    for (std::size_t k = 0; k + 1 < walks[w].size(); ++k) {
+      const Vec3& p = s.points[walks[w][k]];
+      const Vec3& q = s.points[walks[w][k + 1]];
+      const double len = (q - p).norm();
+      out.length += len;
+      edges[w].push_back({0.5 * (p + q), len * per_metre});
+    }
+  }
+  out.weight = out.length * per_metre;
+  const Eigen::MatrixXd& M = problem.equilibrium();
+  const Eigen::MatrixXd& T = problem.torque_rows();
+  const Eigen::VectorXd Ma0 = M * a0;
+  const Eigen::VectorXd Ta0 = T * a0;
+  const Vec3 ref = problem.reference();
+  const double t_max = problem.t_max();
+  // First torque row of each wire (rows are wire by wire, in walk order; see ForceProblem).
+  std::vector<int> first_row(P + 1, 0);
+  {
+    int row = 0;
+    for (int w = 0; w < P; ++w) {
+      first_row[w] = row;
+      row += static_cast<int>(walks[w].size()) - (net.wires[w].closed ? 1 : 0);
+    }
+    first_row[P] = row;
+    if (row != T.rows()) throw InputError("load capacity: the cuts differ from those of the force problem");
+  }
+
+  const char* names[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
+  for (int dir = 0; dir < 6; ++dir) {
+    LoadDirection ld;
+    ld.name = names[dir];
+    ld.gravity = Vec3::Zero();
+    ld.gravity[dir / 2] = dir % 2 == 0 ? 1.0 : -1.0;
+    const Vec3& g = ld.gravity;
+    // The held wires: lowest point along g (largest x·g), ties within tie_tolerance.
+    std::vector<double> low(P, -inf);
+    double lowest = -inf;
+    for (int w = 0; w < P; ++w) {
+      for (const Vec3& p : net.wires[w].points) low[w] = std::max(low[w], p.dot(g));
+      lowest = std::max(lowest, low[w]);
+    }
+    std::vector<char> held(P, 0);
+    for (int w = 0; w < P; ++w)
+      if (low[w] >= lowest - options.tie_tolerance) {
+        held[w] = 1;
+        ld.base.push_back(w);
+      }
+    detail::LinearProgram lp;
+    lp.maximise = true;
+    lp.obj.assign(K + 1, 0.0);
+    lp.obj[K] = 1.0;
+    lp.col_lo.resize(K + 1);
+    lp.col_hi.assign(K + 1, inf);
+    for (int j = 0; j < K; ++j) lp.col_lo[j] = -a0(j);
+    lp.col_lo[K] = 0.0;
+    int row = 0;
+    auto entry = [&](int col, double v) {
+      if (v == 0.0) return;
+      lp.tri_row.push_back(row);
+      lp.tri_col.push_back(col);
+      lp.tri_val.push_back(v);
+    };
+    for (int w = 0; w < P; ++w) {
+      if (held[w]) continue;
+      Vec3 F = Vec3::Zero(), Tq = Vec3::Zero();
+      for (const Edge& e : edges[w]) {
+        F += e.weight * g;
+        Tq += (e.mid - ref).cross(e.weight * g);
+      }
+      Eigen::Matrix<double, 6, 1> load;
+      load << F, Tq;
+      for (int r = 0; r < 6; ++r, ++row) {
+        for (int j = 0; j < K; ++j) entry(j, M(6 * w + r, j));
+        entry(K, load(r));
+        lp.row_lo.push_back(-Ma0(6 * w + r));
+        lp.row_hi.push_back(-Ma0(6 * w + r));
+      }
+      // Torque rows: contact part from T, weight part from the edges after each position.
+      const WireSpec& s = net.wires[w];
+      const int rows_w = first_row[w + 1] - first_row[w];
+      for (int v = 0; v < rows_w; ++v, ++row) {
+        const int tr = first_row[w] + v;
+        const Vec3& xv = s.points[walks[w][v]];
+        double grav = 0.0;
+        for (std::size_t k = static_cast<std::size_t>(v); k < edges[w].size(); ++k)
+          grav += (xv - edges[w][k].mid).cross(edges[w][k].weight * g).dot(s.plane.normal);
+        for (int j = 0; j < K; ++j) entry(j, T(tr, j));
+        entry(K, grav);
+        lp.row_lo.push_back(-t_max - Ta0(tr));
+        lp.row_hi.push_back(t_max - Ta0(tr));
+      }
+    }
+    const detail::LpSolution sol = detail::solve_lp(lp);
+    ld.lp_iterations = sol.iterations;
+    switch (sol.status) {
+      case detail::LpSolution::optimal:
+        ld.status = "optimal";
+        ld.multiple = std::max(0.0, sol.x[K]);
+        break;
+      case detail::LpSolution::unbounded:
+        ld.status = "unbounded";
+        ld.multiple = inf;
+        break;
+      case detail::LpSolution::infeasible:
+        ld.status = "infeasible";
+        break;
+      default:
+        ld.status = "failed";
+    }
+    out.directions.push_back(ld);
+  }
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace wiresculpt

@@ -1,0 +1,255 @@
+// Internal forces (Sec. 4.4, Eq. 6-8): pyramids from the target geometry against contact.hpp's
+// idealised ones, the symmetric three-circle sphere, the torque bound, equilibrium at the
+// optimum, LP vs SLSQP as independent solvers, and finite-difference gradients.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "wire_fixtures.hpp"
+#include "wiresculpt/contact.hpp"
+#include "wiresculpt/error.hpp"
+#include "wiresculpt/forces.hpp"
+
+using namespace wiresculpt;
+using Catch::Matchers::Contains;
+
+namespace {
+
+// The three orthogonal great circles (radius 0.125 m, 64-gons with vertices on the axes), every
+// crossing hooked so that the configuration has the sphere's symmetry (the 3-fold rotation
+// x -> y -> z and the central inversion): hook +1 at the crossings on the positive half-axes,
+// -1 on the negative ones. Each kink is the exact symmetric one of hook_geometry (opening
+// `contact_angle` about its desired bisector), so it is the target the pyramids are read from.
+struct Sphere {
+  Network net;
+  std::vector<int> hooks;
+  std::vector<std::vector<int>> steps{{0, 1}, {2}};
+};
+
+Sphere hooked_sphere(double contact_angle = 2.0 * std::numbers::pi / 3.0) {
+  Sphere s;
+  s.net = build_network(fixtures::sphere_wires(fixtures::great_circle_cuts(), 0.125, 64));
+  ContactOptions co;
+  co.contact_angle = contact_angle;
+  for (std::size_t c = 0; c < s.net.crossings.size(); ++c) {
+    const Vec3& p = s.net.crossings[c].point;
+    s.hooks.push_back(p.sum() > 0 ? 1 : -1);
+  }
+  Network idealised = s.net;
+  for (std::size_t c = 0; c < s.net.crossings.size(); ++c) {
+    const HookGeometry g = hook_geometry(s.net, static_cast<int>(c), s.hooks[c], co);
+    for (int k = 0; k < 2; ++k) {
+      WireSpec& w = idealised.wires[s.net.crossings[c].wires[k]];
+      const int n = static_cast<int>(w.points.size());
+      const int v = s.net.crossings[c].vertices[k];
+      w.points[(v + n - 1) % n] = g.neighbours[k][0];
+      w.points[(v + 1) % n] = g.neighbours[k][1];
+    }
+  }
+  s.net = idealised;
+  return s;
+}
+
+// Cuts mapped onto each other by the rotation x -> y -> z: wire X at (0,1,1)/√2, Y at (1,0,1)/√2,
+// Z at (1,1,0)/√2 (each is the middle of a piece between two crossings).
+std::vector<int> symmetric_cuts(const Network& net) {
+  const Vec3 dirs[3] = {Vec3(0, 1, 1).normalized(), Vec3(1, 0, 1).normalized(), Vec3(1, 1, 0).normalized()};
+  std::vector<int> cuts;
+  for (int w = 0; w < 3; ++w) {
+    const auto& pts = net.wires[w].points;
+    int best = 0;
+    for (int i = 0; i < static_cast<int>(pts.size()); ++i)
+      if (pts[i].normalized().dot(dirs[w]) > pts[best].normalized().dot(dirs[w])) best = i;
+    REQUIRE(pts[best].normalized().dot(dirs[w]) > 1 - 1e-12);
+    cuts.push_back(best);
+  }
+  return cuts;
+}
+
+}  // namespace
+
+TEST_CASE("forces: target pyramids of symmetric kinks are contact.hpp's pyramids", "[forces]") {
+  const Sphere s = hooked_sphere();
+  REQUIRE(s.net.crossings.size() == 6);
+  ContactOptions co;
+  for (int c = 0; c < 6; ++c) {
+    const auto ideal = contact_pyramid(s.net, c, s.hooks[c], co);
+    const auto actual = target_pyramid(s.net, c, s.hooks[c], co.friction);
+    // Same set of vectors (the order of the two arms may differ).
+    for (const Vec3& b : actual) {
+      double best = 1e9;
+      for (const Vec3& q : ideal) best = std::min(best, (b - q).norm());
+      CHECK(best < 1e-12);
+    }
+    // FORMATS sign: every vector on wires[0] has a -hook component along d.
+    const Vec3 d = crossing_direction(s.net, c);
+    for (const Vec3& b : actual) CHECK(b.dot(d) * s.hooks[c] < 0);
+  }
+  CHECK_THROWS_AS(target_pyramid(s.net, 0, 0, 0.3), InputError);
+}
+
+TEST_CASE("forces: the symmetric three-circle sphere has symmetric forces", "[forces]") {
+  const Sphere s = hooked_sphere();
+  const auto cuts = symmetric_cuts(s.net);
+  ForceOptions o;
+  o.assembly_weight = 0.0;  // the assembly order is not symmetric; G_stb alone is
+  for (ForceAlgorithm alg : {ForceAlgorithm::lp, ForceAlgorithm::slsqp}) {
+    o.algorithm = alg;
+    const ForceResult r = optimize_forces(s.net, s.hooks, s.steps, cuts, o);
+    REQUIRE(r.normal.size() == 6);
+    CHECK(r.g_stb > 0);
+    CHECK(r.equilibrium_residual < 1e-9);
+    // The rotation x -> y -> z maps wires, hooks, kinks, walk directions and these cuts onto
+    // each other; its orbits are the crossings on the positive and on the negative half-axes.
+    // (A cut breaks the central inversion, so the two orbits may differ.)
+    for (int sign : {1, -1}) {
+      int first = -1;
+      for (int c = 0; c < 6; ++c) {
+        if ((s.net.crossings[c].point.sum() > 0 ? 1 : -1) != sign) continue;
+        if (first < 0) {
+          first = c;
+          continue;
+        }
+        CHECK(r.normal[c] == Approx(r.normal[first]).epsilon(1e-6));
+        CHECK(r.forces[c].norm() == Approx(r.forces[first].norm()).epsilon(1e-6));
+      }
+    }
+    CHECK(r.torque_active);
+  }
+}
+
+TEST_CASE("forces: LP and SLSQP agree; the assembly term trades little G_stb", "[forces]") {
+  const Sphere s = hooked_sphere();
+  const auto cuts = choose_cuts(s.net);
+  ForceOptions o;
+  o.assembly_weight = 0.0;
+  o.algorithm = ForceAlgorithm::lp;
+  const ForceResult lp = optimize_forces(s.net, s.hooks, s.steps, cuts, o);
+  o.algorithm = ForceAlgorithm::slsqp;
+  const ForceResult nlp = optimize_forces(s.net, s.hooks, s.steps, cuts, o);
+  CHECK(nlp.g_stb == Approx(lp.g_stb).epsilon(1e-6));
+  // With G_asm: the combined solver and SLSQP from zero reach the same G (a convex QP).
+  o.assembly_weight = 0.05;
+  o.algorithm = ForceAlgorithm::lp_then_slsqp;
+  const ForceResult both = optimize_forces(s.net, s.hooks, s.steps, cuts, o);
+  o.algorithm = ForceAlgorithm::slsqp;
+  const ForceResult alone = optimize_forces(s.net, s.hooks, s.steps, cuts, o);
+  CHECK(both.method == "lp+slsqp");
+  CHECK(both.g_stb + both.g_asm == Approx(alone.g_stb + alone.g_asm).epsilon(1e-6));
+  // The combined optimum is at least as good as the LP's point under the combined objective.
+  const ForceProblem p(s.net, s.hooks, s.steps, cuts, o);
+  CHECK(both.g_stb + both.g_asm >= lp.g_stb - p.weight() * lp.assembly_residual - 1e-9);
+  CHECK(both.g_asm == Approx(-p.weight() * both.assembly_residual));
+  CHECK(both.assembly_residual <= lp.assembly_residual + 1e-9);
+  CHECK(both.g_stb <= lp.g_stb + 1e-9);
+  CHECK(both.equilibrium_residual < 1e-9);
+  CHECK(alone.equilibrium_residual < 1e-9);
+}
+
+TEST_CASE("forces: the torque bound is active and G_stb drops with the torque fraction", "[forces]") {
+  const Sphere s = hooked_sphere();
+  const auto cuts = choose_cuts(s.net);
+  double previous = 1e300;
+  for (double fraction : {1.0, 0.6, 0.3}) {
+    ForceOptions o;
+    o.torque_fraction = fraction;
+    const ForceResult r = optimize_forces(s.net, s.hooks, s.steps, cuts, o);
+    CHECK(r.t_max == Approx(1.77 * fraction));
+    CHECK(r.torque_active);
+    double worst = 0;
+    for (const WireTorque& w : r.wires) worst = std::max(worst, w.max_torque);
+    CHECK(worst <= r.t_max * (1 + 1e-7));
+    CHECK(worst >= r.t_max * (1 - 1e-6));
+    CHECK(r.g_stb < previous);
+    previous = r.g_stb;
+    CHECK(r.equilibrium_residual < 1e-9);
+    // a >= 0 and every normal force >= 0.
+    CHECK(r.coefficients.minCoeff() >= 0.0);
+    for (double nk : r.normal) CHECK(nk >= -1e-9);
+  }
+}
+
+TEST_CASE("forces: null crossings carry no force; M a = 0 at the optimum", "[forces]") {
+  Sphere s = hooked_sphere();
+  s.hooks[1] = 0;
+  const auto cuts = choose_cuts(s.net);
+  const ForceResult r = optimize_forces(s.net, s.hooks, s.steps, cuts);
+  CHECK(r.forces[1].norm() == 0.0);
+  CHECK(r.normal[1] == 0.0);
+  CHECK(r.coefficients.size() == 20);
+  // Independent equilibrium check: per wire, sum of forces and of moments about the origin.
+  for (int w = 0; w < 3; ++w) {
+    Vec3 f = Vec3::Zero(), m = Vec3::Zero();
+    double scale = 0;
+    for (const WireLoad& l : wire_loads(s.net, s.hooks, r.forces, w)) {
+      f += l.force;
+      m += s.net.wires[w].points[l.vertex].cross(l.force);
+      scale += l.force.norm();
+    }
+    CHECK(f.norm() <= 1e-9 * scale);
+    CHECK(m.norm() <= 1e-9 * scale * 0.125);
+  }
+}
+
+TEST_CASE("forces: the objective's gradient matches finite differences", "[forces]") {
+  const Sphere s = hooked_sphere();
+  const auto cuts = choose_cuts(s.net);
+  ForceOptions o;
+  o.assembly_weight = 0.3;
+  const ForceProblem p(s.net, s.hooks, s.steps, cuts, o);
+  REQUIRE(p.weight() > 0);
+  REQUIRE(p.assembly_matrix().norm() > 0);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 5.0);
+  for (int trial = 0; trial < 3; ++trial) {
+    Eigen::VectorXd a(p.columns());
+    for (int j = 0; j < p.columns(); ++j) a(j) = u(rng);
+    Eigen::VectorXd g;
+    p.objective(a, &g);
+    for (int j = 0; j < p.columns(); ++j) {
+      const double h = 1e-5;
+      Eigen::VectorXd ap = a, am = a;
+      ap(j) += h;
+      am(j) -= h;
+      const double fd = (p.objective(ap) - p.objective(am)) / (2 * h);
+      CHECK(g(j) == Approx(fd).epsilon(1e-7).margin(1e-9));
+    }
+  }
+  // Torque rows are Eq. 11's plane-normal component: check one row against a direct sum.
+  Eigen::VectorXd a = Eigen::VectorXd::Zero(p.columns());
+  for (int j = 0; j < p.columns(); ++j) a(j) = 1.0 + 0.1 * j;
+  const auto f = p.forces(a);
+  const Eigen::VectorXd t = p.torque_rows() * a;
+  for (int row : {0, 5, 40, 100}) {
+    const auto [w, v] = p.torque_vertex()[row];
+    // walk from the cut: vertices after v are those later in the walk
+    const int n = static_cast<int>(s.net.wires[w].points.size());
+    const int cut = cuts[w];
+    const int pos_v = (v - cut + n) % n;
+    Vec3 sum = Vec3::Zero();
+    for (const WireLoad& l : wire_loads(s.net, s.hooks, f, w))
+      if ((l.vertex - cut + n) % n > pos_v) sum += (s.net.wires[w].points[v] - s.net.wires[w].points[l.vertex]).cross(l.force);
+    CHECK(t(row) == Approx(sum.dot(s.net.wires[w].plane.normal)).margin(1e-12));
+  }
+}
+
+TEST_CASE("forces: bad input names the crossing or wire", "[forces]") {
+  const Sphere s = hooked_sphere();
+  const auto cuts = choose_cuts(s.net);
+  std::vector<int> hooks = s.hooks;
+  hooks[2] = 3;
+  CHECK_THROWS_WITH(optimize_forces(s.net, hooks, s.steps, cuts), Contains("crossing 2"));
+  CHECK_THROWS_AS(optimize_forces(s.net, s.hooks, s.steps, {1, 2}), InputError);
+  ForceOptions o;
+  o.torque_fraction = 0.0;
+  CHECK_THROWS_WITH(optimize_forces(s.net, s.hooks, s.steps, cuts, o), Contains("torque_fraction"));
+  CHECK_THROWS_WITH(optimize_forces(s.net, s.hooks, {{0, 1}, {1}}, cuts), Contains("twice"));
+}
+
+TEST_CASE("forces: progress can cancel", "[forces]") {
+  const Sphere s = hooked_sphere();
+  const auto cuts = choose_cuts(s.net);
+  CHECK_THROWS_AS(optimize_forces(s.net, s.hooks, s.steps, cuts, {}, [](std::string_view, double) { return false; }),
+                  Cancelled);
+}

@@ -1,0 +1,93 @@
+// Load capacity (beyond the paper): a case whose answer is known by hand. A "gallows" wire A
+// (held: its foot is lowest) whose upward V-kink at the origin hooks an inverted-V wire B that
+// hangs from it. Under gravity -z, B's weight hangs straight below the contact, the contact
+// pyramid contains +z, so only B's bending torque limits the load: the largest torque is at B's
+// apex, the weight of one arm (W_B/2) at half the arm's horizontal reach (X/2), so
+// λ = t_max / (W_B X / 4). Under +z the force B would need (-z) lies outside the pyramid: λ = 0.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <numbers>
+
+#include "wiresculpt/error.hpp"
+#include "wiresculpt/load_capacity.hpp"
+
+using namespace wiresculpt;
+using Catch::Matchers::Contains;
+
+namespace {
+
+constexpr double a_ = 0.03, c_ = 0.04, H = 0.3, X = 0.1, Z = 0.08;
+
+Network gallows() {
+  WireSpec A;
+  A.name = "gallows";
+  A.closed = false;
+  A.plane = Plane::make(Vec3::Zero(), Vec3::UnitX());
+  A.points = {Vec3(0, -a_, -H), Vec3(0, -a_, -H / 2), Vec3(0, -a_, c_), Vec3(0, 0, 0), Vec3(0, a_, c_)};
+  WireSpec B;
+  B.name = "lambda";
+  B.closed = false;
+  B.plane = Plane::make(Vec3::Zero(), Vec3::UnitY());
+  for (int k = 0; k <= 8; ++k) {
+    const double t = (k - 4) / 4.0;  // -1 .. 1
+    B.points.emplace_back(X * t, 0.0, -Z * std::abs(t));
+  }
+  Network net;
+  net.wires = {A, B};
+  Crossing x;
+  x.wires = {0, 1};
+  x.vertices = {3, 4};
+  x.point = Vec3::Zero();
+  net.crossings = {x};
+  return net;
+}
+
+}  // namespace
+
+TEST_CASE("load: a wire hanging from a held wire, torque- and pyramid-limited (by hand)", "[load]") {
+  const Network net = gallows();
+  const std::vector<int> hooks{1};  // d = x × y = +z; A opens +z, B opens -z
+  const std::vector<std::vector<int>> steps{{0, 1}};
+  const auto cuts = choose_cuts(net);
+  ForceOptions fo;
+  fo.torque_fraction = 0.5;
+  const ForceResult pre = optimize_forces(net, hooks, steps, cuts, fo);
+  // One contact cannot pre-stress anything: the pyramid is pointed.
+  CHECK(pre.coefficients.norm() < 1e-12);
+  const ForceProblem problem(net, hooks, steps, cuts, fo);
+  LoadCapacityOptions lo;
+  lo.density = 8500.0;
+  const LoadCapacityResult r = load_capacity(net, cuts, problem, pre.coefficients, lo);
+  const double per_metre = std::numbers::pi * 0.25 * 0.003 * 0.003 * 8500.0 * 9.81;
+  const double arm = std::hypot(X, Z);
+  const double length = (H / 2 + H / 2 + c_) + 2 * std::hypot(a_, c_) + 2 * arm;
+  CHECK(r.length == Approx(length).epsilon(1e-12));
+  CHECK(r.weight == Approx(length * per_metre).epsilon(1e-12));
+  REQUIRE(r.directions.size() == 6);
+  const LoadDirection& down = r.directions[5];
+  CHECK(down.name == "-z");
+  CHECK(down.base == std::vector<int>{0});
+  CHECK(down.status == "optimal");
+  const double W_B = 2 * arm * per_metre;
+  CHECK(down.multiple == Approx(1.77 * 0.5 / (W_B * X / 4)).epsilon(1e-7));
+  const LoadDirection& up = r.directions[4];
+  CHECK(up.name == "+z");
+  CHECK(up.base == std::vector<int>{0});  // A's arms reach higher than B's apex
+  CHECK(up.multiple == 0.0);
+  for (const LoadDirection& d : r.directions) CHECK(d.multiple >= 0.0);
+  // Halving the torque limit halves the -z capacity.
+  fo.torque_fraction = 0.25;
+  const ForceProblem half(net, hooks, steps, cuts, fo);
+  const LoadCapacityResult r2 = load_capacity(net, cuts, half, pre.coefficients, lo);
+  CHECK(r2.directions[5].multiple == Approx(0.5 * down.multiple).epsilon(1e-7));
+}
+
+TEST_CASE("load: bad options and sizes are input errors", "[load]") {
+  const Network net = gallows();
+  const auto cuts = choose_cuts(net);
+  const ForceProblem problem(net, {1}, {{0, 1}}, cuts);
+  LoadCapacityOptions lo;
+  lo.density = -1;
+  CHECK_THROWS_WITH(load_capacity(net, cuts, problem, Eigen::VectorXd::Zero(4), lo), Contains("density"));
+  CHECK_THROWS_AS(load_capacity(net, cuts, problem, Eigen::VectorXd::Zero(3)), InputError);
+}
