@@ -1,0 +1,103 @@
+"""Fabrication files of a solved design: every file at 1:1 in mm, checked by parsing it back."""
+import csv
+import math
+import os
+import re
+import tempfile
+import unittest
+import xml.etree.ElementTree as ET
+
+import numpy as np
+
+from wiresculpt import export, native, pipeline
+from wiresculpt.core.materials import PRESETS
+from wiresculpt.core.scene import PlaneSpec
+from wiresculpt.core.settings import defaults
+
+
+def sphere(radius=0.125, segments=48, rings=24):
+    V = [(0.0, 0.0, radius)]
+    for r in range(1, rings):
+        th = math.pi * r / rings
+        V += [(radius * math.sin(th) * math.cos(2 * math.pi * s / segments),
+               radius * math.sin(th) * math.sin(2 * math.pi * s / segments), radius * math.cos(th)) for s in range(segments)]
+    V.append((0.0, 0.0, -radius))
+    at = lambda r, s: 1 + (r - 1) * segments + s % segments
+    F = [(0, at(1, s), at(1, s + 1)) for s in range(segments)]
+    for r in range(1, rings - 1):
+        for s in range(segments):
+            F += [(at(r, s), at(r + 1, s), at(r + 1, s + 1)), (at(r, s), at(r + 1, s + 1), at(r, s + 1))]
+    F += [(len(V) - 1, at(rings - 1, s + 1), at(rings - 1, s)) for s in range(segments)]
+    return np.array(V), np.array(F)
+
+
+def edge_lengths(points):
+    p = np.asarray(points, dtype=float)
+    return np.linalg.norm(np.diff(p, axis=0), axis=1)
+
+
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class ExportTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        V, F = sphere()
+        planes = [PlaneSpec(n, (0, 0, 0), normal) for n, normal in
+                  (("Equator", (0, 0, 1)), ("Meridian0", (1, 0, 0)), ("Meridian90", (0, 1, 0)))]
+        cls.design = pipeline.run(V, F, planes, PRESETS["steel"], defaults())
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.result = export.export(cls.design, cls.tmp.name)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def rest_mm(self, name):
+        wire = next(w for w in self.design["wires"] if w["name"] == name)
+        return 1000.0 * np.asarray(wire["rest"])
+
+    def test_every_wire_gets_its_files(self):
+        self.assertTrue(self.design["stable"])
+        self.assertEqual(self.result["errors"], [])
+        for w in self.design["wires"]:
+            stem = export.file_stem(w["name"])
+            for folder, ext in (("svg", "svg"), ("gcode", "gcode"), ("bends", "csv")):
+                self.assertTrue(os.path.isfile(os.path.join(self.tmp.name, folder, f"{stem}.{ext}")))
+        for extra in ("svg/sheet.svg", "dxf/sculpture.dxf"):
+            self.assertTrue(os.path.isfile(os.path.join(self.tmp.name, extra)))
+        leftovers = [n for _d, _s, files in os.walk(self.tmp.name) for n in files if n.endswith(".tmp")]
+        self.assertEqual(leftovers, [])
+
+    def test_svg_is_one_to_one(self):
+        for w in self.design["wires"]:
+            root = ET.parse(os.path.join(self.tmp.name, "svg", export.file_stem(w["name"]) + ".svg")).getroot()
+            self.assertTrue(root.get("width").endswith("mm"))
+            line = next(e for e in root.iter() if e.tag.endswith("polyline") and "wire-path" in (e.get("class") or ""))
+            pts = [tuple(map(float, p.split(","))) for p in line.get("points").split()]
+            np.testing.assert_allclose(edge_lengths(pts), edge_lengths(self.rest_mm(w["name"])), atol=0.01)
+
+    def test_dxf_is_one_to_one(self):
+        import ezdxf
+
+        doc = ezdxf.readfile(os.path.join(self.tmp.name, "dxf", "sculpture.dxf"))
+        self.assertFalse(doc.audit().has_errors)
+        polylines = list(doc.modelspace().query("POLYLINE"))
+        self.assertEqual(len(polylines), len(self.design["wires"]))
+        lengths = sorted(float(np.sum(edge_lengths([(v.dxf.location.x, v.dxf.location.y) for v in p.vertices]))) for p in polylines)
+        expected = sorted(float(np.sum(edge_lengths(self.rest_mm(w["name"])))) for w in self.design["wires"])
+        np.testing.assert_allclose(lengths, expected, atol=0.01)
+
+    def test_gcode_feeds_make_the_wire_and_the_table_lists_every_bend(self):
+        for w, summary in zip(self.design["wires"], self.result["wires"]):
+            stem = export.file_stem(w["name"])
+            with open(os.path.join(self.tmp.name, "gcode", stem + ".gcode")) as f:
+                feeds = [float(m) for m in re.findall(r"^G1 X(-?[0-9.]+)", f.read(), re.M)]
+            rest_length = float(np.sum(edge_lengths(self.rest_mm(w["name"]))))
+            self.assertAlmostEqual(sum(feeds), rest_length, delta=0.01)
+            with open(os.path.join(self.tmp.name, "bends", stem + ".csv")) as f:
+                rows = list(csv.DictReader(f))
+            self.assertEqual(sum(1 for r in rows if float(r["bend_deg"]) != 0.0), summary["bend_count"])
+            self.assertAlmostEqual(sum(float(r["feed_mm"]) for r in rows) + 0.0, rest_length, delta=0.01)
+
+
+if __name__ == "__main__":
+    unittest.main()
