@@ -1,7 +1,15 @@
-"""The add-on's settings: one PropertyGroup on the scene, `scene.wiresculpt`."""
+"""The add-on's settings: one PropertyGroup on the scene, `scene.wiresculpt`.
+
+Solver defaults and bounds are declared once, in core/settings.py and core/materials.py; the
+properties below read them from there.
+"""
+import math
+
 import bpy
-from bpy.props import (BoolProperty, CollectionProperty, FloatProperty, IntProperty,
+from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, IntProperty,
                        PointerProperty, StringProperty)
+
+from .core import materials, settings as settings_table
 
 HANDLE_KEY = "wiresculpt_handle"  # custom property that marks an object as a slicing handle
 
@@ -12,6 +20,90 @@ def is_handle(obj):
 
 def _poll_target(_settings, obj):
     return obj.type == 'MESH' and not is_handle(obj)
+
+
+# --- solver settings, from the one table ------------------------------------------------------
+
+REFERENCE = materials.PRESETS["steel"]  # the custom material starts from steel's numbers
+
+
+def _setting(key, name, **kw):
+    """A FloatProperty for core/settings.py's `key`: default, bounds and text from the table.
+    Degrees are stored as radians (subtype ANGLE) so Blender shows the user's unit."""
+    default, low, high, unit, text = settings_table.SETTINGS[key]
+    if unit == "deg":
+        kw.update(subtype='ANGLE', default=math.radians(default), min=math.radians(low),
+                  max=math.radians(high))
+        text += " (degrees)"
+    elif unit == "m":
+        kw.update(subtype='DISTANCE', unit='LENGTH', default=default, min=low, max=high)
+        text += " (metres)"
+    else:
+        kw.update(default=default, min=low, max=high, subtype='FACTOR')
+    return FloatProperty(name=name, description=text, **kw)
+
+
+def _material_field(key, name, text, **kw):
+    unit, low, _high = materials.FIELDS[key]
+    # FIELDS bounds are exclusive below: the smallest positive step stands in for "> 0"
+    return FloatProperty(name=name, description=f"{text} ({unit})" if unit else text,
+                         default=REFERENCE[key], min=max(low, 1e-9), max=materials.FIELDS[key][2], **kw)
+
+
+_PRESET_ITEMS = [(key, key.capitalize(),
+                  f"{key.capitalize()} wire: bending stiffness {p['bending_stiffness']} N m², "
+                  f"plastic torque {p['max_torque']} N m, friction {p['friction']} at "
+                  f"{p['wire_diameter'] * 1000:g} mm, scaled to the wire diameter")
+                 for key, p in materials.PRESETS.items()]
+_PRESET_ITEMS.append(("CUSTOM", "Custom", "Give the material's numbers yourself (for the wire "
+                                          "diameter below)"))
+
+
+def _f(value):
+    """A property's float32 value as the number the user typed (7 significant digits)."""
+    return float(f"{value:.7g}")
+
+
+def material_of(settings):
+    """The design's material dict from the panel: a preset scaled to the chosen wire diameter
+    (bending stiffness ~ d^4, plastic torque ~ d^3 for a round wire), or the custom numbers."""
+    d = _f(settings.wire_diameter)
+    if settings.material_preset == "CUSTOM":
+        return {"name": "custom", "wire_diameter": d, "bending_stiffness": _f(settings.bending_stiffness),
+                "max_torque": _f(settings.max_torque), "friction": _f(settings.friction),
+                "density": _f(settings.density)}
+    out = dict(materials.PRESETS[settings.material_preset])
+    ratio = d / out["wire_diameter"]
+    out["bending_stiffness"] *= ratio ** 4
+    out["max_torque"] *= ratio ** 3
+    if ratio != 1.0:
+        out["bending_stiffness"] = _f(out["bending_stiffness"])
+        out["max_torque"] = _f(out["max_torque"])
+    out["wire_diameter"] = d
+    return out
+
+
+def solver_settings(settings):
+    """The pipeline's settings dict (core/settings.py keys, degrees where the table says so)."""
+    out = settings_table.defaults()
+    for key, (_default, _low, _high, unit, _text) in settings_table.SETTINGS.items():
+        if key not in SETTING_PROPS:
+            continue
+        value = getattr(settings, key)
+        out[key] = _f(math.degrees(value) if unit == "deg" else value)
+    if out["min_bend_deg"] >= out["max_bend_deg"]:
+        raise ValueError("the smallest bend must be smaller than the largest bend (Machine settings)")
+    return out
+
+
+# core/settings.py keys shown in the panel (weld_tolerance stays automatic)
+SETTING_PROPS = ("min_segment", "max_bend_deg", "min_bend_deg", "contact_angle_deg", "torque_fraction")
+
+
+def _assembly_step_changed(settings, context):
+    from . import scene_results  # bpy-side module, imported lazily
+
+    scene_results.apply_assembly_step(context.scene)
 
 
 class WiresculptContour(bpy.types.PropertyGroup):
@@ -44,6 +136,48 @@ class WiresculptSettings(bpy.types.PropertyGroup):
     active_contour: IntProperty(
         name="Active Contour", min=0, default=0,
         description="Contour highlighted in the list")
+
+    # material and wire
+    material_preset: EnumProperty(
+        name="Material", items=_PRESET_ITEMS, default=next(iter(materials.PRESETS)),
+        description="Wire material: a preset from the paper's Table 1, or your own numbers")
+    wire_diameter: FloatProperty(
+        name="Wire Diameter", subtype='DISTANCE', unit='LENGTH', default=REFERENCE["wire_diameter"],
+        min=1e-4, max=materials.FIELDS["wire_diameter"][2], precision=4,
+        description="Diameter of the round wire (metres); presets scale their stiffness and "
+                    "torque to it, and the wire curves get it as thickness")
+    bending_stiffness: _material_field(
+        "bending_stiffness", "Bending Stiffness", "Custom material: bending stiffness k_b = E I")
+    max_torque: _material_field(
+        "max_torque", "Plastic Torque", "Custom material: torque at which the wire yields")
+    friction: _material_field(
+        "friction", "Friction", "Custom material: friction coefficient between two wires")
+    density: _material_field(
+        "density", "Density", "Custom material: density, for the sculpture's weight")
+
+    # machine and solver (core/settings.py)
+    min_segment: _setting("min_segment", "Min Segment", precision=4)
+    max_bend_deg: _setting("max_bend_deg", "Max Bend")
+    min_bend_deg: _setting("min_bend_deg", "Min Bend")
+    contact_angle_deg: _setting("contact_angle_deg", "Contact Angle")
+    torque_fraction: _setting("torque_fraction", "Torque Fraction")
+
+    # results display
+    show_forces: BoolProperty(
+        name="Show Forces", default=True,
+        description="Draw the contact force at every crossing as an arrow in the viewport "
+                    "(when the design has forces)")
+    show_markers: BoolProperty(
+        name="Crossing Markers", default=True,
+        description="Show the crossing markers (green: hooked, grey: null)",
+        update=_assembly_step_changed)
+    assembly_step: IntProperty(
+        name="Show After Step", default=0, min=0, soft_max=50,
+        description="Show only the wires added up to this assembly step (0: the whole sculpture)",
+        update=_assembly_step_changed)
+    guide_folder: StringProperty(
+        name="Guide Folder", subtype='DIR_PATH', default="//assembly",
+        description="Folder the assembly guide (index.html and one picture per step) is written to")
 
 
 _classes = (WiresculptContour, WiresculptSettings)

@@ -1,7 +1,7 @@
 """Operators, one module per concern, each with its own register/unregister."""
-from . import slicing
+from . import optimize, results, slicing
 
-_modules = (slicing,)
+_modules = (slicing, optimize, results)
 
 
 def register():

@@ -1,7 +1,8 @@
 """User interface, one module per concern, each with its own register/unregister."""
-from . import panel
+from .. import overlay
+from . import panel, results
 
-_modules = (panel,)
+_modules = (panel, results, overlay)
 
 
 def register():

@@ -1,0 +1,270 @@
+"""Optimize: the ticked contours become wires and the solver's stages run on them.
+
+From the UI the solver runs in a worker thread (the native stages release the GIL) under a modal
+operator with a timer: progress in the panel and the status bar, Esc or Cancel stops it and
+leaves the scene exactly as before. Nothing is written to the scene until the solver is done,
+and then in the modal's last step, so one Undo removes the whole result. In background mode
+(batch, tests) there is no event loop and execute() solves inline.
+"""
+import threading
+import time
+
+import bpy
+
+from .. import mesh_data, native, pipeline, scene_results
+from ..core.design import new_design, wire_entry
+from ..props import material_of, solver_settings
+from .slicing import handle_plane, handles, target_problem
+
+TIMER_SECONDS = 0.1
+STAGE_LABELS = {"slicing": "Slicing", "layering": "Layering", "target_shape": "Target shape",
+                "forces": "Forces", "rest_shape": "Rest shape", "writing": "Writing results"}
+
+
+# --- small functions, no UI -------------------------------------------------------------------
+
+def build_design(context):
+    """(design, material, settings) from the scene: the evaluated target re-sliced by the handles,
+    the ticked contours as wires. ValueError (naming the plane or contour) when that is not
+    possible."""
+    scene = context.scene
+    ws = scene.wiresculpt
+    problem = target_problem(scene, ws.target)
+    if problem:
+        raise ValueError(problem)
+    if not native.available():
+        raise RuntimeError(native.LOAD_ERROR)
+    ticked = [(item.plane, item.index) for item in ws.contours if item.use]
+    if not ticked:
+        raise ValueError("No contour is ticked: Slice, then tick the contours that become wires")
+    material, settings = material_of(ws), solver_settings(ws)
+    by_name = {h.name: h for h in handles(scene)}
+    planes = []
+    for plane, _index in ticked:
+        if plane not in by_name:
+            raise ValueError(f"slicing plane {plane} of a ticked contour is gone: Slice again")
+        if plane not in planes:
+            planes.append(plane)
+    start = time.perf_counter()
+    depsgraph = context.evaluated_depsgraph_get()
+    specs = [handle_plane(by_name[name], depsgraph) for name in planes]
+    V, F = mesh_data.object_triangles(ws.target, depsgraph)
+    result = native.slice_mesh(V, F, specs)
+    design = new_design(material, settings)
+    for (name, origin, normal), contours in zip(specs, result["contours"]):
+        for plane, index in ticked:
+            if plane != name:
+                continue
+            if index >= len(contours):
+                raise ValueError(f"contour {plane} #{index} no longer exists (plane {plane} now cuts "
+                                 f"{len(contours)}): Slice again")
+            c = contours[index]
+            design["wires"].append(wire_entry(len(design["wires"]), f"{plane}/{index}", origin, normal,
+                                              c["closed"], c["points"]))
+    design["stages"]["slicing"] = {"seconds": time.perf_counter() - start, "planes": len(planes),
+                                   "contours": sum(len(c) for c in result["contours"])}
+    return design, material, settings
+
+
+def summary(design):
+    """(report type, sentence) for the finished design."""
+    wires = len(design["wires"])
+    crossings = len(design.get("crossings", []))
+    if design["stable"]:
+        names = [design["wires"][w]["name"] for w in design.get("assembly_order", [])]
+        return {'INFO'}, (f"Stable: {wires} wires, {crossings} crossings; assemble "
+                          f"{', '.join(names)}")
+    return {'WARNING'}, f"Not stable: {design['reason']}"
+
+
+def run_optimize(context, progress=None, cancel=None):
+    """Builds, solves and writes the design into the scene (the synchronous path). Raises
+    pipeline.Cancelled (the scene untouched), ValueError or RuntimeError (untouched too)."""
+    design, material, settings = build_design(context)
+    pipeline.solve(design, material, settings, progress, cancel)
+    scene_results.write_results(context.scene, design)
+    return design
+
+
+class Job:
+    """The running optimisation: the worker thread and what the panel shows of it."""
+
+    def __init__(self, design, material, settings):
+        self.design, self.material, self.settings = design, material, settings
+        self.stage = pipeline.ALL_STAGES[0]
+        self.done = 0
+        self.messages = []
+        self.error = None
+        self.cancelled = False
+        self.cancel_event = threading.Event()
+        self.started = time.perf_counter()
+        self.thread = threading.Thread(target=self._work, name="wiresculpt solve", daemon=True)
+
+    def _progress(self, stage, message):
+        self.messages.append(f"{stage}: {message}")
+        if stage in pipeline.ALL_STAGES:
+            k = pipeline.ALL_STAGES.index(stage) + 1
+            self.done = max(self.done, k)
+            if k < len(pipeline.ALL_STAGES):
+                self.stage = pipeline.ALL_STAGES[k]
+
+    def _work(self):
+        try:
+            pipeline.solve(self.design, self.material, self.settings, self._progress,
+                           self.cancel_event.is_set)
+        except pipeline.Cancelled:
+            self.cancelled = True
+        except (ValueError, RuntimeError) as exc:
+            self.error = str(exc)
+        except Exception as exc:  # a bug of ours: reported, never raised into Blender's UI thread
+            self.error = f"internal error ({type(exc).__name__}: {exc}); please report it"
+
+    def status(self):
+        label = STAGE_LABELS.get(self.stage, self.stage)
+        if self.cancel_event.is_set():
+            return "wiresculpt: cancelling…"
+        return (f"wiresculpt: {label}… stage {self.done + 1} of {len(pipeline.ALL_STAGES)}, "
+                f"{time.perf_counter() - self.started:.0f} s (Esc to cancel)")
+
+
+JOB = None  # the Job while an Optimize runs in the UI, else None
+
+
+def running():
+    return JOB is not None
+
+
+# --- operators --------------------------------------------------------------------------------
+
+class WIRESCULPT_OT_optimize(bpy.types.Operator):
+    """Turn the ticked contours into a stable wire sculpture: layering, target shape and the
+    later stages; the wires appear as curves (Esc cancels)"""
+    bl_idname = "wiresculpt.optimize"
+    bl_label = "Optimize"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    _timer = None
+
+    @classmethod
+    def poll(cls, context):
+        return not running()
+
+    def _finish(self, context, design):
+        scene_results.write_results(context.scene, design)
+        kind, message = summary(design)
+        self.report(kind, message)
+        return {'FINISHED'}
+
+    def execute(self, context):
+        try:
+            design, material, settings = build_design(context)
+            pipeline.solve(design, material, settings)
+        except pipeline.Cancelled:
+            self.report({'WARNING'}, "Optimize cancelled; the scene is unchanged")
+            return {'CANCELLED'}
+        except (ValueError, RuntimeError) as exc:
+            self.report({'ERROR'}, f"Cannot optimize: {exc}")
+            return {'CANCELLED'}
+        return self._finish(context, design)
+
+    def invoke(self, context, event):
+        global JOB
+        if bpy.app.background or context.window is None:
+            return self.execute(context)
+        try:
+            design, material, settings = build_design(context)
+        except (ValueError, RuntimeError) as exc:
+            self.report({'ERROR'}, f"Cannot optimize: {exc}")
+            return {'CANCELLED'}
+        JOB = Job(design, material, settings)
+        JOB.thread.start()
+        wm = context.window_manager
+        self._timer = wm.event_timer_add(TIMER_SECONDS, window=context.window)
+        wm.progress_begin(0, len(pipeline.ALL_STAGES))
+        wm.modal_handler_add(self)
+        self._show(context)
+        return {'RUNNING_MODAL'}
+
+    def _show(self, context):
+        if JOB is not None:
+            context.window_manager.progress_update(JOB.done)
+            if context.workspace is not None:
+                context.workspace.status_text_set(JOB.status())
+        for area in (context.screen.areas if context.screen else []):
+            if area.type == 'VIEW_3D':
+                area.tag_redraw()
+
+    def _cleanup(self, context):
+        global JOB
+        wm = context.window_manager
+        if self._timer is not None:
+            wm.event_timer_remove(self._timer)
+            self._timer = None
+        wm.progress_end()
+        if context.workspace is not None:
+            context.workspace.status_text_set(None)
+        job, JOB = JOB, None
+        self._show(context)
+        return job
+
+    def modal(self, context, event):
+        try:
+            return self._modal(context, event)
+        except Exception as exc:  # never leave a half-finished modal behind in the UI
+            if JOB is not None:
+                JOB.cancel_event.set()
+                JOB.thread.join()
+                self._cleanup(context)
+            self.report({'ERROR'}, f"Optimize failed: internal error ({type(exc).__name__}: {exc}); "
+                                   "the scene is unchanged")
+            return {'CANCELLED'}
+
+    def _modal(self, context, event):
+        job = JOB
+        if job is None:  # cancelled from outside and already cleaned up
+            return {'CANCELLED'}
+        if event.type == 'ESC' and event.value == 'PRESS':
+            job.cancel_event.set()
+            self._show(context)
+            return {'RUNNING_MODAL'}
+        if event.type == 'Z' and (event.ctrl or event.oskey):
+            return {'RUNNING_MODAL'}  # no undo under a running solve
+        if event.type != 'TIMER':
+            return {'PASS_THROUGH'}
+        if job.thread.is_alive():
+            self._show(context)
+            return {'PASS_THROUGH'}
+        self._cleanup(context)
+        if job.cancelled or job.cancel_event.is_set():
+            self.report({'WARNING'}, "Optimize cancelled; the scene is unchanged")
+            return {'CANCELLED'}
+        if job.error is not None:
+            self.report({'ERROR'}, f"Cannot optimize: {job.error}")
+            return {'CANCELLED'}
+        return self._finish(context, job.design)
+
+    def cancel(self, context):  # Blender closes the window or the file under the modal
+        job = JOB
+        if job is not None:
+            job.cancel_event.set()
+            job.thread.join()
+            self._cleanup(context)
+
+
+class WIRESCULPT_OT_optimize_cancel(bpy.types.Operator):
+    """Stop the running Optimize at the next safe point; the scene stays as it was"""
+    bl_idname = "wiresculpt.optimize_cancel"
+    bl_label = "Cancel"
+    bl_options = {'INTERNAL'}
+
+    def execute(self, context):
+        if JOB is None:
+            self.report({'INFO'}, "Nothing to cancel: no Optimize is running")
+            return {'CANCELLED'}
+        JOB.cancel_event.set()
+        self.report({'INFO'}, "Cancelling Optimize…")
+        return {'FINISHED'}
+
+
+register, unregister = bpy.utils.register_classes_factory(
+    (WIRESCULPT_OT_optimize, WIRESCULPT_OT_optimize_cancel))

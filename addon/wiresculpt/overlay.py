@@ -1,0 +1,103 @@
+"""Viewport overlay: the contact force at every crossing as an arrow (gpu module, no bgl).
+
+Drawn only when the stored design has `force` per crossing and scene.wiresculpt.show_forces is
+on. The longest arrow is ARROW_SHARE of the sculpture's size; each arrow starts at the crossing
+and shows the force on wires[0] (FORMATS.md `force`).
+"""
+import bpy
+import gpu
+import numpy as np
+from gpu_extras.batch import batch_for_shader
+
+from . import scene_results
+
+ARROW_SHARE = 0.2
+HEAD_SHARE = 0.25  # arrow head length as a share of the arrow
+COLOUR = (1.0, 0.35, 0.05, 1.0)
+
+_handle = None
+_shader = None
+_arrows = {"design": None, "step": None, "lines": None}  # the last design drawn and its arrows
+
+
+def uniform_colour_shader():
+    """The built-in flat-colour shader: 'UNIFORM_COLOR' (Blender 4+) or '3D_UNIFORM_COLOR' (3.x)."""
+    global _shader
+    if _shader is None:
+        try:
+            _shader = gpu.shader.from_builtin('UNIFORM_COLOR')
+        except (ValueError, TypeError):
+            _shader = gpu.shader.from_builtin('3D_UNIFORM_COLOR')
+    return _shader
+
+
+def force_arrows(design, shown=None):
+    """(2k, 3) float32 line-segment end points of the force arrows, or None without forces.
+    `shown`: wire ids on view (the assembly slider); crossings of hidden wires get no arrow."""
+    crossings = [c for c in design.get("crossings", []) if "force" in c
+                 and (shown is None or all(w in shown for w in c["wires"]))]
+    if not crossings:
+        return None
+    points = np.concatenate([scene_results.wire_points(w) for w in design["wires"]])
+    size = float(np.max(points.max(axis=0) - points.min(axis=0))) or 1.0
+    forces = np.asarray([c["force"] for c in crossings], dtype=np.float64)
+    largest = float(np.max(np.linalg.norm(forces, axis=1)))
+    if largest <= 0:
+        return None
+    scale = ARROW_SHARE * size / largest
+    lines = []
+    for c, f in zip(crossings, forces):
+        length = float(np.linalg.norm(f))
+        if length <= 0:
+            continue
+        start = np.asarray(c["point"], dtype=np.float64)
+        tip = start + scale * f
+        axis = f / length
+        side = np.cross(axis, [0.0, 0.0, 1.0])
+        if np.linalg.norm(side) < 1e-6:
+            side = np.cross(axis, [1.0, 0.0, 0.0])
+        side /= np.linalg.norm(side)
+        head = HEAD_SHARE * scale * length
+        lines += [start, tip, tip, tip - head * axis + 0.5 * head * side,
+                  tip, tip - head * axis - 0.5 * head * side]
+    return np.asarray(lines, dtype=np.float32) if lines else None
+
+
+def draw():
+    scene = bpy.context.scene
+    if scene is None or not scene.wiresculpt.show_forces:
+        return
+    design = scene_results.stored_design()
+    if design is None:
+        return
+    step = scene.wiresculpt.assembly_step
+    # stored_design() returns the same dict until the text changes
+    if _arrows["design"] is not design or _arrows["step"] != step:
+        shown = scene_results.visible_wires(design, step) if step else None
+        _arrows.update(design=design, step=step, lines=force_arrows(design, shown))
+    lines = _arrows["lines"]
+    if lines is None:
+        return
+    shader = uniform_colour_shader()
+    batch = batch_for_shader(shader, 'LINES', {"pos": lines})
+    gpu.state.line_width_set(2.0)
+    gpu.state.depth_test_set('NONE')
+    shader.bind()
+    shader.uniform_float("color", COLOUR)
+    batch.draw(shader)
+    gpu.state.line_width_set(1.0)
+
+
+def register():
+    global _handle
+    if _handle is None:
+        _handle = bpy.types.SpaceView3D.draw_handler_add(draw, (), 'WINDOW', 'POST_VIEW')
+
+
+def unregister():
+    global _handle, _shader
+    if _handle is not None:
+        bpy.types.SpaceView3D.draw_handler_remove(_handle, 'WINDOW')
+        _handle = None
+    _shader = None
+    _arrows.update(design=None, step=None, lines=None)

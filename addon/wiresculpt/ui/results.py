@@ -1,0 +1,210 @@
+"""Sub-panels of the Wire tab: material and machine settings, Optimize with its progress, the
+stability report of the stored design, and the display of the result (forces, assembly steps,
+assembly guide)."""
+import math
+import textwrap
+
+import bpy
+
+from .. import native, scene_results
+from ..operators import optimize
+from ..operators.results import WIRESCULPT_OT_assembly_guide, WIRESCULPT_OT_clear_results
+from .panel import BOX_MARGIN, CHARS_PER_PIXEL, VIEW3D_PT_wiresculpt, length_text
+
+GRAVITY = 9.81  # m/s^2: weights in newtons to grams
+
+
+# --- report text, no UI -------------------------------------------------------------------------
+
+AXIS_WORDS = {"-z": "down (-z)", "+z": "up (+z)"}
+
+
+def sculpture_weight(design):
+    """The sculpture's weight in newtons: the forces stage's `load_capacity.weight_N`, or wire
+    length x section x density x g when the material has a density; None otherwise."""
+    capacity = design.get("load_capacity")
+    if isinstance(capacity, dict):
+        for key in ("weight_N", "weight"):
+            if isinstance(capacity.get(key), (int, float)):
+                return float(capacity[key])
+    mat = design["material"]
+    lengths = [w.get("length") for w in design["wires"]]
+    if "density" not in mat or None in lengths:
+        return None
+    area = math.pi * (0.5 * mat["wire_diameter"]) ** 2
+    return sum(lengths) * area * mat["density"] * GRAVITY
+
+
+def load_capacity_rows(design):
+    """[(direction, grams or None)] from design["load_capacity"] (FORMATS: the weight multiple the
+    sculpture holds with gravity along each axis direction, "+x" ... "-z"), [] when absent.
+    grams = multiple x weight / g x 1000; None where no limit was found (unbounded)."""
+    capacity = design.get("load_capacity")
+    weight = sculpture_weight(design)
+    if not isinstance(capacity, dict) or weight is None:
+        return []
+    rows = []
+    for axis in ("-z", "+z", "+x", "-x", "+y", "-y"):
+        if axis not in capacity:
+            continue
+        multiple = capacity[axis]
+        finite = isinstance(multiple, (int, float)) and math.isfinite(multiple)
+        rows.append((AXIS_WORDS.get(axis, axis), multiple * weight / GRAVITY * 1000.0 if finite else None))
+    return rows
+
+
+def assembly_rows(design):
+    """One row per wire in assembly order: "1. Equator/0", "   + Meridian0/0" for a wire added in
+    the same step, "(two hands)" after a step that adds two wires at once beyond the first pair."""
+    steps = design.get("assembly_steps")
+    if not steps:
+        order = design.get("assembly_order") or []
+        steps = [[w] for w in order]
+    two_hands = set(design.get("two_hand_steps") or [])
+    rows = []
+    for k, step in enumerate(steps):
+        names = [design["wires"][w]["name"] for w in step]
+        note = " (two hands)" if k in two_hands else ""
+        rows.append(f"{k + 1}. {names[0]}" + (note if len(names) == 1 else ""))
+        rows += [f"    + {name}" + (note if i == len(names) - 2 else "") for i, name in enumerate(names[1:])]
+    return rows
+
+
+def _wrap(layout, context, text, icon='NONE'):
+    width = context.region.width if context.region else 280
+    lines = textwrap.wrap(text, max(20, int((width - BOX_MARGIN) * CHARS_PER_PIXEL))) or [""]
+    for i, line in enumerate(lines):
+        layout.label(text=line, icon=icon if i == 0 else 'BLANK1' if icon != 'NONE' else 'NONE')
+
+
+# --- panels -------------------------------------------------------------------------------------
+
+class _Child:
+    bl_space_type = 'VIEW_3D'
+    bl_region_type = 'UI'
+    bl_category = "Wire"
+    bl_parent_id = VIEW3D_PT_wiresculpt.__name__
+
+
+class VIEW3D_PT_wiresculpt_settings(_Child, bpy.types.Panel):
+    bl_label = "Material & Machine"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        ws = context.scene.wiresculpt
+        layout.prop(ws, "material_preset")
+        layout.prop(ws, "wire_diameter")
+        if ws.material_preset == "CUSTOM":
+            col = layout.column(align=True)
+            for key in ("bending_stiffness", "max_torque", "friction", "density"):
+                col.prop(ws, key)
+        col = layout.column(align=True)
+        col.prop(ws, "min_segment")
+        col.prop(ws, "min_bend_deg")
+        col.prop(ws, "max_bend_deg")
+        col = layout.column(align=True)
+        col.prop(ws, "contact_angle_deg")
+        col.prop(ws, "torque_fraction")
+
+
+class VIEW3D_PT_wiresculpt_optimize(_Child, bpy.types.Panel):
+    bl_label = "Optimize"
+    bl_options = {'HIDE_HEADER'}
+
+    def draw(self, context):
+        layout = self.layout
+        job = optimize.JOB
+        if job is None:
+            row = layout.row()
+            row.scale_y = 1.4
+            row.enabled = native.available()
+            row.operator(optimize.WIRESCULPT_OT_optimize.bl_idname, icon='PLAY')
+            return
+        box = layout.box()
+        box.label(text=job.status().replace("wiresculpt: ", ""), icon='SORTTIME')
+        for line in job.messages[-3:]:
+            box.label(text=line)
+        box.operator(optimize.WIRESCULPT_OT_optimize_cancel.bl_idname, icon='CANCEL')
+
+
+class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
+    bl_label = "Stability"
+
+    @classmethod
+    def poll(cls, context):
+        return scene_results.stored_design() is not None
+
+    def draw(self, context):
+        layout = self.layout
+        design = scene_results.stored_design()
+        box = layout.box()
+        if design["stable"]:
+            box.label(text="Stable", icon='CHECKMARK')
+        else:
+            box.alert = True
+            box.label(text="Not stable", icon='ERROR')
+            _wrap(box, context, design.get("reason") or "no reason given")
+        rows = assembly_rows(design)
+        if rows:
+            col = layout.column(align=True)
+            col.label(text="Assembly order:")
+            for row in rows:
+                col.label(text=row.strip(), icon='BLANK1' if row.startswith(" ") else 'FORWARD')
+        distances = [w["target_max_distance"] for w in design["wires"] if "target_max_distance" in w]
+        if distances:
+            row = layout.row()
+            row.label(text="Max deviation")  # the largest distance of a wire from its contour
+            row.label(text=length_text(context.scene, max(distances)))
+        capacity = load_capacity_rows(design)
+        if capacity:
+            col = layout.column(align=True)
+            weight = sculpture_weight(design)
+            col.label(text=f"Load capacity (weighs {weight / GRAVITY * 1000:.0f} g):")
+            for direction, grams in capacity:
+                row = col.row()
+                row.label(text=direction)
+                row.label(text=f"{grams:.0f} g" if grams is not None else "no limit found")
+        pending = design.get("pending_stages") or []
+        if pending:
+            layout.label(text="Pending: " + ", ".join(p.replace("_", " ") for p in pending), icon='INFO')
+        warnings = design.get("warnings") or []
+        if warnings:
+            col = layout.column(align=True)
+            for warning in warnings[:3]:
+                _wrap(col, context, warning, icon='ERROR')
+            if len(warnings) > 3:
+                col.label(text=f"… and {len(warnings) - 3} more (see the wiresculpt_design.json text)")
+
+
+class VIEW3D_PT_wiresculpt_display(_Child, bpy.types.Panel):
+    bl_label = "Result"
+
+    @classmethod
+    def poll(cls, context):
+        return scene_results.stored_design() is not None
+
+    def draw(self, context):
+        layout = self.layout
+        ws = context.scene.wiresculpt
+        design = scene_results.stored_design()
+        if any("force" in c for c in design.get("crossings", [])):
+            layout.prop(ws, "show_forces")
+        layout.prop(ws, "show_markers")
+        steps = design.get("assembly_steps") or []
+        if steps:
+            layout.prop(ws, "assembly_step", slider=False)
+            if ws.assembly_step:
+                names = [design["wires"][w]["name"] for s in steps[:ws.assembly_step] for w in s]
+                _wrap(layout, context, "Shown: " + ", ".join(names))
+            col = layout.column(align=True)
+            col.prop(ws, "guide_folder", text="")
+            col.operator(WIRESCULPT_OT_assembly_guide.bl_idname, icon='HELP')
+        layout.operator(WIRESCULPT_OT_clear_results.bl_idname, icon='TRASH')
+
+
+_classes = (VIEW3D_PT_wiresculpt_settings, VIEW3D_PT_wiresculpt_optimize, VIEW3D_PT_wiresculpt_report,
+            VIEW3D_PT_wiresculpt_display)
+register, unregister = bpy.utils.register_classes_factory(_classes)
