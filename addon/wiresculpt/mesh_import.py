@@ -54,4 +54,6 @@ def import_mesh(path):
     V, F = join_triangles([object_triangles(o, depsgraph) for o in objects])
     if len(V) == 0:
         raise ValueError(f"mesh file {path} has no vertices")
+    if len(F) == 0:
+        raise ValueError(f"mesh file {path} has no faces (only points or edges): planes cut surfaces")
     return V, F, objects

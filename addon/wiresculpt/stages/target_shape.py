@@ -14,6 +14,7 @@ import numpy as np
 
 from .. import native
 from ..core.frames import plane_frame, to_2d, to_3d
+from ..core.polylines import polyline_length
 from . import layering
 
 FAILED = ("too_close", "infeasible", "open_end")
@@ -60,6 +61,27 @@ def solve_wire(design, wire, material, settings, size, native_progress=None):
     return result, refs, (origin, u, v)
 
 
+def _ids(numbers):
+    numbers = sorted(numbers)
+    return ", ".join(map(str, numbers[:-1])) + f" and {numbers[-1]}" if len(numbers) > 1 else str(numbers[0])
+
+
+def unrealised_summary(nulled, size):
+    """One sentence for the crossings the target shape could not realise: those too close along
+    their wires as one group with the size to scale to, the others each with the solver's words."""
+    parts = []
+    close = [n for n in nulled if n["status"] == "too_close"]
+    if close:
+        worst = max(close, key=lambda n: n["scale"])
+        parts.append(f"crossing{'s' if len(close) > 1 else ''} {_ids(n['crossing'] for n in close)}, too "
+                     f"close to {'their' if len(close) > 1 else 'its'} neighbours along the wires for a free "
+                     f"bending point between them (the closest: {worst['message']})")
+    for n in nulled:
+        if n["status"] != "too_close":
+            parts.append(f"crossing {n['crossing']} on wire {n['wire']}: {n['message']}")
+    return "the target shape cannot realise " + "; ".join(parts)
+
+
 def run(design, material, settings, native_progress=None):
     """Fills each wire's target, length and distances, each crossing's vertices, stages.target_shape;
     nulls crossings that cannot be realised and re-checks stability. Returns a progress line."""
@@ -73,12 +95,13 @@ def run(design, material, settings, native_progress=None):
         for wire, (r, refs, _frame) in zip(design["wires"], solved):
             for (c, _k), status in zip(refs, r["crossings"]):
                 if c["hook"] != 0 and status["status"] in FAILED:
-                    failing.setdefault(c["id"], f"crossing {c['id']} on wire {wire['name']}: {status['message']}")
+                    failing.setdefault(c["id"], {"crossing": c["id"], "wire": wire["name"], "status": status["status"],
+                                                 "scale": status["scale"], "message": status["message"]})
         if not failing:
             break
-        for cid, message in failing.items():
+        for cid, failure in failing.items():
             design["crossings"][cid]["hook"] = 0
-            nulled.append({"crossing": cid, "message": message})
+            nulled.append(failure)
     else:
         raise RuntimeError("target shape: crossings kept failing after nulling; this is a solver bug")
 
@@ -86,8 +109,7 @@ def run(design, material, settings, native_progress=None):
     for wire, (r, refs, frame) in zip(design["wires"], solved):
         target = to_3d(r["points"], *frame)
         wire["target"] = target.tolist()
-        wire["length"] = float(np.sum(np.linalg.norm(np.diff(target, axis=0, append=target[:1] if wire["closed"]
-                                                               else None), axis=1)))
+        wire["length"] = polyline_length(target, wire["closed"])
         wire["target_max_distance"] = r["max_distance"]
         wire["target_rms_distance"] = r["rms_distance"]
         for (c, k), vertex in zip(refs, r["crossing_vertices"]):
@@ -111,12 +133,11 @@ def run(design, material, settings, native_progress=None):
         design["stages"]["target_shape"]["recheck_lp_solves"] = verdict["lp_solves"]
         if not verdict["stable"] and design["stable"]:
             step = design["assembly_steps"][verdict["failed_step"]]
-            names = ", ".join(design["wires"][w]["name"] for w in step)
+            names = " and ".join(design["wires"][w]["name"] for w in step)
             design["stable"] = False
-            design["reason"] = (f"the target shape cannot realise {len(nulled)} crossing"
-                                f"{'s' if len(nulled) > 1 else ''} ({'; '.join(n['message'] for n in nulled)}); "
-                                f"without {'them' if len(nulled) > 1 else 'it'} the assembly is no longer "
-                                f"stable when adding {names}")
+            design["reason"] = (f"{unrealised_summary(nulled, size)}; without "
+                                f"{'them' if len(nulled) > 1 else 'it'} the assembly is no longer stable when "
+                                f"adding {names}")
     worst = max(w["max_distance"] for w in per_wire)
     return (f"{len(per_wire)} wires, largest distance to the contour {worst * 1000:.2f} mm, "
             f"{len(nulled)} crossings nulled, {iterations} iterations ({seconds:.3f} s)")

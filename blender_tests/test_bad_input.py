@@ -1,0 +1,72 @@
+"""The bad-input corpus (bad_input.json): each case through the headless run, with the exact
+message it must produce; no case may crash, hang or leave a partial file behind."""
+import json
+import os
+import tempfile
+import unittest
+
+from helpers import BATCH, ROOT, run_blender, wiresculpt_lines
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+GLOBE = os.path.join(ROOT, "scripts", "examples", "globe", "globe.obj")
+
+
+def bowl_obj():
+    """The globe's upper half: an open surface."""
+    with open(GLOBE) as f:
+        lines = f.read().splitlines()
+    vertices = [tuple(map(float, l.split()[1:])) for l in lines if l.startswith("v ")]
+    kept = [l for l in lines if l.startswith("v ")]
+    for l in lines:
+        if l.startswith("f ") and all(vertices[int(i) - 1][2] >= -1e-9 for i in l.split()[1:]):
+            kept.append(l)
+    return "\n".join(kept) + "\n"
+
+
+def mesh_text(spec):
+    if spec.startswith("@globe"):
+        with open(GLOBE) as f:
+            return f.read() + spec[len("@globe+"):]
+    if spec == "@bowl":
+        return bowl_obj()
+    return spec
+
+
+def lookup(design, dotted):
+    value = design
+    for part in dotted.split("."):
+        value = value[int(part)] if isinstance(value, list) else value[part]
+    return value
+
+
+class BadInput(unittest.TestCase):
+    def test_corpus(self):
+        with open(os.path.join(HERE, "bad_input.json")) as f:
+            cases = json.load(f)["cases"]
+        for case in cases:
+            with self.subTest(case["name"]), tempfile.TemporaryDirectory() as tmp:
+                for name, spec in case.get("meshes", {}).items():
+                    with open(os.path.join(tmp, name), "w") as f:
+                        f.write(mesh_text(spec))
+                scene = os.path.join(tmp, "scene.json")
+                with open(scene, "w") as f:
+                    f.write(case["text"] if "text" in case else json.dumps(case["scene"]))
+                out = os.path.join(tmp, "out")
+                r = run_blender(BATCH, scene, "--out", out, timeout=120)
+                self.assertEqual(r.returncode, case["exit"], r.stdout + r.stderr)
+                messages = wiresculpt_lines(r.stderr)
+                if "stderr" in case:
+                    self.assertEqual(messages, [case["stderr"].replace("{dir}", tmp)])
+                if case["exit"] == 1:
+                    self.assertFalse(os.path.exists(out), "a refused input must leave nothing behind")
+                    continue
+                self.assertEqual(sorted(n for n in os.listdir(out) if n.endswith(".tmp")), [])
+                with open(os.path.join(out, "design.json")) as f:
+                    design = json.load(f)
+                self.assertEqual(design["stable"], case["exit"] == 0)
+                for key, expected in case.get("design", {}).items():
+                    self.assertEqual(lookup(design, key), expected, key)
+
+
+if __name__ == "__main__":
+    unittest.main()
