@@ -91,6 +91,11 @@ class BatchTest(unittest.TestCase):
         for c in d["crossings"]:
             self.assertEqual(len(c["force"]), 3)
         self.check_targets(d)
+        for folder, ext in (("svg", ".svg"), ("dxf", ".dxf"), ("gcode", ".gcode"), ("bends", ".csv")):
+            names = os.listdir(os.path.join(self.out, folder))
+            self.assertTrue(names and all(n.endswith(ext) for n in names), (folder, names))
+        self.assertEqual(len(d["fabrication"]["wires"]), 3)
+        self.assertEqual(d["fabrication"]["errors"], [])
 
     def check_targets(self, d):
         """The target shapes against FORMATS.md and the machine, computed from the points alone."""

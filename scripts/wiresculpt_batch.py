@@ -3,7 +3,10 @@
     blender --background --factory-startup --python scripts/wiresculpt_batch.py -- SCENE.json --out DIR
 
 Reads and validates the scene file, imports the mesh, runs the pipeline and writes DIR/design.json
-(atomically). One progress line per stage on stdout. Exit status: 0 a stable design was written;
+(atomically) with the fabrication files beside it (svg/, dxf/, gcode/, bends/), then the results
+as a Blender user sees them: DIR/sculpture.blend (wires, crossing
+markers and the design in a scene), DIR/render.png (a Workbench still) and the assembly guide
+DIR/assembly/index.html with a picture per step. One progress line per stage on stdout. Exit status: 0 a stable design was written;
 2 the input was valid but no stable design exists (design.json still written, with the reason);
 1 bad input or failure, with one clear message on stderr.
 """
@@ -38,6 +41,80 @@ def scaled_planes(planes, factor):
     return [PlaneSpec(p.name, tuple(factor * c for c in p.origin), p.normal, p.contours) for p in planes]
 
 
+def add_handles(scene, planes, design):
+    """The scene file's planes as the add-on's slicing handles, sliced, with the design's wires
+    ticked: the saved .blend can be edited and optimized again in Blender."""
+    import bpy
+    from mathutils import Vector
+
+    picked = {w["name"] for w in design["wires"]}
+    for plane in planes:
+        bpy.ops.wiresculpt.add_plane()
+        handle = bpy.context.view_layer.objects.active
+        handle.name = plane.name
+        handle.location = plane.origin
+        handle.rotation_euler = Vector(plane.normal).normalized().to_track_quat('Z', 'Y').to_euler()
+    bpy.context.view_layer.update()
+    bpy.ops.wiresculpt.slice()
+    for item in scene.wiresculpt.contours:
+        item.use = f"{item.plane}/{item.index}" in picked
+
+
+def write_scene_outputs(design, objects, planes, factor, out, say):
+    """sculpture.blend, render.png and assembly/ in `out`, from the design (each file atomic)."""
+    import bpy
+    from mathutils import Matrix
+
+    import wiresculpt
+    from wiresculpt import assembly_guide, scene_results
+
+    if not wiresculpt._modules:
+        wiresculpt.register()
+    scene = bpy.context.scene
+    for obj in objects:  # the mesh as the solver saw it: scaled about the world origin
+        obj.matrix_world = Matrix.Scale(factor, 4) @ obj.matrix_world
+        obj.display_type = 'WIRE'
+        obj.hide_render = True
+    start = time.perf_counter()
+    if len(objects) == 1 and design["wires"]:
+        scene.wiresculpt.target = objects[0]
+        add_handles(scene, planes, design)
+    scene_results.write_results(scene, design)
+    say("scene", f"{len(design['wires'])} wire curves, {len(design.get('crossings', []))} crossing markers "
+                 f"({time.perf_counter() - start:.3f} s)")
+    if design["wires"]:
+        start = time.perf_counter()
+        path = os.path.join(out, "render.png")
+        assembly_guide.render_still(scene, design, path)
+        say("render", f"{path} ({time.perf_counter() - start:.3f} s)")
+    if design.get("assembly_steps"):
+        start = time.perf_counter()
+        path = assembly_guide.write_guide(scene, design, os.path.join(out, "assembly"))
+        say("guide", f"{path}, {len(design['assembly_steps'])} steps ({time.perf_counter() - start:.3f} s)")
+    path = os.path.abspath(os.path.join(out, "sculpture.blend"))
+    # Blender writes the .blend to a temporary name and renames it: atomic like the rest
+    bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False, compress=True)
+    say("blend", path)
+
+
+def write_fabrication(design, out, say):
+    """svg/, dxf/, gcode/ and bends/ in `out` for every wire with a rest shape; the programs'
+    summary goes into the design as `fabrication`."""
+    from wiresculpt import export
+
+    if not any("rest" in w for w in design["wires"]):
+        return
+    start = time.perf_counter()
+    result = export.export(design, out)
+    design["fabrication"] = {"wires": result["wires"], "errors": result["errors"]}
+    minutes = sum(w["machine_seconds"] for w in result["wires"]) / 60
+    say("fabrication", f"{len(result['wires'])} bend programs ({sum(w['bend_count'] for w in result['wires'])} "
+                       f"bends, about {minutes:.0f} min on the machine), {len(result['files'])} files in svg/, dxf/, "
+                       f"gcode/, bends/ ({time.perf_counter() - start:.3f} s)")
+    for error in result["errors"]:
+        say("fabrication", error)
+
+
 def run(argv):
     import bpy
     import numpy as np
@@ -55,7 +132,7 @@ def run(argv):
     native.require()
     bpy.ops.wm.read_factory_settings(use_empty=True)
     start = time.perf_counter()
-    V, F, _objects = import_mesh(scene.mesh)
+    V, F, objects = import_mesh(scene.mesh)
     factor = 1.0
     if scene.size is not None:
         extent = float(np.max(V.max(axis=0) - V.min(axis=0)))
@@ -65,10 +142,13 @@ def run(argv):
         V = V * factor
     say("mesh", f"{len(V)} vertices, {len(F)} triangles, scale x{factor:g} "
                 f"({time.perf_counter() - start:.3f} s)")
-    design = pipeline.run(V, F, scaled_planes(scene.planes, factor), scene.material, scene.settings, say)
+    planes = scaled_planes(scene.planes, factor)
+    design = pipeline.run(V, F, planes, scene.material, scene.settings, say)
+    write_fabrication(design, args.out, say)
     path = os.path.join(args.out, "design.json")
     write_design(path, design)
     say("written", path)
+    write_scene_outputs(design, objects, planes, factor, args.out, say)
     if design["stable"]:
         return EXIT_STABLE
     print(f"wiresculpt: not stable: {design['reason']}", file=sys.stderr, flush=True)
