@@ -25,7 +25,7 @@ namespace {
 
 class GrblEmulator {
  public:
-  enum class Mode { normal, error_at, alarm_at, slow, disconnect_after };
+  enum class Mode { normal, error_at, alarm_at, slow, disconnect_after, garbage_at };
 
   explicit GrblEmulator(Mode mode, std::size_t k = 0, int delay_ms = 0) : mode_(mode), k_(k), delay_ms_(delay_ms) {
     termios raw{};
@@ -65,6 +65,8 @@ class GrblEmulator {
       locked_ = true;
       return send("ALARM:1\r\n");
     }
+    if (mode_ == Mode::garbage_at && index == k_)  // line noise: near-misses of "ok", binary junk
+      return send("okay\r\nerror\r\n\x01\xff\xfeok?\r\nOK \r\nerror:\r\n");
     if (mode_ == Mode::slow) std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms_));
     {
       std::lock_guard<std::mutex> g(mu_);
@@ -207,6 +209,21 @@ TEST_CASE("serial: slow answers are waited for, missing answers time out", "[fab
     CHECK(state.next_line == 0);
     CHECK_THAT(r.message, Contains("line 1"));
   }
+}
+
+TEST_CASE("serial: a device answering garbage acknowledges nothing and the stream stops there", "[fab][serial]") {
+  const auto lines = program_lines();
+  const std::size_t k = 3;
+  GrblEmulator grbl(GrblEmulator::Mode::garbage_at, k);
+  StreamState state;
+  StreamOptions o = quick();
+  o.response_timeout = 0.3;
+  const auto r = stream_program(grbl.path(), lines, MachineProfile{}, state, o);
+  CHECK(r.status != StreamStatus::completed);
+  CHECK(r.failed_line == k);
+  CHECK(state.next_line == k);  // lines 0..k-1 acknowledged, line k not
+  CHECK(grbl.acknowledged().size() == k);
+  CHECK_FALSE(r.message.empty());
 }
 
 TEST_CASE("serial: after a disconnect, a resume finishes with every line acknowledged exactly once", "[fab][serial]") {
