@@ -8,6 +8,8 @@ from .core.design import new_design
 from .stages import forces, layering, slicing, target_shape
 
 ALL_STAGES = ["layering", "target_shape", "forces", "rest_shape"]
+COUPLING_ROUNDS = 4  # target shape <-> rest shape iterations (Sec. 4.3)
+COUPLING_MARGIN_DEG = 0.5
 
 
 class Cancelled(Exception):
@@ -52,17 +54,51 @@ def solve(design, material, settings, progress=None, cancel=None):
         design["pending_stages"].remove("layering")
         for message in design.get("close_crossings", []):
             say("layering", message)
-        checkpoint()
-        say("target_shape", target_shape.run(design, material, settings, native_progress))
-        design["pending_stages"].remove("target_shape")
-        if design["stable"]:  # forces need the hooks of a complete stable assembly
-            checkpoint()
-            say("forces", forces.run(design, material, settings, native_progress))
-            design["pending_stages"].remove("forces")
-            say("rest_shape", forces.rest_summary(design))
-            design["pending_stages"].remove("rest_shape")
+        design = shape_and_rest(design, material, settings, say, native_progress, checkpoint)
     except native.module.Cancelled:
         raise Cancelled() from None
+    return design
+
+
+def _largest_over_bend(design, limit_deg):
+    """The largest rest bend beyond the machine's limit (degrees over it), 0 when none."""
+    over = [o["angle_deg"] for w in design["wires"] for o in w.get("rest_over_bend", [])]
+    return max((abs(a) - limit_deg for a in over), default=0.0)
+
+
+def shape_and_rest(design, material, settings, say, native_progress, checkpoint):
+    """Target shape, then forces and rest shape, with the coupling of Sec. 4.3: the machine's
+    maximum bend limits the rest shape, which is only known after the forces; when a rest bend
+    exceeds it, the target's limit is lowered by the excess (plus COUPLING_MARGIN_DEG) and the
+    shape is solved again from the same layering, at most COUPLING_ROUNDS times."""
+    import copy
+
+    machine_limit = settings["max_bend_deg"]
+    target_limit = machine_limit
+    before = copy.deepcopy(design)
+    for round_ in range(COUPLING_ROUNDS):
+        if round_:
+            design = copy.deepcopy(before)
+        checkpoint()
+        say("target_shape", target_shape.run(design, material, {**settings, "max_bend_deg": target_limit},
+                                             native_progress))
+        design["pending_stages"].remove("target_shape")
+        design["stages"]["target_shape"]["max_bend_deg"] = target_limit
+        design["stages"]["target_shape"]["coupling_rounds"] = round_ + 1
+        if not design["stable"]:  # forces need the hooks of a complete stable assembly
+            return design
+        checkpoint()
+        say("forces", forces.run(design, material, settings, native_progress))
+        design["pending_stages"].remove("forces")
+        say("rest_shape", forces.rest_summary(design))
+        design["pending_stages"].remove("rest_shape")
+        excess = _largest_over_bend(design, machine_limit)
+        if excess <= 0.0:
+            return design
+        if round_ + 1 < COUPLING_ROUNDS:
+            target_limit = max(1.0, target_limit - excess - COUPLING_MARGIN_DEG)
+            say("target_shape", f"a rest bend exceeds the machine's {machine_limit:g} deg by {excess:.4f} deg; "
+                                f"solving again with target bends up to {target_limit:.2f} deg (Sec. 4.3)")
     return design
 
 

@@ -3,9 +3,10 @@ kinks open the way the layering's hooks say (FORMATS.md `hook`).
 
 Contact angle: the layering stage assumes each kink's edges lie exactly contact_angle/2 from the
 bisector, with friction widening its pyramid by atan(mu). The paper's constraint is
-angle(edge, h*) + atan(mu) <= alpha*/2, so alpha* = contact_angle + 2 atan(mu) keeps every edge
-within contact_angle/2 of h*: the realised kink is at least as sharp as the one the layering
-judged stable.
+angle(edge, h*) + atan(mu) <= alpha*/2; the kink the layering judged stable needs every edge
+within contact_angle/2 of h*, which is that constraint with alpha* = contact_angle and the
+friction term left out (mu = 0 here: friction is already in the layering's pyramid). The
+realised kink is then at least as sharp as the one the layering judged stable.
 """
 import math
 import time
@@ -44,7 +45,7 @@ def solve_wire(design, wire, material, settings, size, native_progress=None):
     """(result, [(crossing, k)]) of the native optimisation of one wire."""
     _n, u, v = plane_frame(wire["plane"]["normal"])
     origin = wire["plane"]["origin"]
-    contact = math.radians(settings["contact_angle_deg"]) + 2 * math.atan(material["friction"])
+    contact = math.radians(settings["contact_angle_deg"])
     specs, refs = [], []
     for c in design["crossings"]:
         if wire["id"] not in c["wires"]:
@@ -55,7 +56,7 @@ def solve_wire(design, wire, material, settings, size, native_progress=None):
                       "contact_angle": contact, "active": c["hook"] != 0})
         refs.append((c, k))
     options = {"min_segment": settings["min_segment"], "max_bend": math.radians(settings["max_bend_deg"]),
-               "friction": material["friction"], "model_size": size, "wire_name": wire["name"]}
+               "friction": 0.0, "model_size": size, "wire_name": wire["name"]}
     result = native.require().optimize_target_shape(to_2d(wire["contour"], origin, u, v), wire["closed"],
                                                     specs, options, native_progress)
     return result, refs, (origin, u, v)

@@ -1,0 +1,73 @@
+"""The pipeline in-process: the Sec. 4.3 coupling between target and rest shape, and cancelling."""
+import math
+import unittest
+
+import numpy as np
+
+from test_export import sphere
+from wiresculpt import native, pipeline
+from wiresculpt.core.materials import PRESETS
+from wiresculpt.core.scene import PlaneSpec
+from wiresculpt.core.settings import defaults
+
+PLANES = [PlaneSpec(n, (0, 0, 0), normal) for n, normal in
+          (("A", (0, 0, 1)), ("B", (1, 0, 0)), ("C", (0, 1, 0)))]
+
+
+def largest_rest_turn_deg(design):
+    """The largest turning angle of any rest polyline, from its points alone."""
+    worst = 0.0
+    for w in design["wires"]:
+        p = np.asarray(w["rest"])
+        e = np.diff(p, axis=0)
+        e = e[np.linalg.norm(e, axis=1) > 0]
+        cross = e[:-1, 0] * e[1:, 1] - e[:-1, 1] * e[1:, 0]
+        dot = np.sum(e[:-1] * e[1:], axis=1)
+        worst = max(worst, float(np.max(np.degrees(np.abs(np.arctan2(cross, dot))))))
+    return worst
+
+
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class Coupling(unittest.TestCase):
+    def solve(self, rounds):
+        settings = defaults()
+        settings.update(contact_angle_deg=140.0, max_bend_deg=50.0)
+        V, F = sphere()
+        saved = pipeline.COUPLING_ROUNDS
+        pipeline.COUPLING_ROUNDS = rounds
+        try:
+            return pipeline.run(V, F, PLANES, PRESETS["steel"], settings)
+        finally:
+            pipeline.COUPLING_ROUNDS = saved
+
+    def test_rest_bends_respect_the_machine_after_coupling(self):
+        once = self.solve(1)
+        self.assertTrue(once["stable"])
+        self.assertGreater(largest_rest_turn_deg(once), 50.0)  # the case needs the coupling
+        coupled = self.solve(4)
+        self.assertTrue(coupled["stable"])
+        self.assertLessEqual(largest_rest_turn_deg(coupled), 50.0 + 1e-6)
+        stage = coupled["stages"]["target_shape"]
+        self.assertGreater(stage["coupling_rounds"], 1)
+        self.assertLess(stage["max_bend_deg"], 50.0)
+        self.assertEqual(coupled["pending_stages"], [])
+
+
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class Cancelling(unittest.TestCase):
+    def test_cancel_at_once_and_after_layering(self):
+        V, F = sphere()
+        for after in (0, 1):
+            calls = []
+
+            def cancel():
+                calls.append(1)
+                return len(calls) > after
+
+            design = pipeline.slice_and_pick(V, F, PLANES, PRESETS["steel"], defaults())
+            with self.assertRaises(pipeline.Cancelled):
+                pipeline.solve(design, PRESETS["steel"], defaults(), cancel=cancel)
+
+
+if __name__ == "__main__":
+    unittest.main()
