@@ -54,6 +54,23 @@ class Coupling(unittest.TestCase):
 
 
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class Cuts(unittest.TestCase):
+    def test_a_users_cut_starts_the_rest_shape(self):
+        settings = defaults()
+        settings["cuts"] = {"A/0": 7}
+        V, F = sphere()
+        design = pipeline.run(V, F, PLANES, PRESETS["steel"], settings)
+        wire = next(w for w in design["wires"] if w["name"] == "A/0")
+        self.assertEqual(wire["cut"], 7)
+        # FORMATS: rest has the target's edge lengths walked from the cut, one point more.
+        target, rest = np.asarray(wire["target"]), np.asarray(wire["rest"])
+        m = len(target)
+        self.assertEqual(len(rest), m + 1)
+        walked = [np.linalg.norm(target[(7 + j + 1) % m] - target[(7 + j) % m]) for j in range(m)]
+        np.testing.assert_allclose(np.linalg.norm(np.diff(rest, axis=0), axis=1), walked, atol=1e-12)
+
+
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
 class Cancelling(unittest.TestCase):
     def test_cancel_at_once_and_after_layering(self):
         V, F = sphere()

@@ -48,6 +48,7 @@ def solve(design, material, settings, progress=None, cancel=None):
         design["reason"] = ("no plane cuts the mesh: move the planes through the mesh" if not design["wires"]
                             else "a sculpture needs at least two wires: add a plane or pick more contours")
         return design
+    apply_cuts(design, settings.get("cuts"))
     try:
         checkpoint()
         say("layering", layering.run(design, material, settings, native_progress))
@@ -58,6 +59,16 @@ def solve(design, material, settings, progress=None, cancel=None):
     except native.module.Cancelled:
         raise Cancelled() from None
     return design
+
+
+def apply_cuts(design, cuts):
+    """The user's cuts ({wire name: target index}) onto the design's wires; ValueError names a
+    wire that does not exist. The index itself is checked by the forces stage."""
+    names = {w["name"]: w for w in design["wires"]}
+    for name, index in (cuts or {}).items():
+        if name not in names:
+            raise ValueError(f'settings.cuts names wire "{name}", but the wires are {", ".join(sorted(names))}')
+        names[name]["cut_override"] = index
 
 
 def _largest_over_bend(design, limit_deg):

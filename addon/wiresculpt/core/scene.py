@@ -108,14 +108,28 @@ def _plane(value, index, names):
     return PlaneSpec(name, origin, normal, contours)
 
 
+def _cuts(value):
+    """settings.cuts: {wire name: index into the wire's target} for closed wires."""
+    if not isinstance(value, dict):
+        raise ValueError('scene key "settings.cuts" must be an object such as {"A/0": 12}')
+    for name, index in value.items():
+        if isinstance(index, bool) or not isinstance(index, int) or index < 0:
+            raise ValueError(f'scene key "settings.cuts.{name}" must be a vertex index (0, 1, ...), got {json.dumps(index)}')
+    return dict(value)
+
+
 def _settings(value):
     out = settings_table.defaults()
+    out["cuts"] = {}
     if value is None:
         return out
     if not isinstance(value, dict):
         raise ValueError('scene key "settings" must be an object')
-    _unknown(value, set(settings_table.SETTINGS), "settings")
+    _unknown(value, set(settings_table.SETTINGS) | {"cuts"}, "settings")
     for key, raw in value.items():
+        if key == "cuts":
+            out["cuts"] = _cuts(raw)
+            continue
         _default, low, high, _unit, _text = settings_table.SETTINGS[key]
         out[key] = None if raw is None and _default is None else _number(raw, f"settings.{key}", low, high)
     if out["min_bend_deg"] >= out["max_bend_deg"]:
