@@ -33,4 +33,5 @@ PYBIND11_MODULE(_wiresculpt, m) {
   wiresculpt::python::bind_layering(m);
   wiresculpt::python::bind_target_shape(m);
   wiresculpt::python::bind_forces(m);
+  wiresculpt::python::bind_calibration(m);
 }

@@ -179,7 +179,7 @@ RestShapeResult rest_shape(const WireSpec& wire, int cut, const std::vector<Wire
   }
   r.rest_angles = r.target_angles;
   for (int k = 1; k + 1 < m; ++k) {
-    const double l_bar = 0.5 * (lengths[k - 1] + lengths[k]);
+    const double l_bar = voronoi_length(lengths[k - 1], lengths[k]);
     const double th = std::tan(0.5 * r.target_angles[k]);
     const double K = 4.0 * options.bending_stiffness / l_bar;
     r.rest_angles[k] = 2.0 * std::atan(th + r.torque[k] / (K * (1.0 + th * th)));

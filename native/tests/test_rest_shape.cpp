@@ -78,7 +78,9 @@ TEST_CASE("rest: a cantilever bends back against its load (closed form)", "[rest
   for (int k = 1; k < n - 1; ++k) {
     const double x = L * k / (n - 1);
     CHECK(r.torque[k] == Approx(-(L - x) * F).epsilon(1e-12));
-    CHECK(r.rest_angles[k] == Approx(2 * std::atan(-(L - x) * F * l_bar / (4 * kb))).epsilon(1e-12));
+    // Eq. 12 with l̄ = 2h (voronoi_length): 2 atan(M h / (2 k_b)), the continuum turn M h / E·I
+    // to first order.
+    CHECK(r.rest_angles[k] == Approx(2 * std::atan(-(L - x) * F * (2 * l_bar) / (4 * kb))).epsilon(1e-12));
     CHECK(r.rest_angles[k] < 0);
   }
   CHECK(r.max_torque == Approx(L * F));
@@ -126,8 +128,8 @@ TEST_CASE("rest: loaded closed wire keeps its edge lengths and every vertex in e
     CHECK(std::abs(edge(r.rest, k) - target_len) < 1e-12);
   }
   for (int k = 1; k + 1 < m_pts; ++k) {
-    const double l_bar = 0.5 * ((w.points[r.walk[k]] - w.points[r.walk[k - 1]]).norm() +
-                                (w.points[r.walk[k + 1]] - w.points[r.walk[k]]).norm());
+    const double l_bar = voronoi_length((w.points[r.walk[k]] - w.points[r.walk[k - 1]]).norm(),
+                                        (w.points[r.walk[k + 1]] - w.points[r.walk[k]]).norm());
     const double t_int = elastic_torque(r.target_angles[k], r.rest_angles[k], l_bar, o.bending_stiffness);
     CHECK(std::abs(t_int - r.torque[k]) <= 1e-9 * std::max(1e-3, std::abs(r.torque[k])));
     worst_out = std::max(worst_out, r.out_of_plane_torque[k]);

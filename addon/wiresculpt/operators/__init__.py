@@ -1,7 +1,7 @@
 """Operators, one module per concern, each with its own register/unregister."""
-from . import optimize, results, slicing
+from . import calibration, optimize, results, slicing
 
-_modules = (slicing, optimize, results)
+_modules = (slicing, optimize, results, calibration)
 
 
 def register():

@@ -1,8 +1,8 @@
 """User interface, one module per concern, each with its own register/unregister."""
 from .. import overlay
-from . import panel, results
+from . import calibration, panel, results
 
-_modules = (panel, results, overlay)
+_modules = (panel, results, calibration, overlay)
 
 
 def register():

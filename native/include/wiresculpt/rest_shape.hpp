@@ -85,6 +85,15 @@ std::vector<double> turning_angles(const Polyline2& points);
 Polyline2 polyline_from_angles(const Vec2& start, double heading, const std::vector<double>& lengths,
                                const std::vector<double>& angles);
 
+/// l̄_v, the length vertex v's bending energy integrates over (Eq. 9), from its two edge lengths:
+/// |e_{v-1}| + |e_v|, the Voronoi length of Bergou et al. 2008 (discrete elastic rods), which the
+/// paper builds on. The paper prints ½(|e_{v-1}| + |e_v|); with that, a uniform rod of stiffness
+/// k_b bends half as much as the continuum rod E·I = k_b (cantilever tip P·L³/(6 k_b) instead of
+/// P·L³/(3 k_b)), while Table 1's k_b (steel 0.73, brass 0.42 N·m² for 3 mm wire) are the wires'
+/// E·I (0.80 and about 0.42 N·m²). So this model uses the full sum: k_b means E·I, and the
+/// presets, the calibration fit (fab/calibration.hpp) and the rest shapes agree.
+inline double voronoi_length(double prev_edge, double next_edge) { return prev_edge + next_edge; }
+
 /// Eq. 10: the elastic torque t_int = -(4 k_b / l̄)(tan(α/2) - tan(ᾱ/2))(1 + tan²(α/2)), N·m.
 double elastic_torque(double alpha, double rest_alpha, double l_bar, double bending_stiffness);
 

@@ -1,0 +1,454 @@
+"""Calibration captures (Sec. 5.1-5.2): reading the CSV files with errors that name the line and
+column, the fits (through the native module), custom materials and machine profiles as JSON, and
+a small plot of each fit written as a PNG with numpy alone. Free of bpy: the add-on's operators,
+the batch script and the tests all call it. Formats and rigs: docs/calibration.md.
+
+CSV files (comma separated, one header row naming the columns in any order, extra columns
+ignored, blank lines and lines starting with '#' skipped):
+
+    cantilever   load_g, state, s_m, deflection_m   one row per (load, mark); state is
+                 "loaded" or "unloaded"; s_m arc length from the clamp's edge (m); deflection_m
+                 downward from the clamp's horizontal line (m)
+    tilt         repeat, angle_deg                  one row per repeat
+    spring-back  commanded_deg, measured_deg        one row per test bend
+"""
+import csv
+import io
+import json
+import math
+import os
+import struct
+import zlib
+
+import numpy as np
+
+from . import materials
+from .files import write_atomic
+
+CANTILEVER_COLUMNS = ("load_g", "state", "s_m", "deflection_m")
+TILT_COLUMNS = ("repeat", "angle_deg")
+SPRINGBACK_COLUMNS = ("commanded_deg", "measured_deg")
+STATES = ("loaded", "unloaded")
+
+
+class CaptureError(ValueError):
+    """A malformed capture file: the message names the file's line (and column)."""
+
+    def __init__(self, message, line=None, column=None):
+        where = ""
+        if line is not None:
+            where = f"line {line}" + (f", column {column}" if column else "") + ": "
+        super().__init__(where + message)
+        self.line, self.column = line, column
+
+
+# --- CSV ------------------------------------------------------------------------------------------
+
+def _text(source):
+    """The text of `source`: a path, or the CSV text itself when it contains a newline."""
+    if isinstance(source, str) and "\n" in source:
+        return source
+    try:
+        with open(source, encoding="utf-8-sig", newline="") as f:
+            return f.read()
+    except UnicodeDecodeError as exc:
+        raise CaptureError(f"{os.path.basename(os.fspath(source))} is not a UTF-8 text (CSV) file") from exc
+
+
+def read_table(source, columns):
+    """Rows of a CSV with the named `columns`: {column: [str], "line": [int]}. CaptureError when a
+    column is missing, a row has too few fields, or there are no data rows."""
+    rows = list(csv.reader(io.StringIO(_text(source))))
+    header, header_line, index = None, 0, {}
+    out = {c: [] for c in columns}
+    out["line"] = []
+    for number, row in enumerate(rows, start=1):
+        if not row or all(not cell.strip() for cell in row) or row[0].lstrip().startswith("#"):
+            continue
+        cells = [cell.strip() for cell in row]
+        if header is None:
+            header, header_line = [c.lower() for c in cells], number
+            missing = [c for c in columns if c not in header]
+            if missing:
+                raise CaptureError(
+                    f"missing column{'s' if len(missing) > 1 else ''} {', '.join(missing)} in the header "
+                    f"(expected {', '.join(columns)}; found {', '.join(cells)})", header_line)
+            index = {c: header.index(c) for c in columns}
+            continue
+        need = max(index.values()) + 1
+        if len(cells) < need:
+            absent = [c for c in columns if index[c] >= len(cells)]
+            raise CaptureError(f"{len(cells)} field{'s' if len(cells) != 1 else ''}, but the header has "
+                               f"{len(header)}; no value for {', '.join(absent)}", number)
+        for c in columns:
+            out[c].append(cells[index[c]])
+        out["line"].append(number)
+    if header is None:
+        raise CaptureError(f"the file is empty: expected a header with {', '.join(columns)}")
+    if not out["line"]:
+        raise CaptureError("the file has a header but no data rows", header_line)
+    return out
+
+
+def _numbers(table, column, unit=""):
+    values = []
+    for text, line in zip(table[column], table["line"]):
+        try:
+            value = float(text)
+        except ValueError:
+            raise CaptureError(f"'{text}' is not a number" + (f" ({unit})" if unit else ""), line, column) from None
+        if not math.isfinite(value):
+            raise CaptureError(f"'{text}' is not a finite number", line, column)
+        values.append(value)
+    return values
+
+
+def read_cantilever(source):
+    """{"load_g", "loaded" (bools), "s", "deflection" (m), "lines"} of a cantilever capture."""
+    t = read_table(source, CANTILEVER_COLUMNS)
+    loaded = []
+    for text, line in zip(t["state"], t["line"]):
+        state = text.lower()
+        if state not in STATES:
+            raise CaptureError(f"state must be 'loaded' or 'unloaded', got '{text}'", line, "state")
+        loaded.append(state == "loaded")
+    load = _numbers(t, "load_g", "grams")
+    for value, line in zip(load, t["line"]):
+        if value < 0:
+            raise CaptureError(f"a load of {value:g} g: loads are grams >= 0", line, "load_g")
+    return {"load_g": load, "loaded": loaded, "s": _numbers(t, "s_m", "metres"),
+            "deflection": _numbers(t, "deflection_m", "metres"), "lines": t["line"]}
+
+
+def read_tilt(source):
+    """{"repeat": [str], "angle_deg": [float], "lines"} of a tilt capture."""
+    t = read_table(source, TILT_COLUMNS)
+    return {"repeat": t["repeat"], "angle_deg": _numbers(t, "angle_deg", "degrees"), "lines": t["line"]}
+
+
+def read_springback(source):
+    """{"commanded_deg", "measured_deg", "lines"} of a spring-back table."""
+    t = read_table(source, SPRINGBACK_COLUMNS)
+    return {"commanded_deg": _numbers(t, "commanded_deg", "degrees"),
+            "measured_deg": _numbers(t, "measured_deg", "degrees"), "lines": t["line"]}
+
+
+# --- fits -------------------------------------------------------------------------------------------
+
+def _native():
+    from .. import native  # imported lazily: core stays importable without the compiled module
+    return native.require()
+
+
+def linear_density(material):
+    """kg/m of a round wire of the material (0 when it has no density)."""
+    if not material or not material.get("density"):
+        return 0.0
+    return material["density"] * math.pi * 0.25 * material["wire_diameter"] ** 2
+
+
+def fit_cantilever(source, overhang=0.30, linear_density=0.0, plastic_tolerance=0.001):
+    """k_b (Eq. 13) and the plastic limit of a cantilever capture (a path or CSV text)."""
+    c = read_cantilever(source)
+    singles = {}
+    for load, loaded, line in zip(c["load_g"], c["loaded"], c["lines"]):
+        singles.setdefault((load, loaded), []).append(line)
+    for (load, loaded), lines in singles.items():
+        if len(lines) < 3:
+            state = "loaded" if loaded else "unloaded"
+            raise CaptureError(f"the {load:g} g {state} frame has {len(lines)} mark{'s' if len(lines) > 1 else ''}; "
+                               "at least 3 points along the wire are needed", lines[0])
+    fit = _native().fit_cantilever(c["load_g"], c["loaded"], c["s"], c["deflection"], c["lines"],
+                                   overhang=overhang, linear_density=linear_density,
+                                   plastic_tolerance=plastic_tolerance)
+    fit.update(overhang=overhang, linear_density=linear_density, plastic_tolerance=plastic_tolerance)
+    return fit
+
+
+def fit_friction(source):
+    t = read_tilt(source)
+    return _native().fit_friction(t["angle_deg"], t["lines"])
+
+
+def fit_springback(source):
+    t = read_springback(source)
+    return _native().fit_springback(t["commanded_deg"], t["measured_deg"], t["lines"])
+
+
+# --- materials as JSON ------------------------------------------------------------------------------
+
+MATERIAL_FORMAT = "wiresculpt-material"
+
+
+def validate_material(material, where="material"):
+    """The material with float fields, or ValueError naming the field (materials.FIELDS bounds)."""
+    if not isinstance(material, dict):
+        raise ValueError(f"{where}: expected an object with {', '.join(materials.REQUIRED)}")
+    name = str(material.get("name", "")).strip()
+    if not name:
+        raise ValueError(f"{where}: a material needs a name")
+    out = {"name": name}
+    for key, (unit, low, high) in materials.FIELDS.items():
+        if key not in material:
+            if key in materials.REQUIRED:
+                raise ValueError(f"{where}: '{key}' ({unit}) is missing")
+            continue
+        value = material[key]
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise ValueError(f"{where}: '{key}' must be a number ({unit}), got {value!r}")
+        if not low < value <= high:
+            raise ValueError(f"{where}: '{key}' = {value:g} is outside ({low:g}, {high:g}] {unit}".rstrip())
+        out[key] = float(value)
+    if isinstance(material.get("calibration"), dict):
+        out["calibration"] = material["calibration"]
+    return out
+
+
+def material_file_name(name):
+    safe = "".join(ch if ch.isalnum() or ch in "-_." else "-" for ch in name.strip()).strip("-.")
+    return (safe or "material") + ".json"
+
+
+def save_material(material, folder):
+    """Writes the material to folder/materials/<name>.json (atomically); returns the path."""
+    m = validate_material(material)
+    if m["name"].lower() in materials.PRESETS:
+        raise ValueError(f"'{m['name']}' is a preset's name: give the calibrated material its own name")
+    path = os.path.join(folder, "materials", material_file_name(m["name"]))
+    write_atomic(path, json.dumps({"format": MATERIAL_FORMAT, "version": 1, **m}, indent=2) + "\n")
+    return path
+
+
+def load_material(path):
+    try:
+        with open(path, encoding="utf-8") as f:
+            data = json.load(f)
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{os.path.basename(path)}: not JSON (line {exc.lineno}: {exc.msg})") from None
+    return validate_material(data, os.path.basename(path))
+
+
+def list_materials(folder=None):
+    """{name: material}: the presets (Table 1), then the custom materials saved in `folder`.
+    Unreadable files are skipped and reported in the "errors" list of the second value."""
+    out = {name: dict(p) for name, p in materials.PRESETS.items()}
+    errors = []
+    directory = os.path.join(folder, "materials") if folder else None
+    if directory and os.path.isdir(directory):
+        for entry in sorted(os.listdir(directory)):
+            if not entry.endswith(".json"):
+                continue
+            try:
+                m = load_material(os.path.join(directory, entry))
+            except (OSError, ValueError) as exc:
+                errors.append(str(exc))
+                continue
+            if m["name"] not in out:
+                out[m["name"]] = m
+    return out, errors
+
+
+def calibrated_material(name, base, cantilever=None, friction=None):
+    """A new material named `name` from `base` (diameter, density and anything not calibrated)
+    with the cantilever fit's k_b and plastic torque and the tilt fit's friction."""
+    m = {k: base[k] for k in ("wire_diameter", "bending_stiffness", "max_torque", "friction", "density") if k in base}
+    m["name"] = name
+    note = {}
+    if cantilever:
+        m["bending_stiffness"] = cantilever["bending_stiffness"]
+        if cantilever.get("plastic_found") and cantilever.get("max_torque", 0) > 0:
+            m["max_torque"] = cantilever["max_torque"]
+        note["cantilever"] = {k: cantilever[k] for k in (
+            "position_rms", "torque_rms", "plastic_load_g", "plastic_reached", "lever_arm", "frames_used",
+            "overhang") if k in cantilever}
+    if friction:
+        m["friction"] = friction["friction"]
+        note["tilt"] = {k: friction[k] for k in ("spread", "repeats", "mean_angle_deg")}
+    if note:
+        m["calibration"] = note
+    return validate_material(m)
+
+
+# --- machine profiles as JSON -----------------------------------------------------------------------
+
+PROFILE_FORMAT = "wiresculpt-machine-profile"
+# The keys of the native profile dict (bind_fab's default_machine_profile), its edge units.
+PROFILE_KEYS = ("name", "min_segment", "max_bend_deg", "min_bend_deg", "max_commanded_deg",
+                "left_is_positive", "springback_a", "springback_b_deg", "feed_speed_mm_s",
+                "bend_speed_deg_s", "seconds_per_bend", "feed_axis", "bend_axis", "pin_axis",
+                "feed_units_per_mm", "bend_units_per_deg", "pin_travel", "baud", "data_bits",
+                "stop_bits", "parity", "flow_control")
+
+
+def default_profile():
+    """The DIWire-class default (l_min 1.5 cm, 1 deg minimum bend) from the native module."""
+    return dict(_native().default_machine_profile())
+
+
+def machine_dict(profile):
+    """The keys the native functions take (the fit's statistics and file markers dropped)."""
+    return {k: profile[k] for k in PROFILE_KEYS if k in profile}
+
+
+def with_springback(profile, fit, source=""):
+    out = dict(profile)
+    out["springback_a"] = fit["springback_a"]
+    out["springback_b_deg"] = fit["springback_b_deg"]
+    out["springback_fit"] = {"rms_deg": fit["rms_deg"], "max_residual_deg": fit["max_residual_deg"],
+                             "samples": fit["samples"], "source": os.path.basename(source) if source else ""}
+    return out
+
+
+def validate_profile(profile, where="machine profile"):
+    """The profile, checked by the native module (ValueError naming the key at fault)."""
+    if not isinstance(profile, dict):
+        raise ValueError(f"{where}: expected a JSON object")
+    unknown = [k for k in profile if k not in PROFILE_KEYS and k not in ("format", "version", "springback_fit")]
+    if unknown:
+        raise ValueError(f"{where}: unknown key{'s' if len(unknown) > 1 else ''} {', '.join(unknown)}")
+    try:
+        _native().make_bend_program(np.array([[0.0, 0.0], [0.05, 0.0]]), machine_dict(profile))
+    except (ValueError, TypeError) as exc:
+        raise ValueError(f"{where}: {exc}") from None
+    return profile
+
+
+def save_profile(profile, path):
+    p = {k: v for k, v in profile.items() if k not in ("format", "version")}
+    validate_profile(p)
+    write_atomic(path, json.dumps({"format": PROFILE_FORMAT, "version": 1, **p}, indent=2) + "\n")
+    return path
+
+
+def load_profile(path):
+    """The default profile updated by the file's keys (a file may give only some)."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            data = json.load(f)
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{os.path.basename(path)}: not JSON (line {exc.lineno}: {exc.msg})") from None
+    if not isinstance(data, dict):
+        raise ValueError(f"{os.path.basename(path)}: expected a JSON object")
+    profile = default_profile()
+    profile.update({k: v for k, v in data.items() if k not in ("format", "version")})
+    return validate_profile(profile, os.path.basename(path))
+
+
+# --- plots (PNG with numpy alone) -------------------------------------------------------------------
+
+BACKGROUND = (255, 255, 255)
+AXES = (90, 90, 90)
+GRID = (228, 228, 228)
+PALETTE = [(31, 119, 180), (255, 127, 14), (44, 160, 44), (214, 39, 40), (148, 103, 189),
+           (140, 86, 75), (227, 119, 194), (127, 127, 127), (188, 189, 34), (23, 190, 207)]
+GREY = (185, 185, 185)
+
+
+def png_bytes(rgb):
+    """An (h, w, 3) uint8 array as PNG bytes (8-bit RGB, no interlace)."""
+    rgb = np.ascontiguousarray(rgb, dtype=np.uint8)
+    h, w, _ = rgb.shape
+    raw = np.concatenate([np.zeros((h, 1), np.uint8), rgb.reshape(h, w * 3)], axis=1).tobytes()
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
+            + chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
+
+
+class Canvas:
+    """A small plot: data coordinates mapped into a margin box; lines, dots, a grid."""
+
+    def __init__(self, xlim, ylim, width=480, height=320, margin=24):
+        self.img = np.empty((height, width, 3), np.uint8)
+        self.img[:] = BACKGROUND
+        self.w, self.h, self.m = width, height, margin
+        (x0, x1), (y0, y1) = xlim, ylim
+        self.x0, self.x1 = x0, x1 if x1 > x0 else x0 + 1.0
+        self.y0, self.y1 = y0, y1 if y1 > y0 else y0 + 1.0
+        for k in range(1, 5):
+            self.line([self.x0 + k * (self.x1 - self.x0) / 5] * 2, [self.y0, self.y1], GRID)
+            self.line([self.x0, self.x1], [self.y0 + k * (self.y1 - self.y0) / 5] * 2, GRID)
+        self.line([self.x0, self.x1, self.x1, self.x0, self.x0], [self.y0, self.y0, self.y1, self.y1, self.y0], AXES)
+
+    def _px(self, x, y):
+        px = self.m + (np.asarray(x, float) - self.x0) / (self.x1 - self.x0) * (self.w - 2 * self.m)
+        py = self.h - self.m - (np.asarray(y, float) - self.y0) / (self.y1 - self.y0) * (self.h - 2 * self.m)
+        return px, py
+
+    def _plot(self, px, py, colour, r=0):
+        ix, iy = np.rint(px).astype(int), np.rint(py).astype(int)
+        for dx in range(-r, r + 1):
+            for dy in range(-r, r + 1):
+                jx, jy = ix + dx, iy + dy
+                ok = (jx >= 0) & (jx < self.w) & (jy >= 0) & (jy < self.h)
+                self.img[jy[ok], jx[ok]] = colour
+
+    def line(self, x, y, colour, width=1):
+        px, py = self._px(x, y)
+        for a in range(len(px) - 1):
+            n = int(max(abs(px[a + 1] - px[a]), abs(py[a + 1] - py[a]))) + 2
+            t = np.linspace(0.0, 1.0, n)
+            self._plot(px[a] + t * (px[a + 1] - px[a]), py[a] + t * (py[a + 1] - py[a]), colour, width // 2)
+
+    def dots(self, x, y, colour, r=2):
+        px, py = self._px(x, y)
+        self._plot(px, py, colour, r)
+
+    def png(self):
+        return png_bytes(self.img)
+
+
+def _limits(values, pad=0.05):
+    v = np.asarray([x for x in values if math.isfinite(x)] or [0.0, 1.0], float)
+    lo, hi = float(v.min()), float(v.max())
+    span = hi - lo or max(abs(hi), 1.0)
+    return lo - pad * span, hi + pad * span
+
+
+def plot_cantilever(fit):
+    """Deflection (down) against s: measured marks (dots) and the fitted model (lines), one colour
+    per used load; unused frames (beyond the plastic limit, unloaded) grey."""
+    frames = fit["frames"]
+    s_all = [0.0] + [s for f in frames for s in f["s"]]
+    w_all = [0.0] + [w for f in frames for w in f["deflection"]] + [w for f in frames for w in f["simulated"]]
+    canvas = Canvas(_limits(s_all), _limits([-w for w in w_all]))
+    colour = 0
+    for f in frames:
+        s, w = np.asarray(f["s"]), np.asarray(f["deflection"])
+        if f["used"]:
+            c = PALETTE[colour % len(PALETTE)]
+            colour += 1
+            canvas.line(np.concatenate([[0.0], s]), -np.concatenate([[0.0], f["simulated"]]), c, width=2)
+            canvas.dots(s, -w, c, r=2)
+        else:
+            canvas.dots(s, -w, GREY, r=1)
+    return canvas.png()
+
+
+def plot_springback(table, fit):
+    c = np.abs(table["commanded_deg"])
+    m = np.abs(table["measured_deg"])
+    canvas = Canvas(_limits(np.concatenate([[0.0], c])), _limits(np.concatenate([[0.0], m])))
+    xs = np.array([0.0, float(c.max())])
+    canvas.line(xs, fit["springback_a"] * xs + fit["springback_b_deg"], PALETTE[3], width=2)
+    canvas.line([0.0, float(c.max())], [0.0, float(c.max())], GREY)
+    canvas.dots(c, m, PALETTE[0], r=2)
+    return canvas.png()
+
+
+def plot_friction(table, fit):
+    mu = np.tan(np.radians(table["angle_deg"]))
+    k = np.arange(1, len(mu) + 1, dtype=float)
+    canvas = Canvas((0.0, len(mu) + 1.0), _limits(np.concatenate([mu, [fit["friction"]]]), pad=0.3))
+    canvas.line([0.0, len(mu) + 1.0], [fit["friction"]] * 2, PALETTE[3], width=2)
+    for off in (-1, 1):
+        canvas.line([0.0, len(mu) + 1.0], [fit["friction"] + off * fit["spread"]] * 2, GREY)
+    canvas.dots(k, mu, PALETTE[0], r=3)
+    return canvas.png()
+
+
+def write_plot(path, png):
+    write_atomic(path, png)
+    return path

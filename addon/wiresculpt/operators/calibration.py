@@ -1,0 +1,287 @@
+"""Calibration (Sec. 5.1-5.2): load the cantilever, tilt and spring-back captures (CSV), show each
+fit as a small plot, save the calibrated material (JSON in the user's config folder, listed with
+the presets) and the machine profile with its spring-back line (JSON). Formats: docs/calibration.md.
+"""
+import json
+import os
+
+import bpy
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, StringProperty
+from bpy_extras.io_utils import ExportHelper, ImportHelper
+
+from .. import native
+from ..core import calibration as cal
+from ..core import materials
+
+RESULTS_KEY = "wiresculpt_calibration_results"  # scene custom property: JSON of the last fits
+MATERIAL_NAME_KEY = "wiresculpt_material_name"  # scene custom property: name of the material in use
+KINDS = (("CANTILEVER", "Cantilever", "Bending stiffness and plastic limit (load_g, state, s_m, deflection_m)"),
+         ("TILT", "Tilt", "Friction coefficient (repeat, angle_deg)"),
+         ("SPRINGBACK", "Spring-back", "Machine spring-back line (commanded_deg, measured_deg)"))
+PLOT_IMAGE = {"CANTILEVER": "wiresculpt cantilever fit", "TILT": "wiresculpt tilt fit",
+              "SPRINGBACK": "wiresculpt spring-back fit"}
+
+
+def config_folder():
+    """The user's wiresculpt config folder (materials/, plots/); WIRESCULPT_CONFIG overrides it."""
+    folder = os.environ.get("WIRESCULPT_CONFIG")
+    if folder:
+        os.makedirs(folder, exist_ok=True)
+        return folder
+    return bpy.utils.user_resource('CONFIG', path="wiresculpt", create=True)
+
+
+def results(scene):
+    """The stored fits: {"cantilever", "tilt", "springback"} (each may be absent)."""
+    try:
+        return json.loads(scene.get(RESULTS_KEY, "{}"))
+    except (TypeError, ValueError):
+        return {}
+
+
+def store(scene, key, value):
+    r = results(scene)
+    r[key] = value
+    scene[RESULTS_KEY] = json.dumps(r)
+
+
+def base_material(scene):
+    """The material in the Material & Machine panel (diameter and density for the weight)."""
+    from ..props import material_of
+    return material_of(scene.wiresculpt)
+
+
+def load_plot(kind, png):
+    """Writes the plot into the config folder and (re)loads it as a Blender image."""
+    path = cal.write_plot(os.path.join(config_folder(), "plots", kind.lower() + ".png"), png)
+    name = PLOT_IMAGE[kind]
+    image = bpy.data.images.get(name)
+    if image is None:
+        image = bpy.data.images.load(path, check_existing=False)
+        image.name = name
+    else:
+        image.filepath = path
+        image.reload()
+    return image
+
+
+def _material_items(_self, _context):
+    try:
+        found, _errors = cal.list_materials(config_folder())
+    except OSError:
+        found = dict(materials.PRESETS)
+    items = []
+    for name, m in found.items():
+        kind = "preset (Table 1)" if name in materials.PRESETS else "calibrated"
+        items.append((name, name, f"{name}, {kind}: k_b {m['bending_stiffness']:.4g} N m², plastic torque "
+                                  f"{m['max_torque']:.4g} N m, friction {m['friction']:.3g}"))
+    _material_items.cache = items  # Blender needs the strings kept alive
+    return items
+
+
+class WiresculptCalibrationSettings(bpy.types.PropertyGroup):
+    overhang: FloatProperty(
+        name="Overhang", subtype='DISTANCE', unit='LENGTH', default=0.30, min=0.02, max=2.0, precision=3,
+        description="Free length of the cantilever from the clamp's edge to the load (metres; paper: 30 cm)")
+    include_weight: BoolProperty(
+        name="Wire's Own Weight", default=True,
+        description="Add the wire's weight (density and diameter of the material below) to the external "
+                    "torques of the cantilever fit")
+    plastic_tolerance: FloatProperty(
+        name="Return Tolerance", subtype='DISTANCE', unit='LENGTH', default=0.001, min=1e-5, max=0.05,
+        precision=4,
+        description="An unloaded wire has returned when no mark is farther than this from the initial shape")
+    material_name: StringProperty(
+        name="Name", default="calibrated steel",
+        description="Name of the calibrated material (saved as JSON in the user's config folder)")
+    plot: EnumProperty(name="Plot", items=KINDS, default="CANTILEVER", description="Which fit the panel shows")
+
+
+class WIRESCULPT_OT_calibration_load(bpy.types.Operator, ImportHelper):
+    """Load a calibration capture (CSV) and fit it"""
+    bl_idname = "wiresculpt.calibration_load"
+    bl_label = "Load Capture"
+    bl_options = {'REGISTER'}
+
+    filename_ext = ".csv"
+    filter_glob: StringProperty(default="*.csv;*.txt", options={'HIDDEN'})
+    kind: EnumProperty(name="Capture", items=KINDS, default="CANTILEVER")
+
+    def execute(self, context):
+        if not native.available():
+            self.report({'ERROR'}, native.LOAD_ERROR)
+            return {'CANCELLED'}
+        scene = context.scene
+        settings = scene.wiresculpt_calibration
+        path = self.filepath
+        name = os.path.basename(path)
+        try:
+            if self.kind == 'CANTILEVER':
+                density = cal.linear_density(base_material(scene)) if settings.include_weight else 0.0
+                fit = cal.fit_cantilever(path, settings.overhang, density, settings.plastic_tolerance)
+                png = cal.plot_cantilever(fit)
+                text = (f"k_b {fit['bending_stiffness']:.4g} N m², position RMS {fit['position_rms'] * 1000:.2f} mm"
+                        + (f", plastic torque {fit['max_torque']:.3g} N m at {fit['plastic_load_g']:g} g"
+                           if fit["plastic_found"] else ", no unloaded rows: plastic limit not measured"))
+            elif self.kind == 'TILT':
+                table = cal.read_tilt(path)
+                fit = cal.fit_friction(path)
+                png = cal.plot_friction(table, fit)
+                text = f"friction {fit['friction']:.3f} ± {fit['spread']:.3f} over {fit['repeats']} repeats"
+            else:
+                table = cal.read_springback(path)
+                fit = cal.fit_springback(path)
+                png = cal.plot_springback(table, fit)
+                text = (f"measured = {fit['springback_a']:.4f} × commanded {fit['springback_b_deg']:+.3f}°, "
+                        f"RMS {fit['rms_deg']:.3f}°, max {fit['max_residual_deg']:.3f}°")
+        except (ValueError, OSError) as exc:
+            self.report({'ERROR'}, f"{name}: {exc}")
+            return {'CANCELLED'}
+        fit["source"] = path
+        store(scene, self.kind.lower(), fit)
+        try:
+            load_plot(self.kind, png)
+        except (OSError, RuntimeError) as exc:
+            self.report({'WARNING'}, f"Cannot show the plot: {exc}")
+        settings.plot = self.kind
+        self.report({'INFO'}, f"{name}: {text}")
+        return {'FINISHED'}
+
+
+class WIRESCULPT_OT_calibration_save_material(bpy.types.Operator):
+    """Save the calibrated material (stiffness and plastic torque from the cantilever, friction from the
+    tilt) to the user's config folder; it is listed with the presets"""
+    bl_idname = "wiresculpt.calibration_save_material"
+    bl_label = "Save Material"
+    bl_options = {'REGISTER'}
+
+    def execute(self, context):
+        scene = context.scene
+        r = results(scene)
+        if "cantilever" not in r and "tilt" not in r:
+            self.report({'ERROR'}, "Load a cantilever or tilt capture first")
+            return {'CANCELLED'}
+        try:
+            m = cal.calibrated_material(scene.wiresculpt_calibration.material_name, base_material(scene),
+                                        r.get("cantilever"), r.get("tilt"))
+            path = cal.save_material(m, config_folder())
+        except (ValueError, OSError) as exc:
+            self.report({'ERROR'}, f"Cannot save the material: {exc}")
+            return {'CANCELLED'}
+        self.report({'INFO'}, f"Material '{m['name']}' saved: {path}")
+        return {'FINISHED'}
+
+
+def use_material(scene, m):
+    """Sets the Material & Machine panel to material `m` (a preset by key, else Custom)."""
+    ws = scene.wiresculpt
+    if m["name"] in materials.PRESETS:
+        ws.material_preset = m["name"]
+        ws.wire_diameter = m["wire_diameter"]
+    else:
+        ws.material_preset = 'CUSTOM'
+        ws.wire_diameter = m["wire_diameter"]
+        for key in ("bending_stiffness", "max_torque", "friction", "density"):
+            if key in m:
+                setattr(ws, key, m[key])
+    scene[MATERIAL_NAME_KEY] = m["name"]
+
+
+class WIRESCULPT_OT_calibration_use_material(bpy.types.Operator):
+    """Use a material: a Table 1 preset or one you calibrated"""
+    bl_idname = "wiresculpt.calibration_use_material"
+    bl_label = "Use Material"
+    bl_options = {'REGISTER', 'UNDO'}
+    bl_property = "material"
+
+    material: EnumProperty(name="Material", items=_material_items)
+
+    def execute(self, context):
+        found, _errors = cal.list_materials(config_folder())
+        m = found.get(self.material)
+        if m is None:
+            self.report({'ERROR'}, f"No material '{self.material}'")
+            return {'CANCELLED'}
+        use_material(context.scene, m)
+        self.report({'INFO'}, f"Material: {m['name']}")
+        return {'FINISHED'}
+
+
+class WIRESCULPT_OT_calibration_save_profile(bpy.types.Operator, ExportHelper):
+    """Save a machine profile (limits, axes, serial settings and the spring-back fit) as JSON"""
+    bl_idname = "wiresculpt.calibration_save_profile"
+    bl_label = "Save Machine Profile"
+    bl_options = {'REGISTER'}
+
+    filename_ext = ".json"
+    filter_glob: StringProperty(default="*.json", options={'HIDDEN'})
+
+    def execute(self, context):
+        if not native.available():
+            self.report({'ERROR'}, native.LOAD_ERROR)
+            return {'CANCELLED'}
+        scene = context.scene
+        from ..props import solver_settings
+        try:
+            profile = cal.default_profile()
+            limits = solver_settings(scene.wiresculpt)
+            profile.update({k: limits[k] for k in ("min_segment", "max_bend_deg", "min_bend_deg")})
+            fit = results(scene).get("springback")
+            if fit:
+                profile = cal.with_springback(profile, fit, fit.get("source", ""))
+            cal.save_profile(profile, self.filepath)
+        except (ValueError, OSError) as exc:
+            self.report({'ERROR'}, f"Cannot save the machine profile: {exc}")
+            return {'CANCELLED'}
+        note = "with the spring-back fit" if fit else "without a spring-back fit (load one first)"
+        self.report({'INFO'}, f"Machine profile saved {note}: {self.filepath}")
+        return {'FINISHED'}
+
+
+class WIRESCULPT_OT_calibration_show_plot(bpy.types.Operator):
+    """Open the fit's plot in an Image Editor"""
+    bl_idname = "wiresculpt.calibration_show_plot"
+    bl_label = "Open Plot"
+    bl_options = {'REGISTER'}
+
+    kind: EnumProperty(name="Capture", items=KINDS, default="CANTILEVER")
+
+    def execute(self, context):
+        image = bpy.data.images.get(PLOT_IMAGE[self.kind])
+        if image is None:
+            self.report({'ERROR'}, "No plot yet: load the capture first")
+            return {'CANCELLED'}
+        screen = context.window.screen if context.window else None
+        areas = [a for a in screen.areas if a.type == 'IMAGE_EDITOR'] if screen else []
+        if not areas and screen is not None:
+            try:
+                bpy.ops.wm.window_new()
+                areas = [context.window_manager.windows[-1].screen.areas[0]]
+                areas[0].ui_type = 'IMAGE_EDITOR'
+            except (RuntimeError, IndexError):
+                areas = []
+        if not areas:
+            self.report({'WARNING'}, f"Open an Image Editor and pick '{image.name}'")
+            return {'FINISHED'}
+        areas[0].spaces.active.image = image
+        self.report({'INFO'}, f"Showing '{image.name}'")
+        return {'FINISHED'}
+
+
+_classes = (WiresculptCalibrationSettings, WIRESCULPT_OT_calibration_load, WIRESCULPT_OT_calibration_save_material,
+            WIRESCULPT_OT_calibration_use_material, WIRESCULPT_OT_calibration_save_profile,
+            WIRESCULPT_OT_calibration_show_plot)
+
+
+def register():
+    for cls in _classes:
+        bpy.utils.register_class(cls)
+    bpy.types.Scene.wiresculpt_calibration = bpy.props.PointerProperty(
+        type=WiresculptCalibrationSettings, name="Calibration",
+        description="Settings of the calibration captures")
+
+
+def unregister():
+    del bpy.types.Scene.wiresculpt_calibration
+    for cls in reversed(_classes):
+        bpy.utils.unregister_class(cls)
