@@ -17,6 +17,9 @@ PACKAGES=(
 # The sanitizer and fuzz builds (scripts/test, scripts/fuzz).
 FUZZ_PACKAGES=(clang libclang-rt-14-dev)
 
+# The benchmark's plot (scripts/bench).
+BENCH_PACKAGES=(python3-matplotlib)
+
 say() { printf 'wiresculpt: %s\n' "$*" >&2; }
 
 as_root() {
