@@ -238,7 +238,16 @@ class StreamThroughBinding(unittest.TestCase):
             result = w.stream_program(os.ttyname(slave), lines, {}, state, settle=0.05, response_timeout=1.0)
             self.assertEqual(result["status"], "completed")
             self.assertEqual(state["next_line"], len(lines))
-            self.assertEqual(received, lines[:4] + lines[3:])  # only the rejected line went twice
+            modes = [l for l in lines[:3] if l in ("G21", "G91", "G94")]
+            self.assertEqual(modes, ["G21", "G91", "G94"])
+            # the mode lines are restored before resuming; only the rejected line went twice
+            self.assertEqual(received, lines[:4] + modes + lines[3:])
+            # Without a state each call starts a program afresh (no progress shared between calls).
+            before = len(received)
+            for _ in range(2):
+                again = w.stream_program(os.ttyname(slave), lines, {}, settle=0.05, response_timeout=1.0)
+                self.assertEqual((again["status"], again["next_line"]), ("completed", len(lines)))
+            self.assertEqual(received[before:], lines + lines)
             # A callback that raises stops the stream (feed hold + reset) and the error reaches Python.
             fresh = {}
             with self.assertRaises(ZeroDivisionError):

@@ -242,9 +242,12 @@ std::string write_bend_table(const std::optional<std::string>& path, const Point
 }
 
 py::dict stream_program_py(const std::string& port, const std::vector<std::string>& lines, const py::dict& profile,
-                           py::dict state, const py::object& progress, StreamControl* control,
+                           std::optional<py::dict> state_arg, const py::object& progress, StreamControl* control,
                            bool dry_run, double response_timeout, double settle) {
   const MachineProfile m = to_profile(profile);
+  // A fresh dict per call when none is given: a shared default would carry one program's
+  // progress into the next and skip its first lines.
+  py::dict state = state_arg ? *state_arg : py::dict();
   StreamState s;
   if (state.contains("next_line")) {
     const long long next = py::cast<long long>(state["next_line"]);
@@ -322,7 +325,7 @@ sheet: None = a sheet when more than one wire. Writes atomically when path is no
     return out;
   }, "Serial ports: [{'name', 'description'}].");
   m.def("stream_program", &stream_program_py, py::arg("port"), py::arg("lines"), py::arg("profile") = py::dict(),
-        py::arg("state") = py::dict(), py::arg("progress") = py::none(), py::arg("control") = nullptr,
+        py::arg("state") = py::none(), py::arg("progress") = py::none(), py::arg("control") = nullptr,
         py::arg("dry_run") = false, py::arg("response_timeout") = 30.0, py::arg("settle") = 2.0,
         R"(Stream G-code lines to a GRBL bender (send one line, wait for ok / error:N; ALARM stops).
 

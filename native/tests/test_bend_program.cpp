@@ -259,3 +259,10 @@ TEST_CASE("bend program: a carry that would overbend waits for the next point", 
   CHECK(p.steps[1].bend == Approx(10.45 * deg));
   CHECK(p.shape_error == Approx(dense_distance(poly, rebuild_polyline(p), 20000)).epsilon(1e-6));
 }
+
+TEST_CASE("bend program: absurd lengths are refused before anything overflows", "[fab]") {
+  using Catch::Matchers::Contains;
+  const Polyline2 huge{{0, 0}, {1e300, 0}, {1e300, 1e300}};
+  CHECK_THROWS_WITH(wiresculpt::fab::make_bend_program(huge, wiresculpt::fab::MachineProfile{}),
+                    Contains("segment 0") && Contains("not in metres"));
+}

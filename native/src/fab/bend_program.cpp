@@ -27,9 +27,13 @@ std::vector<double> cumulative_length(const Polyline2& p) {
   return s;
 }
 
+// No machine feeds more than this in one go; longer segments mean the units are wrong (and
+// past ~1e154 m the lengths overflow).
+constexpr double kMaxSegment = 1000.0;
+
 Vec2 point_at(const Polyline2& p, const std::vector<double>& s, double t) {
-  if (p.size() == 1 || t <= 0.0) return p.front();
-  if (t >= s.back()) return p.back();
+  if (p.size() == 1 || !(t > 0.0)) return p.front();  // also NaN
+  if (!(t < s.back())) return p.back();
   const auto it = std::upper_bound(s.begin(), s.end(), t);
   const std::size_t i = static_cast<std::size_t>(it - s.begin());  // s[i-1] <= t < s[i]
   const double len = s[i] - s[i - 1];
@@ -68,6 +72,10 @@ BendProgram make_bend_program(const Polyline2& points, const MachineProfile& pro
     if (!(L[i] > 1e-12))
       throw InputError("segment " + std::to_string(i) + " (points " + std::to_string(i) + " and " +
                        std::to_string(i + 1) + ") has zero length; remove the repeated point");
+    if (!(L[i] < kMaxSegment))
+      throw InputError("segment " + std::to_string(i) + " (points " + std::to_string(i) + " and " +
+                       std::to_string(i + 1) + ") is longer than " + fmt(kMaxSegment, 0) +
+                       " m: the points are not in metres");
   }
 
   BendProgram prog;

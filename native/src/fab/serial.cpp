@@ -11,6 +11,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <sstream>
 #include <string>
 #include <thread>
 
@@ -313,6 +314,26 @@ int code_after_colon(const std::string& s) {
   }
 }
 
+// A line that only sets modes (units, distance mode, feed-rate mode, plane): G17-G19, G20/G21,
+// G90/G91, G93/G94, nothing else but comments.
+bool is_modal_setup(const std::string& line) {
+  std::string code = line.substr(0, line.find(';'));
+  for (std::size_t open; (open = code.find('(')) != std::string::npos;) {
+    const std::size_t close = code.find(')', open);
+    code.erase(open, close == std::string::npos ? std::string::npos : close - open + 1);
+  }
+  std::istringstream words(code);
+  std::string word;
+  int count = 0;
+  while (words >> word) {
+    for (char& c : word) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    static const char* const modal[] = {"G17", "G18", "G19", "G20", "G21", "G90", "G91", "G93", "G94"};
+    if (std::find(std::begin(modal), std::end(modal), word) == std::end(modal)) return false;
+    ++count;
+  }
+  return count > 0;
+}
+
 }  // namespace
 
 StreamResult stream_program(SerialPort& port, const std::vector<std::string>& lines, const MachineProfile& profile,
@@ -350,6 +371,39 @@ StreamResult stream_program(SerialPort& port, const std::vector<std::string>& li
   auto report = [&] { return !progress || progress("stream", fraction()); };
 
   if (!report()) return abort_machine(static_cast<long>(state.next_line));
+
+  // Resuming mid-program: GRBL comes back from any reset (reopening the port, our own abort, an
+  // alarm cleared with a reset) in its default modes (G21 G90 G94), so the program's mode lines
+  // before the resume point are sent again first; relative feeds run as absolute moves otherwise.
+  // They change no position, so sending them twice is harmless; next_line does not move.
+  for (std::size_t j = 0; j < state.next_line && j < total; ++j) {
+    if (!is_modal_setup(lines[j])) continue;
+    const long lj = static_cast<long>(state.next_line);
+    const std::string resume = "; resume from line " + std::to_string(state.next_line + 1) + " again";
+    if (!port.write(lines[j] + "\n", write_ms))
+      return stop(StreamStatus::disconnected, lj, "the link to " + port.name() + " dropped while restoring the "
+                  "machine's modes (" + quoted(lines, j) + ") before resuming" + resume);
+    const auto deadline = Clock::now() + std::chrono::milliseconds(answer_ms);
+    for (bool ok = false; !ok;) {
+      if (wants_abort()) return abort_machine(lj);
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+      if (left <= 0)
+        return stop(StreamStatus::timeout, lj, "no answer to " + quoted(lines, j) +
+                    " while restoring the machine's modes before resuming" + resume);
+      std::string answer;
+      const auto got = reader.next(answer, static_cast<int>(std::min<long long>(left, kSliceMs)));
+      if (got == LineReader::Got::lost)
+        return stop(StreamStatus::disconnected, lj, "the link to " + port.name() +
+                    " dropped while restoring the machine's modes before resuming" + resume);
+      if (got == LineReader::Got::nothing) continue;
+      if (answer == "ok") ok = true;
+      else if (starts_with(answer, "error:") || starts_with(answer, "ALARM"))
+        return stop(starts_with(answer, "error:") ? StreamStatus::error : StreamStatus::alarm, lj,
+                    "GRBL answered " + answer + " to " + quoted(lines, j) +
+                    " while its modes were restored before resuming (clear any alarm with $X)" + resume);
+    }
+  }
+
   while (state.next_line < total) {
     const std::size_t i = state.next_line;
     const long li = static_cast<long>(i);
