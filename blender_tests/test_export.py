@@ -59,7 +59,7 @@ class ExportTest(unittest.TestCase):
         self.assertTrue(self.design["stable"])
         self.assertEqual(self.result["errors"], [])
         for w in self.design["wires"]:
-            stem = export.file_stem(w["name"])
+            stem = export.file_stem(w)
             for folder, ext in (("svg", "svg"), ("gcode", "gcode"), ("bends", "csv")):
                 self.assertTrue(os.path.isfile(os.path.join(self.tmp.name, folder, f"{stem}.{ext}")))
         for extra in ("svg/sheet.svg", "dxf/sculpture.dxf"):
@@ -67,9 +67,24 @@ class ExportTest(unittest.TestCase):
         leftovers = [n for _d, _s, files in os.walk(self.tmp.name) for n in files if n.endswith(".tmp")]
         self.assertEqual(leftovers, [])
 
+    def test_file_names_stay_unique_and_old_files_go(self):
+        self.assertEqual(export.file_stem({"id": 3, "name": "Equator/0"}), "03-Equator-0")
+        names = ["\u5e73\u9762/0", "\u65ad\u9762/0", "Cut/1", "Cut-1"]  # collide once made safe
+        stems = {export.file_stem({"id": i, "name": n}) for i, n in enumerate(names)}
+        self.assertEqual(len(stems), len(names))
+        with tempfile.TemporaryDirectory() as tmp:
+            stale = os.path.join(tmp, "gcode", "99-gone.gcode")
+            os.makedirs(os.path.dirname(stale))
+            open(stale, "w").close()
+            mine = os.path.join(tmp, "gcode", "notes.txt")
+            open(mine, "w").close()
+            export.export(self.design, tmp)
+            self.assertFalse(os.path.exists(stale))
+            self.assertTrue(os.path.exists(mine))
+
     def test_svg_is_one_to_one(self):
         for w in self.design["wires"]:
-            root = ET.parse(os.path.join(self.tmp.name, "svg", export.file_stem(w["name"]) + ".svg")).getroot()
+            root = ET.parse(os.path.join(self.tmp.name, "svg", export.file_stem(w) + ".svg")).getroot()
             self.assertTrue(root.get("width").endswith("mm"))
             line = next(e for e in root.iter() if e.tag.endswith("polyline") and "wire-path" in (e.get("class") or ""))
             pts = [tuple(map(float, p.split(","))) for p in line.get("points").split()]
@@ -88,7 +103,7 @@ class ExportTest(unittest.TestCase):
 
     def test_gcode_feeds_make_the_wire_and_the_table_lists_every_bend(self):
         for w, summary in zip(self.design["wires"], self.result["wires"]):
-            stem = export.file_stem(w["name"])
+            stem = export.file_stem(w)
             with open(os.path.join(self.tmp.name, "gcode", stem + ".gcode")) as f:
                 feeds = [float(m) for m in re.findall(r"^G1 X(-?[0-9.]+)", f.read(), re.M)]
             rest_length = float(np.sum(edge_lengths(self.rest_mm(w["name"]))))

@@ -103,6 +103,7 @@ def write_fabrication(design, out, say):
     from wiresculpt import export
 
     if not any("rest" in w for w in design["wires"]):
+        export.clear(out)  # an earlier run's files must not sit beside this design
         return
     start = time.perf_counter()
     result = export.export(design, out)

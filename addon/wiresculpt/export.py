@@ -20,9 +20,25 @@ def machine_profile(design):
     return profile
 
 
-def file_stem(name):
-    """A wire name as a file name: "Equator/0" -> "Equator-0"."""
-    return re.sub(r"[^A-Za-z0-9._-]+", "-", name).strip("-") or "wire"
+EXTENSIONS = (".svg", ".dxf", ".gcode", ".csv")
+
+
+def file_stem(wire):
+    """A wire's file name: its id, then its name made safe ("Equator/0", id 3 -> "03-Equator-0").
+    The id keeps names unique where the safe names of two wires would be the same."""
+    safe = re.sub(r"[^A-Za-z0-9._-]+", "-", wire["name"]).strip("-")
+    return f"{wire['id']:02d}-{safe}" if safe else f"{wire['id']:02d}-wire"
+
+
+def clear(out_dir):
+    """Removes the fabrication files of an earlier export from out_dir's four folders, so what is
+    there always belongs to the design written beside it. Other files are left alone."""
+    for folder in FOLDERS:
+        path = os.path.join(out_dir, folder)
+        if os.path.isdir(path):
+            for name in os.listdir(path):
+                if name.endswith(EXTENSIONS):
+                    os.remove(os.path.join(path, name))
 
 
 def crossing_indices(design, wire):
@@ -42,6 +58,7 @@ def export(design, out_dir):
     gcode, bends}. Returns {"files": [paths], "wires": [per-wire program summary], "errors":
     [one sentence per wire that cannot be bent]}."""
     w = native.require()
+    clear(out_dir)
     profile = machine_profile(design)
     material = design["material"].get("name", "")
     files, summaries, errors, templates = [], [], [], []
@@ -53,7 +70,7 @@ def export(design, out_dir):
         except ValueError as exc:
             errors.append(f"wire {wire['name']}: {exc}")
             continue
-        stem = file_stem(wire["name"])
+        stem = file_stem(wire)
         template = {"name": wire["name"], "points": rest, "bend_points": list(program["bend_vertices"]),
                     "crossing_points": crossing_indices(design, wire)}
         templates.append(template)
