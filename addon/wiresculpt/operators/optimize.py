@@ -97,6 +97,7 @@ class Job:
         self.error = None
         self.cancelled = False
         self.cancel_event = threading.Event()
+        self.scene_name = ""  # set by the operator: the scene the results go to
         self.started = time.perf_counter()
         self.thread = threading.Thread(target=self._work, name="wiresculpt solve", daemon=True)
 
@@ -149,8 +150,8 @@ class WIRESCULPT_OT_optimize(bpy.types.Operator):
     def poll(cls, context):
         return not running()
 
-    def _finish(self, context, design):
-        scene_results.write_results(context.scene, design)
+    def _finish(self, context, design, scene=None):
+        scene_results.write_results(scene or context.scene, design)
         kind, message = summary(design)
         self.report(kind, message)
         return {'FINISHED'}
@@ -177,6 +178,7 @@ class WIRESCULPT_OT_optimize(bpy.types.Operator):
             self.report({'ERROR'}, f"Cannot optimize: {exc}")
             return {'CANCELLED'}
         JOB = Job(design, material, settings)
+        JOB.scene_name = context.scene.name  # the results belong to the scene that was optimized
         JOB.thread.start()
         wm = context.window_manager
         self._timer = wm.event_timer_add(TIMER_SECONDS, window=context.window)
@@ -241,7 +243,12 @@ class WIRESCULPT_OT_optimize(bpy.types.Operator):
         if job.error is not None:
             self.report({'ERROR'}, f"Cannot optimize: {job.error}")
             return {'CANCELLED'}
-        return self._finish(context, job.design)
+        scene = bpy.data.scenes.get(job.scene_name)
+        if scene is None:
+            self.report({'WARNING'}, f"The scene '{job.scene_name}' was removed while optimizing; "
+                                     "nothing was written")
+            return {'CANCELLED'}
+        return self._finish(context, job.design, scene)
 
     def cancel(self, context):  # Blender closes the window or the file under the modal
         job = JOB
