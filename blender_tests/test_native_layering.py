@@ -54,6 +54,12 @@ class LayeringBinding(unittest.TestCase):
         self.assertIn("A", str(ctx.exception))
         self.assertIn("B", str(ctx.exception))
 
+    def test_wrong_types_are_value_errors(self):
+        for bad in ({"tolerance": "abc"}, {"max_nodes": 1.5}):
+            with self.assertRaises(ValueError) as ctx:
+                native.module.layering([wire("X", [1, 0, 0]), wire("Y", [0, 1, 0])], bad)
+            self.assertIn("wrong type", str(ctx.exception))
+
     def test_cancel(self):
         wires = [wire("X", [1, 0, 0]), wire("Y", [0, 1, 0]), wire("Z", [0, 0, 1])]
         with self.assertRaises(native.module.Cancelled):

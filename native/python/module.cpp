@@ -2,6 +2,8 @@
 // computes; every function converts arguments, calls the core and converts the result.
 #include <pybind11/pybind11.h>
 
+#include <string>
+
 #include "bindings.hpp"
 #include "wiresculpt/error.hpp"
 
@@ -21,6 +23,8 @@ PYBIND11_MODULE(_wiresculpt, m) {
       cancelled(e.what());
     } catch (const wiresculpt::InputError& e) {
       PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const py::cast_error& e) {  // a value of the wrong type in a dict or list the caller gave
+      PyErr_SetString(PyExc_ValueError, (std::string("a value has the wrong type: ") + e.what()).c_str());
     } catch (const wiresculpt::Error& e) {
       PyErr_SetString(PyExc_RuntimeError, e.what());
     } catch (const std::bad_alloc&) {

@@ -19,6 +19,12 @@ from ..core.polylines import polyline_length
 from . import layering
 
 FAILED = ("too_close", "infeasible", "open_end")
+# After the solve, a crossing counts as realised when its kink is inside the contact cone and its
+# segments and bends within the machine's limits to within what a bender can make at all (its
+# reliable minimum bend is 1 deg): SLSQP ends within about 0.02 deg, far below this, while the
+# solver's own default check (1e-6 rad) nulled crossings missing the cone by 0.0003 deg.
+REALISED_ANGLE = math.radians(0.1)
+REALISED_LENGTH = 1e-5  # metres
 MAX_ROUNDS = 4  # solve, null what cannot be realised, solve again (each round nulls at least one)
 
 
@@ -56,7 +62,8 @@ def solve_wire(design, wire, material, settings, size, native_progress=None):
                       "contact_angle": contact, "active": c["hook"] != 0})
         refs.append((c, k))
     options = {"min_segment": settings["min_segment"], "max_bend": math.radians(settings["max_bend_deg"]),
-               "friction": 0.0, "model_size": size, "wire_name": wire["name"]}
+               "friction": 0.0, "model_size": size, "wire_name": wire["name"],
+               "angle_tolerance": REALISED_ANGLE, "length_tolerance": REALISED_LENGTH}
     result = native.require().optimize_target_shape(to_2d(wire["contour"], origin, u, v), wire["closed"],
                                                     specs, options, native_progress)
     return result, refs, (origin, u, v)
