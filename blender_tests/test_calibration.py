@@ -240,6 +240,8 @@ class OperatorTest(unittest.TestCase):
         self.assertEqual(scene.wiresculpt.material_preset, 'CUSTOM')
         self.assertAlmostEqual(scene.wiresculpt.bending_stiffness, fit["bending_stiffness"], places=5)
         self.assertEqual(scene[self.ops.MATERIAL_NAME_KEY], "bench steel")
+        from wiresculpt import props
+        self.assertEqual(props.material_of(scene.wiresculpt)["name"], "bench steel")  # what design.json records
         self.assertEqual(bpy.ops.wiresculpt.calibration_use_material(material="brass"), {'FINISHED'})
         self.assertEqual(scene.wiresculpt.material_preset, "brass")
 

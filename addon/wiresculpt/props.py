@@ -12,6 +12,7 @@ from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProp
 from .core import materials, settings as settings_table
 
 HANDLE_KEY = "wiresculpt_handle"  # custom property that marks an object as a slicing handle
+MATERIAL_NAME_KEY = "wiresculpt_material_name"  # scene custom property: name of the material in use
 
 
 def is_handle(obj):
@@ -69,7 +70,9 @@ def material_of(settings):
     (bending stiffness ~ d^4, plastic torque ~ d^3 for a round wire), or the custom numbers."""
     d = _f(settings.wire_diameter)
     if settings.material_preset == "CUSTOM":
-        return {"name": "custom", "wire_diameter": d, "bending_stiffness": _f(settings.bending_stiffness),
+        # A calibrated or saved material's name (set by the Calibration panel), else "custom".
+        name = str(settings.id_data.get(MATERIAL_NAME_KEY, "custom"))
+        return {"name": name, "wire_diameter": d, "bending_stiffness": _f(settings.bending_stiffness),
                 "max_torque": _f(settings.max_torque), "friction": _f(settings.friction),
                 "density": _f(settings.density)}
     out = dict(materials.PRESETS[settings.material_preset])

@@ -12,9 +12,9 @@ from bpy_extras.io_utils import ExportHelper, ImportHelper
 from .. import native
 from ..core import calibration as cal
 from ..core import materials
+from ..props import MATERIAL_NAME_KEY
 
 RESULTS_KEY = "wiresculpt_calibration_results"  # scene custom property: JSON of the last fits
-MATERIAL_NAME_KEY = "wiresculpt_material_name"  # scene custom property: name of the material in use
 KINDS = (("CANTILEVER", "Cantilever", "Bending stiffness and plastic limit (load_g, state, s_m, deflection_m)"),
          ("TILT", "Tilt", "Friction coefficient (repeat, angle_deg)"),
          ("SPRINGBACK", "Spring-back", "Machine spring-back line (commanded_deg, measured_deg)"))
