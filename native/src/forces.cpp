@@ -6,11 +6,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <csetjmp>
 #include <limits>
 #include <nlopt.hpp>
 #include <string>
 
+#include "glpk_guard.hpp"
+#include "nlopt_text.hpp"
 #include "wiresculpt/error.hpp"
 
 namespace wiresculpt {
@@ -18,51 +19,9 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// --- GLPK guard (as in stability.cpp) ----------------------------------------------------------
-// GLPK reports internal errors through a hook and aborts the process if the hook returns; the
-// hook jumps back here, GLPK's environment is freed as GLPK requires, and the solve reports
-// failure. Only GLPK's own C frames lie between setjmp and longjmp.
-thread_local std::jmp_buf* t_jump = nullptr;
-
-void on_glpk_error(void*) {
-  if (t_jump) std::longjmp(*t_jump, 1);
-}
-
-// glp_simplex with GLPK's error hook unwinding here; -1 when GLPK hit an internal error (its
-// environment is then freed, with every problem object in it).
-int guarded_simplex(glp_prob* lp, const glp_smcp* parm) {
-  std::jmp_buf buf;
-  t_jump = &buf;
-  glp_error_hook(on_glpk_error, nullptr);
-  if (setjmp(buf) != 0) {
-    t_jump = nullptr;
-    glp_free_env();
-    return -1;
-  }
-  const int ret = glp_simplex(lp, parm);
-  glp_error_hook(nullptr, nullptr);
-  t_jump = nullptr;
-  return ret;
-}
 
 std::string wname(const Network& net, int w) { return "wire '" + net.wires[w].name + "'"; }
 
-std::string result_text(nlopt::result r) {
-  switch (r) {
-    case nlopt::FAILURE: return "NLOPT_FAILURE";
-    case nlopt::INVALID_ARGS: return "NLOPT_INVALID_ARGS";
-    case nlopt::OUT_OF_MEMORY: return "NLOPT_OUT_OF_MEMORY";
-    case nlopt::ROUNDOFF_LIMITED: return "NLOPT_ROUNDOFF_LIMITED";
-    case nlopt::FORCED_STOP: return "NLOPT_FORCED_STOP";
-    case nlopt::SUCCESS: return "NLOPT_SUCCESS";
-    case nlopt::STOPVAL_REACHED: return "NLOPT_STOPVAL_REACHED";
-    case nlopt::FTOL_REACHED: return "NLOPT_FTOL_REACHED";
-    case nlopt::XTOL_REACHED: return "NLOPT_XTOL_REACHED";
-    case nlopt::MAXEVAL_REACHED: return "NLOPT_MAXEVAL_REACHED";
-    case nlopt::MAXTIME_REACHED: return "NLOPT_MAXTIME_REACHED";
-    default: return "NLOPT_UNKNOWN";
-  }
-}
 
 void validate(const ForceOptions& o) {
   auto finite_pos = [](double v) { return std::isfinite(v) && v > 0; };
@@ -144,7 +103,6 @@ LpSolution solve_lp(const LinearProgram& in) {
       out.status = LpSolution::infeasible;
       return out;
     }
-  glp_term_out(GLP_OFF);
   glp_prob* lp = glp_create_prob();
   glp_set_obj_dir(lp, in.maximise ? GLP_MAX : GLP_MIN);
   if (R > 0) glp_add_rows(lp, R);
@@ -163,7 +121,7 @@ LpSolution solve_lp(const LinearProgram& in) {
   glp_init_smcp(&parm);
   parm.msg_lev = GLP_MSG_OFF;
   parm.presolve = GLP_ON;
-  int ret = guarded_simplex(lp, &parm);
+  int ret = detail::guarded_simplex(lp, &parm);
   if (ret == -1) {  // GLPK's environment (and with it `lp`) is gone
     out.status = LpSolution::failed;
     return out;
@@ -171,7 +129,7 @@ LpSolution solve_lp(const LinearProgram& in) {
   if (ret != 0 && ret != GLP_ENOPFS && ret != GLP_ENODFS) {  // retry without presolve
     parm.presolve = GLP_OFF;
     glp_adv_basis(lp, 0);
-    ret = guarded_simplex(lp, &parm);
+    ret = detail::guarded_simplex(lp, &parm);
     if (ret == -1) {
       out.status = LpSolution::failed;
       return out;
@@ -525,7 +483,7 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
       nlopt::result res = nlopt::FAILURE;
       try {
         res = opt.optimize(z, g);
-        r.nlopt_result = result_text(res);
+        r.nlopt_result = detail::nlopt_result_text(res);
       } catch (const nlopt::forced_stop&) {
         if (data.cancelled) throw Cancelled();
         r.nlopt_result = "NLOPT_FORCED_STOP";

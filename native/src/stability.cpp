@@ -3,59 +3,24 @@
 #include <glpk.h>
 
 #include <cmath>
-#include <csetjmp>
 #include <string>
 
+#include "glpk_guard.hpp"
 #include "wiresculpt/error.hpp"
 
 namespace wiresculpt {
 namespace {
 
-// --- GLPK guard -------------------------------------------------------------------------------
-// GLPK reports internal errors through a hook and aborts the process if the hook returns. The
-// hook jumps back to guarded_simplex, which frees GLPK's (per-thread) environment as GLPK
-// requires; every problem object of that environment is then gone, which the generation counter
-// tells the Lp wrapper. Only GLPK's own C frames lie between setjmp and longjmp.
-thread_local std::jmp_buf* t_jump = nullptr;
-thread_local unsigned t_generation = 0;
-thread_local unsigned t_configured = ~0u;
-
-void on_glpk_error(void*) {
-  if (t_jump) std::longjmp(*t_jump, 1);
-}
-
-void configure_glpk() {
-  if (t_configured == t_generation) return;
-  glp_term_out(GLP_OFF);
-  t_configured = t_generation;
-}
-
-int guarded_simplex(glp_prob* lp, const glp_smcp* parm) {
-  std::jmp_buf buf;
-  t_jump = &buf;
-  glp_error_hook(on_glpk_error, nullptr);
-  if (setjmp(buf) != 0) {
-    t_jump = nullptr;
-    glp_free_env();
-    ++t_generation;
-    return -1;
-  }
-  const int ret = glp_simplex(lp, parm);
-  glp_error_hook(nullptr, nullptr);
-  t_jump = nullptr;
-  return ret;
-}
-
 struct Lp {
   glp_prob* p = nullptr;
   unsigned generation = 0;
-  Lp() : p(glp_create_prob()), generation(t_generation) {}
+  Lp() : p(glp_create_prob()), generation(detail::glpk_generation()) {}
   ~Lp() {
-    if (p && generation == t_generation) glp_delete_prob(p);
+    if (p && generation == detail::glpk_generation()) glp_delete_prob(p);
   }
   Lp(const Lp&) = delete;
   Lp& operator=(const Lp&) = delete;
-  bool alive() const { return generation == t_generation; }
+  bool alive() const { return generation == detail::glpk_generation(); }
 };
 
 std::string wire_name(const Network& net, int w) { return "'" + net.wires[w].name + "'"; }
@@ -204,7 +169,7 @@ StabilityResult StabilityChecker::check(const std::vector<int>& wires, const std
     return result;
   }
 
-  configure_glpk();
+  detail::configure_glpk();
   Lp lp;
   glp_set_obj_dir(lp.p, GLP_MIN);
   glp_add_rows(lp.p, R);
@@ -236,7 +201,7 @@ StabilityResult StabilityChecker::check(const std::vector<int>& wires, const std
     for (int attempt = 0; attempt < 2; ++attempt) {
       ++result.lp_solves;
       ++lp_solves_;
-      const int ret = guarded_simplex(lp.p, &parm);
+      const int ret = detail::guarded_simplex(lp.p, &parm);
       if (ret == -1 || !lp.alive())
         throw SolverError("GLPK stopped with an internal error while checking the stability of wire " +
                           wire_name(net, wires.back()) + "; please report this input");

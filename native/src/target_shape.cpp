@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "nlopt_text.hpp"
 #include "wiresculpt/error.hpp"
 
 namespace wiresculpt {
@@ -36,22 +37,6 @@ double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x
 // Angle in [0, π] between two non-zero vectors.
 double angle_between(const Vec2& a, const Vec2& b) { return std::atan2(std::abs(cross2(a, b)), a.dot(b)); }
 
-std::string result_text(nlopt::result r) {
-  switch (r) {
-    case nlopt::FAILURE: return "NLOPT_FAILURE";
-    case nlopt::INVALID_ARGS: return "NLOPT_INVALID_ARGS";
-    case nlopt::OUT_OF_MEMORY: return "NLOPT_OUT_OF_MEMORY";
-    case nlopt::ROUNDOFF_LIMITED: return "NLOPT_ROUNDOFF_LIMITED";
-    case nlopt::FORCED_STOP: return "NLOPT_FORCED_STOP";
-    case nlopt::SUCCESS: return "NLOPT_SUCCESS";
-    case nlopt::STOPVAL_REACHED: return "NLOPT_STOPVAL_REACHED";
-    case nlopt::FTOL_REACHED: return "NLOPT_FTOL_REACHED";
-    case nlopt::XTOL_REACHED: return "NLOPT_XTOL_REACHED";
-    case nlopt::MAXEVAL_REACHED: return "NLOPT_MAXEVAL_REACHED";
-    case nlopt::MAXTIME_REACHED: return "NLOPT_MAXTIME_REACHED";
-    default: return "NLOPT_UNKNOWN";
-  }
-}
 
 void validate(const Polyline2& contour, bool closed, const std::vector<TargetCrossing>& crossings,
               const TargetShapeOptions& o) {
@@ -827,7 +812,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     for (int q : b.points) moved = std::max(moved, (data.p[q] - before[q]).norm());
     for (int q : b.points) data.var_of[q] = -1;
     // Keep the first non-success code (a failure in any block is the one worth reporting).
-    const std::string text = result_text(r);
+    const std::string text = detail::nlopt_result_text(r);
     if (r < 0 && worst_result.empty()) worst_result = text;
     result.nlopt_result = worst_result.empty() ? text : worst_result;
     if (!finite) result.warnings.push_back("the solver diverged on part of wire " + w + "; that part keeps its previous shape");
