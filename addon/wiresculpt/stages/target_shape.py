@@ -95,10 +95,14 @@ def run(design, material, settings, native_progress=None):
     nulls crossings that cannot be realised and re-checks stability. Returns a progress line."""
     start = time.perf_counter()
     size = model_size(design)
-    nulled, iterations = [], 0
+    nulled, iterations, wire_solves = [], 0, 0
+    solved = [None] * len(design["wires"])
+    pending = range(len(design["wires"]))  # the first round solves every wire
     for _round in range(MAX_ROUNDS):
-        solved = [solve_wire(design, w, material, settings, size, native_progress) for w in design["wires"]]
-        iterations += sum(r["iterations"] for r, _refs, _frame in solved)
+        for i in pending:
+            solved[i] = solve_wire(design, design["wires"][i], material, settings, size, native_progress)
+            iterations += solved[i][0]["iterations"]
+            wire_solves += 1
         failing = {}
         for wire, (r, refs, _frame) in zip(design["wires"], solved):
             for (c, _k), status in zip(refs, r["crossings"]):
@@ -110,6 +114,8 @@ def run(design, material, settings, native_progress=None):
         for cid, failure in failing.items():
             design["crossings"][cid]["hook"] = 0
             nulled.append(failure)
+        # Only the wires through a newly nulled crossing change; the others keep their shapes.
+        pending = sorted({w for cid in failing for w in design["crossings"][cid]["wires"]})
     else:
         raise RuntimeError("target shape: crossings kept failing after nulling; this is a solver bug")
 
@@ -134,8 +140,8 @@ def run(design, material, settings, native_progress=None):
         if c["hook"] == 0:
             c["metric"] = 0.0
     seconds = time.perf_counter() - start
-    design["stages"]["target_shape"] = {"seconds": seconds, "iterations": iterations, "wires": per_wire,
-                                        "nulled_crossings": nulled}
+    design["stages"]["target_shape"] = {"seconds": seconds, "iterations": iterations, "wire_solves": wire_solves,
+                                        "wires": per_wire, "nulled_crossings": nulled}
     if nulled:
         verdict = layering.recheck(design, material, settings)
         design["stages"]["target_shape"]["recheck_lp_solves"] = verdict["lp_solves"]
