@@ -202,3 +202,29 @@ TEST_CASE("network: bad wires are input errors naming the wire") {
   few.points[1].x() = std::nan("");
   CHECK_THROWS_WITH(build_network({few}), Contains("'stub'") && Contains("non-finite"));
 }
+
+TEST_CASE("network: a vertex just off the other plane on a shallow crossing still makes the crossing there") {
+  // Wire A (plane z = 0) crosses x = 0 transversally at y = -0.05 and, near the top, at a shallow
+  // slope (1:100) through a vertex V 9.6 um from x = 0 (inside the 10 um tolerance): the wire meets
+  // the plane at y = 0.11 exactly, 0.96 mm along the line from V. Wire B (plane x = 0) crosses
+  // z = 0 at y = -0.05 and y = 0.11.
+  WireSpec a;
+  a.name = "A";
+  a.plane = Plane::make({0, 0, 0}, {0, 0, 1});
+  a.points = {{-0.05, -0.05, 0}, {0.05, -0.05, 0}, {0.05, 0.05, 0}, {0.0003, 0.08, 0},
+              {0.0000096, 0.10904, 0}, {-0.0003, 0.14, 0}, {-0.05, 0.05, 0}};
+  WireSpec b;
+  b.name = "B";
+  b.plane = Plane::make({0, 0, 0}, {1, 0, 0});
+  b.points = {{0, -0.05, -0.03}, {0, -0.05, 0.03}, {0, 0.11, 0.03}, {0, 0.11, -0.03}};
+  const Network net = build_network({a, b});
+  REQUIRE(net.crossings.size() == 2);
+  CHECK(net.crossings[0].point.isApprox(Vec3(0, -0.05, 0), 1e-12));
+  CHECK((net.crossings[1].point - Vec3(0, 0.11, 0)).norm() < 1e-9);
+  // inserted into A as a new vertex on the edge V -> (-0.0003, 0.14); V itself stays
+  const Vec3 v = net.wires[0].points[static_cast<std::size_t>(net.crossings[1].vertices[0])];
+  CHECK((v - Vec3(0, 0.11, 0)).norm() < 1e-9);
+  bool kept = false;
+  for (const Vec3& p : net.wires[0].points) kept = kept || (p - Vec3(0.0000096, 0.10904, 0)).norm() < 1e-12;
+  CHECK(kept);
+}

@@ -9,6 +9,7 @@ friction term left out (mu = 0 here: friction is already in the layering's pyram
 realised kink is then at least as sharp as the one the layering judged stable.
 """
 import math
+import re
 import time
 
 import numpy as np
@@ -86,7 +87,9 @@ def unrealised_summary(nulled, size):
                      f"bending point between them (the closest: {worst['message']})")
     for n in nulled:
         if n["status"] != "too_close":
-            parts.append(f"crossing {n['crossing']} on wire {n['wire']}: {n['message']}")
+            # The solver numbers crossings along the wire; the design's id is the one users see.
+            message = re.sub(r"^crossing \d+ on wire .*?: ", "", n["message"])
+            parts.append(f"crossing {n['crossing']} on wire {n['wire']}: {message}")
     return "the target shape cannot realise " + "; ".join(parts)
 
 
