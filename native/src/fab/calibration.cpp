@@ -325,7 +325,8 @@ CantileverFit fit_cantilever(const std::vector<CantileverRecord>& records, const
     f.deflection.push_back(r.deflection);
   }
   CantileverFit fit;
-  for (auto& [key, f] : groups) {
+  for (auto& entry : groups) {
+    CantileverFrame& f = entry.second;  // not a structured binding: lambdas capture it (clang 14)
     std::vector<int> order(f.s.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
     std::sort(order.begin(), order.end(), [&](int a, int b) { return f.s[a] < f.s[b]; });
