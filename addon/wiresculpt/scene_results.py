@@ -10,6 +10,7 @@ import bmesh
 import bpy
 import numpy as np
 
+from . import cut_handles
 from .core.design import dumps
 from .operators.slicing import remove_object, scene_collection, write_polyline
 
@@ -237,6 +238,7 @@ def write_results(scene, design):
         obj["wiresculpt_hook"] = int(c.get("hook", 0))
     for obj in markers.values():
         bpy.data.objects.remove(obj, do_unlink=True)
+    cut_handles.write(scene, design)
     settings = scene.wiresculpt
     steps = design.get("assembly_steps") or []
     if settings.assembly_step > len(steps):
@@ -276,6 +278,7 @@ def clear_results(scene):
         remove_object(obj)
     for obj in tagged(scene, CROSSING_KEY).values():
         bpy.data.objects.remove(obj, do_unlink=True)
+    cut_handles.remove(scene)
     text = bpy.data.texts.get(DESIGN_TEXT)
     if text is not None:
         bpy.data.texts.remove(text)

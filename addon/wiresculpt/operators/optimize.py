@@ -11,7 +11,7 @@ import time
 
 import bpy
 
-from .. import mesh_data, native, pipeline, scene_results
+from .. import cut_handles, mesh_data, native, pipeline, scene_results
 from ..core.design import new_design, wire_entry
 from ..props import material_of, solver_settings
 from .slicing import handle_plane, handles, target_problem
@@ -63,6 +63,7 @@ def build_design(context):
                                               c["closed"], c["points"]))
     design["stages"]["slicing"] = {"seconds": time.perf_counter() - start, "planes": len(planes),
                                    "contours": sum(len(c) for c in result["contours"])}
+    cut_handles.apply_to_design(scene, design)
     return design, material, settings
 
 

@@ -10,8 +10,10 @@ Fills, per crossing, `force` (N, on wires[0] by wires[1], FORMATS.md), `normal_f
 axis direction; absent when the material has no density), `out_of_plane` statistics,
 `stages.forces` and `stages.rest_shape`. Only computed values are written.
 
-A user's cut for a closed wire may be given as the wire's `cut_override` (index into `target`);
-it is validated by the solver (a ValueError names the wire).
+A user's cut for a closed wire may be given as the wire's `cut_override` (index into `target`,
+the batch scene's settings.cuts), validated by the solver (a ValueError names the wire), or as a
+`cut_point` (x, y, z metres, the add-on's cut handle), which is snapped to the target point
+nearest it that is not a crossing.
 """
 import math
 
@@ -22,10 +24,32 @@ from .. import native
 AXES = ("+x", "-x", "+y", "-y", "+z", "-z")
 
 
+def snap_cut(design, wire):
+    """Index of the wire's target point nearest its `cut_point` among those that are not a
+    crossing (where the solver refuses to cut). ValueError when every point is a crossing."""
+    target = np.asarray(wire["target"], dtype=np.float64)
+    crossing = {c["vertices"][k] for c in design.get("crossings", []) for k in (0, 1)
+                if c["wires"][k] == wire["id"]}
+    distance = np.linalg.norm(target - np.asarray(wire["cut_point"], dtype=np.float64), axis=1)
+    distance[sorted(crossing)] = np.inf
+    if not np.isfinite(distance).any():
+        raise ValueError(f'wire {wire["name"]}: every target point is a crossing; there is no point to cut at')
+    return int(np.argmin(distance))
+
+
+def requested_cut(design, wire):
+    """The cut the user asked for: an index, a point snapped to the target, or -1 (automatic)."""
+    if "cut_override" in wire:
+        return int(wire["cut_override"])
+    if wire["closed"] and "cut_point" in wire:
+        return snap_cut(design, wire)
+    return -1
+
+
 def _inputs(design):
     wires = [{"name": w["name"], "origin": w["plane"]["origin"], "normal": w["plane"]["normal"],
               "target": np.asarray(w["target"], dtype=np.float64), "closed": w["closed"],
-              "cut": int(w.get("cut_override", -1))}
+              "cut": requested_cut(design, w)}
              for w in design["wires"]]
     crossings = [{"wires": list(c["wires"]), "vertices": list(c["vertices"]), "hook": int(c["hook"])}
                  for c in design["crossings"]]

@@ -158,6 +158,13 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
             row = layout.row()
             row.label(text="Max deviation")  # the largest distance of a wire from its contour
             row.label(text=length_text(context.scene, max(distances)))
+        gaps = [w["closure_gap"] for w in design["wires"] if w.get("closed") and "closure_gap" in w]
+        if gaps:
+            row = layout.row()
+            # how far the two ends of the largest rest shape stand apart before assembly
+            row.label(text="Max closure gap")
+            row.label(text=length_text(context.scene, max(gaps)))
+            layout.label(text="Move a sphere in Cuts to move a cut", icon='INFO')
         capacity = load_capacity_rows(design)
         if capacity:
             col = layout.column(align=True)
