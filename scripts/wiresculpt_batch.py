@@ -3,10 +3,12 @@
     blender --background --factory-startup --python scripts/wiresculpt_batch.py -- SCENE.json --out DIR
 
 Reads and validates the scene file, imports the mesh, runs the pipeline and writes DIR/design.json
-(atomically) with the fabrication files beside it (svg/, dxf/, gcode/, bends/), then the results
-as a Blender user sees them: DIR/sculpture.blend (wires, crossing
-markers and the design in a scene), DIR/render.png (a Workbench still) and the assembly guide
-DIR/assembly/index.html with a picture per step. One progress line per stage on stdout. Exit status: 0 a stable design was written;
+with the fabrication files beside it (svg/, dxf/, gcode/, bends/), then the results as a Blender
+user sees them: DIR/sculpture.blend (wires, crossing markers and the design in a scene),
+DIR/render.png (a Workbench still) and the assembly guide DIR/assembly/index.html with a picture
+per step. The outputs replace an earlier run's as one set, only once all are written (the folders
+svg/ dxf/ gcode/ bends/ assembly/ belong to the run; other files in DIR are left alone). One
+progress line per stage on stdout. Exit status: 0 a stable design was written;
 2 the input was valid but no stable design exists (design.json still written, with the reason);
 1 bad input or failure, with one clear message on stderr.
 """
@@ -21,6 +23,9 @@ if os.path.isdir(os.path.join(ADDON, "wiresculpt")) and ADDON not in sys.path:
     sys.path.insert(0, ADDON)
 
 EXIT_STABLE, EXIT_FAILURE, EXIT_UNSTABLE = 0, 1, 2
+# What a run writes into DIR, replaced as one set (files, or folders that belong to the run).
+OUTPUTS = ("design.json", "sculpture.blend", "sculpture.blend1", "render.png", "assembly", "svg", "dxf",
+           "gcode", "bends")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -61,7 +66,8 @@ def add_handles(scene, planes, design):
 
 
 def write_scene_outputs(design, objects, planes, factor, out, say):
-    """sculpture.blend, render.png and assembly/ in `out`, from the design (each file atomic)."""
+    """sculpture.blend, render.png and assembly/ in `out`, from the design (progress lines name
+    them relative to `out`, which is the run's staging folder)."""
     import bpy
     from mathutils import Matrix
 
@@ -86,15 +92,16 @@ def write_scene_outputs(design, objects, planes, factor, out, say):
         start = time.perf_counter()
         path = os.path.join(out, "render.png")
         assembly_guide.render_still(scene, design, path)
-        say("render", f"{path} ({time.perf_counter() - start:.3f} s)")
+        say("render", f"render.png ({time.perf_counter() - start:.3f} s)")
     if design.get("assembly_steps"):
         start = time.perf_counter()
         path = assembly_guide.write_guide(scene, design, os.path.join(out, "assembly"))
-        say("guide", f"{path}, {len(design['assembly_steps'])} steps ({time.perf_counter() - start:.3f} s)")
+        say("guide", f"{os.path.relpath(path, out)}, {len(design['assembly_steps'])} steps "
+                     f"({time.perf_counter() - start:.3f} s)")
     path = os.path.abspath(os.path.join(out, "sculpture.blend"))
     # Blender writes the .blend to a temporary name and renames it: atomic like the rest
     bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False, compress=True)
-    say("blend", path)
+    say("blend", "sculpture.blend")
 
 
 def write_fabrication(design, out, say):
@@ -103,8 +110,7 @@ def write_fabrication(design, out, say):
     from wiresculpt import export
 
     if not any("rest" in w for w in design["wires"]):
-        export.clear(out)  # an earlier run's files must not sit beside this design
-        return
+        return  # no folders: the earlier run's are removed with the rest of its set
     start = time.perf_counter()
     result = export.export(design, out)
     design["fabrication"] = {"wires": result["wires"], "errors": result["errors"]}
@@ -122,6 +128,7 @@ def run(argv):
 
     from wiresculpt import native, pipeline
     from wiresculpt.core.design import write_design
+    from wiresculpt.core.staging import staged
     from wiresculpt.core.scene import load_scene
     from wiresculpt.mesh_import import import_mesh
 
@@ -145,11 +152,13 @@ def run(argv):
                 f"({time.perf_counter() - start:.3f} s)")
     planes = scaled_planes(scene.planes, factor)
     design = pipeline.run(V, F, planes, scene.material, scene.settings, say)
-    write_fabrication(design, args.out, say)
-    path = os.path.join(args.out, "design.json")
-    write_design(path, design)
-    say("written", path)
-    write_scene_outputs(design, objects, planes, factor, args.out, say)
+    # Everything is written into a hidden folder first and replaces the earlier run's outputs
+    # only when all of it is there: a failure half-way leaves the earlier set as it was.
+    with staged(args.out, OUTPUTS) as folder:
+        write_fabrication(design, folder, say)
+        write_design(os.path.join(folder, "design.json"), design)
+        write_scene_outputs(design, objects, planes, factor, folder, say)
+    say("written", os.path.join(args.out, "design.json"))
     if design["stable"]:
         return EXIT_STABLE
     print(f"wiresculpt: not stable: {design['reason']}", file=sys.stderr, flush=True)
