@@ -114,6 +114,18 @@ class CutHandles(Case):
         self.assertEqual(wire_named(again, name)["cut"], wire["cut"])
         self.assertFalse(cut_handles.is_moved(handles()[name]))
 
+    def test_assembly_slider_hides_the_handles_of_wires_not_yet_added(self):
+        globe()
+        design = optimize()
+        step = 1
+        shown = {design["wires"][w]["name"] for w in design["assembly_steps"][0]}
+        self.assertLess(len(shown), 3)
+        bpy.context.scene.wiresculpt.assembly_step = step
+        for name, obj in handles().items():
+            self.assertEqual(obj.hide_viewport, name not in shown, name)
+        bpy.context.scene.wiresculpt.assembly_step = 0
+        self.assertFalse(any(obj.hide_viewport for obj in handles().values()))
+
     def test_clear_results_removes_the_handles(self):
         globe()
         optimize()

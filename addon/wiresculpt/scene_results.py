@@ -270,6 +270,9 @@ def apply_assembly_step(scene):
     for obj in tagged(scene, CROSSING_KEY).values():
         wires = list(obj.get("wiresculpt_wires", []))
         obj.hide_viewport = not (settings.show_markers and all(w in shown for w in wires))
+    ids = {w["name"]: w["id"] for w in design["wires"]}
+    for name, obj in tagged(scene, cut_handles.CUT_KEY).items():
+        obj.hide_viewport = ids.get(name) not in shown
 
 
 def clear_results(scene):
