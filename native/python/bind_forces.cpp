@@ -227,7 +227,9 @@ py::dict forces_and_rest_py(const py::list& wire_list, const py::list& crossing_
                    py::arg("max_out_of_plane") = fr.max_out_of_plane);
   py::dict stats(py::arg("forces_seconds") = fr.seconds, py::arg("lp_seconds") = fr.lp_seconds,
                  py::arg("nlp_seconds") = fr.nlp_seconds, py::arg("rest_seconds") = rest_seconds,
-                 py::arg("lp_iterations") = fr.lp_iterations, py::arg("iterations") = fr.iterations);
+                 py::arg("lp_iterations") = fr.lp_iterations, py::arg("iterations") = fr.iterations,
+                 py::arg("working_set_rounds") = fr.working_set_rounds,
+                 py::arg("working_set_rows") = fr.working_set_rows);
   return py::dict(py::arg("crossings") = crossings, py::arg("wires") = wires, py::arg("forces") = summary,
                   py::arg("load_capacity") = load, py::arg("stats") = stats, py::arg("warnings") = fr.warnings);
 }
@@ -256,7 +258,7 @@ Returns {"crossings": [{"force": [3] N on wires[0] by wires[1], "normal": N, "ou
 nlopt_result, mean_out_of_plane, max_out_of_plane}, "load_capacity": {"weight_N", "length",
 "+x", "-x", "+y", "-y", "+z", "-z" (multiples of the weight; None when unbounded), "base",
 "status", "seconds"} or None, "stats": {forces_seconds, lp_seconds, nlp_seconds, rest_seconds,
-lp_iterations, iterations}, "warnings": [str]}.
+lp_iterations, iterations, working_set_rounds, working_set_rows}, "warnings": [str]}.
 Bad input raises ValueError naming the wire or crossing.)");
 }
 

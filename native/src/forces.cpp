@@ -455,41 +455,81 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
     const Eigen::MatrixXd N = svd.matrixV().rightCols(K - rank);
     const int k = static_cast<int>(N.cols());
     if (k > 0) {
-      SlsqpData data{&problem, &N, {}, {}, &progress};
+      // Every constraint row in z (c(z) = G z - h <= 0), scaled to O(1): signs by F_ref, torques
+      // by t_max.
       const Eigen::Index m = K + 2 * T.rows() + Nk.rows();
-      data.G.resize(m, k);
-      data.h.resize(m);
-      // Rows scaled to O(1): signs by F_ref, torques by t_max.
-      data.G.topRows(K) = -N / F_ref;
-      data.h.head(K).setZero();
+      Eigen::MatrixXd G_all(m, k);
+      Eigen::VectorXd h_all(m);
+      G_all.topRows(K) = -N / F_ref;
+      h_all.head(K).setZero();
       const Eigen::MatrixXd TN = T * N / problem.t_max();
-      data.G.middleRows(K, T.rows()) = TN;
-      data.G.middleRows(K + T.rows(), T.rows()) = -TN;
-      data.h.segment(K, 2 * T.rows()).setOnes();
-      data.G.bottomRows(Nk.rows()) = -Nk * N / F_ref;
-      data.h.tail(Nk.rows()).setZero();
-      nlopt::opt opt(nlopt::LD_SLSQP, static_cast<unsigned>(k));
-      opt.set_max_objective(slsqp_objective, &data);
-      opt.add_inequality_mconstraint(slsqp_constraints, &data,
-                                     std::vector<double>(static_cast<std::size_t>(m), options.constraint_tol));
-      opt.set_ftol_rel(options.ftol_rel);
-      opt.set_xtol_rel(options.xtol_rel);
-      opt.set_maxeval(options.max_iterations);
+      G_all.middleRows(K, T.rows()) = TN;
+      G_all.middleRows(K + T.rows(), T.rows()) = -TN;
+      h_all.segment(K, 2 * T.rows()).setOnes();
+      G_all.bottomRows(Nk.rows()) = -Nk * N / F_ref;
+      h_all.tail(Nk.rows()).setZero();
       std::vector<double> z(static_cast<std::size_t>(k));
       Eigen::Map<Eigen::VectorXd>(z.data(), k) = N.transpose() * a;
+      // The working set: sign and normal rows always; torque rows within the margin of their
+      // bound at the start (the LP's optimum sits on many of them), later any row the solution
+      // violates.
+      const double kNear = -options.working_set_margin;
+      std::vector<char> in_set(static_cast<std::size_t>(m), 1);
+      bool partial = options.working_set && use_lp;  // from zero nothing is near a bound yet
+      if (partial) {
+        const Eigen::VectorXd c0 = G_all * Eigen::Map<const Eigen::VectorXd>(z.data(), k) - h_all;
+        for (Eigen::Index i = K; i < K + 2 * T.rows(); ++i) in_set[i] = c0(i) >= kNear;
+      }
+      SlsqpData data{&problem, &N, {}, {}, &progress};
       const Eigen::VectorXd a_start = a;
       const double g_start = problem.objective(a_start);
       double g = 0.0;
       nlopt::result res = nlopt::FAILURE;
-      try {
-        res = opt.optimize(z, g);
-        r.nlopt_result = detail::nlopt_result_text(res);
-      } catch (const nlopt::forced_stop&) {
-        if (data.cancelled) throw Cancelled();
-        r.nlopt_result = "NLOPT_FORCED_STOP";
-      } catch (const std::exception& e) {
-        if (data.cancelled) throw Cancelled();
-        r.nlopt_result = std::string("NLOPT_FAILURE (") + e.what() + ")";
+      for (int round = 0;; ++round) {
+        std::vector<Eigen::Index> rows;
+        for (Eigen::Index i = 0; i < m; ++i)
+          if (in_set[i]) rows.push_back(i);
+        data.G.resize(static_cast<Eigen::Index>(rows.size()), k);
+        data.h.resize(static_cast<Eigen::Index>(rows.size()));
+        for (std::size_t i = 0; i < rows.size(); ++i) {
+          data.G.row(static_cast<Eigen::Index>(i)) = G_all.row(rows[i]);
+          data.h(static_cast<Eigen::Index>(i)) = h_all(rows[i]);
+        }
+        nlopt::opt opt(nlopt::LD_SLSQP, static_cast<unsigned>(k));
+        opt.set_max_objective(slsqp_objective, &data);
+        opt.add_inequality_mconstraint(slsqp_constraints, &data,
+                                       std::vector<double>(rows.size(), options.constraint_tol));
+        opt.set_ftol_rel(options.ftol_rel);
+        opt.set_xtol_rel(options.xtol_rel);
+        opt.set_maxeval(std::max(1, options.max_iterations - data.evaluations));
+        try {
+          res = opt.optimize(z, g);
+          r.nlopt_result = detail::nlopt_result_text(res);
+        } catch (const nlopt::forced_stop&) {
+          if (data.cancelled) throw Cancelled();
+          r.nlopt_result = "NLOPT_FORCED_STOP";
+          break;
+        } catch (const std::exception& e) {
+          if (data.cancelled) throw Cancelled();
+          r.nlopt_result = std::string("NLOPT_FAILURE (") + e.what() + ")";
+          if (!partial) break;
+          // A partial set may leave the relaxed problem unbounded: start again with every row.
+          partial = false;
+          std::fill(in_set.begin(), in_set.end(), 1);
+          Eigen::Map<Eigen::VectorXd>(z.data(), k) = N.transpose() * a_start;
+          continue;
+        }
+        r.working_set_rounds = round + 1;
+        r.working_set_rows = static_cast<int>(rows.size());
+        // Rows outside the set that the solution violates join it, with their near neighbours
+        // in value; none violated: the relaxed optimum is feasible, hence the full optimum.
+        const Eigen::VectorXd c = G_all * Eigen::Map<const Eigen::VectorXd>(z.data(), k) - h_all;
+        bool added = false;
+        for (Eigen::Index i = 0; i < m; ++i)
+          if (!in_set[i] && c(i) > options.constraint_tol) added = true;
+        if (!added || data.evaluations >= options.max_iterations) break;
+        for (Eigen::Index i = 0; i < m; ++i)
+          if (!in_set[i] && c(i) >= kNear) in_set[i] = 1;
       }
       if (data.cancelled) throw Cancelled();
       r.iterations = data.evaluations;

@@ -253,3 +253,64 @@ TEST_CASE("forces: progress can cancel", "[forces]") {
   CHECK_THROWS_AS(optimize_forces(s.net, s.hooks, s.steps, cuts, {}, [](std::string_view, double) { return false; }),
                   Cancelled);
 }
+
+TEST_CASE("forces: the working set reaches the optimum of the full constraint set", "[forces]") {
+  // Random sphere cuts with random hooks: SLSQP over every torque row (the reference) and over
+  // the growing working set must agree on G, and the working-set result must satisfy every row.
+  // With a tiny first margin the set starts from the LP's active rows alone and has to grow.
+  for (const double margin : {0.5, 1e-3}) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    const double R = 0.125;
+    int tested = 0, grew = 0;
+    for (int attempt = 0; attempt < 400 && tested < 12; ++attempt) {
+      const int P = 3 + attempt % 3;
+      std::vector<fixtures::Cut> cuts;
+      for (int k = 0; k < P; ++k) {
+        Vec3 n(unit(rng), unit(rng), unit(rng));
+        if (n.norm() < 0.2) n = Vec3::UnitZ();
+        cuts.push_back({std::string(1, static_cast<char>('A' + k)), n.normalized(), 0.5 * R * unit(rng)});
+      }
+      Network net;
+      try {
+        net = build_network(fixtures::sphere_wires(cuts, R, 48));
+      } catch (const InputError&) {
+        continue;
+      }
+      const int C = static_cast<int>(net.crossings.size());
+      if (C < 4) continue;
+      std::vector<int> hooks;
+      for (int c = 0; c < C; ++c) hooks.push_back(rng() % 2 ? 1 : -1);
+      std::vector<std::vector<int>> steps{{0, 1}};
+      for (int w = 2; w < P; ++w) steps.push_back({w});
+      ForceOptions o;
+      o.torque_fraction = attempt % 2 ? 1.0 : 0.3;
+      o.working_set_margin = margin;
+      ForceResult full, ws;
+      try {
+        o.working_set = false;
+        full = optimize_forces(net, hooks, steps, choose_cuts(net), o);
+        o.working_set = true;
+        ws = optimize_forces(net, hooks, steps, choose_cuts(net), o);
+      } catch (const SolverError&) {
+        continue;  // random hooks may leave a force no torque bounds
+      }
+      if (full.method != "lp+slsqp") continue;
+      ++tested;
+      INFO("margin " << margin << ", attempt " << attempt << ", " << P << " wires, " << C << " crossings");
+      CHECK(ws.method == "lp+slsqp");
+      const double G_full = full.g_stb + full.g_asm, G_ws = ws.g_stb + ws.g_asm;
+      CHECK(G_ws == Approx(G_full).epsilon(1e-7));
+      // every row of the full problem holds at the working-set optimum
+      const ForceProblem p(net, hooks, steps, ws.cuts, o);
+      CHECK((p.torque_rows() * ws.coefficients).cwiseAbs().maxCoeff() <= p.t_max() * (1 + 1e-7));
+      CHECK(ws.coefficients.minCoeff() >= 0.0);
+      CHECK(ws.equilibrium_residual < 1e-9);
+      CHECK(ws.working_set_rows < full.working_set_rows);
+      if (ws.working_set_rounds > 1) ++grew;
+    }
+    INFO("margin " << margin);
+    CHECK(tested >= 10);
+    if (margin < 0.01) CHECK(grew > 0);
+  }
+}

@@ -100,7 +100,9 @@ def run(design, material, settings, native_progress=None):
     design.setdefault("warnings", []).extend(r["warnings"])
     design["stages"]["forces"] = {
         "seconds": stats["forces_seconds"], "lp_seconds": stats["lp_seconds"], "nlp_seconds": stats["nlp_seconds"],
-        "lp_iterations": stats["lp_iterations"], "iterations": stats["iterations"], "method": summary["method"],
+        "lp_iterations": stats["lp_iterations"], "iterations": stats["iterations"],
+        "working_set_rounds": stats["working_set_rounds"], "working_set_rows": stats["working_set_rows"],
+        "method": summary["method"],
         "nlopt_result": summary["nlopt_result"], "g_stb": summary["g_stb"], "g_asm": summary["g_asm"],
         "assembly_residual": summary["assembly_residual"], "equilibrium_residual": summary["equilibrium_residual"],
         "t_max": summary["t_max"], "torque_active": summary["torque_active"],
