@@ -2,7 +2,6 @@
 the panel runs it (INVOKE: worker thread, modal timer) to a GRBL emulator on a pseudo-terminal,
 cancelled mid-program, then Resume (also modal) to the end on a new link. Prints one line
 `MODAL {json}` with what it saw, then quits."""
-import json
 import math
 import os
 import sys
@@ -17,6 +16,7 @@ import wiresculpt  # noqa: E402
 
 wiresculpt.register()
 from helpers import GrblEmulator, gcode_lines  # noqa: E402
+from ui_steps import guarded, report, start_watchdog  # noqa: E402
 from wiresculpt import scene_results, streaming  # noqa: E402
 
 WIRE = "Ring/0"
@@ -63,7 +63,7 @@ def start_send():
     links["first"] = GrblEmulator(delay=0.15)
     seen["invoke"] = invoke(port=links["first"].port)
     seen["running"] = streaming.running()
-    bpy.app.timers.register(guarded(cancel_when_busy), first_interval=0.05)
+    bpy.app.timers.register(guarded(seen, cancel_when_busy), first_interval=0.05)
 
 
 def cancel_when_busy():
@@ -73,7 +73,7 @@ def cancel_when_busy():
     seen["in_flight_at_cancel"] = len(first.received) - len(first.acknowledged)
     seen["status"] = streaming.JOB.status() if streaming.JOB else ""
     seen["cancel_op"] = sorted(bpy.ops.wiresculpt.send_cancel())
-    bpy.app.timers.register(guarded(check_cancelled), first_interval=0.1)
+    bpy.app.timers.register(guarded(seen, check_cancelled), first_interval=0.1)
     return None
 
 
@@ -88,7 +88,7 @@ def check_cancelled():
     first.close()
     links["second"] = GrblEmulator()
     seen["resume_invoke"] = invoke(port=links["second"].port, resume=True)
-    bpy.app.timers.register(guarded(check_resumed), first_interval=0.1)
+    bpy.app.timers.register(guarded(seen, check_resumed), first_interval=0.1)
     return None
 
 
@@ -102,28 +102,10 @@ def check_resumed():
     seen["once"] = first.acknowledged + second.acknowledged[len(modes):] == program
     seen["pending_after"] = WIRE in streaming.PENDING
     seen["running_after"] = streaming.running()
-    print("MODAL " + json.dumps(seen), flush=True)
-    bpy.ops.wm.quit_blender()
+    report(seen)
     return None
 
 
-def guarded(step):
-    """A timer callback that reports an exception and quits instead of hanging the test."""
-    def run():
-        try:
-            return step()
-        except Exception as exc:
-            print("MODAL " + json.dumps({"error": f"{type(exc).__name__}: {exc}", **seen}), flush=True)
-            bpy.ops.wm.quit_blender()
-            return None
-    return run
-
-
-def watchdog():
-    print("MODAL " + json.dumps({"error": "timed out", **seen}), flush=True)
-    bpy.ops.wm.quit_blender()
-
-
 setup()
-bpy.app.timers.register(guarded(start_send), first_interval=1.0)
-bpy.app.timers.register(watchdog, first_interval=60.0)
+bpy.app.timers.register(guarded(seen, start_send), first_interval=1.0)
+start_watchdog(seen)

@@ -13,8 +13,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, StringProperty
 from .. import export, native, scene_results, streaming
 from ..core import calibration as cal
 from ..props import NO_WIRE
-
-TIMER_SECONDS = 0.1
+from .progress import WorkerModal
 
 
 def chosen_profile(scene):
@@ -107,7 +106,7 @@ class WIRESCULPT_OT_pick_port(bpy.types.Operator):
         return {'FINISHED'}
 
 
-class WIRESCULPT_OT_send_to_machine(bpy.types.Operator):
+class WIRESCULPT_OT_send_to_machine(WorkerModal, bpy.types.Operator):
     """Stream a wire's bend program (G-code) to the bender on the chosen serial port; Esc cancels,
     and Resume continues a stopped stream without repeating or skipping a line"""
     bl_idname = "wiresculpt.send_to_machine"
@@ -125,8 +124,6 @@ class WIRESCULPT_OT_send_to_machine(bpy.types.Operator):
     response_timeout: FloatProperty(name="Answer Timeout", default=30.0, min=0.1, max=600.0,
                                     unit='TIME_ABSOLUTE',
                                     description="Longest wait for GRBL's answer to one line (seconds)")
-
-    _timer = None
 
     @classmethod
     def description(cls, context, properties):
@@ -181,34 +178,18 @@ class WIRESCULPT_OT_send_to_machine(bpy.types.Operator):
             return {'CANCELLED'}
         streaming.JOB = job
         job.thread.start()
-        wm = context.window_manager
-        self._timer = wm.event_timer_add(TIMER_SECONDS, window=context.window)
-        wm.progress_begin(0, 100)
-        wm.modal_handler_add(self)
+        self.begin_watch(context, 100)
         self._show(context)
         return {'RUNNING_MODAL'}
 
     def _show(self, context):
         job = streaming.JOB
         if job is not None:
-            context.window_manager.progress_update(int(100 * job.fraction))
-            if context.workspace is not None:
-                context.workspace.status_text_set(job.status())
-        for area in (context.screen.areas if context.screen else []):
-            if area.type == 'VIEW_3D':
-                area.tag_redraw()
+            self.show_progress(context, int(100 * job.fraction), job.status())
 
     def _cleanup(self, context):
-        wm = context.window_manager
-        if self._timer is not None:
-            wm.event_timer_remove(self._timer)
-            self._timer = None
-        wm.progress_end()
-        if context.workspace is not None:
-            context.workspace.status_text_set(None)
-        job, streaming.JOB = streaming.JOB, None
-        self._show(context)
-        return job
+        self.end_watch(context)
+        streaming.JOB = None
 
     def modal(self, context, event):
         job = streaming.JOB

@@ -35,12 +35,12 @@ class VIEW3D_PT_wiresculpt_fabrication(_Child, bpy.types.Panel):
             status.operator(ops.WIRESCULPT_OT_send_cancel.bl_idname, icon='CANCEL')
             return
         stopped = streaming.PENDING.get(ws.fab_wire)
-        row = box.row(align=True)
-        send = row.operator(ops.WIRESCULPT_OT_send_to_machine.bl_idname,
+        col = box.column(align=True)
+        send = col.operator(ops.WIRESCULPT_OT_send_to_machine.bl_idname,
                             text="Send from Start" if stopped else "Send", icon='PLAY')
         send.resume = False
         if stopped is not None:
-            resume = row.operator(ops.WIRESCULPT_OT_send_to_machine.bl_idname,
+            resume = col.operator(ops.WIRESCULPT_OT_send_to_machine.bl_idname,
                                   text=f"Resume at Line {stopped.next_line + 1}", icon='FORWARD')
             resume.resume = True
         last = streaming.LAST.get(ws.fab_wire)
