@@ -205,6 +205,21 @@ class FabricationOperators(unittest.TestCase):
         self.assertNotIn(self.wire["name"], streaming.PENDING)
         self.assertIn(f"resumed at line {k}", streaming.LAST[self.wire["name"]][1])
 
+    def test_a_rejected_line_stops_there_and_resume_sends_it_again(self):
+        lines = self.program()
+        k = 9  # GRBL answers error:20 to the k-th line: it was not executed
+        with GrblEmulator(error_on=k) as grbl:
+            with self.assertRaises(RuntimeError) as ctx:
+                self.send(grbl.port)
+            message = str(ctx.exception)
+            self.assertIn("stopped (error)", message)
+            self.assertIn(f"the last acknowledged line is line {k - 1} (`{lines[k - 2]}`)", message)
+            self.assertIn(f"error:20", message)
+            self.assertEqual(self.send(grbl.port, resume=True), {'FINISHED'})
+        modes = [line for line in lines[:k - 1] if line in MODES]
+        self.assertEqual(grbl.received, lines[:k] + modes + lines[k - 1:])
+        self.assertEqual(grbl.acknowledged, lines[:k - 1] + modes + lines[k - 1:])
+
     def test_cancel_stops_the_machine_and_resume_continues(self):
         lines = self.program()
         k = 6  # cancelled while the k-th line (1-based) waits for its answer
