@@ -1,8 +1,14 @@
 """Shared by the Blender suites: paths, running Blender in a subprocess, small mesh writers."""
+import json
 import math
 import os
+import select
+import signal
 import subprocess
 import sys
+import threading
+import time
+import tty
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BATCH = os.path.join(ROOT, "scripts", "wiresculpt_batch.py")
@@ -15,6 +21,24 @@ def run_blender(script, *args, env=None, timeout=300):
            "--python", script, "--", *args]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout,
                           env={**os.environ, **(env or {})})
+
+
+def run_under_xvfb(script, marker, timeout=180):
+    """Runs `script` in a Blender with a window under Xvfb (modal operators need the event loop);
+    returns (CompletedProcess, the JSON after the last stdout line starting with `marker`, or None)."""
+    cmd = ["xvfb-run", "-a", "-s", "-screen 0 1280x800x24", BLENDER, "--factory-startup",
+           "--python-exit-code", "1", "--python", script]
+    # its own process group: on a timeout Blender goes too, not only xvfb-run
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    try:
+        out, err = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        out, err = proc.communicate()
+    result = subprocess.CompletedProcess(cmd, proc.returncode, out, err)
+    lines = [line for line in out.splitlines() if line.startswith(marker)]
+    return result, json.loads(lines[-1][len(marker):]) if lines else None
 
 
 def wiresculpt_lines(text):
@@ -57,7 +81,99 @@ def write_ply(path, vertices, faces):
         f.writelines("3 " + " ".join(map(str, t)) + "\n" for t in faces)
 
 
+def gcode_lines(path):
+    """The lines a G-code file streams, read by hand: no `;` comment, no blank line."""
+    with open(path) as f:
+        return [line.strip() for line in f if line.strip() and not line.lstrip().startswith(";")]
+
+
 def polyline_length(points, closed):
     n = len(points)
     edges = range(n if closed else n - 1)
     return sum(math.dist(points[i], points[(i + 1) % n]) for i in edges)
+
+
+class GrblEmulator:
+    """A small GRBL on a pseudo-terminal pair (os.openpty), answering in a thread: `ok` to every
+    line, `error:20` to the `error_on`-th line received (1-based), silence and a pulled cable
+    (the master end closed) on the `drop_on`-th, `delay` seconds before each answer. GRBL's
+    realtime bytes (! ~ Ctrl-X) are recorded apart, as GRBL acts on them outside the line stream;
+    a soft reset (Ctrl-X) while a line waits for its answer discards that line unanswered.
+
+    received: every line as it arrived; acknowledged: the lines answered `ok`, in order."""
+
+    def __init__(self, error_on=None, drop_on=None, delay=0.0):
+        self.master, self.slave = os.openpty()
+        tty.setraw(self.slave)
+        self.port = os.ttyname(self.slave)
+        self.error_on, self.drop_on, self.delay = error_on, drop_on, delay
+        self.received, self.acknowledged, self.realtime = [], [], []
+        self.dropped = False
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._serve, daemon=True)
+        self._thread.start()
+
+    def _answer(self, line):
+        self.received.append(line)
+        if self.drop_on is not None and len(self.received) == self.drop_on:
+            self.dropped = True
+            os.close(self.master)  # the cable is pulled: the slave end hangs up
+            return False
+        if self.delay and self._reset_within(self.delay):
+            return True  # a soft reset discards the line before it is answered, as GRBL does
+        if self.error_on is not None and len(self.received) == self.error_on:
+            os.write(self.master, b"error:20\r\n")
+        else:
+            self.acknowledged.append(line)
+            os.write(self.master, b"ok\r\n")
+        return True
+
+    def _read(self, timeout):
+        """Reads what arrived within `timeout` s into the line buffer, realtime bytes apart;
+        True when a soft reset (Ctrl-X) was among them."""
+        ready, _, _ = select.select([self.master], [], [], timeout)
+        if not ready:
+            return False
+        reset = False
+        for byte in os.read(self.master, 256):
+            if byte in b"!~\x18":
+                self.realtime.append(chr(byte))
+                reset = reset or byte == 0x18
+            else:
+                self._buffer += bytes((byte,))
+        return reset
+
+    def _reset_within(self, seconds):
+        end = time.monotonic() + seconds
+        while (left := end - time.monotonic()) > 0:
+            if self._read(left):
+                self._buffer = b""
+                return True
+        return False
+
+    def _serve(self):
+        self._buffer = b""
+        while not self._stop.is_set():
+            try:
+                self._read(0.01)
+                while b"\n" in self._buffer:
+                    line, self._buffer = self._buffer.split(b"\n", 1)
+                    if not self._answer(line.decode().strip()):
+                        return
+            except OSError:
+                return
+
+    def close(self):
+        self._stop.set()
+        self._thread.join(2)
+        for fd in ((self.slave,) if self.dropped else (self.master, self.slave)):
+            try:
+                os.close(fd)
+            except OSError:
+                pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()

@@ -8,19 +8,17 @@ import csv
 import math
 import os
 import random
-import select
 import shutil
 import struct
 import subprocess
 import tempfile
-import threading
 import time
-import tty
 import unittest
 import xml.etree.ElementTree as ET
 
 import numpy as np
 
+from helpers import GrblEmulator
 from wiresculpt import native
 
 SVG = "{http://www.w3.org/2000/svg}"
@@ -205,28 +203,12 @@ class StreamThroughBinding(unittest.TestCase):
     def test_stream_with_progress_callback_and_resume_state(self):
         w = native.require()
         lines = w.stream_lines(w.write_gcode(None, square(), {}, "A/0", "steel"))
-        master, slave = os.openpty()
-        tty.setraw(slave)
-        received, stop = [], threading.Event()
-
-        def grbl():
-            buffer = b""
-            while not stop.is_set():
-                ready, _, _ = select.select([master], [], [], 0.01)
-                if not ready:
-                    continue
-                buffer += os.read(master, 256)
-                while b"\n" in buffer:
-                    line, buffer = buffer.split(b"\n", 1)
-                    received.append(line.decode().strip())
-                    os.write(master, b"error:20\r\n" if len(received) == 4 else b"ok\r\n")
-
-        thread = threading.Thread(target=grbl, daemon=True)
-        thread.start()
+        grbl = GrblEmulator(error_on=4)
+        received, port = grbl.received, grbl.port
         try:
             fractions, state = [], {}
             started = time.monotonic()
-            result = w.stream_program(os.ttyname(slave), lines, {}, state,
+            result = w.stream_program(port, lines, {}, state,
                                       progress=lambda stage, f: fractions.append(f) or True,
                                       control=w.StreamControl(), settle=0.05, response_timeout=1.0)
             self.assertLess(time.monotonic() - started, 5.0)
@@ -235,7 +217,7 @@ class StreamThroughBinding(unittest.TestCase):
             self.assertEqual(state["next_line"], 3)   # updated in place for the resume
             self.assertEqual(fractions[-1], 3 / len(lines))
             self.assertIn("line 4", result["message"])
-            result = w.stream_program(os.ttyname(slave), lines, {}, state, settle=0.05, response_timeout=1.0)
+            result = w.stream_program(port, lines, {}, state, settle=0.05, response_timeout=1.0)
             self.assertEqual(result["status"], "completed")
             self.assertEqual(state["next_line"], len(lines))
             modes = [l for l in lines[:3] if l in ("G21", "G91", "G94")]
@@ -245,19 +227,16 @@ class StreamThroughBinding(unittest.TestCase):
             # Without a state each call starts a program afresh (no progress shared between calls).
             before = len(received)
             for _ in range(2):
-                again = w.stream_program(os.ttyname(slave), lines, {}, settle=0.05, response_timeout=1.0)
+                again = w.stream_program(port, lines, {}, settle=0.05, response_timeout=1.0)
                 self.assertEqual((again["status"], again["next_line"]), ("completed", len(lines)))
             self.assertEqual(received[before:], lines + lines)
             # A callback that raises stops the stream (feed hold + reset) and the error reaches Python.
             fresh = {}
             with self.assertRaises(ZeroDivisionError):
-                w.stream_program(os.ttyname(slave), lines, {}, fresh, progress=lambda stage, f: 1 / 0, settle=0.05)
+                w.stream_program(port, lines, {}, fresh, progress=lambda stage, f: 1 / 0, settle=0.05)
             self.assertEqual(fresh["next_line"], 0)
         finally:
-            stop.set()
-            thread.join(2)
-            os.close(master)
-            os.close(slave)
+            grbl.close()
 
 
 if __name__ == "__main__":

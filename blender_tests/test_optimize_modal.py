@@ -1,13 +1,10 @@
 """Optimize from the UI (modal operator, worker thread, timer) in a Blender with a window, run
 under Xvfb when xvfb-run is installed: completes, and Cancel leaves the scene as it was."""
-import json
 import os
 import shutil
-import signal
-import subprocess
 import unittest
 
-from helpers import BLENDER, ROOT
+from helpers import ROOT, run_under_xvfb
 
 SCRIPT = os.path.join(ROOT, "blender_tests", "ui_optimize_modal.py")
 
@@ -16,19 +13,7 @@ SCRIPT = os.path.join(ROOT, "blender_tests", "ui_optimize_modal.py")
 class ModalOptimize(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cmd = ["xvfb-run", "-a", "-s", "-screen 0 1280x800x24", BLENDER, "--factory-startup",
-               "--python-exit-code", "1", "--python", SCRIPT]
-        # its own process group: on a timeout Blender goes too, not only xvfb-run
-        proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                                start_new_session=True)
-        try:
-            out, err = proc.communicate(timeout=180)
-        except subprocess.TimeoutExpired:
-            os.killpg(proc.pid, signal.SIGKILL)
-            out, err = proc.communicate()
-        cls.result = subprocess.CompletedProcess(cmd, proc.returncode, out, err)
-        lines = [l for l in cls.result.stdout.splitlines() if l.startswith("MODAL ")]
-        cls.seen = json.loads(lines[-1][len("MODAL "):]) if lines else None
+        cls.result, cls.seen = run_under_xvfb(SCRIPT, "MODAL ")
 
     def setUp(self):
         self.assertIsNotNone(self.seen, self.result.stdout[-3000:] + self.result.stderr[-3000:])

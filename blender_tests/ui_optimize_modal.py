@@ -7,7 +7,7 @@ import os
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(os.path.dirname(HERE), "addon"))
+sys.path[:0] = [os.path.join(os.path.dirname(HERE), "addon"), HERE]
 
 import bpy  # noqa: E402
 
@@ -17,6 +17,7 @@ wiresculpt.register()
 from wiresculpt import overlay, scene_results  # noqa: E402
 from wiresculpt.mesh_import import import_mesh  # noqa: E402
 from wiresculpt.operators import optimize  # noqa: E402
+from ui_steps import guarded, report, start_watchdog  # noqa: E402
 
 seen = {}
 
@@ -52,14 +53,14 @@ def start_cancelled():
     seen["cancel_invoke"] = invoke()
     seen["cancel_running"] = optimize.running()
     seen["cancel_op"] = sorted(bpy.ops.wiresculpt.optimize_cancel())
-    bpy.app.timers.register(guarded(check_cancelled), first_interval=0.5)
+    bpy.app.timers.register(guarded(seen, check_cancelled), first_interval=0.5)
 
 
 def check_cancelled():
     if optimize.running():
         return 0.2
     seen["cancel_unchanged"] = state() == seen.pop("before_cancel")
-    bpy.app.timers.register(guarded(start_full), first_interval=0.1)
+    bpy.app.timers.register(guarded(seen, start_full), first_interval=0.1)
     return None
 
 
@@ -71,7 +72,7 @@ def start_full():
     seen["invoke"] = invoke()
     seen["running"] = optimize.running()
     seen["status_while_running"] = optimize.JOB.status() if optimize.JOB else ""
-    bpy.app.timers.register(guarded(check_full), first_interval=0.5)
+    bpy.app.timers.register(guarded(seen, check_full), first_interval=0.5)
 
 
 def check_full():
@@ -91,28 +92,10 @@ def check_full():
         seen["after_undo"] = after
     else:
         seen.pop("before_full")
-    print("MODAL " + json.dumps(seen), flush=True)
-    bpy.ops.wm.quit_blender()
+    report(seen)
     return None
 
 
-def guarded(step):
-    """A timer callback that reports an exception and quits instead of hanging the test."""
-    def run():
-        try:
-            return step()
-        except Exception as exc:
-            print("MODAL " + json.dumps({"error": f"{type(exc).__name__}: {exc}"}), flush=True)
-            bpy.ops.wm.quit_blender()
-            return None
-    return run
-
-
-def watchdog():
-    print("MODAL " + json.dumps({"error": "timed out", **seen}), flush=True)
-    bpy.ops.wm.quit_blender()
-
-
 setup()
-bpy.app.timers.register(guarded(start_cancelled), first_interval=1.0)
-bpy.app.timers.register(watchdog, first_interval=60.0)
+bpy.app.timers.register(guarded(seen, start_cancelled), first_interval=1.0)
+start_watchdog(seen)

@@ -13,11 +13,42 @@ from . import native
 FOLDERS = ("svg", "dxf", "gcode", "bends")
 
 
-def machine_profile(design):
-    """The default machine profile with the design's machine limits."""
-    profile = native.require().default_machine_profile()
-    profile.update({k: design["machine"][k] for k in ("min_segment", "max_bend_deg", "min_bend_deg")})
-    return profile
+# The machine limits a design records, each with the function that picks the stricter of two values.
+LIMITS = (("min_segment", max), ("max_bend_deg", min), ("min_bend_deg", max))
+
+
+def _limit_text(key, value):
+    return f"{value * 1000:g} mm" if key == "min_segment" else f"{value:g}°"
+
+
+def machine_profile(design, profile=None):
+    """(native profile dict, notes) for bending the design's wires on a machine.
+
+    `profile`: a machine profile as core.calibration.load_profile returns it (spring-back fit,
+    axes, serial settings, its own limits), or None for the default profile. The three machine
+    limits (min_segment, max_bend_deg, min_bend_deg) are the stricter of the design's and the
+    profile's: the design's target shape was solved against the design's limits, so a looser
+    machine changes nothing, while a machine stricter than the design must never be commanded
+    beyond what it can do. Each limit where the profile is stricter gives a note (the wires
+    that break it are then refused by the bend program, naming the bend or step)."""
+    out = native.require().default_machine_profile()
+    notes = []
+    if profile is not None:
+        from .core.calibration import machine_dict
+
+        out.update(machine_dict(profile))
+    name = out.get("name") or "machine profile"
+    for key, stricter in LIMITS:
+        ours = float(design["machine"][key])
+        theirs = float(out[key]) if profile is not None and key in profile else ours
+        out[key] = stricter(ours, theirs)
+        if abs(out[key] - ours) <= 1e-9 * max(abs(ours), 1.0):  # equal but for a unit round trip
+            out[key] = ours
+        else:
+            notes.append(f"{name}: {key} {_limit_text(key, theirs)} is stricter than the design's "
+                         f"{_limit_text(key, ours)} (the shape was solved for {_limit_text(key, ours)}); "
+                         f"the machine's limit is used; optimize again with it to fit every wire")
+    return out, notes
 
 
 EXTENSIONS = (".svg", ".dxf", ".gcode", ".csv")
@@ -53,13 +84,14 @@ def crossing_indices(design, wire):
     return sorted(out)
 
 
-def export(design, out_dir):
+def export(design, out_dir, profile=None):
     """Writes the fabrication files of every wire that has a rest shape into out_dir/{svg, dxf,
-    gcode, bends}. Returns {"files": [paths], "wires": [per-wire program summary], "errors":
-    [one sentence per wire that cannot be bent]}."""
+    gcode, bends}, with the machine `profile` (None: the default; see machine_profile). Returns
+    {"files": [paths], "wires": [per-wire program summary], "errors": [one sentence per wire that
+    cannot be bent], "notes": [limits where the profile is stricter than the design]}."""
     w = native.require()
     clear(out_dir)
-    profile = machine_profile(design)
+    profile, notes = machine_profile(design, profile)
     material = design["material"].get("name", "")
     files, summaries, errors, templates = [], [], [], []
     wires = [x for x in design["wires"] if "rest" in x]
@@ -93,4 +125,22 @@ def export(design, out_dir):
             os.makedirs(os.path.dirname(path), exist_ok=True)
             write(path)
             files.append(path)
-    return {"files": files, "wires": summaries, "errors": errors}
+    return {"files": files, "wires": summaries, "errors": errors, "notes": notes}
+
+
+def summary(result, out_dir):
+    """(level, one message) of an export: counts per folder, then each wire's bends, length and
+    machine time or the reason it cannot be bent, then the profile notes. level is "INFO",
+    "WARNING" (some wire refused or a note) or "ERROR" (no wire written)."""
+    counts = {folder: sum(1 for p in result["files"] if os.path.basename(os.path.dirname(p)) == folder)
+              for folder in FOLDERS}
+    done, refused = result["wires"], result["errors"]
+    if not done and not refused:
+        return "ERROR", "No wire has a rest shape: optimize until the rest shape stage has run"
+    parts = [f"{w['name']}: {w['bend_count']} bends, {w['wire_length'] * 1000:.0f} mm, "
+             f"about {w['machine_seconds']:.0f} s" for w in done]
+    head = (f"Exported {len(done)} of {len(done) + len(refused)} wires to {out_dir} ("
+            + ", ".join(f"{counts[f]} {f}" for f in FOLDERS) + " files)")
+    text = "; ".join([head] + parts + [f"not bendable: {e}" for e in refused] + list(result.get("notes", [])))
+    level = "ERROR" if not done else "WARNING" if refused or result.get("notes") else "INFO"
+    return level, text

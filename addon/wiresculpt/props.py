@@ -109,6 +109,30 @@ def _assembly_step_changed(settings, context):
     scene_results.apply_assembly_step(context.scene)
 
 
+def _port_suggestions(_settings, _context, _text):
+    """Serial ports libserialport lists, offered while typing the port (any path may be typed:
+    a pseudo-terminal, a udev symlink)."""
+    from . import native  # lazily: the compiled module may be missing
+
+    if not native.available():
+        return []
+    return [p["name"] for p in native.require().list_ports()]
+
+
+NO_WIRE = "__none__"  # the wire enum's only item when the design has no wire with a rest shape
+
+
+def _wire_items(_settings, _context):
+    """The stored design's wires that have a rest shape; the enum's number is the wire's id."""
+    from . import scene_results, streaming  # bpy-side modules, imported lazily
+
+    wires = streaming.rest_wires(scene_results.stored_design())
+    items = [(w["name"], w["name"], f"Wire {w['name']} (id {w['id']}, {w.get('length', 0) * 1000:.0f} mm)", w["id"])
+             for w in wires] or [(NO_WIRE, "(no wire with a rest shape)", "Optimize first", 0)]
+    _wire_items.cache = items  # Blender needs the strings kept alive
+    return items
+
+
 class WiresculptContour(bpy.types.PropertyGroup):
     plane: StringProperty(
         name="Plane", description="Name of the slicing plane that cut this contour")
@@ -181,6 +205,21 @@ class WiresculptSettings(bpy.types.PropertyGroup):
     guide_folder: StringProperty(
         name="Guide Folder", subtype='DIR_PATH', default="//assembly",
         description="Folder the assembly guide (index.html and one picture per step) is written to")
+
+    # fabrication (docs/user-guide.md, Fabrication)
+    machine_profile: StringProperty(
+        name="Machine Profile", subtype='FILE_PATH', default="",
+        description="Machine profile JSON saved by Calibration > Save Machine Profile (spring-back fit, "
+                    "axes, serial settings); empty: the default DIWire-class profile")
+    fab_port: StringProperty(
+        name="Port", default="", search=_port_suggestions,
+        description="Serial port of the bender: pick a listed port or type a path (e.g. /dev/ttyUSB0)")
+    fab_wire: EnumProperty(
+        name="Wire", items=_wire_items,
+        description="Wire whose bend program is sent to the machine")
+    fab_dry_run: BoolProperty(
+        name="Dry Run", default=False,
+        description="Only check the program against the machine profile; nothing is sent")
 
 
 _classes = (WiresculptContour, WiresculptSettings)

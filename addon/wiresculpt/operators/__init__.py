@@ -1,7 +1,7 @@
 """Operators, one module per concern, each with its own register/unregister."""
-from . import calibration, optimize, results, slicing
+from . import calibration, fabrication, optimize, results, slicing
 
-_modules = (slicing, optimize, results, calibration)
+_modules = (slicing, optimize, results, calibration, fabrication)
 
 
 def register():

@@ -14,9 +14,9 @@ import bpy
 from .. import cut_handles, mesh_data, native, pipeline, scene_results
 from ..core.design import new_design, wire_entry
 from ..props import material_of, solver_settings
+from .progress import WorkerModal
 from .slicing import handle_plane, handles, target_problem
 
-TIMER_SECONDS = 0.1
 STAGE_LABELS = {"slicing": "Slicing", "layering": "Layering", "target_shape": "Target shape",
                 "forces": "Forces", "rest_shape": "Rest shape", "writing": "Writing results"}
 
@@ -138,14 +138,12 @@ def running():
 
 # --- operators --------------------------------------------------------------------------------
 
-class WIRESCULPT_OT_optimize(bpy.types.Operator):
+class WIRESCULPT_OT_optimize(WorkerModal, bpy.types.Operator):
     """Turn the ticked contours into a stable wire sculpture: layering, target shape and the
     later stages; the wires appear as curves (Esc cancels)"""
     bl_idname = "wiresculpt.optimize"
     bl_label = "Optimize"
     bl_options = {'REGISTER', 'UNDO'}
-
-    _timer = None
 
     @classmethod
     def poll(cls, context):
@@ -181,33 +179,18 @@ class WIRESCULPT_OT_optimize(bpy.types.Operator):
         JOB = Job(design, material, settings)
         JOB.scene_name = context.scene.name  # the results belong to the scene that was optimized
         JOB.thread.start()
-        wm = context.window_manager
-        self._timer = wm.event_timer_add(TIMER_SECONDS, window=context.window)
-        wm.progress_begin(0, len(pipeline.ALL_STAGES))
-        wm.modal_handler_add(self)
+        self.begin_watch(context, len(pipeline.ALL_STAGES))
         self._show(context)
         return {'RUNNING_MODAL'}
 
     def _show(self, context):
         if JOB is not None:
-            context.window_manager.progress_update(JOB.done)
-            if context.workspace is not None:
-                context.workspace.status_text_set(JOB.status())
-        for area in (context.screen.areas if context.screen else []):
-            if area.type == 'VIEW_3D':
-                area.tag_redraw()
+            self.show_progress(context, JOB.done, JOB.status())
 
     def _cleanup(self, context):
         global JOB
-        wm = context.window_manager
-        if self._timer is not None:
-            wm.event_timer_remove(self._timer)
-            self._timer = None
-        wm.progress_end()
-        if context.workspace is not None:
-            context.workspace.status_text_set(None)
+        self.end_watch(context)
         job, JOB = JOB, None
-        self._show(context)
         return job
 
     def modal(self, context, event):

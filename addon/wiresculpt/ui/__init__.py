@@ -1,8 +1,8 @@
 """User interface, one module per concern, each with its own register/unregister."""
 from .. import overlay
-from . import calibration, panel, results
+from . import calibration, fabrication, panel, results
 
-_modules = (panel, results, calibration, overlay)
+_modules = (panel, results, fabrication, calibration, overlay)
 
 
 def register():

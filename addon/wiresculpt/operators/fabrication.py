@@ -1,0 +1,242 @@
+"""Fabrication (Sec. 5.1): Export writes every wire's SVG, DXF, G-code and bend table into a
+folder; Send to Machine streams one wire's G-code to a GRBL bender over a serial port, in a worker
+thread under a modal operator (progress in the status bar and the panel, Esc cancels), and Resume
+continues a stopped stream from its first unacknowledged line. Both use the machine profile chosen
+in the panel (docs/user-guide.md, Fabrication). In background mode (batch, tests) there is no
+event loop and Send runs to its end inside execute().
+"""
+import os
+
+import bpy
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, StringProperty
+
+from .. import export, native, scene_results, streaming
+from ..core import calibration as cal
+from ..props import NO_WIRE
+from .progress import WorkerModal
+
+
+def chosen_profile(scene):
+    """The machine profile of the panel's file (None: the default). ValueError naming the file."""
+    path = scene.wiresculpt.machine_profile.strip()
+    if not path:
+        return None
+    full = os.path.normpath(bpy.path.abspath(path))
+    try:
+        return cal.load_profile(full)
+    except FileNotFoundError:
+        raise ValueError(f"machine profile {full} does not exist (Calibration > Save Machine Profile "
+                         "writes one; leave the field empty for the default)") from None
+    except OSError as exc:
+        raise ValueError(f"machine profile {full}: {exc.strerror or exc}") from None
+
+
+def _design_or_error(op):
+    design = scene_results.stored_design()
+    if design is None:
+        op.report({'ERROR'}, "No design yet: press Optimize first")
+    return design
+
+
+class WIRESCULPT_OT_export_fabrication(bpy.types.Operator):
+    """Write every wire's 1:1 SVG template, G-code and bend table, an SVG sheet and a DXF into a
+    folder (svg/, dxf/, gcode/, bends/), using the chosen machine profile"""
+    bl_idname = "wiresculpt.export_fabrication"
+    bl_label = "Export Fabrication Files"
+    bl_options = {'REGISTER'}
+
+    directory: StringProperty(name="Folder", subtype='DIR_PATH',
+                              description="Folder that gets svg/, dxf/, gcode/ and bends/")
+    filter_folder: BoolProperty(default=True, options={'HIDDEN'})
+
+    @classmethod
+    def poll(cls, context):
+        return scene_results.stored_design() is not None
+
+    def invoke(self, context, event):
+        if not self.directory and bpy.data.filepath:
+            self.directory = os.path.join(os.path.dirname(bpy.data.filepath), "fabrication") + os.sep
+        context.window_manager.fileselect_add(self)
+        return {'RUNNING_MODAL'}
+
+    def execute(self, context):
+        if not native.available():
+            self.report({'ERROR'}, native.LOAD_ERROR)
+            return {'CANCELLED'}
+        design = _design_or_error(self)
+        if design is None:
+            return {'CANCELLED'}
+        if not self.directory:
+            self.report({'ERROR'}, "Choose a folder to export into")
+            return {'CANCELLED'}
+        folder = os.path.normpath(bpy.path.abspath(self.directory))
+        try:
+            profile = chosen_profile(context.scene)
+            os.makedirs(folder, exist_ok=True)
+            result = export.export(design, folder, profile)
+        except (ValueError, RuntimeError, OSError) as exc:
+            self.report({'ERROR'}, f"Cannot export: {exc}")
+            return {'CANCELLED'}
+        level, text = export.summary(result, folder)
+        self.report({level}, text)
+        return {'CANCELLED'} if level == "ERROR" else {'FINISHED'}
+
+
+def _port_items(_self, _context):
+    ports = native.require().list_ports() if native.available() else []
+    items = [(p["name"], p["name"], p["description"] or p["name"]) for p in ports]
+    _port_items.cache = items or [("", "(no serial port found)", "Type the port's path instead")]
+    return _port_items.cache
+
+
+class WIRESCULPT_OT_pick_port(bpy.types.Operator):
+    """Choose one of the serial ports found on this computer"""
+    bl_idname = "wiresculpt.pick_port"
+    bl_label = "Pick Port"
+    bl_options = {'REGISTER', 'INTERNAL'}
+    bl_property = "port"
+
+    port: EnumProperty(name="Port", items=_port_items)
+
+    def execute(self, context):
+        if not self.port:
+            self.report({'WARNING'}, "No serial port found: type the port's path")
+            return {'CANCELLED'}
+        context.scene.wiresculpt.fab_port = self.port
+        return {'FINISHED'}
+
+
+class WIRESCULPT_OT_send_to_machine(WorkerModal, bpy.types.Operator):
+    """Stream a wire's bend program (G-code) to the bender on the chosen serial port; Esc cancels,
+    and Resume continues a stopped stream without repeating or skipping a line"""
+    bl_idname = "wiresculpt.send_to_machine"
+    bl_label = "Send to Machine"
+    bl_options = {'REGISTER'}
+
+    wire: StringProperty(name="Wire", default="", description="Wire name (empty: the panel's wire)")
+    port: StringProperty(name="Port", default="", description="Serial port (empty: the panel's port)")
+    resume: BoolProperty(name="Resume", default=False,
+                         description="Continue the wire's stopped stream from its first unacknowledged line")
+    dry_run: BoolProperty(name="Dry Run", default=False,
+                          description="Only check the program; also when the panel's Dry Run is ticked")
+    settle: FloatProperty(name="Settle", default=2.0, min=0.0, max=30.0, unit='TIME_ABSOLUTE',
+                          description="Seconds GRBL gets to restart after the port opens (seconds)")
+    response_timeout: FloatProperty(name="Answer Timeout", default=30.0, min=0.1, max=600.0,
+                                    unit='TIME_ABSOLUTE',
+                                    description="Longest wait for GRBL's answer to one line (seconds)")
+
+    @classmethod
+    def description(cls, context, properties):
+        if properties.resume:
+            return "Continue the wire's stopped stream from its first unacknowledged line"
+        return cls.__doc__
+
+    @classmethod
+    def poll(cls, context):
+        return not streaming.running()
+
+    def _job(self, context):
+        """The StreamJob, or None after reporting why not."""
+        if not native.available():
+            self.report({'ERROR'}, native.LOAD_ERROR)
+            return None
+        design = _design_or_error(self)
+        if design is None:
+            return None
+        ws = context.scene.wiresculpt
+        wire = self.wire or ws.fab_wire
+        try:
+            if not wire or wire == NO_WIRE:
+                raise ValueError("no wire chosen (optimize until the wires have rest shapes)")
+            return streaming.prepare(design, wire, (self.port or ws.fab_port).strip(), chosen_profile(context.scene),
+                                     self.resume, self.dry_run or ws.fab_dry_run, self.settle, self.response_timeout)
+        except (ValueError, RuntimeError) as exc:
+            self.report({'ERROR'}, f"Cannot send: {exc}")
+            return None
+
+    def _finish(self, job):
+        kind, message = streaming.finish(job)
+        self.report(kind, message)
+        return {'FINISHED'} if kind == {'INFO'} else {'CANCELLED'}
+
+    def execute(self, context):
+        job = self._job(context)
+        if job is None:
+            return {'CANCELLED'}
+        streaming.JOB = job
+        try:
+            job.run()  # blocking: no event loop in background mode
+        finally:
+            streaming.JOB = None
+        return self._finish(job)
+
+    def invoke(self, context, event):
+        if bpy.app.background or context.window is None:
+            return self.execute(context)
+        job = self._job(context)
+        if job is None:
+            return {'CANCELLED'}
+        streaming.JOB = job
+        job.thread.start()
+        self.begin_watch(context, 100)
+        self._show(context)
+        return {'RUNNING_MODAL'}
+
+    def _show(self, context):
+        job = streaming.JOB
+        if job is not None:
+            self.show_progress(context, int(100 * job.fraction), job.status())
+
+    def _cleanup(self, context):
+        self.end_watch(context)
+        streaming.JOB = None
+
+    def modal(self, context, event):
+        job = streaming.JOB
+        if job is None:
+            return {'CANCELLED'}
+        try:
+            if event.type == 'ESC' and event.value == 'PRESS':
+                job.cancel()
+                self._show(context)
+                return {'RUNNING_MODAL'}
+            if event.type != 'TIMER':
+                return {'PASS_THROUGH'}
+            if job.thread.is_alive():
+                self._show(context)
+                return {'PASS_THROUGH'}
+            self._cleanup(context)
+            return self._finish(job)
+        except Exception as exc:  # never leave a half-finished modal behind in the UI
+            job.cancel()
+            job.thread.join()
+            self._cleanup(context)
+            self.report({'ERROR'}, f"Send to Machine failed: internal error ({type(exc).__name__}: {exc})")
+            return {'CANCELLED'}
+
+    def cancel(self, context):  # Blender closes the window or the file under the modal
+        job = streaming.JOB
+        if job is not None:
+            job.cancel()
+            job.thread.join()
+            self._cleanup(context)
+            streaming.finish(job)
+
+
+class WIRESCULPT_OT_send_cancel(bpy.types.Operator):
+    """Stop sending: the machine gets a feed hold and a soft reset; Resume continues later"""
+    bl_idname = "wiresculpt.send_cancel"
+    bl_label = "Cancel Sending"
+    bl_options = {'INTERNAL'}
+
+    def execute(self, context):
+        if not streaming.cancel():
+            self.report({'INFO'}, "Nothing to cancel: no wire is being sent")
+            return {'CANCELLED'}
+        self.report({'INFO'}, "Cancelling the stream…")
+        return {'FINISHED'}
+
+
+register, unregister = bpy.utils.register_classes_factory(
+    (WIRESCULPT_OT_export_fabrication, WIRESCULPT_OT_pick_port, WIRESCULPT_OT_send_to_machine,
+     WIRESCULPT_OT_send_cancel))

@@ -1,0 +1,54 @@
+"""The Fabrication sub-panel of the Wire tab: machine profile, Export, and Send to Machine with its
+port, wire, progress, Cancel and Resume."""
+import bpy
+
+from .. import native, scene_results, streaming
+from ..operators import fabrication as ops
+from .results import _Child, _wrap
+
+
+class VIEW3D_PT_wiresculpt_fabrication(_Child, bpy.types.Panel):
+    bl_label = "Fabrication"
+
+    @classmethod
+    def poll(cls, context):
+        return scene_results.stored_design() is not None
+
+    def draw(self, context):
+        layout = self.layout
+        layout.enabled = native.available()
+        ws = context.scene.wiresculpt
+        layout.prop(ws, "machine_profile", text="Profile")
+        layout.operator(ops.WIRESCULPT_OT_export_fabrication.bl_idname, text="Export…", icon='EXPORT')
+
+        box = layout.box()
+        box.label(text="Send to Machine", icon='PLUGIN')
+        row = box.row(align=True)
+        row.prop(ws, "fab_port", text="")
+        row.operator_menu_enum(ops.WIRESCULPT_OT_pick_port.bl_idname, "port", text="", icon='DOWNARROW_HLT')
+        box.prop(ws, "fab_wire", text="Wire")
+        box.prop(ws, "fab_dry_run")
+        job = streaming.JOB
+        if job is not None:
+            status = box.box()
+            _wrap(status, context, job.status().replace("wiresculpt: ", ""), icon='SORTTIME')
+            status.operator(ops.WIRESCULPT_OT_send_cancel.bl_idname, icon='CANCEL')
+            return
+        stopped = streaming.PENDING.get(ws.fab_wire)
+        col = box.column(align=True)
+        send = col.operator(ops.WIRESCULPT_OT_send_to_machine.bl_idname,
+                            text="Send from Start" if stopped else "Send", icon='PLAY')
+        send.resume = False
+        if stopped is not None:
+            resume = col.operator(ops.WIRESCULPT_OT_send_to_machine.bl_idname,
+                                  text=f"Resume at Line {stopped.next_line + 1}", icon='FORWARD')
+            resume.resume = True
+        last = streaming.LAST.get(ws.fab_wire)
+        if last is not None:
+            kind, message = last
+            status = box.box()
+            status.alert = kind == {'ERROR'}
+            _wrap(status, context, message, icon='INFO' if kind == {'INFO'} else 'ERROR')
+
+
+register, unregister = bpy.utils.register_classes_factory((VIEW3D_PT_wiresculpt_fabrication,))

@@ -1,0 +1,292 @@
+"""The add-on's fabrication operators on a solved design: Export writes every file with the chosen
+machine profile (its spring-back fit changes the commanded angles exactly as (target - b) / a),
+Send to Machine streams a wire to a GRBL emulator on a pseudo-terminal, a dropped link is reported
+with the last acknowledged line and Resume finishes with every line acknowledged exactly once,
+Cancel stops; the modal operator (worker thread, status bar, Cancel, Resume) under Xvfb.
+
+    blender --background --factory-startup --python-exit-code 1 --python blender_tests/run.py -- fabrication_ops
+"""
+import csv
+import glob
+import math
+import os
+import shutil
+import tempfile
+import threading
+import time
+import unittest
+
+import bpy
+
+import wiresculpt
+from helpers import ROOT, GrblEmulator, gcode_lines, run_under_xvfb
+from wiresculpt import export, native, pipeline, scene_results, streaming
+from wiresculpt.core import calibration as cal
+from wiresculpt.core.materials import PRESETS
+from wiresculpt.core.scene import PlaneSpec
+from wiresculpt.core.settings import defaults
+
+SPRINGBACK_A, SPRINGBACK_B = 0.92, -1.5  # measured = a * commanded + b (degrees)
+MODES = ("G21", "G91", "G94")  # the program's mode lines, sent again before a resume
+UI_SCRIPT = os.path.join(ROOT, "blender_tests", "ui_fabrication_modal.py")
+FAST = {"settle": 0.05, "response_timeout": 2.0}
+
+
+def globe_design():
+    """The three-wire globe solved by the pipeline (a sphere of 12.5 cm radius)."""
+    from test_export import sphere
+
+    V, F = sphere()
+    planes = [PlaneSpec(n, (0, 0, 0), normal) for n, normal in
+              (("Equator", (0, 0, 1)), ("Meridian0", (1, 0, 0)), ("Meridian90", (0, 1, 0)))]
+    return pipeline.run(V, F, planes, PRESETS["steel"], defaults())
+
+
+def read_rows(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class FabricationOperators(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        if wiresculpt._modules:
+            wiresculpt.unregister()
+        wiresculpt.register()
+        cls.design = globe_design()
+        scene_results.store_design(cls.design)
+        cls.tmp = tempfile.TemporaryDirectory()
+        fit = {"springback_a": SPRINGBACK_A, "springback_b_deg": SPRINGBACK_B, "rms_deg": 0.1,
+               "max_residual_deg": 0.2, "samples": 5}
+        cls.profile_path = cal.save_profile(cal.with_springback(cal.default_profile(), fit, "bench.csv"),
+                                            os.path.join(cls.tmp.name, "bender.json"))
+        cls.wire = cls.design["wires"][0]
+
+    @classmethod
+    def tearDownClass(cls):
+        text = bpy.data.texts.get(scene_results.DESIGN_TEXT)
+        if text is not None:
+            bpy.data.texts.remove(text)
+        bpy.context.scene.wiresculpt.property_unset("machine_profile")
+        streaming.PENDING.clear()
+        streaming.LAST.clear()
+        cls.tmp.cleanup()
+
+    def setUp(self):
+        bpy.context.scene.wiresculpt.machine_profile = ""
+        streaming.PENDING.clear()
+
+    def export_to(self, name, profile_path=""):
+        bpy.context.scene.wiresculpt.machine_profile = profile_path
+        out = os.path.join(self.tmp.name, name)
+        self.assertEqual(bpy.ops.wiresculpt.export_fabrication(directory=out), {'FINISHED'})
+        return out
+
+    def program(self, profile_path=""):
+        """The wire's streamed lines, read by hand from the G-code file Export writes."""
+        out = self.export_to("program", profile_path)
+        return gcode_lines(os.path.join(out, "gcode", export.file_stem(self.wire) + ".gcode"))
+
+    # --- Export ------------------------------------------------------------------------------
+
+    def test_export_writes_every_file_and_the_profile_compensates_spring_back(self):
+        self.assertTrue(self.design["stable"])
+        plain = self.export_to("plain")
+        out = self.export_to("calibrated", self.profile_path)
+        for wire in self.design["wires"]:
+            stem = export.file_stem(wire)
+            for rel in (f"svg/{stem}.svg", f"gcode/{stem}.gcode", f"bends/{stem}.csv"):
+                self.assertTrue(os.path.isfile(os.path.join(out, rel)), rel)
+        for rel in ("svg/sheet.svg", "dxf/sculpture.dxf"):
+            self.assertTrue(os.path.isfile(os.path.join(out, rel)), rel)
+        self.assertEqual(glob.glob(os.path.join(out, "*", "*.tmp*")), [])
+        bends = 0
+        for wire in self.design["wires"]:
+            stem = export.file_stem(wire)
+            rows, plain_rows = read_rows(f"{out}/bends/{stem}.csv"), read_rows(f"{plain}/bends/{stem}.csv")
+            self.assertEqual([r["bend_deg"] for r in rows], [r["bend_deg"] for r in plain_rows])
+            for row, plain_row in zip(rows, plain_rows):
+                target = float(row["bend_deg"])
+                if target == 0.0:
+                    continue
+                bends += 1
+                # measured = a * commanded + b on magnitudes: commanded = (|target| - b) / a
+                expected = math.copysign((abs(target) - SPRINGBACK_B) / SPRINGBACK_A, target)
+                self.assertAlmostEqual(float(row["commanded_deg"]), expected, delta=2e-4)
+                self.assertAlmostEqual(float(plain_row["commanded_deg"]), target, delta=1e-4)
+            with open(f"{out}/gcode/{stem}.gcode") as f:
+                self.assertIn(f"measured = {SPRINGBACK_A:.4f} * commanded + {SPRINGBACK_B:.3f} deg", f.read())
+        self.assertGreater(bends, 10)
+
+    def test_export_reports_a_missing_profile_naming_the_file(self):
+        bpy.context.scene.wiresculpt.machine_profile = os.path.join(self.tmp.name, "nowhere.json")
+        with self.assertRaisesRegex(RuntimeError, "nowhere.json does not exist"):
+            bpy.ops.wiresculpt.export_fabrication(directory=os.path.join(self.tmp.name, "x"))
+        self.assertFalse(os.path.exists(os.path.join(self.tmp.name, "x")))
+
+    def test_limits_are_the_stricter_of_design_and_profile_and_a_stricter_profile_is_reported(self):
+        limits = self.design["machine"]
+        # The saved default limits (degrees through radians and back) equal the design's: no note.
+        self.assertEqual(export.machine_profile(self.design, cal.load_profile(self.profile_path))[1], [])
+        looser = dict(cal.default_profile(), min_segment=limits["min_segment"] / 2,
+                      max_bend_deg=limits["max_bend_deg"] + 10, min_bend_deg=limits["min_bend_deg"] / 2)
+        machine, notes = export.machine_profile(self.design, looser)
+        self.assertEqual(notes, [])
+        for key in ("min_segment", "max_bend_deg", "min_bend_deg"):
+            self.assertEqual(machine[key], limits[key])
+        stricter = dict(looser, min_segment=limits["min_segment"] + 0.005, max_bend_deg=limits["max_bend_deg"] - 30)
+        machine, notes = export.machine_profile(self.design, stricter)
+        self.assertEqual(machine["min_segment"], limits["min_segment"] + 0.005)
+        self.assertEqual(machine["max_bend_deg"], limits["max_bend_deg"] - 30)
+        self.assertEqual(machine["min_bend_deg"], limits["min_bend_deg"])
+        self.assertEqual(len(notes), 2)
+        self.assertIn(f"min_segment {(limits['min_segment'] + 0.005) * 1000:g} mm", notes[0])
+        self.assertIn(f"max_bend_deg {limits['max_bend_deg'] - 30:g}°", notes[1])
+        # The stricter machine refuses the wires it cannot make; the summary names them and the note.
+        out = os.path.join(self.tmp.name, "strict")
+        result = export.export(self.design, out, dict(stricter, min_segment=0.2))
+        level, text = export.summary(result, out)
+        self.assertEqual(level, "ERROR")
+        self.assertEqual(result["wires"], [])
+        for wire in self.design["wires"]:
+            self.assertIn(f"not bendable: wire {wire['name']}:", text)
+        self.assertIn("min_segment 200 mm is stricter", text)
+
+    # --- Send to Machine ---------------------------------------------------------------------
+
+    def send(self, port, **kw):
+        return bpy.ops.wiresculpt.send_to_machine(wire=self.wire["name"], port=port, **FAST, **kw)
+
+    def test_send_streams_the_whole_program_once(self):
+        lines = self.program()
+        with GrblEmulator() as grbl:
+            self.assertEqual(self.send(grbl.port), {'FINISHED'})
+        self.assertEqual(grbl.acknowledged, lines)
+        self.assertEqual(grbl.received, lines)
+        self.assertNotIn(self.wire["name"], streaming.PENDING)
+        self.assertIn(f"all {len(lines)} lines acknowledged", streaming.LAST[self.wire["name"]][1])
+
+    def test_dry_run_sends_nothing(self):
+        with GrblEmulator() as grbl:
+            self.assertEqual(self.send(grbl.port, dry_run=True), {'FINISHED'})
+            time.sleep(0.1)
+        self.assertEqual(grbl.received, [])
+        self.assertIn("dry run", streaming.LAST[self.wire["name"]][1])
+
+    def test_a_dropped_link_names_the_last_acknowledged_line_and_resume_finishes_once(self):
+        lines = self.program(self.profile_path)
+        k = len(lines) // 2  # the k-th line (1-based) is in flight when the cable is pulled
+        bpy.context.scene.wiresculpt.machine_profile = self.profile_path
+        with GrblEmulator(drop_on=k) as first:
+            with self.assertRaises(RuntimeError) as ctx:
+                self.send(first.port)
+        message = str(ctx.exception)
+        self.assertIn(f"the last acknowledged line is line {k - 1} (`{lines[k - 2]}`)", message)
+        self.assertIn(f"Resume continues from line {k} of {len(lines)}", message)
+        self.assertEqual(first.acknowledged, lines[:k - 1])
+        self.assertEqual(first.received, lines[:k])
+        # Nothing to resume on another wire; Resume under another profile is refused.
+        other = self.design["wires"][1]["name"]
+        with self.assertRaisesRegex(RuntimeError, f"nothing to resume for wire {other}"):
+            bpy.ops.wiresculpt.send_to_machine(wire=other, port=first.port, resume=True, **FAST)
+        bpy.context.scene.wiresculpt.machine_profile = ""
+        with self.assertRaisesRegex(RuntimeError, "program changed"):
+            self.send(first.port, resume=True)
+        bpy.context.scene.wiresculpt.machine_profile = self.profile_path
+        # The device comes back under another name (a new pseudo-terminal): resume there.
+        with GrblEmulator() as second:
+            self.assertEqual(self.send(second.port, resume=True), {'FINISHED'})
+        modes = [line for line in lines[:k - 1] if line in MODES]
+        self.assertEqual(modes, list(MODES))
+        self.assertEqual(second.acknowledged, modes + lines[k - 1:])
+        # every program line acknowledged exactly once, in order, over the two links
+        self.assertEqual(first.acknowledged + second.acknowledged[len(modes):], lines)
+        self.assertNotIn(self.wire["name"], streaming.PENDING)
+        self.assertIn(f"resumed at line {k}", streaming.LAST[self.wire["name"]][1])
+
+    def test_a_rejected_line_stops_there_and_resume_sends_it_again(self):
+        lines = self.program()
+        k = 9  # GRBL answers error:20 to the k-th line: it was not executed
+        with GrblEmulator(error_on=k) as grbl:
+            with self.assertRaises(RuntimeError) as ctx:
+                self.send(grbl.port)
+            message = str(ctx.exception)
+            self.assertIn("stopped (error)", message)
+            self.assertIn(f"the last acknowledged line is line {k - 1} (`{lines[k - 2]}`)", message)
+            self.assertIn(f"error:20", message)
+            self.assertEqual(self.send(grbl.port, resume=True), {'FINISHED'})
+        modes = [line for line in lines[:k - 1] if line in MODES]
+        self.assertEqual(grbl.received, lines[:k] + modes + lines[k - 1:])
+        self.assertEqual(grbl.acknowledged, lines[:k - 1] + modes + lines[k - 1:])
+
+    def test_cancel_stops_the_machine_and_resume_continues(self):
+        lines = self.program()
+        k = 6  # cancelled while the k-th line (1-based) waits for its answer
+        with GrblEmulator(delay=0.2) as grbl:
+            def cancel_in_flight():
+                while len(grbl.received) < k:
+                    time.sleep(0.005)
+                self.assertTrue(streaming.cancel())  # what the Cancel operator and Esc call
+
+            canceller = threading.Thread(target=cancel_in_flight, daemon=True)
+            canceller.start()
+            self.assertEqual(self.send(grbl.port), {'CANCELLED'})
+            canceller.join(5)
+            time.sleep(0.3)
+        self.assertEqual(grbl.received, lines[:k])
+        self.assertEqual(grbl.acknowledged, lines[:k - 1])
+        self.assertEqual(grbl.realtime, ["!", "\x18"])  # feed hold, then soft reset
+        self.assertEqual(streaming.PENDING[self.wire["name"]].next_line, k - 1)
+        self.assertIn(f"cancelled on {grbl.port}: the last acknowledged line is line {k - 1}",
+                      streaming.LAST[self.wire["name"]][1])
+        self.assertFalse(streaming.running())
+        self.assertFalse(streaming.cancel())
+        with GrblEmulator() as again:
+            self.assertEqual(self.send(again.port, resume=True), {'FINISHED'})
+        modes = [line for line in lines[:k - 1] if line in MODES]
+        self.assertEqual(again.acknowledged, modes + lines[k - 1:])
+
+    def test_bad_port_and_missing_wire_are_one_clear_message(self):
+        with self.assertRaisesRegex(RuntimeError, "could not open serial port '/dev/no-such-bender'"):
+            self.send("/dev/no-such-bender")
+        self.assertNotIn(self.wire["name"], streaming.PENDING)
+        with self.assertRaisesRegex(RuntimeError, "no wire 'Nope/7'"):
+            bpy.ops.wiresculpt.send_to_machine(wire="Nope/7", port="/dev/null", **FAST)
+        with self.assertRaisesRegex(RuntimeError, "no serial port chosen"):
+            bpy.ops.wiresculpt.send_to_machine(wire=self.wire["name"], port="")
+
+
+@unittest.skipUnless(shutil.which("xvfb-run"), "xvfb-run is not installed")
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class ModalSend(unittest.TestCase):
+    """Send to Machine as the panel runs it (INVOKE: worker thread, modal timer, status bar)."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.result, cls.seen = run_under_xvfb(UI_SCRIPT, "MODAL ")
+
+    def setUp(self):
+        output = self.result.stdout[-3000:] + self.result.stderr[-3000:]
+        self.assertIsNotNone(self.seen, output)
+        self.assertNotIn("error", self.seen, output)
+
+    def test_runs_modal_shows_progress_and_cancels(self):
+        self.assertEqual(self.seen["invoke"], ["RUNNING_MODAL"])
+        self.assertTrue(self.seen["running"])
+        self.assertRegex(self.seen["status"], r"sending .* line \d+ of \d+ .*Esc to cancel")
+        self.assertEqual(self.seen["cancel_op"], ["FINISHED"])
+        self.assertLess(self.seen["acknowledged_at_cancel"], self.seen["lines"])
+        self.assertEqual(self.seen["in_flight_at_cancel"], 1)
+        self.assertEqual(self.seen["pending_next_line"], self.seen["acknowledged_at_cancel"])
+        self.assertEqual(self.seen["realtime"][-2:], ["!", "\x18"])
+
+    def test_resume_modal_finishes_with_every_line_once(self):
+        self.assertEqual(self.seen["resume_invoke"], ["RUNNING_MODAL"])
+        self.assertTrue(self.seen["once"])
+        self.assertFalse(self.seen["pending_after"])
+        self.assertFalse(self.seen["running_after"])
+
+
+if __name__ == "__main__":
+    unittest.main()
