@@ -69,12 +69,20 @@ class ForcesStageTest(unittest.TestCase):
             # the force on wires[0] has a -hook component along d
             self.assertLess(dot(c["force"], dvec) * c["hook"], 0.0, c)
             self.assertEqual(len(c["out_of_plane"]), 2)
-            for share in c["out_of_plane"]:
-                self.assertGreaterEqual(share, 0.0)
-                self.assertLessEqual(share, 1.0)
+            # each share is |f.n| / |f| in that wire's own plane, recomputed here
+            for share, n in zip(c["out_of_plane"], (n0, n1)):
+                self.assertAlmostEqual(share, abs(dot(c["force"], n)) / math.sqrt(dot(c["force"], c["force"])), 9)
             loaded += 1
         self.assertGreater(loaded, 0)
-        self.assertIn("mean", d["out_of_plane"])
+        shares = [s for c in d["crossings"] if c["hook"] != 0 for s in c["out_of_plane"]]
+        self.assertAlmostEqual(d["out_of_plane"]["mean"], sum(shares) / len(shares), 9)
+        largest = max(math.sqrt(dot(c["force"], c["force"])) for c in d["crossings"])
+        along = [abs(dot(c["force"], d["wires"][w]["plane"]["normal"]))
+                 for c in d["crossings"] if c["hook"] != 0 for w in c["wires"]]
+        self.assertAlmostEqual(d["out_of_plane"]["mean_to_max_force"], sum(along) / len(along) / largest, 9)
+        self.assertAlmostEqual(d["out_of_plane"]["max_to_max_force"], max(along) / largest, 9)
+        for w in d["wires"]:
+            self.assertGreaterEqual(w["max_torque_3d"], w["max_torque"] * (1 - 1e-12), w["name"])
 
     def test_equilibrium_of_every_wire(self):
         # Independent of the solver: sum the crossing forces on each wire (wires[1] gets -f).

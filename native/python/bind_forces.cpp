@@ -201,6 +201,7 @@ py::dict forces_and_rest_py(const py::list& wire_list, const py::list& crossing_
                           py::arg("closure_gap") = r.closure_gap, py::arg("max_torque") = fr.wires[w].max_torque,
                           py::arg("max_torque_vertex") = fr.wires[w].max_torque_vertex,
                           py::arg("max_out_of_plane_torque") = fr.wires[w].max_out_of_plane,
+                          py::arg("max_torque_3d") = fr.wires[w].max_torque_3d,
                           py::arg("over_bend") = over));
   }
   py::object load = py::none();
@@ -224,7 +225,9 @@ py::dict forces_and_rest_py(const py::list& wire_list, const py::list& crossing_
                    py::arg("equilibrium_residual") = fr.equilibrium_residual, py::arg("t_max") = fr.t_max,
                    py::arg("torque_active") = fr.torque_active, py::arg("method") = fr.method,
                    py::arg("nlopt_result") = fr.nlopt_result, py::arg("mean_out_of_plane") = fr.mean_out_of_plane,
-                   py::arg("max_out_of_plane") = fr.max_out_of_plane);
+                   py::arg("max_out_of_plane") = fr.max_out_of_plane,
+                   py::arg("mean_out_of_plane_to_max_force") = fr.mean_out_of_plane_to_max_force,
+                   py::arg("max_out_of_plane_to_max_force") = fr.max_out_of_plane_to_max_force);
   py::dict stats(py::arg("forces_seconds") = fr.seconds, py::arg("lp_seconds") = fr.lp_seconds,
                  py::arg("nlp_seconds") = fr.nlp_seconds, py::arg("rest_seconds") = rest_seconds,
                  py::arg("lp_iterations") = fr.lp_iterations, py::arg("iterations") = fr.iterations,
@@ -253,9 +256,10 @@ progress(stage, fraction) -> False cancels (raises Cancelled).
 Returns {"crossings": [{"force": [3] N on wires[0] by wires[1], "normal": N, "out_of_plane":
 (share on wires[0], on wires[1])}], "wires": [{"cut", "rest": (m, 2) metres in the plane frame,
 "walk", "rest_angles", "target_angles" (rad, per rest point), "closure_gap" m, "max_torque" N m,
-"max_torque_vertex", "max_out_of_plane_torque" N m, "over_bend": [{"vertex", "angle"}]}],
+"max_torque_vertex", "max_out_of_plane_torque" N m, "max_torque_3d" N m, "over_bend": [{"vertex", "angle"}]}],
 "forces": {g_stb, g_asm, assembly_residual, equilibrium_residual, t_max, torque_active, method,
-nlopt_result, mean_out_of_plane, max_out_of_plane}, "load_capacity": {"weight_N", "length",
+nlopt_result, mean_out_of_plane, max_out_of_plane, mean_out_of_plane_to_max_force,
+max_out_of_plane_to_max_force}, "load_capacity": {"weight_N", "length",
 "+x", "-x", "+y", "-y", "+z", "-z" (multiples of the weight; None when unbounded), "base",
 "status", "seconds"} or None, "stats": {forces_seconds, lp_seconds, nlp_seconds, rest_seconds,
 lp_iterations, iterations, working_set_rounds, working_set_rows}, "warnings": [str]}.

@@ -201,6 +201,36 @@ std::array<Vec3, 4> target_pyramid(const Network& net, int c, int hook, double f
   return out;
 }
 
+OutOfPlaneShares out_of_plane_shares(const Network& net, const std::vector<int>& hooks, const std::vector<Vec3>& forces) {
+  if (hooks.size() != net.crossings.size() || forces.size() != net.crossings.size())
+    throw InputError("out-of-plane shares: expected one hook and one force per crossing (" +
+                     std::to_string(net.crossings.size()) + "), got " + std::to_string(hooks.size()) + " and " +
+                     std::to_string(forces.size()));
+  OutOfPlaneShares out;
+  out.share.assign(net.crossings.size(), {0.0, 0.0});
+  double largest = 0.0;
+  for (std::size_t c = 0; c < forces.size(); ++c)
+    if (hooks[c] != 0) largest = std::max(largest, forces[c].norm());
+  if (!(largest > 0)) return out;
+  int counted = 0;
+  for (std::size_t c = 0; c < forces.size(); ++c) {
+    const double fn = forces[c].norm();
+    if (hooks[c] == 0 || !(fn > 0)) continue;
+    for (int k = 0; k < 2; ++k) {
+      const double along = std::abs(forces[c].dot(net.wires[net.crossings[c].wires[k]].plane.normal));
+      out.share[c][k] = along / fn;
+      out.mean += out.share[c][k];
+      out.max = std::max(out.max, out.share[c][k]);
+      out.mean_to_max_force += along / largest;
+      out.max_to_max_force = std::max(out.max_to_max_force, along / largest);
+      ++counted;
+    }
+  }
+  out.mean /= counted;
+  out.mean_to_max_force /= counted;
+  return out;
+}
+
 std::vector<WireLoad> wire_loads(const Network& net, const std::vector<int>& hooks, const std::vector<Vec3>& forces,
                                  int wire) {
   std::vector<WireLoad> out;
@@ -563,23 +593,18 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
   r.forces = problem.forces(a);
   const int C = static_cast<int>(net.crossings.size());
   r.normal.assign(C, 0.0);
-  r.out_of_plane.assign(C, {0.0, 0.0});
-  int counted = 0;
   for (int c = 0; c < C; ++c) {
     if (hooks[c] == 0) continue;
     const Crossing& x = net.crossings[c];
     const Vec3 d = net.wires[x.wires[0]].plane.normal.cross(net.wires[x.wires[1]].plane.normal).normalized();
-    const Vec3& f = r.forces[c];
-    r.normal[c] = -static_cast<double>(hooks[c]) * f.dot(d);
-    const double fn = f.norm();
-    for (int k = 0; k < 2; ++k) {
-      r.out_of_plane[c][k] = fn > 0 ? std::abs(f.dot(net.wires[x.wires[k]].plane.normal)) / fn : 0.0;
-      r.mean_out_of_plane += r.out_of_plane[c][k];
-      r.max_out_of_plane = std::max(r.max_out_of_plane, r.out_of_plane[c][k]);
-      ++counted;
-    }
+    r.normal[c] = -static_cast<double>(hooks[c]) * r.forces[c].dot(d);
   }
-  if (counted) r.mean_out_of_plane /= counted;
+  const OutOfPlaneShares shares = out_of_plane_shares(net, hooks, r.forces);
+  r.out_of_plane = shares.share;
+  r.mean_out_of_plane = shares.mean;
+  r.max_out_of_plane = shares.max;
+  r.mean_out_of_plane_to_max_force = shares.mean_to_max_force;
+  r.max_out_of_plane_to_max_force = shares.max_to_max_force;
   r.g_stb = problem.normal_weights().dot(a);
   r.assembly_residual = a.dot(problem.assembly_matrix() * a);
   r.g_asm = -problem.weight() * r.assembly_residual;
@@ -593,7 +618,14 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
     r.wires[w].max_torque = rs.max_torque;
     r.wires[w].max_torque_vertex = rs.max_torque_vertex;
     for (double t : rs.out_of_plane_torque) r.wires[w].max_out_of_plane = std::max(r.wires[w].max_out_of_plane, t);
+    for (std::size_t k = 0; k < rs.torque.size(); ++k)
+      r.wires[w].max_torque_3d = std::max(r.wires[w].max_torque_3d, std::hypot(rs.torque[k], rs.out_of_plane_torque[k]));
     if (rs.max_torque >= (1.0 - 1e-6) * r.t_max) r.torque_active = true;
+    if (r.wires[w].max_torque_3d > (1.0 + 1e-6) * r.t_max)
+      r.warnings.push_back(wname(net, w) + ": in-plane bending, out-of-plane bending and twist together reach " +
+                           std::to_string(r.wires[w].max_torque_3d) + " N m, above t_max = " + std::to_string(r.t_max) +
+                           " N m (only in-plane bending is bounded; see docs/method-forces.md, \"Out-of-plane share "
+                           "and closure gaps\")");
   }
   r.seconds = since(start);
   report_progress(progress, "forces", 1.0);

@@ -2,6 +2,7 @@
 // (rest = target), a cantilever (closed-form angles and the sign of the bend), a loaded closed
 // wire (edge lengths, torque equilibrium at every vertex), and cut placement and validation.
 #include <catch2/catch.hpp>
+#include <Eigen/Dense>
 #include <cmath>
 #include <numbers>
 
@@ -86,6 +87,96 @@ TEST_CASE("rest: a cantilever bends back against its load (closed form)", "[rest
   CHECK(r.max_torque == Approx(L * F));
   CHECK(r.max_torque_vertex == 0);
   CHECK(r.closure_gap == 0.0);
+}
+
+namespace {
+// An independent forward model of a clamped cantilever (clamp at the origin along +x, N edges of
+// length h, a load (0, -P) at the free end), solved by minimising the total potential
+//   Π(φ) = Σ_v 4 k_b / l̄_v tan²(φ_v / 2) + P y_tip(φ)
+// (Eq. 9 with a straight rest shape and the Voronoi length l̄ = |e_{v-1}| + |e_v|, a ghost edge
+// of length 0 at the clamp) over the turning angles φ, with Newton steps whose gradient and
+// Hessian are central finite differences of Π itself: nothing of Eq. 10-12 is used.
+struct Cantilever {
+  int N;
+  double L, kb;
+  double h() const { return L / N; }
+  std::vector<Vec3> nodes(const Eigen::VectorXd& phi) const {
+    std::vector<Vec3> x{Vec3::Zero()};
+    double theta = 0;
+    for (int k = 0; k < N; ++k) {
+      theta += phi(k);
+      x.push_back(x.back() + h() * Vec3(std::cos(theta), std::sin(theta), 0));
+    }
+    return x;
+  }
+  double potential(const Eigen::VectorXd& phi, double P) const {
+    double e = 0;
+    for (int v = 0; v < N; ++v) {
+      const double l_bar = (v == 0 ? 0.0 : h()) + h();
+      e += 4 * kb / l_bar * std::pow(std::tan(phi(v) / 2), 2);
+    }
+    return e + P * nodes(phi).back().y();
+  }
+  Eigen::VectorXd gradient(const Eigen::VectorXd& phi, double P) const {
+    Eigen::VectorXd g(N);
+    const double s = 1e-6;
+    for (int k = 0; k < N; ++k) {
+      Eigen::VectorXd a = phi, b = phi;
+      a(k) += s;
+      b(k) -= s;
+      g(k) = (potential(a, P) - potential(b, P)) / (2 * s);
+    }
+    return g;
+  }
+  Eigen::VectorXd solve(double P, Eigen::VectorXd phi) const {
+    for (int it = 0; it < 50; ++it) {
+      const Eigen::VectorXd g = gradient(phi, P);
+      if (g.norm() < 1e-10) break;
+      Eigen::MatrixXd H(N, N);
+      const double s = 1e-4;
+      for (int k = 0; k < N; ++k) {
+        Eigen::VectorXd a = phi, b = phi;
+        a(k) += s;
+        b(k) -= s;
+        H.col(k) = (gradient(a, P) - gradient(b, P)) / (2 * s);
+      }
+      phi -= H.ldlt().solve(g);
+    }
+    return phi;
+  }
+};
+}  // namespace
+
+TEST_CASE("rest: an independent cantilever (finite differences) checks the stiffness scale and Eq. 12",
+          "[rest][cantilever]") {
+  const Cantilever c{40, 0.3, 0.73};
+  // Small load: the discrete rod must deflect as the continuum rod of E·I = k_b, P L³ / (3 k_b)
+  // (with the printed l̄ = ½(|e_{v-1}| + |e_v|) it would deflect half as much). The discrete sum
+  // is the trapezoid rule of ∫ P (L - x)² / k_b dx: relative error 1 / (2 N²) = 3e-4.
+  const double P0 = 0.1;
+  const Eigen::VectorXd small = c.solve(P0, Eigen::VectorXd::Zero(c.N));
+  const double tip = -c.nodes(small).back().y();
+  CHECK(tip == Approx(P0 * std::pow(c.L, 3) / (3 * c.kb)).epsilon(1e-3));
+  // Large load (tip deflection about a third of the length): the deformed rod as the target, its
+  // load on the free end, and rest_shape must give back the straight rod at every interior vertex.
+  Eigen::VectorXd phi = small;
+  const double P = 8.0;
+  for (int step = 1; step <= 8; ++step) phi = c.solve(P * step / 8, phi);
+  const std::vector<Vec3> x = c.nodes(phi);
+  REQUIRE(-x.back().y() > 0.25 * c.L);
+  WireSpec w;
+  w.name = "cantilever";
+  w.plane = Plane::make(Vec3::Zero(), Vec3::UnitZ());
+  w.closed = false;
+  w.points = x;
+  RestShapeOptions o;
+  o.bending_stiffness = c.kb;
+  const RestShapeResult r = rest_shape(w, -1, {{c.N, Vec3(0, -P, 0)}}, o);
+  for (int v = 1; v < c.N; ++v) {
+    INFO("vertex " << v << ": target turn " << r.target_angles[v]);
+    CHECK(std::abs(r.target_angles[v]) > 1e-4);  // really bent
+    CHECK(r.rest_angles[v] == Approx(0.0).margin(1e-7));
+  }
 }
 
 TEST_CASE("rest: loaded closed wire keeps its edge lengths and every vertex in equilibrium", "[rest]") {

@@ -5,9 +5,11 @@ Fills, per crossing, `force` (N, on wires[0] by wires[1], FORMATS.md), `normal_f
 `out_of_plane` (|f.n|/|f| for the plane of wires[0] and of wires[1]); per wire `cut`, `rest`
 (2D, metres, in the wire's plane frame, from the cut in the direction of increasing target index),
 `rest_angles` and `target_angles` (radians, one per rest point), `closure_gap` (m),
-`max_torque` (N m) and `max_torque_vertex`, `max_out_of_plane_torque`, `rest_over_bend`;
+`max_torque` (N m) and `max_torque_vertex`, `max_out_of_plane_torque`, `max_torque_3d` (N m, in-plane
+and out-of-plane bending and twist together), `rest_over_bend`;
 `load_capacity` (weight_N and the multiple of it the sculpture holds with gravity along each
-axis direction; absent when the material has no density), `out_of_plane` statistics,
+axis direction; absent when the material has no density), `out_of_plane` statistics (mean and max of
+the shares; mean_to_max_force and max_to_max_force: |f.n| over the largest |f|, the paper's measure),
 `stages.forces` and `stages.rest_shape`. Only computed values are written.
 
 A user's cut for a closed wire may be given as the wire's `cut_override` (index into `target`,
@@ -79,6 +81,7 @@ def run(design, material, settings, native_progress=None):
         w["max_torque"] = float(out["max_torque"])
         w["max_torque_vertex"] = int(out["max_torque_vertex"])
         w["max_out_of_plane_torque"] = float(out["max_out_of_plane_torque"])
+        w["max_torque_3d"] = float(out["max_torque_3d"])
         w["rest_over_bend"] = [{"vertex": int(o["vertex"]), "angle_deg": math.degrees(o["angle"])}
                                for o in out["over_bend"]]
         for o in out["over_bend"]:
@@ -89,6 +92,8 @@ def run(design, material, settings, native_progress=None):
     summary, stats = r["forces"], r["stats"]
     hooked = [c for c in design["crossings"] if c["hook"] != 0]
     design["out_of_plane"] = {"mean": summary["mean_out_of_plane"], "max": summary["max_out_of_plane"],
+                              "mean_to_max_force": summary["mean_out_of_plane_to_max_force"],
+                              "max_to_max_force": summary["max_out_of_plane_to_max_force"],
                               "crossings": len(hooked)}
     if r["load_capacity"] is not None:
         lc = r["load_capacity"]
@@ -117,7 +122,8 @@ def run(design, material, settings, native_progress=None):
     normals = [c["normal_force"] for c in hooked]
     line = (f"{len(hooked)} loaded crossings, normal forces {min(normals, default=0):.2f}-"
             f"{max(normals, default=0):.2f} N (sum {summary['g_stb'] / 2:.2f} N), out of plane "
-            f"{100 * summary['mean_out_of_plane']:.1f}% mean, {100 * summary['max_out_of_plane']:.1f}% max, "
+            f"{100 * summary['mean_out_of_plane']:.1f}% mean, {100 * summary['max_out_of_plane']:.1f}% max "
+            f"({100 * summary['mean_out_of_plane_to_max_force']:.1f}% mean of the largest force), "
             f"{summary['method']} ({stats['forces_seconds']:.3f} s)")
     if "load_capacity" in design:
         lc = design["load_capacity"]

@@ -98,7 +98,33 @@ struct WireTorque {
   double max_torque = 0.0;       ///< max_v |t_v| (plane-normal component), N·m
   int max_torque_vertex = -1;    ///< target index of that vertex (-1 when all are 0)
   double max_out_of_plane = 0.0; ///< max_v of the in-plane part of the 3D torque sum, N·m
+  /// max_v of the whole 3D torque |Σ (x_v - x_k) × f_k| (in-plane bending, out-of-plane bending
+  /// and twist together; the paper's |t_v| of Eq. 6), N·m. Only the plane-normal part is bounded
+  /// by t_max here (docs/method-forces.md, "Out-of-plane share and closure gaps").
+  double max_torque_3d = 0.0;
 };
+
+/// Out-of-plane shares of the contact forces, per wire and in its own plane's terms.
+struct OutOfPlaneShares {
+  /// Per crossing: |f·n_w| / |f| for w = wires[0] and wires[1] (n_w the unit normal of that
+  /// wire's own plane; the same |f| for both since wires[1] receives -f); {0, 0} when f = 0 or
+  /// the crossing is null. A force along the planes' common line d = n0 × n1 lies in both planes:
+  /// {0, 0}. A force along n0 gives {1, |n0·n1|}: the part of it in plane 1 bends wire 1 in its
+  /// plane.
+  std::vector<std::array<double, 2>> share;
+  double mean = 0.0;  ///< mean of `share` over the crossings with a force and both their wires
+  double max = 0.0;   ///< max of `share`
+  /// The paper's normalisation (Sec. 7: "per-assembly out-of-plane component to maximum contact
+  /// force ratio"): |f·n_w| divided by the largest |f| of the whole structure, mean and max over
+  /// the same (crossing, wire) pairs.
+  double mean_to_max_force = 0.0;
+  double max_to_max_force = 0.0;
+};
+
+/// The out-of-plane shares of `forces` (per crossing, on wires[0]; ForceResult::forces) on `net`.
+/// Null crossings (hooks[c] == 0) and zero forces are left out of the statistics.
+OutOfPlaneShares out_of_plane_shares(const Network& net, const std::vector<int>& hooks,
+                                     const std::vector<Vec3>& forces);
 
 struct ForceResult {
   std::vector<Vec3> forces;    ///< per crossing: force on wires[0] by wires[1], N (0 when null)
@@ -107,6 +133,9 @@ struct ForceResult {
   std::vector<std::array<double, 2>> out_of_plane;
   double mean_out_of_plane = 0.0;  ///< mean over hooked crossings and both wires
   double max_out_of_plane = 0.0;
+  /// The same |f·n_w| over the structure's largest |f| (the paper's normalisation), mean and max.
+  double mean_out_of_plane_to_max_force = 0.0;
+  double max_out_of_plane_to_max_force = 0.0;
   Eigen::VectorXd coefficients;      ///< a, 4 per hooked crossing
   std::vector<int> column_crossing;  ///< crossing id of each coefficient
   std::vector<int> cuts;             ///< per wire (choose_cuts)
