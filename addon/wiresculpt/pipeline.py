@@ -81,18 +81,21 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint)
     """Target shape, then forces and rest shape, with the coupling of Sec. 4.3: the machine's
     maximum bend limits the rest shape, which is only known after the forces; when a rest bend
     exceeds it, the target's limit is lowered by the excess (plus COUPLING_MARGIN_DEG) and the
-    shape is solved again from the same layering, at most COUPLING_ROUNDS times."""
+    shape is solved again from the same layering, at most COUPLING_ROUNDS times. Each round starts
+    from what the previous one learnt (target_shape.Memo): its nulled crossings, and the wires whose
+    optimum the lower limit leaves optimal."""
     import copy
 
     machine_limit = settings["max_bend_deg"]
     target_limit = machine_limit
     before = copy.deepcopy(design)
+    memo = target_shape.Memo()
     for round_ in range(COUPLING_ROUNDS):
         if round_:
             design = copy.deepcopy(before)
         checkpoint()
         say("target_shape", target_shape.run(design, material, {**settings, "max_bend_deg": target_limit},
-                                             native_progress))
+                                             native_progress, memo))
         design["pending_stages"].remove("target_shape")
         design["stages"]["target_shape"]["max_bend_deg"] = target_limit
         design["stages"]["target_shape"]["coupling_rounds"] = round_ + 1
