@@ -371,6 +371,38 @@ TEST_CASE("target shape: windows reach the optimum of one global solve", "[targe
   for (const auto& s : a.crossings) CHECK(s.status == "ok");
 }
 
+TEST_CASE("target shape: the default sweep tolerance stops where 1 nm sweeps stop", "[target]") {
+  // The wavy loop above, solved in windows with the default sweep_tol (0.1 µm) and with sweeps
+  // continued until nothing moves by 1 nm: the same optimum (energy to 1e-8, every point within the
+  // 10 µm to which realised segments are checked), for fewer evaluations.
+  Polyline2 contour;
+  const int n = 1300;
+  for (int k = 0; k < n; ++k) {
+    const double t = 2 * pi * k / n;
+    const double rr = 0.2 + 0.03 * std::cos(5 * t);
+    contour.emplace_back(rr * std::cos(t), rr * std::sin(t));
+  }
+  std::vector<TargetCrossing> xs;
+  for (int k = 0; k < 5; ++k) {
+    const int v = k * n / 5 + 11;
+    xs.push_back({v, (k % 2 ? -1.0 : 1.0) * contour[v].normalized(), 2 * pi / 3, true});
+  }
+  TargetShapeOptions standard, fine;
+  fine.sweep_tol = 1e-9;
+  REQUIRE(standard.sweep_tol > fine.sweep_tol);
+  const TargetShapeResult a = optimize_target_shape(contour, true, xs, standard);
+  const TargetShapeResult b = optimize_target_shape(contour, true, xs, fine);
+  REQUIRE(a.points.size() == b.points.size());
+  CHECK(a.sweeps > 1);
+  CHECK(a.iterations < b.iterations);
+  CHECK(a.energy == Approx(b.energy).epsilon(1e-8));
+  double worst = 0.0;
+  for (std::size_t i = 0; i < a.points.size(); ++i) worst = std::max(worst, (a.points[i] - b.points[i]).norm());
+  CHECK(worst < 1e-5);
+  check_constraints(a, true, xs, standard, 1e-6);
+  for (const auto& s : a.crossings) CHECK(s.status == "ok");
+}
+
 TEST_CASE("target shape: a 2 m wire with ten crossings, half of them inverted", "[target]") {
   Polyline2 contour;
   const int n = 2000;  // 1 mm sampling
