@@ -90,6 +90,7 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint)
     target_limit = machine_limit
     before = copy.deepcopy(design)
     memo = target_shape.Memo()
+    totals = dict.fromkeys(("seconds", "iterations", "wire_solves", "reused_wires"), 0)
     for round_ in range(COUPLING_ROUNDS):
         if round_:
             design = copy.deepcopy(before)
@@ -97,6 +98,10 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint)
         say("target_shape", target_shape.run(design, material, {**settings, "max_bend_deg": target_limit},
                                              native_progress, memo))
         design["pending_stages"].remove("target_shape")
+        stage = design["stages"]["target_shape"]
+        for key in totals:  # the stage's cost over every coupling round; its shapes are the last round's
+            totals[key] += stage[key]
+            stage[key] = totals[key]
         design["stages"]["target_shape"]["max_bend_deg"] = target_limit
         design["stages"]["target_shape"]["coupling_rounds"] = round_ + 1
         if not design["stable"]:  # forces need the hooks of a complete stable assembly
