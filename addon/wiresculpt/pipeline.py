@@ -86,14 +86,19 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint)
     optimum the lower limit leaves optimal."""
     import copy
 
+    def fresh(d):
+        """A copy to solve on; the wires' contours are only read after layering, so they are shared
+        (copying their points took most of the glue of a coupling round)."""
+        return copy.deepcopy(d, {id(w["contour"]): w["contour"] for w in d["wires"]})
+
     machine_limit = settings["max_bend_deg"]
     target_limit = machine_limit
-    before = copy.deepcopy(design)
+    before = fresh(design)
     memo = target_shape.Memo()
     totals = dict.fromkeys(("seconds", "iterations", "wire_solves", "reused_wires"), 0)
     for round_ in range(COUPLING_ROUNDS):
         if round_:
-            design = copy.deepcopy(before)
+            design = fresh(before)
         checkpoint()
         say("target_shape", target_shape.run(design, material, {**settings, "max_bend_deg": target_limit},
                                              native_progress, memo))

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <utility>
 
 #include "wiresculpt/error.hpp"
 #include "wiresculpt/target_shape.hpp"
@@ -72,6 +73,24 @@ void check_gradient(F f, const Polyline2& p, const Polyline2& g, double step) {
     }
   REQUIRE(scale > 0.0);
   CHECK(worst / scale < 1e-5);
+}
+
+// A 1.3 m wavy loop (r = 0.2 + 0.03 cos 5t, 1,300 points) with five active crossings whose
+// bisectors alternate outwards and inwards: about 58 optimised points, solved in windows.
+std::pair<Polyline2, std::vector<TargetCrossing>> wavy_loop() {
+  Polyline2 contour;
+  const int n = 1300;
+  for (int k = 0; k < n; ++k) {
+    const double t = 2 * pi * k / n;
+    const double rr = 0.2 + 0.03 * std::cos(5 * t);
+    contour.emplace_back(rr * std::cos(t), rr * std::sin(t));
+  }
+  std::vector<TargetCrossing> xs;
+  for (int k = 0; k < 5; ++k) {
+    const int v = k * n / 5 + 11;
+    xs.push_back({v, (k % 2 ? -1.0 : 1.0) * contour[v].normalized(), 2 * pi / 3, true});
+  }
+  return {contour, xs};
 }
 }  // namespace
 
@@ -341,19 +360,7 @@ TEST_CASE("target shape: analytic gradients match central differences", "[target
 }
 
 TEST_CASE("target shape: windows reach the optimum of one global solve", "[target]") {
-  // A 1.3 m wavy loop with five active crossings (about 58 points: solved in windows by default).
-  Polyline2 contour;
-  const int n = 1300;
-  for (int k = 0; k < n; ++k) {
-    const double t = 2 * pi * k / n;
-    const double rr = 0.2 + 0.03 * std::cos(5 * t);
-    contour.emplace_back(rr * std::cos(t), rr * std::sin(t));
-  }
-  std::vector<TargetCrossing> xs;
-  for (int k = 0; k < 5; ++k) {
-    const int v = k * n / 5 + 11;
-    xs.push_back({v, (k % 2 ? -1.0 : 1.0) * contour[v].normalized(), 2 * pi / 3, true});
-  }
+  const auto [contour, xs] = wavy_loop();
   TargetShapeOptions windowed, global;
   global.window = 0;
   const TargetShapeResult a = optimize_target_shape(contour, true, xs, windowed);
@@ -372,21 +379,10 @@ TEST_CASE("target shape: windows reach the optimum of one global solve", "[targe
 }
 
 TEST_CASE("target shape: the default sweep tolerance stops where 1 nm sweeps stop", "[target]") {
-  // The wavy loop above, solved in windows with the default sweep_tol (0.1 µm) and with sweeps
+  // The wavy loop, solved in windows with the default sweep_tol (0.1 µm) and with sweeps
   // continued until nothing moves by 1 nm: the same optimum (energy to 1e-8, every point within the
   // 10 µm to which realised segments are checked), for fewer evaluations.
-  Polyline2 contour;
-  const int n = 1300;
-  for (int k = 0; k < n; ++k) {
-    const double t = 2 * pi * k / n;
-    const double rr = 0.2 + 0.03 * std::cos(5 * t);
-    contour.emplace_back(rr * std::cos(t), rr * std::sin(t));
-  }
-  std::vector<TargetCrossing> xs;
-  for (int k = 0; k < 5; ++k) {
-    const int v = k * n / 5 + 11;
-    xs.push_back({v, (k % 2 ? -1.0 : 1.0) * contour[v].normalized(), 2 * pi / 3, true});
-  }
+  const auto [contour, xs] = wavy_loop();
   TargetShapeOptions standard, fine;
   fine.sweep_tol = 1e-9;
   REQUIRE(standard.sweep_tol > fine.sweep_tol);
