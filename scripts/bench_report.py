@@ -410,7 +410,7 @@ def markdown(data):
             "sliced once per case so it measures the solver, not OBJ parsing or Python start-up. For the "
             "slowest stage, the target shape: after a crossing is nulled only the wires through it are solved "
             "again (the first version solved every wire in every round: on the Chair 40 wire solves and 79,098 "
-            "NLopt iterations became 28 and 49,243), and a crossing counts as realised within 0.1 deg of its "
+            "NLopt iterations became 28 and 49,243, iterations then counted in the last coupling round only), and a crossing counts as realised within 0.1 deg of its "
             "contact cone instead of 1e-6 rad, which had nulled crossings missing it by 0.0003-0.02 deg, "
             "forced extra rounds and made the Chair unstable. Then (measured on the Chair's 28 recorded wire solves, "
             "replayed on one core): the windows stop when nothing moves by 0.1 µm instead of 1 nm (at 1 nm the "
@@ -418,7 +418,8 @@ def markdown(data):
             "to 7 digits), and each Sec. 4.3 coupling round starts with the crossings the previous one nulled "
             "and reuses every wire whose optimum already fits the lower bend limit: 28 wire solves, 93,681 "
             "NLopt evaluations and 1.84 s of solver CPU time became 14, 12,921 and 0.25 s, with every wire's "
-            "distance to its contour unchanged. Still open: the layering search on unfavourable "
+            "largest and RMS distance to its contour unchanged to the µm (Duck and Airplane likewise). The stage's "
+            "NLopt iterations and wire solves now add every coupling round. Still open: the layering search on unfavourable "
             "networks (exact branch and bound, exponential once its bound stops pruning; `search-554`), the "
             "forces stage's NLP at large C (its `nlp_seconds` dominate), and NLopt's per-wire evaluation cap "
             "on wires over about 2.5 m.",
