@@ -75,16 +75,22 @@ void check_gradient(F f, const Polyline2& p, const Polyline2& g, double step) {
   CHECK(worst / scale < 1e-5);
 }
 
+// n points of the closed curve r = r0 + amplitude cos(lobes t).
+Polyline2 wavy(double r0, double amplitude, int lobes, int n) {
+  Polyline2 contour;
+  for (int k = 0; k < n; ++k) {
+    const double t = 2 * pi * k / n;
+    const double rr = r0 + amplitude * std::cos(lobes * t);
+    contour.emplace_back(rr * std::cos(t), rr * std::sin(t));
+  }
+  return contour;
+}
+
 // A 1.3 m wavy loop (r = 0.2 + 0.03 cos 5t, 1,300 points) with five active crossings whose
 // bisectors alternate outwards and inwards: about 58 optimised points, solved in windows.
 std::pair<Polyline2, std::vector<TargetCrossing>> wavy_loop() {
-  Polyline2 contour;
   const int n = 1300;
-  for (int k = 0; k < n; ++k) {
-    const double t = 2 * pi * k / n;
-    const double rr = 0.2 + 0.03 * std::cos(5 * t);
-    contour.emplace_back(rr * std::cos(t), rr * std::sin(t));
-  }
+  const Polyline2 contour = wavy(0.2, 0.03, 5, n);
   std::vector<TargetCrossing> xs;
   for (int k = 0; k < 5; ++k) {
     const int v = k * n / 5 + 11;
@@ -301,13 +307,7 @@ TEST_CASE("target shape: the progress callback can cancel", "[target]") {
 }
 
 TEST_CASE("target shape: analytic gradients match central differences", "[target]") {
-  Polyline2 contour;
-  const int n = 700;
-  for (int k = 0; k < n; ++k) {
-    const double t = 2 * pi * k / n;
-    const double rr = 0.1 + 0.02 * std::cos(3 * t);
-    contour.emplace_back(rr * std::cos(t), rr * std::sin(t));
-  }
+  const Polyline2 contour = wavy(0.1, 0.02, 3, 700);
   const std::vector<TargetCrossing> xs{{10, Vec2(1, 0), 2 * pi / 3, true}, {300, Vec2(0, 1), 1.8, true}};
   TargetShapeProblem problem(contour, true, xs);
   std::mt19937 rng(7);
