@@ -33,12 +33,26 @@ class Coupling(unittest.TestCase):
         settings = defaults()
         settings.update(contact_angle_deg=140.0, max_bend_deg=50.0)
         V, F = sphere()
-        saved = pipeline.COUPLING_ROUNDS
+        saved, module = pipeline.COUPLING_ROUNDS, native.require()
         pipeline.COUPLING_ROUNDS = rounds
+        self.calls = 0
+
+        class Counting:  # counts the native target-shape solves of every round
+            def __getattr__(_self, name):
+                if name != "optimize_target_shape":
+                    return getattr(module, name)
+
+                def solve(*args):
+                    self.calls += 1
+                    return module.optimize_target_shape(*args)
+                return solve
+        saved_require = native.require
+        native.require = Counting
         try:
             return pipeline.run(V, F, PLANES, PRESETS["steel"], settings)
         finally:
             pipeline.COUPLING_ROUNDS = saved
+            native.require = saved_require
 
     def test_rest_bends_respect_the_machine_after_coupling(self):
         once = self.solve(1)
@@ -49,6 +63,9 @@ class Coupling(unittest.TestCase):
         self.assertLessEqual(largest_rest_turn_deg(coupled), 50.0 + 1e-6)
         stage = coupled["stages"]["target_shape"]
         self.assertGreater(stage["coupling_rounds"], 1)
+        # The stage's counts add every coupling round, as its time does.
+        self.assertEqual(stage["wire_solves"], self.calls)
+        self.assertGreater(stage["wire_solves"], len(coupled["wires"]))
         self.assertLess(stage["max_bend_deg"], 50.0)
         self.assertEqual(coupled["pending_stages"], [])
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <utility>
 
 #include "wiresculpt/error.hpp"
 #include "wiresculpt/target_shape.hpp"
@@ -72,6 +73,30 @@ void check_gradient(F f, const Polyline2& p, const Polyline2& g, double step) {
     }
   REQUIRE(scale > 0.0);
   CHECK(worst / scale < 1e-5);
+}
+
+// n points of the closed curve r = r0 + amplitude cos(lobes t).
+Polyline2 wavy(double r0, double amplitude, int lobes, int n) {
+  Polyline2 contour;
+  for (int k = 0; k < n; ++k) {
+    const double t = 2 * pi * k / n;
+    const double rr = r0 + amplitude * std::cos(lobes * t);
+    contour.emplace_back(rr * std::cos(t), rr * std::sin(t));
+  }
+  return contour;
+}
+
+// A 1.3 m wavy loop (r = 0.2 + 0.03 cos 5t, 1,300 points) with five active crossings whose
+// bisectors alternate outwards and inwards: about 58 optimised points, solved in windows.
+std::pair<Polyline2, std::vector<TargetCrossing>> wavy_loop() {
+  const int n = 1300;
+  const Polyline2 contour = wavy(0.2, 0.03, 5, n);
+  std::vector<TargetCrossing> xs;
+  for (int k = 0; k < 5; ++k) {
+    const int v = k * n / 5 + 11;
+    xs.push_back({v, (k % 2 ? -1.0 : 1.0) * contour[v].normalized(), 2 * pi / 3, true});
+  }
+  return {contour, xs};
 }
 }  // namespace
 
@@ -282,13 +307,7 @@ TEST_CASE("target shape: the progress callback can cancel", "[target]") {
 }
 
 TEST_CASE("target shape: analytic gradients match central differences", "[target]") {
-  Polyline2 contour;
-  const int n = 700;
-  for (int k = 0; k < n; ++k) {
-    const double t = 2 * pi * k / n;
-    const double rr = 0.1 + 0.02 * std::cos(3 * t);
-    contour.emplace_back(rr * std::cos(t), rr * std::sin(t));
-  }
+  const Polyline2 contour = wavy(0.1, 0.02, 3, 700);
   const std::vector<TargetCrossing> xs{{10, Vec2(1, 0), 2 * pi / 3, true}, {300, Vec2(0, 1), 1.8, true}};
   TargetShapeProblem problem(contour, true, xs);
   std::mt19937 rng(7);
@@ -341,19 +360,7 @@ TEST_CASE("target shape: analytic gradients match central differences", "[target
 }
 
 TEST_CASE("target shape: windows reach the optimum of one global solve", "[target]") {
-  // A 1.3 m wavy loop with five active crossings (about 58 points: solved in windows by default).
-  Polyline2 contour;
-  const int n = 1300;
-  for (int k = 0; k < n; ++k) {
-    const double t = 2 * pi * k / n;
-    const double rr = 0.2 + 0.03 * std::cos(5 * t);
-    contour.emplace_back(rr * std::cos(t), rr * std::sin(t));
-  }
-  std::vector<TargetCrossing> xs;
-  for (int k = 0; k < 5; ++k) {
-    const int v = k * n / 5 + 11;
-    xs.push_back({v, (k % 2 ? -1.0 : 1.0) * contour[v].normalized(), 2 * pi / 3, true});
-  }
+  const auto [contour, xs] = wavy_loop();
   TargetShapeOptions windowed, global;
   global.window = 0;
   const TargetShapeResult a = optimize_target_shape(contour, true, xs, windowed);
@@ -368,6 +375,27 @@ TEST_CASE("target shape: windows reach the optimum of one global solve", "[targe
   for (std::size_t i = 0; i < a.points.size(); ++i) worst = std::max(worst, (a.points[i] - b.points[i]).norm());
   CHECK(worst < 1e-5);
   check_constraints(a, true, xs, windowed, 1e-6);
+  for (const auto& s : a.crossings) CHECK(s.status == "ok");
+}
+
+TEST_CASE("target shape: the default sweep tolerance stops where 1 nm sweeps stop", "[target]") {
+  // The wavy loop, solved in windows with the default sweep_tol (0.1 µm) and with sweeps
+  // continued until nothing moves by 1 nm: the same optimum (energy to 1e-8, every point within the
+  // 10 µm to which realised segments are checked), for fewer evaluations.
+  const auto [contour, xs] = wavy_loop();
+  TargetShapeOptions standard, fine;
+  fine.sweep_tol = 1e-9;
+  REQUIRE(standard.sweep_tol > fine.sweep_tol);
+  const TargetShapeResult a = optimize_target_shape(contour, true, xs, standard);
+  const TargetShapeResult b = optimize_target_shape(contour, true, xs, fine);
+  REQUIRE(a.points.size() == b.points.size());
+  CHECK(a.sweeps > 1);
+  CHECK(a.iterations < b.iterations);
+  CHECK(a.energy == Approx(b.energy).epsilon(1e-8));
+  double worst = 0.0;
+  for (std::size_t i = 0; i < a.points.size(); ++i) worst = std::max(worst, (a.points[i] - b.points[i]).norm());
+  CHECK(worst < 1e-5);
+  check_constraints(a, true, xs, standard, 1e-6);
   for (const auto& s : a.crossings) CHECK(s.status == "ok");
 }
 

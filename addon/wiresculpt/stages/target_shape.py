@@ -48,8 +48,10 @@ def model_size(design):
     return float(np.max(points.max(axis=0) - points.min(axis=0)))
 
 
-def solve_wire(design, wire, material, settings, size, native_progress=None):
-    """(result, [(crossing, k)]) of the native optimisation of one wire."""
+def solve_wire(design, wire, material, settings, size, native_progress=None, memo=None):
+    """(result, [(crossing, k)], frame) of the native optimisation of one wire; with a `memo`, a
+    result from an earlier coupling round is taken instead of solving when it is still optimal
+    (Memo.reusable)."""
     _n, u, v = plane_frame(wire["plane"]["normal"])
     origin = wire["plane"]["origin"]
     contact = math.radians(settings["contact_angle_deg"])
@@ -65,9 +67,59 @@ def solve_wire(design, wire, material, settings, size, native_progress=None):
     options = {"min_segment": settings["min_segment"], "max_bend": math.radians(settings["max_bend_deg"]),
                "friction": 0.0, "model_size": size, "wire_name": wire["name"],
                "angle_tolerance": REALISED_ANGLE, "length_tolerance": REALISED_LENGTH}
-    result = native.require().optimize_target_shape(to_2d(wire["contour"], origin, u, v), wire["closed"],
-                                                    specs, options, native_progress)
+    contour = to_2d(wire["contour"], origin, u, v)
+    key = Memo.key(contour, wire["closed"], specs, options) if memo is not None else None
+    result = memo.reusable(key, options["max_bend"]) if memo is not None else None
+    if result is None:
+        result = native.require().optimize_target_shape(contour, wire["closed"], specs, options, native_progress)
+        if memo is not None:
+            memo.remember(key, options["max_bend"], result)
     return result, refs, (origin, u, v)
+
+
+class Memo:
+    """What the target shape learnt in one coupling round (Sec. 4.3), for the next, which only
+    lowers the maximum bend:
+
+    - `nulled`: the crossings it could not realise. A lower bend limit only shrinks each wire's
+      feasible set, so they are nulled from the start of the next round instead of being solved
+      (and failing) again.
+    - every wire's solve. A result that was a converged, feasible optimum with every active crossing
+      realised under the old limit and whose bends all lie within the new one is still a local
+      optimum of the tighter problem (the same point, feasible, in a smaller feasible set): it is
+      reused for the same contour, crossings and options. Only the other wires are solved again.
+    """
+
+    CONVERGED = ("NLOPT_SUCCESS", "NLOPT_FTOL_REACHED", "NLOPT_XTOL_REACHED", "none")  # "none": nothing free
+
+    def __init__(self):
+        self.nulled = []
+        self.solves = {}  # key -> (max_bend, result)
+        self.reused = 0
+
+    @staticmethod
+    def key(contour, closed, specs, options):
+        """Everything the solve depends on except the bend limit."""
+        spec_key = tuple((s["vertex"], s["bisector"], s["contact_angle"], s["active"]) for s in specs)
+        other = tuple(sorted((k, v) for k, v in options.items() if k != "max_bend"))
+        return (np.ascontiguousarray(contour, dtype=np.float64).tobytes(), bool(closed), spec_key, other)
+
+    def reusable(self, key, max_bend):
+        """The remembered result for `key` if it is an optimum that the limit `max_bend` (radians)
+        leaves optimal, else None."""
+        entry = self.solves.get(key)
+        if entry is None:
+            return None
+        old_limit, r = entry
+        optimum = (r["feasible"] and r["nlopt_result"] in self.CONVERGED
+                   and all(s["status"] in ("ok", "inactive") for s in r["crossings"]))
+        if not (optimum and max_bend <= old_limit and r["max_bend"] <= max_bend):
+            return None
+        self.reused += 1
+        return r
+
+    def remember(self, key, max_bend, result):
+        self.solves[key] = (max_bend, result)
 
 
 def _ids(numbers):
@@ -93,19 +145,29 @@ def unrealised_summary(nulled, size):
     return "the target shape cannot realise " + "; ".join(parts)
 
 
-def run(design, material, settings, native_progress=None):
+def run(design, material, settings, native_progress=None, memo=None):
     """Fills each wire's target, length and distances, each crossing's vertices, stages.target_shape;
-    nulls crossings that cannot be realised and re-checks stability. Returns a progress line."""
+    nulls crossings that cannot be realised and re-checks stability. Returns a progress line.
+    `memo` (a Memo) carries the nulled crossings and the solves of an earlier coupling round with a
+    higher bend limit into this one, and is updated with this round's."""
     start = time.perf_counter()
     size = model_size(design)
     nulled, iterations, wire_solves = [], 0, 0
+    if memo is not None:
+        for failure in memo.nulled:
+            design["crossings"][failure["crossing"]]["hook"] = 0
+            nulled.append(dict(failure))
     solved = [None] * len(design["wires"])
+    reused = [False] * len(design["wires"])
     pending = range(len(design["wires"]))  # the first round solves every wire
     for _round in range(MAX_ROUNDS):
         for i in pending:
-            solved[i] = solve_wire(design, design["wires"][i], material, settings, size, native_progress)
-            iterations += solved[i][0]["iterations"]
-            wire_solves += 1
+            count = memo.reused if memo is not None else 0
+            solved[i] = solve_wire(design, design["wires"][i], material, settings, size, native_progress, memo)
+            reused[i] = memo is not None and memo.reused != count
+            if not reused[i]:
+                iterations += solved[i][0]["iterations"]
+                wire_solves += 1
         failing = {}
         for wire, (r, refs, _frame) in zip(design["wires"], solved):
             for (c, _k), status in zip(refs, r["crossings"]):
@@ -123,7 +185,7 @@ def run(design, material, settings, native_progress=None):
         raise RuntimeError("target shape: crossings kept failing after nulling; this is a solver bug")
 
     per_wire = []
-    for wire, (r, refs, frame) in zip(design["wires"], solved):
+    for wire, (r, refs, frame), again in zip(design["wires"], solved, reused):
         target = to_3d(r["points"], *frame)
         wire["target"] = target.tolist()
         wire["length"] = polyline_length(target, wire["closed"])
@@ -131,7 +193,9 @@ def run(design, material, settings, native_progress=None):
         wire["target_rms_distance"] = r["rms_distance"]
         for (c, k), vertex in zip(refs, r["crossing_vertices"]):
             c.setdefault("vertices", [None, None])[k] = int(vertex)
-        per_wire.append({"id": wire["id"], "seconds": r["seconds"], "iterations": r["iterations"],
+        # A reused result cost nothing in this round (its solve is counted in the round that ran it).
+        per_wire.append({"id": wire["id"], "seconds": 0.0 if again else r["seconds"],
+                         "iterations": 0 if again else r["iterations"], "reused": again,
                          "max_distance": r["max_distance"], "rms_distance": r["rms_distance"],
                          "feasible": r["feasible"], "nlopt_result": r["nlopt_result"]})
         design.setdefault("warnings", []).extend(f"wire {wire['name']}: {w}" for w in r["warnings"])
@@ -144,7 +208,10 @@ def run(design, material, settings, native_progress=None):
             c["metric"] = 0.0
     seconds = time.perf_counter() - start
     design["stages"]["target_shape"] = {"seconds": seconds, "iterations": iterations, "wire_solves": wire_solves,
+                                        "reused_wires": sum(reused),
                                         "wires": per_wire, "nulled_crossings": nulled}
+    if memo is not None:
+        memo.nulled = [dict(n) for n in nulled]
     if nulled:
         verdict = layering.recheck(design, material, settings)
         design["stages"]["target_shape"]["recheck_lp_solves"] = verdict["lp_solves"]

@@ -1,0 +1,121 @@
+"""The target shape's memory between coupling rounds (Sec. 4.3; stages/target_shape.Memo): a wire's
+optimum is reused under a lower bend limit only where a cold solve reaches the same answer, and
+crossings nulled in one round stay nulled in the next."""
+import copy
+import math
+import unittest
+
+import numpy as np
+
+from test_export import sphere
+from test_pipeline import PLANES
+from wiresculpt import native, pipeline
+from wiresculpt.core.materials import PRESETS
+from wiresculpt.core.settings import defaults
+from wiresculpt.stages import layering, target_shape
+
+
+def result(max_bend=1.0, feasible=True, nlopt="NLOPT_FTOL_REACHED", status="ok"):
+    return {"feasible": feasible, "nlopt_result": nlopt, "crossings": [{"status": "inactive"}, {"status": status}],
+            "max_bend": max_bend}
+
+
+class Reusable(unittest.TestCase):
+    """Memo.reusable on results written by hand (radians)."""
+
+    def memo_with(self, r, limit=2.0):
+        memo = target_shape.Memo()
+        memo.remember("key", limit, r)
+        return memo
+
+    def test_an_optimum_within_the_lower_limit_is_reused(self):
+        r = result(max_bend=1.0)
+        memo = self.memo_with(r)
+        self.assertIs(memo.reusable("key", 1.5), r)
+        self.assertIs(memo.reusable("key", 1.0), r)  # the limit reached exactly still holds
+        self.assertEqual(memo.reused, 2)
+
+    def test_what_is_not_reused(self):
+        self.assertIsNone(self.memo_with(result(max_bend=1.0)).reusable("key", 0.99))  # bends over the new limit
+        self.assertIsNone(self.memo_with(result(max_bend=1.0)).reusable("key", 2.5))  # a looser limit
+        self.assertIsNone(self.memo_with(result(max_bend=1.0)).reusable("other", 1.5))  # another problem
+        self.assertIsNone(self.memo_with(result(feasible=False)).reusable("key", 1.5))
+        self.assertIsNone(self.memo_with(result(nlopt="NLOPT_ROUNDOFF_LIMITED")).reusable("key", 1.5))
+        self.assertIsNone(self.memo_with(result(nlopt="NLOPT_MAXEVAL_REACHED")).reusable("key", 1.5))
+        self.assertIsNone(self.memo_with(result(status="infeasible")).reusable("key", 1.5))
+        self.assertIsNone(target_shape.Memo().reusable("key", 1.5))
+
+    def test_the_key_sees_every_input_but_the_bend_limit(self):
+        contour = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+        specs = [{"vertex": 1, "bisector": (0.0, 1.0), "contact_angle": 2.0, "active": True}]
+        options = {"min_segment": 0.015, "max_bend": 2.0}
+        key = target_shape.Memo.key(contour, True, specs, options)
+        self.assertEqual(key, target_shape.Memo.key(contour.copy(), True, specs, {**options, "max_bend": 1.0}))
+        self.assertNotEqual(key, target_shape.Memo.key(contour, False, specs, options))
+        self.assertNotEqual(key, target_shape.Memo.key(contour + 1e-9, True, specs, options))
+        self.assertNotEqual(key, target_shape.Memo.key(contour, True, [{**specs[0], "active": False}], options))
+        self.assertNotEqual(key, target_shape.Memo.key(contour, True, specs, {**options, "min_segment": 0.02}))
+
+
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class AgainstColdSolves(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.settings = defaults()
+        cls.material = PRESETS["steel"]
+        V, F = sphere()
+        cls.design = pipeline.slice_and_pick(V, F, PLANES, cls.material, cls.settings)
+        layering.run(cls.design, cls.material, cls.settings)
+        cls.size = target_shape.model_size(cls.design)
+
+    def solve(self, wire, limit_deg, memo=None):
+        settings = {**self.settings, "max_bend_deg": limit_deg}
+        return target_shape.solve_wire(self.design, wire, self.material, settings, self.size, None, memo)[0]
+
+    def test_a_reused_optimum_is_what_a_cold_solve_finds(self):
+        machine = self.settings["max_bend_deg"]
+        for wire in self.design["wires"]:
+            memo = target_shape.Memo()
+            first = self.solve(wire, machine, memo)
+            bend = math.degrees(first["max_bend"])
+            self.assertLess(bend, machine - 1.0, wire["name"])  # room for a lower limit that fits
+            lower = (bend + machine) / 2
+            again = self.solve(wire, lower, memo)
+            self.assertIs(again, first)
+            self.assertEqual(memo.reused, 1)
+            cold = self.solve(wire, lower)
+            self.assertLess(np.max(np.linalg.norm(np.asarray(cold["points"]) - np.asarray(again["points"]), axis=1)),
+                            1e-5, wire["name"])
+            self.assertAlmostEqual(cold["energy"] / again["energy"], 1.0, delta=1e-8)
+            # Below the optimum's largest bend the wire is solved again and keeps the new limit.
+            tight = self.solve(wire, bend - 1.0, memo)
+            self.assertEqual(memo.reused, 1)
+            self.assertLessEqual(math.degrees(tight["max_bend"]), bend - 1.0 + 1e-4)
+
+    def test_a_second_round_reuses_every_fitting_wire_and_keeps_the_nulled_crossings(self):
+        machine = self.settings["max_bend_deg"]
+        memo = target_shape.Memo()
+        first = copy.deepcopy(self.design)
+        target_shape.run(first, self.material, self.settings, None, memo)
+        self.assertEqual(first["stages"]["target_shape"]["reused_wires"], 0)
+        bends = [math.degrees(w["max_bend"]) for _k, (_l, w) in memo.solves.items()]
+        # Pretend the first round could not realise crossing 0: the next round starts without it.
+        memo.nulled = [{"crossing": 0, "wire": "A/0", "status": "infeasible", "scale": 1.0, "message": "by hand"}]
+        second = copy.deepcopy(self.design)
+        self.assertNotEqual(second["crossings"][0]["hook"], 0)
+        target_shape.run(second, self.material, {**self.settings, "max_bend_deg": (max(bends) + machine) / 2},
+                         None, memo)
+        stage = second["stages"]["target_shape"]
+        self.assertEqual(second["crossings"][0]["hook"], 0)
+        self.assertEqual([n["message"] for n in stage["nulled_crossings"]], ["by hand"])
+        through = {w for w in second["crossings"][0]["wires"]}
+        # The wires through the nulled crossing are new problems; every other one is reused as is.
+        self.assertEqual(stage["wire_solves"], len(through))
+        self.assertEqual(stage["reused_wires"], len(second["wires"]) - len(through))
+        for w1, w2 in zip(first["wires"], second["wires"]):
+            if w1["id"] not in through:
+                self.assertEqual(w1["target"], w2["target"])
+
+
+if __name__ == "__main__":
+    unittest.main()
