@@ -146,7 +146,7 @@ def run(design, material, settings, native_progress=None):
     design["stages"]["target_shape"] = {"seconds": seconds, "iterations": iterations, "wire_solves": wire_solves,
                                         "wires": per_wire, "nulled_crossings": nulled}
     if nulled:
-        verdict = layering.recheck(design, material, settings)
+        verdict = layering.recheck(design, material, settings, native_progress)
         design["stages"]["target_shape"]["recheck_lp_solves"] = verdict["lp_solves"]
         if not verdict["stable"] and design["stable"]:
             step = design["assembly_steps"][verdict["failed_step"]]
