@@ -1,5 +1,6 @@
 """Optimize from the UI (modal operator, worker thread, timer) in a Blender with a window, run
-under Xvfb when xvfb-run is installed: completes, and Cancel leaves the scene as it was."""
+under Xvfb when xvfb-run is installed: completes, and Cancel leaves the scene as it was, also
+when it lands inside a native stage; cancelling never waits for a worker stuck in native code."""
 import json
 import os
 import shutil
@@ -22,7 +23,7 @@ class ModalOptimize(unittest.TestCase):
         proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                                 start_new_session=True)
         try:
-            out, err = proc.communicate(timeout=180)
+            out, err = proc.communicate(timeout=300)
         except subprocess.TimeoutExpired:
             os.killpg(proc.pid, signal.SIGKILL)
             out, err = proc.communicate()
@@ -50,3 +51,23 @@ class ModalOptimize(unittest.TestCase):
         self.assertTrue(self.seen["cancel_running"])
         self.assertEqual(self.seen["cancel_op"], ["FINISHED"])
         self.assertTrue(self.seen["cancel_unchanged"])
+
+
+    def test_cancel_inside_native_layering_and_forces(self):
+        for stage in ("layering", "forces"):
+            with self.subTest(stage):
+                self.assertEqual(self.seen[stage + "_invoke"], ["RUNNING_MODAL"])
+                self.assertEqual(self.seen[stage + "_cancel_op"], ["FINISHED"])
+                self.assertEqual(self.seen[stage + "_cancelled_in"], stage)  # the native poll saw it
+                self.assertTrue(self.seen[stage + "_unchanged"])
+                self.assertLess(self.seen[stage + "_cancel_seconds"], 1.0)
+
+    def test_removing_the_modal_never_waits_for_a_stuck_worker(self):
+        self.assertEqual(self.seen["stuck_invoke"], ["RUNNING_MODAL"])
+        # the worker sleeps 4 s (STUCK_SECONDS of ui_optimize_modal.py); the load waits 0.2 s
+        self.assertLess(self.seen["stuck_load_seconds"], 1.5)
+        self.assertTrue(self.seen["stuck_running_after_load"])  # the job is still cancelling
+        self.assertEqual(self.seen["stuck_status"], "wiresculpt: cancelling…")
+        self.assertGreaterEqual(self.seen["stuck_ticks"], 1)  # timers kept firing meanwhile
+        self.assertEqual(self.seen["stuck_cancelled_in"], "forces")
+        self.assertEqual(self.seen["stuck_results_in_new_scene"], 0)
