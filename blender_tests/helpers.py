@@ -1,8 +1,10 @@
-"""Shared by the Blender suites: paths, running Blender in a subprocess, small mesh writers."""
+"""Shared by the Blender suites: paths, running Blender in a subprocess, small mesh writers, a circle."""
 import math
 import os
 import subprocess
 import sys
+
+import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BATCH = os.path.join(ROOT, "scripts", "wiresculpt_batch.py")
@@ -61,3 +63,13 @@ def polyline_length(points, closed):
     n = len(points)
     edges = range(n if closed else n - 1)
     return sum(math.dist(points[i], points[(i + 1) % n]) for i in edges)
+
+
+def circle(normal, radius=0.1, n=64):
+    """n points of the circle of `radius` metres about the origin in the plane of `normal`."""
+    normal = np.asarray(normal, float)
+    u = np.cross(normal, [0.0, 0.0, 1.0] if abs(normal[2]) < 0.9 else [1.0, 0.0, 0.0])
+    u /= np.linalg.norm(u)
+    v = np.cross(normal, u)
+    t = np.linspace(0, 2 * math.pi, n, endpoint=False)
+    return radius * (np.outer(np.cos(t), u) + np.outer(np.sin(t), v))

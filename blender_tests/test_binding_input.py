@@ -1,21 +1,12 @@
 """Every binding reads its dicts and lists through one converter (native/python/convert.hpp): a
 value of the wrong type or shape is a ValueError naming its path (key and index), an unknown key
 is named with the keys that exist. One exact message per case, for each binding."""
-import math
 import unittest
 
 import numpy as np
+from helpers import circle
 
 from wiresculpt import native
-
-
-def circle(normal, n=32, radius=0.1):
-    normal = np.asarray(normal, float)
-    u = np.cross(normal, [0.0, 0.0, 1.0] if abs(normal[2]) < 0.9 else [1.0, 0.0, 0.0])
-    u /= np.linalg.norm(u)
-    v = np.cross(normal, u)
-    t = np.linspace(0, 2 * math.pi, n, endpoint=False)
-    return radius * (np.outer(np.cos(t), u) + np.outer(np.sin(t), v))
 
 
 def wire(name, normal, key="points"):
@@ -31,6 +22,11 @@ class BindingInput(unittest.TestCase):
         with self.assertRaises(ValueError) as ctx:
             call()
         self.assertEqual(str(ctx.exception), message)
+
+    def check_all(self, cases):
+        for call, message in cases:
+            with self.subTest(message):
+                self.check(call, message)
 
     def test_layering(self):
         m = native.module
@@ -54,9 +50,7 @@ class BindingInput(unittest.TestCase):
              "got 100000000000000000000"),
             (lambda: m.check_assembly([x, y], [1, "-1"], [[0, 1]]), "hooks[1]: expected an integer, got str"),
         ]
-        for call, message in cases:
-            with self.subTest(message):
-                self.check(call, message)
+        self.check_all(cases)
 
     def test_forces(self):
         m = native.module
@@ -79,9 +73,7 @@ class BindingInput(unittest.TestCase):
              "crossings[0]['hook']: expected an integer, got None"),
             (lambda: m.forces_and_rest(wires, [], [[0, 1], 2], {}), "steps[1]: expected a list, got int"),
         ]
-        for call, message in cases:
-            with self.subTest(message):
-                self.check(call, message)
+        self.check_all(cases)
 
     def test_target_shape(self):
         m = native.module
@@ -98,9 +90,7 @@ class BindingInput(unittest.TestCase):
             (lambda: m.optimize_target_shape(LINE, False, [], {"min_segment": float("inf")}),
              "options['min_segment']: expected a finite number, got inf"),
         ]
-        for call, message in cases:
-            with self.subTest(message):
-                self.check(call, message)
+        self.check_all(cases)
 
     def test_fabrication(self):
         m = native.module
@@ -118,9 +108,7 @@ class BindingInput(unittest.TestCase):
             (lambda: m.stream_program("/dev/null", [], {}, {"next_line": -1}, dry_run=True),
              "state['next_line']: expected an integer from 0 to 9223372036854775807, got -1"),
         ]
-        for call, message in cases:
-            with self.subTest(message):
-                self.check(call, message)
+        self.check_all(cases)
 
     def test_slicing(self):
         m = native.module

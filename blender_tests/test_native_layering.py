@@ -1,19 +1,10 @@
 """The layering binding from Python: results by hand on great circles, errors and cancellation."""
-import math
 import unittest
 
 import numpy as np
+from helpers import circle
 
 from wiresculpt import native
-
-
-def circle(normal, radius=0.1, n=64):
-    normal = np.asarray(normal, float)
-    u = np.cross(normal, [0.0, 0.0, 1.0] if abs(normal[2]) < 0.9 else [1.0, 0.0, 0.0])
-    u /= np.linalg.norm(u)
-    v = np.cross(normal, u)
-    t = np.linspace(0, 2 * math.pi, n, endpoint=False)
-    return radius * (np.outer(np.cos(t), u) + np.outer(np.sin(t), v))
 
 
 def wire(name, normal, **kw):
