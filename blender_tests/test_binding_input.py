@@ -39,6 +39,8 @@ class BindingInput(unittest.TestCase):
             (lambda: m.layering([x, dict(y, points=[["a", "b", "c"]])]),
              "wires[1]['points']: expected an (n, 3) array of numbers, got an array of <U1"),
             (lambda: m.layering([x, dict(y, closed=1)]), "wires[1]['closed']: expected True or False, got int"),
+            (lambda: m.layering([x, dict(y, name="Y\ud800")]),
+             "wires[1]['name']: expected a string of Unicode characters, got a str with a lone surrogate"),
             (lambda: m.layering([x, {k: v for k, v in y.items() if k != "points"}]),
              "wires[1]: the key 'points' is missing"),
             (lambda: m.layering([x, dict(y, colour="red")]),

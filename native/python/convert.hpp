@@ -88,7 +88,13 @@ inline bool to_bool(py::handle v, const std::string& where) {
 
 inline std::string to_text(py::handle v, const std::string& where) {
   if (!PyUnicode_Check(v.ptr())) wrong(where, "a string", type_name(v));
-  return py::cast<std::string>(v);
+  Py_ssize_t size = 0;
+  const char* utf8 = PyUnicode_AsUTF8AndSize(v.ptr(), &size);
+  if (!utf8) {  // lone surrogates
+    PyErr_Clear();
+    wrong(where, "a string of Unicode characters", "a str with a lone surrogate");
+  }
+  return {utf8, static_cast<std::size_t>(size)};
 }
 
 // --- containers -----------------------------------------------------------------------------------
@@ -175,7 +181,7 @@ inline std::vector<std::string> read_fields(py::handle d, const std::string& whe
   for (const auto& item : py::reinterpret_borrow<py::dict>(d)) {
     if (!PyUnicode_Check(item.first.ptr()))
       throw InputError(where + ": keys must be strings, got " + type_name(item.first) + " " + shown(item.first));
-    const std::string key = py::cast<std::string>(item.first);
+    const std::string key = to_text(item.first, where + " key");
     const auto it = std::find_if(fields.begin(), fields.end(), [&](const Field& f) { return f.key == key; });
     if (it == fields.end()) {
       std::string known;
