@@ -1,4 +1,5 @@
-"""Shared by the Blender suites: paths, running Blender in a subprocess, small mesh writers."""
+"""Shared by the Blender suites: paths, running Blender in a subprocess, small mesh writers, a
+circle, a GRBL emulator on a pseudo-terminal."""
 import json
 import math
 import os
@@ -9,6 +10,8 @@ import sys
 import threading
 import time
 import tty
+
+import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BATCH = os.path.join(ROOT, "scripts", "wiresculpt_batch.py")
@@ -177,3 +180,12 @@ class GrblEmulator:
 
     def __exit__(self, *exc):
         self.close()
+
+def circle(normal, radius=0.1, n=64):
+    """n points of the circle of `radius` metres about the origin in the plane of `normal`."""
+    normal = np.asarray(normal, float)
+    u = np.cross(normal, [0.0, 0.0, 1.0] if abs(normal[2]) < 0.9 else [1.0, 0.0, 0.0])
+    u /= np.linalg.norm(u)
+    v = np.cross(normal, u)
+    t = np.linspace(0, 2 * math.pi, n, endpoint=False)
+    return radius * (np.outer(np.cos(t), u) + np.outer(np.sin(t), v))

@@ -39,10 +39,31 @@ def lookup(design, dotted):
     return value
 
 
+def corpus(section):
+    with open(os.path.join(HERE, "bad_input.json")) as f:
+        return json.load(f)[section]
+
+
 class BadInput(unittest.TestCase):
+    def test_profile_files(self):
+        """Malformed machine-profile files: one ValueError each, naming the file and the key."""
+        from wiresculpt import native
+        from wiresculpt.core import calibration
+
+        if not native.available():
+            self.skipTest(native.LOAD_ERROR)
+        for case in corpus("profiles"):
+            with self.subTest(case["name"]), tempfile.TemporaryDirectory() as tmp:
+                path = os.path.join(tmp, "profile.json")
+                with open(path, "w", encoding=case.get("encoding", "utf-8")) as f:
+                    f.write(case["text"] if "text" in case else json.dumps(case["profile"]))
+                with self.assertRaises(ValueError) as ctx:
+                    calibration.load_profile(path)
+                self.assertEqual(str(ctx.exception), case["message"])
+                self.assertEqual(os.listdir(tmp), ["profile.json"])
+
     def test_corpus(self):
-        with open(os.path.join(HERE, "bad_input.json")) as f:
-            cases = json.load(f)["cases"]
+        cases = corpus("cases")
         for case in cases:
             with self.subTest(case["name"]), tempfile.TemporaryDirectory() as tmp:
                 for name, spec in case.get("meshes", {}).items():

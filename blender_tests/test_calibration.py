@@ -185,7 +185,7 @@ class FilesTest(unittest.TestCase):
             cal.load_profile(path)
         with open(path, "w") as f:
             json.dump({"bogus": 1}, f)
-        with self.assertRaisesRegex(ValueError, "unknown key bogus"):
+        with self.assertRaisesRegex(ValueError, "unknown key 'bogus'"):
             cal.load_profile(path)
 
 

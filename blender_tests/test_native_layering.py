@@ -1,19 +1,10 @@
 """The layering binding from Python: results by hand on great circles, errors and cancellation."""
-import math
 import unittest
 
 import numpy as np
+from helpers import circle
 
 from wiresculpt import native
-
-
-def circle(normal, radius=0.1, n=64):
-    normal = np.asarray(normal, float)
-    u = np.cross(normal, [0.0, 0.0, 1.0] if abs(normal[2]) < 0.9 else [1.0, 0.0, 0.0])
-    u /= np.linalg.norm(u)
-    v = np.cross(normal, u)
-    t = np.linspace(0, 2 * math.pi, n, endpoint=False)
-    return radius * (np.outer(np.cos(t), u) + np.outer(np.sin(t), v))
 
 
 def wire(name, normal, **kw):
@@ -54,11 +45,36 @@ class LayeringBinding(unittest.TestCase):
         self.assertIn("A", str(ctx.exception))
         self.assertIn("B", str(ctx.exception))
 
-    def test_wrong_types_are_value_errors(self):
-        for bad in ({"tolerance": "abc"}, {"max_nodes": 1.5}):
+    def test_wrong_types_are_value_errors_naming_the_key(self):
+        cases = [({"tolerance": "abc"}, "settings['tolerance']: expected a number, got str"),
+                 ({"max_nodes": 1.5}, "settings['max_nodes']: expected an integer, got float"),
+                 ({"friction": float("nan")}, "settings['friction']: expected a finite number, got nan"),
+                 ({"two_wire_steps": "yes"}, "settings['two_wire_steps']: expected True or False, got str")]
+        for bad, message in cases:
             with self.assertRaises(ValueError) as ctx:
                 native.module.layering([wire("X", [1, 0, 0]), wire("Y", [0, 1, 0])], bad)
-            self.assertIn("wrong type", str(ctx.exception))
+            self.assertEqual(str(ctx.exception), message)
+        flat = dict(wire("Y", [0, 1, 0]), points=circle([0, 1, 0])[:, :2])
+        with self.assertRaises(ValueError) as ctx:
+            native.module.layering([wire("X", [1, 0, 0]), flat])
+        self.assertEqual(str(ctx.exception),
+                         "wires[1]['points']: expected an (n, 3) array of numbers, got shape (64, 2)")
+        with self.assertRaises(ValueError) as ctx:
+            native.module.check_assembly([wire("X", [1, 0, 0]), wire("Y", [0, 1, 0])], [1, -1], [[0, "1"]])
+        self.assertEqual(str(ctx.exception), "steps[0][1]: expected an integer, got str")
+
+    def test_check_assembly_cancel(self):
+        wires = [wire("X", [1, 0, 0]), wire("Y", [0, 1, 0]), wire("Z", [0, 0, 1])]
+        r = native.module.layering(wires)
+        stages = []
+        verdict = native.module.check_assembly(wires, r["hook"], r["steps"], {},
+                                               lambda stage, fraction: stages.append(stage))
+        self.assertTrue(verdict["stable"])
+        self.assertIn("check_assembly", stages)
+        self.assertIn("network", stages)
+        with self.assertRaises(native.module.Cancelled):
+            native.module.check_assembly(wires, r["hook"], r["steps"], {},
+                                         lambda stage, fraction: stage != "check_assembly")
 
     def test_cancel(self):
         wires = [wire("X", [1, 0, 0]), wire("Y", [0, 1, 0]), wire("Z", [0, 0, 1])]

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bindings.hpp"
+#include "convert.hpp"
 #include "wiresculpt/error.hpp"
 #include "wiresculpt/fab/calibration.hpp"
 
@@ -76,11 +77,7 @@ py::array_t<double> simulate_cantilever_py(double kb, double length, double tip_
     py::gil_scoped_release release;
     rod = simulate_cantilever(kb, length, tip_load_g / kGramsPerKilogram * gravity, linear_density * gravity, segments);
   }
-  py::array_t<double> out({static_cast<py::ssize_t>(rod.size()), py::ssize_t{2}});
-  auto w = out.mutable_unchecked<2>();
-  for (py::ssize_t i = 0; i < w.shape(0); ++i)
-    for (py::ssize_t k = 0; k < 2; ++k) w(i, k) = rod[static_cast<std::size_t>(i)][k];
-  return out;
+  return to_array(rod);
 }
 
 py::dict fit_friction_py(const std::vector<double>& angles_deg, const std::optional<std::vector<int>>& lines) {

@@ -1,17 +1,17 @@
 // Fabrication: bend programs, 1:1 templates (SVG, DXF), G-code, the bend table, serial streaming.
 // Degrees and millimetres are the edge units of the profile dict; they become SI right here
 // through fab/machine.hpp's helpers (the one conversion place) before anything reaches the core.
-#include <pybind11/eigen.h>
-#include <pybind11/functional.h>
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <cctype>
 #include <exception>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "bindings.hpp"
+#include "convert.hpp"
 #include "progress.hpp"
 #include "wiresculpt/error.hpp"
 #include "wiresculpt/fab/atomic_file.hpp"
@@ -28,70 +28,41 @@ namespace wiresculpt::python {
 namespace {
 
 using namespace wiresculpt::fab;
-using Points2 = Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>;
-
-Polyline2 to_polyline(const Points2& P) {
-  Polyline2 out;
-  out.reserve(static_cast<std::size_t>(P.rows()));
-  for (Eigen::Index i = 0; i < P.rows(); ++i) out.emplace_back(P(i, 0), P(i, 1));
-  return out;
-}
-
-py::array_t<double> to_array(const Polyline2& points) {
-  py::array_t<double> out({static_cast<py::ssize_t>(points.size()), py::ssize_t{2}});
-  auto w = out.mutable_unchecked<2>();
-  for (py::ssize_t i = 0; i < w.shape(0); ++i)
-    for (py::ssize_t k = 0; k < 2; ++k) w(i, k) = points[static_cast<std::size_t>(i)][k];
-  return out;
-}
-
-char axis_letter(const py::handle& v, const std::string& key) {
-  const std::string s = py::cast<std::string>(v);
-  if (s.size() > 1) throw InputError("machine profile: '" + key + "' must be one letter, got '" + s + "'");
+char axis_letter(py::handle v, const std::string& at) {
+  const std::string s = to_text(v, at);
+  if (s.size() > 1) wrong(at, "one letter", "'" + s + "'");
   return s.empty() ? '\0' : static_cast<char>(std::toupper(static_cast<unsigned char>(s[0])));
 }
 
 /// The profile dict (edge units, every key optional) -> MachineProfile (SI).
-MachineProfile to_profile(const py::dict& d) {
+MachineProfile to_profile(py::handle d) {
   MachineProfile p;
-  for (const auto& [k, v] : d) {
-    const std::string key = py::cast<std::string>(k);
-    if (key == "name") p.name = py::cast<std::string>(v);
-    else if (key == "min_segment" || key == "min_feed") p.min_feed = py::cast<double>(v);  // metres, as design.json
-    else if (key == "max_bend_deg") p.max_bend = from_deg(py::cast<double>(v));
-    else if (key == "min_bend_deg") p.min_bend = from_deg(py::cast<double>(v));
-    else if (key == "max_commanded_deg") p.max_commanded = from_deg(py::cast<double>(v));
-    else if (key == "left_is_positive") p.left_is_positive = py::cast<bool>(v);
-    else if (key == "springback_a") p.springback_a = py::cast<double>(v);
-    else if (key == "springback_b_deg") p.springback_b = from_deg(py::cast<double>(v));
-    else if (key == "feed_speed_mm_s") p.feed_speed = from_mm(py::cast<double>(v));
-    else if (key == "bend_speed_deg_s") p.bend_speed = from_deg(py::cast<double>(v));
-    else if (key == "seconds_per_bend") p.seconds_per_bend = py::cast<double>(v);
-    else if (key == "feed_axis") p.axes.feed_axis = axis_letter(v, key);
-    else if (key == "bend_axis") p.axes.bend_axis = axis_letter(v, key);
-    else if (key == "pin_axis") p.axes.pin_axis = v.is_none() ? '\0' : axis_letter(v, key);
-    else if (key == "feed_units_per_mm") p.axes.feed_units_per_mm = py::cast<double>(v);
-    else if (key == "bend_units_per_deg") p.axes.bend_units_per_deg = py::cast<double>(v);
-    else if (key == "pin_travel") p.axes.pin_travel = py::cast<double>(v);
-    else if (key == "baud") p.serial.baud = py::cast<int>(v);
-    else if (key == "data_bits") p.serial.data_bits = py::cast<int>(v);
-    else if (key == "stop_bits") p.serial.stop_bits = py::cast<int>(v);
-    else if (key == "parity") {
-      const std::string s = py::cast<std::string>(v);
-      if (s == "none") p.serial.parity = SerialSettings::Parity::none;
-      else if (s == "odd") p.serial.parity = SerialSettings::Parity::odd;
-      else if (s == "even") p.serial.parity = SerialSettings::Parity::even;
-      else throw InputError("machine profile: parity must be 'none', 'odd' or 'even', got '" + s + "'");
-    } else if (key == "flow_control") {
-      const std::string s = py::cast<std::string>(v);
-      if (s == "none") p.serial.flow_control = SerialSettings::FlowControl::none;
-      else if (s == "xon_xoff") p.serial.flow_control = SerialSettings::FlowControl::xon_xoff;
-      else if (s == "rts_cts") p.serial.flow_control = SerialSettings::FlowControl::rts_cts;
-      else throw InputError("machine profile: flow_control must be 'none', 'xon_xoff' or 'rts_cts', got '" + s + "'");
-    } else {
-      throw InputError("machine profile: unknown key '" + key + "'");
-    }
-  }
+  auto degrees = [](double& out) {
+    return [&out](py::handle v, const std::string& at) { out = from_deg(to_number(v, at)); };
+  };
+  auto axis = [](char& out) { return [&out](py::handle v, const std::string& at) { out = axis_letter(v, at); }; };
+  read_fields(d, "profile",
+              {field::text("name", p.name), field::number("min_segment", p.min_feed),  // metres, as design.json
+               field::number("min_feed", p.min_feed), {"max_bend_deg", degrees(p.max_bend)},
+               {"min_bend_deg", degrees(p.min_bend)}, {"max_commanded_deg", degrees(p.max_commanded)},
+               field::boolean("left_is_positive", p.left_is_positive), field::number("springback_a", p.springback_a),
+               {"springback_b_deg", degrees(p.springback_b)},
+               {"feed_speed_mm_s", [&](py::handle v, const std::string& at) { p.feed_speed = from_mm(to_number(v, at)); }},
+               {"bend_speed_deg_s", degrees(p.bend_speed)}, field::number("seconds_per_bend", p.seconds_per_bend),
+               {"feed_axis", axis(p.axes.feed_axis)}, {"bend_axis", axis(p.axes.bend_axis)},
+               {"pin_axis", [&](py::handle v, const std::string& at) { p.axes.pin_axis = v.is_none() ? '\0' : axis_letter(v, at); }},
+               field::number("feed_units_per_mm", p.axes.feed_units_per_mm),
+               field::number("bend_units_per_deg", p.axes.bend_units_per_deg),
+               field::number("pin_travel", p.axes.pin_travel), field::integer("baud", p.serial.baud),
+               field::integer("data_bits", p.serial.data_bits), field::integer("stop_bits", p.serial.stop_bits),
+               field::choice("parity", p.serial.parity,
+                             {{"none", SerialSettings::Parity::none},
+                              {"odd", SerialSettings::Parity::odd},
+                              {"even", SerialSettings::Parity::even}}),
+               field::choice("flow_control", p.serial.flow_control,
+                             {{"none", SerialSettings::FlowControl::none},
+                              {"xon_xoff", SerialSettings::FlowControl::xon_xoff},
+                              {"rts_cts", SerialSettings::FlowControl::rts_cts}})});
   validate(p);
   return p;
 }
@@ -115,39 +86,27 @@ py::dict from_profile(const MachineProfile& p) {
 }
 
 /// {"name", "points" (n, 2) m, "bend_points", "crossing_points"} -> TemplateWire.
-TemplateWire to_template(const py::handle& h, std::size_t index) {
-  const py::dict d = py::cast<py::dict>(h);
-  TemplateWire w;
-  for (const auto& [k, v] : d) {
-    const std::string key = py::cast<std::string>(k);
-    if (key == "name") w.name = py::cast<std::string>(v);
-    else if (key == "points") w.points = to_polyline(py::cast<Points2>(v));
-    else if (key == "bend_points") w.bend_points = py::cast<std::vector<std::size_t>>(v);
-    else if (key == "crossing_points") w.crossing_points = py::cast<std::vector<std::size_t>>(v);
-    else throw InputError("wire " + std::to_string(index) + ": unknown key '" + key + "'");
-  }
-  return w;
-}
-
-std::vector<TemplateWire> to_templates(const py::list& wires) {
+std::vector<TemplateWire> to_templates(py::handle wires) {
   std::vector<TemplateWire> out;
-  for (std::size_t i = 0; i < wires.size(); ++i) out.push_back(to_template(wires[i], i));
+  each_item(wires, "wires", [&](py::handle item, const std::string& where) {
+    TemplateWire w;
+    read_fields(item, where,
+                {field::text("name", w.name),
+                 {"points", [&](py::handle v, const std::string& at) { w.points = to_points<2>(v, at); }},
+                 {"bend_points", [&](py::handle v, const std::string& at) { w.bend_points = to_integers<std::size_t>(v, at); }},
+                 {"crossing_points",
+                  [&](py::handle v, const std::string& at) { w.crossing_points = to_integers<std::size_t>(v, at); }}});
+    out.push_back(std::move(w));
+  });
   return out;
 }
 
-SvgOptions to_svg_options(const py::dict& d) {
+SvgOptions to_svg_options(py::handle d) {
   SvgOptions o;
-  for (const auto& [k, v] : d) {
-    const std::string key = py::cast<std::string>(k);
-    const double x = py::cast<double>(v);
-    if (key == "margin_mm") o.margin_mm = x;
-    else if (key == "stroke_mm") o.stroke_mm = x;
-    else if (key == "tick_mm") o.tick_mm = x;
-    else if (key == "crossing_radius_mm") o.crossing_radius_mm = x;
-    else if (key == "label_mm") o.label_mm = x;
-    else if (key == "sheet_width_mm") o.sheet_width_mm = x;
-    else throw InputError("SVG options: unknown key '" + key + "'");
-  }
+  read_fields(d, "options",
+              {field::number("margin_mm", o.margin_mm), field::number("stroke_mm", o.stroke_mm),
+               field::number("tick_mm", o.tick_mm), field::number("crossing_radius_mm", o.crossing_radius_mm),
+               field::number("label_mm", o.label_mm), field::number("sheet_width_mm", o.sheet_width_mm)});
   return o;
 }
 
@@ -176,9 +135,9 @@ py::dict program_dict(const BendProgram& p) {
                   py::arg("bend_vertices") = bend_vertices(p), py::arg("rebuilt") = to_array(rebuild_polyline(p)));
 }
 
-py::dict make_bend_program_py(const Points2& points, const py::dict& profile) {
+py::dict make_bend_program_py(const py::object& points, const py::object& profile) {
   const MachineProfile m = to_profile(profile);
-  const Polyline2 poly = to_polyline(points);
+  const Polyline2 poly = to_points<2>(points, "points");
   BendProgram p;
   {
     py::gil_scoped_release release;
@@ -187,8 +146,8 @@ py::dict make_bend_program_py(const Points2& points, const py::dict& profile) {
   return program_dict(p);
 }
 
-std::string write_svg(const std::optional<std::string>& path, const py::list& wires, std::optional<bool> sheet,
-                      const py::dict& options) {
+std::string write_svg(const std::optional<std::string>& path, const py::object& wires, std::optional<bool> sheet,
+                      const py::object& options) {
   const std::vector<TemplateWire> w = to_templates(wires);
   const SvgOptions o = to_svg_options(options);
   const bool as_sheet = sheet.value_or(w.size() != 1);
@@ -203,7 +162,7 @@ std::string write_svg(const std::optional<std::string>& path, const py::list& wi
   return text;
 }
 
-std::string write_dxf(const std::optional<std::string>& path, const py::list& wires, bool labels) {
+std::string write_dxf(const std::optional<std::string>& path, const py::object& wires, bool labels) {
   const std::vector<TemplateWire> w = to_templates(wires);
   std::string text;
   {
@@ -216,10 +175,10 @@ std::string write_dxf(const std::optional<std::string>& path, const py::list& wi
   return text;
 }
 
-std::string write_gcode(const std::optional<std::string>& path, const Points2& points, const py::dict& profile,
+std::string write_gcode(const std::optional<std::string>& path, const py::object& points, const py::object& profile,
                         const std::string& wire_name, const std::string& material, bool sync_each_step) {
   const MachineProfile m = to_profile(profile);
-  const Polyline2 poly = to_polyline(points);
+  const Polyline2 poly = to_points<2>(points, "points");
   std::string text;
   {
     py::gil_scoped_release release;
@@ -229,9 +188,10 @@ std::string write_gcode(const std::optional<std::string>& path, const Points2& p
   return text;
 }
 
-std::string write_bend_table(const std::optional<std::string>& path, const Points2& points, const py::dict& profile) {
+std::string write_bend_table(const std::optional<std::string>& path, const py::object& points,
+                             const py::object& profile) {
   const MachineProfile m = to_profile(profile);
-  const Polyline2 poly = to_polyline(points);
+  const Polyline2 poly = to_points<2>(points, "points");
   std::string text;
   {
     py::gil_scoped_release release;
@@ -241,7 +201,7 @@ std::string write_bend_table(const std::optional<std::string>& path, const Point
   return text;
 }
 
-py::dict stream_program_py(const std::string& port, const std::vector<std::string>& lines, const py::dict& profile,
+py::dict stream_program_py(const std::string& port, const std::vector<std::string>& lines, const py::object& profile,
                            std::optional<py::dict> state_arg, const py::object& progress, StreamControl* control,
                            bool dry_run, double response_timeout, double settle) {
   const MachineProfile m = to_profile(profile);
@@ -249,11 +209,7 @@ py::dict stream_program_py(const std::string& port, const std::vector<std::strin
   // progress into the next and skip its first lines.
   py::dict state = state_arg ? *state_arg : py::dict();
   StreamState s;
-  if (state.contains("next_line")) {
-    const long long next = py::cast<long long>(state["next_line"]);
-    if (next < 0) throw InputError("state['next_line'] must be >= 0, got " + std::to_string(next));
-    s.next_line = static_cast<std::size_t>(next);
-  }
+  if (state.contains("next_line")) s.next_line = to_integer<std::size_t>(state["next_line"], "state['next_line']");
   StreamOptions o;
   o.dry_run = dry_run;
   o.response_timeout = response_timeout;
@@ -289,6 +245,10 @@ void bind_fab(py::module_& m) {
 
   m.def("default_machine_profile", [] { return from_profile(MachineProfile{}); },
         "The default (DIWire-class) machine profile as a dict of edge units (m, deg, mm/s, deg/s).");
+  m.def("validate_machine_profile", [](const py::object& profile) { return from_profile(to_profile(profile)); },
+        py::arg("profile"),
+        "The profile dict checked (every key optional, the defaults filled in), or ValueError naming the key "
+        "at fault: an unknown key, a wrong type or a value out of range.");
   m.def("make_bend_program", &make_bend_program_py, py::arg("points"), py::arg("profile") = py::dict(),
         R"(Feeds and bends that make a 2D wire.
 

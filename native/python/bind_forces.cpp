@@ -1,17 +1,18 @@
 // Forces, rest shapes, cuts and load capacity (Sec. 4.4 and beyond): converts, releases the GIL
 // around the core work, converts back. SI units and radians, as the core.
-#include <pybind11/functional.h>
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "bindings.hpp"
+#include "convert.hpp"
 #include "progress.hpp"
 #include "wiresculpt/error.hpp"
 #include "wiresculpt/forces.hpp"
@@ -23,142 +24,101 @@ namespace py = pybind11;
 namespace wiresculpt::python {
 namespace {
 
-using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
-
-Vec3 to_vec3(const py::handle& v, const std::string& what) {
-  const Array a = py::cast<Array>(v);
-  if (a.ndim() != 1 || a.shape(0) != 3) throw InputError(what + " must be 3 numbers");
-  return {a.at(0), a.at(1), a.at(2)};
-}
-
-py::list to_list(const Vec3& v) { return py::cast(std::vector<double>{v.x(), v.y(), v.z()}); }
-
 struct Input {
   Network net;
   std::vector<int> hooks;
   std::vector<int> requested_cuts;
 };
 
-Input read_input(const py::list& wire_list, const py::list& crossing_list) {
+WireSpec to_wire(py::handle item, const std::string& where, std::size_t index, int& cut) {
+  WireSpec w;
+  Vec3 origin, normal;
+  cut = -1;
+  const auto seen = read_fields(
+      item, where,
+      {field::text("name", w.name),
+       {"origin", [&](py::handle v, const std::string& at) { origin = to_vector<3>(v, at); }},
+       {"normal", [&](py::handle v, const std::string& at) { normal = to_vector<3>(v, at); }},
+       {"target", [&](py::handle v, const std::string& at) { w.points = to_points<3>(v, at); }},
+       field::boolean("closed", w.closed),
+       {"cut", [&](py::handle v, const std::string& at) { cut = v.is_none() ? -1 : to_integer<int>(v, at); }}});
+  require_keys(seen, where, {"origin", "normal", "target"});
+  if (w.name.empty()) w.name = std::to_string(index);
+  if (w.points.size() < (w.closed ? 3u : 2u)) throw InputError("wire '" + w.name + "' has too few target points");
+  w.plane = Plane::make(origin, normal, "wire '" + w.name + "'");
+  return w;
+}
+
+Crossing to_crossing(py::handle item, const std::string& where, const Network& net, int& hook) {
+  Crossing x;
+  hook = 0;
+  auto pair = [](py::handle v, const std::string& at, const char* what) {
+    const std::vector<int> ids = to_integers<int>(v, at);
+    if (ids.size() != 2) throw InputError(at + ": expected two " + what + ", got " + std::to_string(ids.size()));
+    return std::array<int, 2>{ids[0], ids[1]};
+  };
+  const auto seen = read_fields(
+      item, where,
+      {{"wires", [&](py::handle v, const std::string& at) { x.wires = pair(v, at, "wire ids"); }},
+       {"vertices", [&](py::handle v, const std::string& at) { x.vertices = pair(v, at, "target indices"); }},
+       field::integer("hook", hook)});
+  require_keys(seen, where, {"wires", "vertices"});
+  const int P = static_cast<int>(net.wires.size());
+  for (int k = 0; k < 2; ++k) {
+    if (x.wires[k] < 0 || x.wires[k] >= P) throw InputError(where + ": wire id " + std::to_string(x.wires[k]) + " does not exist");
+    const auto& pts = net.wires[x.wires[k]].points;
+    if (x.vertices[k] < 0 || x.vertices[k] >= static_cast<int>(pts.size()))
+      throw InputError(where + ": vertex " + std::to_string(x.vertices[k]) + " is outside wire '" +
+                       net.wires[x.wires[k]].name + "''s " + std::to_string(pts.size()) + " target points");
+  }
+  if (x.wires[0] == x.wires[1]) throw InputError(where + " joins a wire to itself");
+  const Vec3 p0 = net.wires[x.wires[0]].points[x.vertices[0]];
+  const Vec3 p1 = net.wires[x.wires[1]].points[x.vertices[1]];
+  if ((p0 - p1).norm() > 1e-6)
+    throw InputError(where + ": its points on wire '" + net.wires[x.wires[0]].name + "' and wire '" +
+                     net.wires[x.wires[1]].name + "' are " + std::to_string((p0 - p1).norm() * 1000) +
+                     " mm apart; they must coincide");
+  x.point = 0.5 * (p0 + p1);
+  return x;
+}
+
+Input read_input(py::handle wire_list, py::handle crossing_list) {
   Input in;
-  for (std::size_t i = 0; i < wire_list.size(); ++i) {
-    const py::dict d = py::cast<py::dict>(wire_list[i]);
-    const std::string who = "wire " + std::to_string(i);
-    WireSpec w;
-    std::optional<Vec3> origin, normal;
-    bool have_points = false;
+  each_item(wire_list, "wires", [&](py::handle item, const std::string& at) {
     int cut = -1;
-    for (const auto& [k, v] : d) {
-      const std::string key = py::cast<std::string>(k);
-      if (key == "name") w.name = py::cast<std::string>(v);
-      else if (key == "origin") origin = to_vec3(v, who + ": origin");
-      else if (key == "normal") normal = to_vec3(v, who + ": normal");
-      else if (key == "closed") w.closed = py::cast<bool>(v);
-      else if (key == "cut") cut = v.is_none() ? -1 : py::cast<int>(v);
-      else if (key == "target") {
-        const Array a = py::cast<Array>(v);
-        if (a.ndim() != 2 || a.shape(1) != 3) throw InputError(who + ": target must be an (n, 3) array");
-        const auto r = a.unchecked<2>();
-        for (py::ssize_t p = 0; p < r.shape(0); ++p) w.points.emplace_back(r(p, 0), r(p, 1), r(p, 2));
-        have_points = true;
-      } else {
-        throw InputError(who + ": unknown key '" + key + "' (expected name, origin, normal, target, closed, cut)");
-      }
-    }
-    if (w.name.empty()) w.name = std::to_string(i);
-    if (!origin || !normal || !have_points) throw InputError("wire '" + w.name + "' needs 'origin', 'normal' and 'target'");
-    if (w.points.size() < (w.closed ? 3u : 2u)) throw InputError("wire '" + w.name + "' has too few target points");
-    w.plane = Plane::make(*origin, *normal, "wire '" + w.name + "'");
-    in.net.wires.push_back(std::move(w));
+    in.net.wires.push_back(to_wire(item, at, in.net.wires.size(), cut));
     in.requested_cuts.push_back(cut);
-  }
-  const int P = static_cast<int>(in.net.wires.size());
-  for (std::size_t c = 0; c < crossing_list.size(); ++c) {
-    const py::dict d = py::cast<py::dict>(crossing_list[c]);
-    const std::string who = "crossing " + std::to_string(c);
-    Crossing x;
+  });
+  each_item(crossing_list, "crossings", [&](py::handle item, const std::string& at) {
     int hook = 0;
-    bool have_w = false, have_v = false;
-    for (const auto& [k, v] : d) {
-      const std::string key = py::cast<std::string>(k);
-      if (key == "wires") {
-        const auto ids = py::cast<std::vector<int>>(v);
-        if (ids.size() != 2) throw InputError(who + ": 'wires' must be two wire ids");
-        x.wires = {ids[0], ids[1]};
-        have_w = true;
-      } else if (key == "vertices") {
-        const auto ids = py::cast<std::vector<int>>(v);
-        if (ids.size() != 2) throw InputError(who + ": 'vertices' must be two target indices");
-        x.vertices = {ids[0], ids[1]};
-        have_v = true;
-      } else if (key == "hook") {
-        hook = py::cast<int>(v);
-      } else {
-        throw InputError(who + ": unknown key '" + key + "' (expected wires, vertices, hook)");
-      }
-    }
-    if (!have_w || !have_v) throw InputError(who + " needs 'wires' and 'vertices'");
-    for (int k = 0; k < 2; ++k) {
-      if (x.wires[k] < 0 || x.wires[k] >= P) throw InputError(who + ": wire id " + std::to_string(x.wires[k]) + " does not exist");
-      const auto& pts = in.net.wires[x.wires[k]].points;
-      if (x.vertices[k] < 0 || x.vertices[k] >= static_cast<int>(pts.size()))
-        throw InputError(who + ": vertex " + std::to_string(x.vertices[k]) + " is outside wire '" +
-                         in.net.wires[x.wires[k]].name + "''s " + std::to_string(pts.size()) + " target points");
-    }
-    if (x.wires[0] == x.wires[1]) throw InputError(who + " joins a wire to itself");
-    const Vec3 p0 = in.net.wires[x.wires[0]].points[x.vertices[0]];
-    const Vec3 p1 = in.net.wires[x.wires[1]].points[x.vertices[1]];
-    if ((p0 - p1).norm() > 1e-6)
-      throw InputError(who + ": its points on wire '" + in.net.wires[x.wires[0]].name + "' and wire '" +
-                       in.net.wires[x.wires[1]].name + "' are " + std::to_string((p0 - p1).norm() * 1000) +
-                       " mm apart; they must coincide");
-    x.point = 0.5 * (p0 + p1);
-    in.net.crossings.push_back(x);
+    in.net.crossings.push_back(to_crossing(item, at, in.net, hook));
     in.hooks.push_back(hook);
-  }
+  });
   return in;
 }
 
-py::dict forces_and_rest_py(const py::list& wire_list, const py::list& crossing_list,
-                            const std::vector<std::vector<int>>& steps, const py::dict& material,
-                            const py::dict& settings, const py::object& progress) {
+py::dict forces_and_rest_py(const py::object& wire_list, const py::object& crossing_list, const py::object& step_list,
+                            const py::object& material, const py::object& settings, const py::object& progress) {
   Input in = read_input(wire_list, crossing_list);
+  const std::vector<std::vector<int>> steps = to_integer_lists(step_list, "steps");
   ForceOptions fo;
   RestShapeOptions ro;
   LoadCapacityOptions lo;
-  bool have_density = false;
-  for (const auto& [k, v] : material) {
-    const std::string key = py::cast<std::string>(k);
-    if (key == "bending_stiffness") ro.bending_stiffness = py::cast<double>(v);
-    else if (key == "max_torque") fo.max_torque = py::cast<double>(v);
-    else if (key == "friction") fo.friction = py::cast<double>(v);
-    else if (key == "wire_diameter") lo.wire_diameter = py::cast<double>(v);
-    else if (key == "density") {
-      lo.density = py::cast<double>(v);
-      have_density = true;
-    } else if (key == "name") {
-      // shown by the caller only
-    } else {
-      throw InputError("material: unknown key '" + key + "'");
-    }
-  }
-  for (const auto& [k, v] : settings) {
-    const std::string key = py::cast<std::string>(k);
-    if (key == "torque_fraction") fo.torque_fraction = py::cast<double>(v);
-    else if (key == "max_bend") ro.max_bend = py::cast<double>(v);
-    else if (key == "assembly_weight") fo.assembly_weight = py::cast<double>(v);
-    else if (key == "gravity") lo.gravity = py::cast<double>(v);
-    else if (key == "max_iterations") fo.max_iterations = py::cast<int>(v);
-    else if (key == "algorithm") {
-      const auto a = py::cast<std::string>(v);
-      if (a == "lp_then_slsqp") fo.algorithm = ForceAlgorithm::lp_then_slsqp;
-      else if (a == "lp") fo.algorithm = ForceAlgorithm::lp;
-      else if (a == "slsqp") fo.algorithm = ForceAlgorithm::slsqp;
-      else throw InputError("settings: algorithm must be lp_then_slsqp, lp or slsqp, not '" + a + "'");
-    } else {
-      throw InputError("settings: unknown key '" + key + "'");
-    }
-  }
+  std::string material_name;  // shown by the caller only
+  const auto given = read_fields(material, "material",
+                                 {field::number("bending_stiffness", ro.bending_stiffness),
+                                  field::number("max_torque", fo.max_torque), field::number("friction", fo.friction),
+                                  field::number("wire_diameter", lo.wire_diameter), field::number("density", lo.density),
+                                  field::text("name", material_name)});
+  const bool have_density = std::find(given.begin(), given.end(), "density") != given.end();
+  read_fields(settings, "settings",
+              {field::number("torque_fraction", fo.torque_fraction), field::number("max_bend", ro.max_bend),
+               field::number("assembly_weight", fo.assembly_weight), field::number("gravity", lo.gravity),
+               field::integer("max_iterations", fo.max_iterations),
+               field::choice("algorithm", fo.algorithm,
+                             {{"lp_then_slsqp", ForceAlgorithm::lp_then_slsqp},
+                              {"lp", ForceAlgorithm::lp},
+                              {"slsqp", ForceAlgorithm::slsqp}})});
 
   PythonProgress reporter(progress);
   const ProgressFn fn = reporter.fn();
@@ -171,13 +131,17 @@ py::dict forces_and_rest_py(const py::list& wire_list, const py::list& crossing_
     cuts = choose_cuts(in.net, in.requested_cuts);
     fr = optimize_forces(in.net, in.hooks, steps, cuts, fo, fn);
     const auto t0 = std::chrono::steady_clock::now();
-    for (int w = 0; w < static_cast<int>(in.net.wires.size()); ++w)
-      rests.push_back(rest_shape(in.net.wires[w], cuts[w], wire_loads(in.net, in.hooks, fr.forces, w), ro));
+    const std::size_t P = in.net.wires.size();
+    for (std::size_t w = 0; w < P; ++w) {
+      report_progress(fn, "rest_shape", static_cast<double>(w) / static_cast<double>(P));
+      const int wi = static_cast<int>(w);
+      rests.push_back(rest_shape(in.net.wires[w], cuts[w], wire_loads(in.net, in.hooks, fr.forces, wi), ro));
+    }
     rest_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     report_progress(fn, "rest_shape", 1.0);
     if (have_density) {
       const ForceProblem problem(in.net, in.hooks, steps, cuts, fo);
-      lc = load_capacity(in.net, cuts, problem, fr.coefficients, lo);
+      lc = load_capacity(in.net, cuts, problem, fr.coefficients, lo, fn);
     }
     return true;
   });
@@ -189,14 +153,10 @@ py::dict forces_and_rest_py(const py::list& wire_list, const py::list& crossing_
   py::list wires;
   for (std::size_t w = 0; w < rests.size(); ++w) {
     const RestShapeResult& r = rests[w];
-    py::array_t<double> rest({static_cast<py::ssize_t>(r.rest.size()), py::ssize_t{2}});
-    auto a = rest.mutable_unchecked<2>();
-    for (py::ssize_t i = 0; i < a.shape(0); ++i)
-      for (py::ssize_t k = 0; k < 2; ++k) a(i, k) = r.rest[static_cast<std::size_t>(i)][k];
     py::list over;
     for (std::size_t i = 0; i < r.over_bend.size(); ++i)
       over.append(py::dict(py::arg("vertex") = r.over_bend[i], py::arg("angle") = r.over_bend_angle[i]));
-    wires.append(py::dict(py::arg("cut") = cuts[w], py::arg("rest") = rest, py::arg("walk") = r.walk,
+    wires.append(py::dict(py::arg("cut") = cuts[w], py::arg("rest") = to_array(r.rest), py::arg("walk") = r.walk,
                           py::arg("rest_angles") = r.rest_angles, py::arg("target_angles") = r.target_angles,
                           py::arg("closure_gap") = r.closure_gap, py::arg("max_torque") = fr.wires[w].max_torque,
                           py::arg("max_torque_vertex") = fr.wires[w].max_torque_vertex,
@@ -263,7 +223,8 @@ max_out_of_plane_to_max_force}, "load_capacity": {"weight_N", "length",
 "+x", "-x", "+y", "-y", "+z", "-z" (multiples of the weight; None when unbounded), "base",
 "status", "seconds"} or None, "stats": {forces_seconds, lp_seconds, nlp_seconds, rest_seconds,
 lp_iterations, iterations, working_set_rounds, working_set_rows}, "warnings": [str]}.
-Bad input raises ValueError naming the wire or crossing.)");
+Bad input raises ValueError naming the wire, crossing or key, e.g. "material['friction']:
+expected a number, got str"; unknown keys are named too.)");
 }
 
 }  // namespace wiresculpt::python

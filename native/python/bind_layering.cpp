@@ -1,15 +1,13 @@
 // Layering (Sec. 4.2): wires -> network -> hooks, assembly order and verdict. Converts, releases
 // the GIL around the core work, converts back. SI units and radians, as the core.
-#include <pybind11/functional.h>
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
-#include <exception>
-#include <optional>
 #include <string>
 #include <vector>
 
 #include "bindings.hpp"
+#include "convert.hpp"
 #include "progress.hpp"
 #include "wiresculpt/error.hpp"
 #include "wiresculpt/layering.hpp"
@@ -21,67 +19,35 @@ namespace py = pybind11;
 namespace wiresculpt::python {
 namespace {
 
-using Points3 = py::array_t<double, py::array::c_style | py::array::forcecast>;
-
-Vec3 to_vec3(const py::handle& v, const std::string& what) {
-  const Points3 a = py::cast<Points3>(v);
-  if (a.ndim() != 1 || a.shape(0) != 3) throw InputError(what + " must be 3 numbers");
-  return {a.at(0), a.at(1), a.at(2)};
-}
-
-py::array_t<double> to_array(const Polyline3& points) {
-  py::array_t<double> out({static_cast<py::ssize_t>(points.size()), py::ssize_t{3}});
-  auto w = out.mutable_unchecked<2>();
-  for (py::ssize_t i = 0; i < w.shape(0); ++i)
-    for (py::ssize_t k = 0; k < 3; ++k) w(i, k) = points[static_cast<std::size_t>(i)][k];
-  return out;
-}
-
-py::list to_list(const Vec3& v) { return py::cast(std::vector<double>{v.x(), v.y(), v.z()}); }
-
-WireSpec to_wire(const py::handle& item, std::size_t index) {
-  const py::dict d = py::cast<py::dict>(item);
-  const std::string who = "wire " + std::to_string(index);
+WireSpec to_wire(py::handle item, const std::string& where, std::size_t index) {
   WireSpec w;
-  std::optional<Vec3> origin, normal;
-  bool have_points = false;
-  for (const auto& [k, v] : d) {
-    const std::string key = py::cast<std::string>(k);
-    if (key == "name") w.name = py::cast<std::string>(v);
-    else if (key == "origin") origin = to_vec3(v, who + ": origin");
-    else if (key == "normal") normal = to_vec3(v, who + ": normal");
-    else if (key == "closed") w.closed = py::cast<bool>(v);
-    else if (key == "points") {
-      const Points3 a = py::cast<Points3>(v);
-      if (a.ndim() != 2 || a.shape(1) != 3) throw InputError(who + ": points must be an (n, 3) array");
-      const auto r = a.unchecked<2>();
-      for (py::ssize_t i = 0; i < r.shape(0); ++i) w.points.emplace_back(r(i, 0), r(i, 1), r(i, 2));
-      have_points = true;
-    } else {
-      throw InputError(who + ": unknown key '" + key + "'");
-    }
-  }
+  Vec3 origin, normal;
+  const auto seen = read_fields(item, where,
+                                {field::text("name", w.name),
+                                 {"origin", [&](py::handle v, const std::string& at) { origin = to_vector<3>(v, at); }},
+                                 {"normal", [&](py::handle v, const std::string& at) { normal = to_vector<3>(v, at); }},
+                                 field::boolean("closed", w.closed),
+                                 {"points", [&](py::handle v, const std::string& at) { w.points = to_points<3>(v, at); }}});
+  require_keys(seen, where, {"origin", "normal", "points"});
   if (w.name.empty()) w.name = std::to_string(index);
-  if (!origin || !normal || !have_points)
-    throw InputError("wire '" + w.name + "' needs 'origin', 'normal' and 'points'");
-  w.plane = Plane::make(*origin, *normal, "wire '" + w.name + "'");
+  w.plane = Plane::make(origin, normal, "wire '" + w.name + "'");
   return w;
 }
 
-void read_settings(const py::dict& d, NetworkOptions& net, LayeringOptions& lay) {
-  for (const auto& [k, v] : d) {
-    const std::string key = py::cast<std::string>(k);
-    if (key == "tolerance") net.tolerance = py::cast<double>(v);
-    else if (key == "min_segment") net.min_segment = py::cast<double>(v);
-    else if (key == "friction") lay.contact.friction = py::cast<double>(v);
-    else if (key == "contact_angle") lay.contact.contact_angle = py::cast<double>(v);
-    else if (key == "bisector_span") lay.contact.bisector_span = py::cast<double>(v);
-    else if (key == "straight_angle") lay.contact.straight_angle = py::cast<double>(v);
-    else if (key == "two_wire_steps") lay.two_wire_steps = py::cast<bool>(v);
-    else if (key == "max_nodes") lay.max_nodes = py::cast<long>(v);
-    else if (key == "max_step_crossings") lay.max_step_crossings = py::cast<int>(v);
-    else throw InputError("layering settings: unknown key '" + key + "'");
-  }
+std::vector<WireSpec> to_wires(py::handle list) {
+  std::vector<WireSpec> wires;
+  each_item(list, "wires", [&](py::handle item, const std::string& at) { wires.push_back(to_wire(item, at, wires.size())); });
+  return wires;
+}
+
+void read_settings(py::handle d, NetworkOptions& net, LayeringOptions& lay) {
+  read_fields(d, "settings",
+              {field::number("tolerance", net.tolerance), field::number("min_segment", net.min_segment),
+               field::number("friction", lay.contact.friction), field::number("contact_angle", lay.contact.contact_angle),
+               field::number("bisector_span", lay.contact.bisector_span),
+               field::number("straight_angle", lay.contact.straight_angle),
+               field::boolean("two_wire_steps", lay.two_wire_steps), field::integer("max_nodes", lay.max_nodes),
+               field::integer("max_step_crossings", lay.max_step_crossings)});
 }
 
 py::dict network_dict(const Network& net, const std::vector<int>& hooks) {
@@ -107,9 +73,8 @@ py::dict network_dict(const Network& net, const std::vector<int>& hooks) {
                   py::arg("required_size") = net.required_size);
 }
 
-py::dict layering_py(const py::list& wire_list, const py::dict& settings, const py::object& progress) {
-  std::vector<WireSpec> wires;
-  for (std::size_t i = 0; i < wire_list.size(); ++i) wires.push_back(to_wire(wire_list[i], i));
+py::dict layering_py(const py::object& wire_list, const py::object& settings, const py::object& progress) {
+  const std::vector<WireSpec> wires = to_wires(wire_list);
   NetworkOptions net_options;
   LayeringOptions options;
   read_settings(settings, net_options, options);
@@ -118,7 +83,7 @@ py::dict layering_py(const py::list& wire_list, const py::dict& settings, const 
   const ProgressFn fn = reporter.fn();
   Network net;
   const LayeringResult r = reporter.run([&] {
-    net = build_network(wires, net_options);
+    net = build_network(wires, net_options, fn);
     return layering(net, options, fn);
   });
 
@@ -138,38 +103,24 @@ py::dict layering_py(const py::list& wire_list, const py::dict& settings, const 
                                   py::arg("nodes") = r.stats.nodes));
 }
 
-// Eq. 1 for every prefix of a given assembly: the check after a later stage changed hooks.
-py::dict check_assembly_py(const py::list& wire_list, const std::vector<int>& hooks,
-                           const std::vector<std::vector<int>>& steps, const py::dict& settings) {
-  std::vector<WireSpec> wires;
-  for (std::size_t i = 0; i < wire_list.size(); ++i) wires.push_back(to_wire(wire_list[i], i));
+py::dict check_assembly_py(const py::object& wire_list, const py::object& hook_list, const py::object& step_list,
+                           const py::object& settings, const py::object& progress) {
+  const std::vector<WireSpec> wires = to_wires(wire_list);
+  const std::vector<int> hooks = to_integers<int>(hook_list, "hooks");
+  const std::vector<std::vector<int>> steps = to_integer_lists(step_list, "steps");
   NetworkOptions net_options;
   LayeringOptions options;
   read_settings(settings, net_options, options);
-  int failed_step = -1, failed_wire = -1, lp_solves = 0;
+  PythonProgress reporter(progress);
+  const ProgressFn fn = reporter.fn();
   std::size_t crossings = 0;
-  {
-    py::gil_scoped_release release;
-    const Network net = build_network(wires, net_options);
+  const AssemblyCheck r = reporter.run([&] {
+    const Network net = build_network(wires, net_options, fn);
     crossings = net.crossings.size();
-    if (hooks.size() != crossings)
-      throw InputError("check_assembly: " + std::to_string(hooks.size()) + " hooks given for " +
-                       std::to_string(crossings) + " crossings");
-    std::vector<int> prefix;
-    for (std::size_t k = 0; k < steps.size() && failed_step < 0; ++k) {
-      prefix.insert(prefix.end(), steps[k].begin(), steps[k].end());
-      StabilityOptions check;
-      check.forces_only = k == 0 && prefix.size() == 2;  // the first pair: forces only (Sec. 4.2)
-      const StabilityResult r = check_stability(net, prefix, hooks, options.contact, check);
-      lp_solves += r.lp_solves;
-      if (!r.stable) {
-        failed_step = static_cast<int>(k);
-        failed_wire = r.failed_wire;
-      }
-    }
-  }
-  return py::dict(py::arg("stable") = failed_step < 0, py::arg("failed_step") = failed_step,
-                  py::arg("failed_wire") = failed_wire, py::arg("lp_solves") = lp_solves,
+    return check_assembly(net, hooks, steps, options.contact, fn);
+  });
+  return py::dict(py::arg("stable") = r.stable, py::arg("failed_step") = r.failed_step,
+                  py::arg("failed_wire") = r.failed_wire, py::arg("lp_solves") = r.lp_solves,
                   py::arg("crossings") = crossings);
 }
 
@@ -177,13 +128,14 @@ py::dict check_assembly_py(const py::list& wire_list, const std::vector<int>& ho
 
 void bind_layering(py::module_& m) {
   m.def("check_assembly", &check_assembly_py, py::arg("wires"), py::arg("hooks"), py::arg("steps"),
-        py::arg("settings") = py::dict(),
+        py::arg("settings") = py::dict(), py::arg("progress") = py::none(),
         R"(Stability (Eq. 1) of every prefix of an assembly with the given hooks.
 
 wires and settings as for layering(); hooks: -1, 0 or 1 per crossing of the network those wires
 form; steps: lists of wire ids added together (the first pair is judged under forces only).
 Returns {"stable", "failed_step" (-1 when stable), "failed_wire" (the wire whose unit load could
-not be balanced, -1 for the negative-sum load), "lp_solves", "crossings"}.)");
+not be balanced, -1 for the negative-sum load), "lp_solves", "crossings"}. progress(stage,
+fraction) -> False cancels (raises Cancelled).)");
 
   m.def("layering", &layering_py, py::arg("wires"), py::arg("settings") = py::dict(),
         py::arg("progress") = py::none(),
@@ -200,7 +152,8 @@ Returns {"network": {"wires": [{id, name, origin, normal, closed, points (n, 3)}
 "required_size"}, "hook": [-1|0|1 per crossing], "metric": [e_c], "assembly_order": [wire ids],
 "steps": [[ids]], "two_hand_steps": [step indices], "stable": bool, "reason": str,
 "warnings": [str], "objective": {max_metric, null_crossings, sum_metric}, "complete_search": bool,
-"stats": {seconds, lp_solves, nodes}}. Bad input raises ValueError naming the wire or key.)");
+"stats": {seconds, lp_solves, nodes}}. Bad input raises ValueError naming the wire or key, e.g.
+wires[1]['points']: expected an (n, 3) array of numbers, got shape (5, 2).)");
 }
 
 }  // namespace wiresculpt::python

@@ -3,10 +3,10 @@
 #include <pybind11/stl.h>
 
 #include <string>
-#include <tuple>
 #include <vector>
 
 #include "bindings.hpp"
+#include "convert.hpp"
 #include "wiresculpt/slicing.hpp"
 
 namespace py = pybind11;
@@ -14,24 +14,37 @@ namespace py = pybind11;
 namespace wiresculpt::python {
 namespace {
 
-using PlaneSpec = std::tuple<std::string, Vec3, Vec3>;  // name, origin, normal
+struct PlaneSpec {
+  std::string name;
+  Vec3 origin, normal;
+};
 
-py::array_t<double> to_array(const Polyline3& points) {
-  py::array_t<double> out({static_cast<py::ssize_t>(points.size()), py::ssize_t{3}});
-  auto w = out.mutable_unchecked<2>();
-  for (py::ssize_t i = 0; i < w.shape(0); ++i)
-    for (py::ssize_t k = 0; k < 3; ++k) w(i, k) = points[static_cast<std::size_t>(i)][k];
+/// planes: [(name, origin, normal)].
+std::vector<PlaneSpec> to_planes(py::handle planes) {
+  std::vector<PlaneSpec> out;
+  each_item(planes, "planes", [&](py::handle item, const std::string& where) {
+    PlaneSpec p;
+    std::size_t k = 0;
+    each_item(item, where, [&](py::handle v, const std::string& at) {
+      if (k == 0) p.name = to_text(v, at);
+      else if (k == 1) p.origin = to_vector<3>(v, at);
+      else if (k == 2) p.normal = to_vector<3>(v, at);
+      ++k;
+    });
+    if (k != 3) wrong(where, "(name, origin, normal)", std::to_string(k) + " items");
+    out.push_back(std::move(p));
+  });
   return out;
 }
 
-py::dict slice_mesh(const MatrixX3d& V, const MatrixX3i& F, const std::vector<PlaneSpec>& planes,
-                    double weld_tolerance) {
+py::dict slice_mesh(const MatrixX3d& V, const MatrixX3i& F, const py::object& plane_list, double weld_tolerance) {
+  const std::vector<PlaneSpec> planes = to_planes(plane_list);
   TriMesh mesh;
   std::vector<std::vector<Contour>> results;
   {
     py::gil_scoped_release release;
     std::vector<Plane> made;
-    for (const auto& [name, origin, normal] : planes) made.push_back(Plane::make(origin, normal, "plane " + name));
+    for (const PlaneSpec& p : planes) made.push_back(Plane::make(p.origin, p.normal, "plane " + p.name));
     mesh = prepare_mesh(V, F, MeshOptions{weld_tolerance});
     for (const Plane& p : made) results.push_back(slice(mesh, p));
   }

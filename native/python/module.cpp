@@ -23,7 +23,7 @@ PYBIND11_MODULE(_wiresculpt, m) {
       cancelled(e.what());
     } catch (const wiresculpt::InputError& e) {
       PyErr_SetString(PyExc_ValueError, e.what());
-    } catch (const py::cast_error& e) {  // a value of the wrong type in a dict or list the caller gave
+    } catch (const py::cast_error& e) {  // a fallback: convert.hpp's readers name the key themselves
       PyErr_SetString(PyExc_ValueError, (std::string("a value has the wrong type: ") + e.what()).c_str());
     } catch (const wiresculpt::Error& e) {
       PyErr_SetString(PyExc_RuntimeError, e.what());

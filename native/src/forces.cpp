@@ -365,13 +365,20 @@ struct SlsqpData {
   const ProgressFn* progress;
   int evaluations = 0;
   bool cancelled = false;
+  std::chrono::steady_clock::time_point polled = std::chrono::steady_clock::now();
 };
 
 double slsqp_objective(unsigned n, const double* z, double* grad, void* data) {
   auto* s = static_cast<SlsqpData*>(data);
-  if (++s->evaluations % 20 == 0 && s->progress && *s->progress && !(*s->progress)("forces", 0.6)) {
-    s->cancelled = true;
-    throw nlopt::forced_stop();
+  // Polled every 20 evaluations, or sooner when evaluations are slow (large C): cancel stays prompt.
+  const auto now = std::chrono::steady_clock::now();
+  if ((++s->evaluations % 20 == 0 || now - s->polled >= std::chrono::milliseconds(50)) && s->progress &&
+      *s->progress) {
+    s->polled = now;
+    if (!(*s->progress)("forces", 0.6)) {
+      s->cancelled = true;
+      throw nlopt::forced_stop();
+    }
   }
   const Eigen::Map<const Eigen::VectorXd> zv(z, n);
   const Eigen::VectorXd a = *s->N * zv;
@@ -452,6 +459,7 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
       // Name the crossings whose force no torque limits: bound every coefficient and look.
       const double cap = 1e6 * F_ref;
       lp.col_hi.assign(K, cap);
+      report_progress(progress, "forces", 0.25);  // between the two LPs
       const detail::LpSolution capped = detail::solve_lp(lp);
       std::string names;
       if (capped.status == detail::LpSolution::optimal)
@@ -614,6 +622,7 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
   // Per-wire torques, from the 3D sums (the out-of-plane part is reported too).
   r.wires.resize(net.wires.size());
   for (int w = 0; w < static_cast<int>(net.wires.size()); ++w) {
+    report_progress(progress, "forces", 0.9 + 0.1 * w / static_cast<double>(net.wires.size()));
     const RestShapeResult rs = rest_shape(net.wires[w], cuts[w], wire_loads(net, hooks, r.forces, w), RestShapeOptions{});
     r.wires[w].max_torque = rs.max_torque;
     r.wires[w].max_torque_vertex = rs.max_torque_vertex;

@@ -566,4 +566,30 @@ LayeringResult layering(const Network& net, const LayeringOptions& options, cons
   return finish();
 }
 
+AssemblyCheck check_assembly(const Network& net, const std::vector<int>& hooks,
+                             const std::vector<std::vector<int>>& steps, const ContactOptions& contact,
+                             const ProgressFn& progress) {
+  if (hooks.size() != net.crossings.size())
+    throw InputError("check_assembly: " + std::to_string(hooks.size()) + " hooks given for " +
+                     std::to_string(net.crossings.size()) + " crossings");
+  AssemblyCheck out;
+  std::vector<int> prefix;
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    report_progress(progress, "check_assembly", static_cast<double>(k) / static_cast<double>(steps.size()));
+    prefix.insert(prefix.end(), steps[k].begin(), steps[k].end());
+    StabilityOptions check;
+    check.forces_only = k == 0 && prefix.size() == 2;  // the first pair: forces only (Sec. 4.2)
+    const StabilityResult r = check_stability(net, prefix, hooks, contact, check);
+    out.lp_solves += r.lp_solves;
+    if (!r.stable) {
+      out.failed_step = static_cast<int>(k);
+      out.failed_wire = r.failed_wire;
+      return out;
+    }
+  }
+  report_progress(progress, "check_assembly", 1.0);
+  out.stable = true;
+  return out;
+}
+
 }  // namespace wiresculpt

@@ -11,7 +11,8 @@
 namespace wiresculpt {
 
 LoadCapacityResult load_capacity(const Network& net, const std::vector<int>& cuts, const ForceProblem& problem,
-                                 const Eigen::VectorXd& a0, const LoadCapacityOptions& options) {
+                                 const Eigen::VectorXd& a0, const LoadCapacityOptions& options,
+                                 const ProgressFn& progress) {
   const auto start = std::chrono::steady_clock::now();
   auto positive = [](double v) { return std::isfinite(v) && v > 0; };
   if (!positive(options.wire_diameter)) throw InputError("wire_diameter must be a finite number of metres > 0");
@@ -68,6 +69,7 @@ LoadCapacityResult load_capacity(const Network& net, const std::vector<int>& cut
 
   const char* names[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
   for (int dir = 0; dir < 6; ++dir) {
+    report_progress(progress, "load_capacity", dir / 6.0);
     LoadDirection ld;
     ld.name = names[dir];
     ld.gravity = Vec3::Zero();
@@ -151,6 +153,7 @@ LoadCapacityResult load_capacity(const Network& net, const std::vector<int>& cut
     out.directions.push_back(ld);
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report_progress(progress, "load_capacity", 1.0);
   return out;
 }
 

@@ -239,19 +239,27 @@ std::vector<int> Network::crossings_of(int wire) const {
   return out;
 }
 
-Network build_network(const std::vector<WireSpec>& input, const NetworkOptions& options) {
+Network build_network(const std::vector<WireSpec>& input, const NetworkOptions& options, const ProgressFn& progress) {
   if (!(options.tolerance > 0) || !std::isfinite(options.tolerance))
     throw InputError("network tolerance must be a positive number of metres");
   if (!(options.min_segment >= 0) || !std::isfinite(options.min_segment))
     throw InputError("min_segment must be a non-negative number of metres");
   const double tol = options.tolerance;
   Network net;
-  for (const auto& w : input) net.wires.push_back(clean_wire(w, tol));
-  const int P = static_cast<int>(net.wires.size());
+  const int P = static_cast<int>(input.size());
+  // Progress: one step per wire cleaned, per pair of wires met, per wire the crossings go into.
+  const double work = 2.0 * P + 0.5 * P * (P - 1.0) + 1.0;
+  double done = 0.0;
+  auto step = [&] { report_progress(progress, "network", done++ / work); };
+  for (const auto& w : input) {
+    step();
+    net.wires.push_back(clean_wire(w, tol));
+  }
 
   std::vector<RawCrossing> raw;
   for (int i = 0; i < P; ++i)
     for (int j = i + 1; j < P; ++j) {
+      step();
       const WireSpec& wi = net.wires[i];
       const WireSpec& wj = net.wires[j];
       const Vec3 cr = wi.plane.normal.cross(wj.plane.normal);
@@ -330,6 +338,7 @@ Network build_network(const std::vector<WireSpec>& input, const NetworkOptions& 
 
   // Insert the crossings as vertices of both wires.
   for (int w = 0; w < P; ++w) {
+    step();
     WireSpec& wire = net.wires[w];
     const int n = static_cast<int>(wire.points.size());
     std::map<int, int> at_vertex;                              // old vertex -> crossing
@@ -417,6 +426,7 @@ Network build_network(const std::vector<WireSpec>& input, const NetworkOptions& 
     }
   }
   net.required_size = net.size * net.min_scale;
+  report_progress(progress, "network", 1.0);
   return net;
 }
 

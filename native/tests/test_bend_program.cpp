@@ -266,3 +266,32 @@ TEST_CASE("bend program: absurd lengths are refused before anything overflows", 
   CHECK_THROWS_WITH(wiresculpt::fab::make_bend_program(huge, wiresculpt::fab::MachineProfile{}),
                     Contains("segment 0") && Contains("not in metres"));
 }
+
+TEST_CASE("machine profile: huge values are refused, naming the profile's key", "[fab][bend_program]") {
+  const MachineProfile m;
+  CHECK_NOTHROW(validate(m));
+  MachineProfile bad = m;
+  bad.min_feed = 1e300;  // a hand-edited file's 1e300 m
+  CHECK_THROWS_WITH(validate(bad), Contains("min_segment") && Contains("at most 1 m"));
+  bad = m;
+  bad.max_bend = from_deg(720.0);
+  CHECK_THROWS_WITH(validate(bad), Contains("max_bend_deg") && Contains("180 deg"));
+  bad = m;
+  bad.springback_b = from_deg(-1e9);
+  CHECK_THROWS_WITH(validate(bad), Contains("springback_b_deg"));
+  bad = m;
+  bad.feed_speed = 1e12;
+  CHECK_THROWS_WITH(validate(bad), Contains("feed_speed_mm_s"));
+  bad = m;
+  bad.axes.feed_units_per_mm = 1e7;
+  CHECK_THROWS_WITH(validate(bad), Contains("feed_units_per_mm"));
+  bad = m;
+  bad.serial.baud = 2000000000;
+  CHECK_THROWS_WITH(validate(bad), Contains("baud"));
+  bad = m;  // the largest values allowed pass
+  bad.min_feed = 1.0;
+  bad.max_bend = from_deg(180.0);
+  bad.max_commanded = from_deg(360.0);
+  bad.serial.baud = 10000000;
+  CHECK_NOTHROW(validate(bad));
+}

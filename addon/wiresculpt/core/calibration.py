@@ -299,38 +299,43 @@ def with_springback(profile, fit, source=""):
     return out
 
 
+FILE_MARKERS = ("format", "version")  # written by save_profile, dropped by load_profile
+PROFILE_FILE_KEYS = FILE_MARKERS + ("springback_fit",)  # in the file, not machine settings
+
+
 def validate_profile(profile, where="machine profile"):
-    """The profile, checked by the native module (ValueError naming the key at fault)."""
+    """The profile, checked by the native module: ValueError naming the key at fault (an unknown
+    key, a wrong type, a value out of range), prefixed with `where`."""
     if not isinstance(profile, dict):
         raise ValueError(f"{where}: expected a JSON object")
-    unknown = [k for k in profile if k not in PROFILE_KEYS and k not in ("format", "version", "springback_fit")]
-    if unknown:
-        raise ValueError(f"{where}: unknown key{'s' if len(unknown) > 1 else ''} {', '.join(unknown)}")
     try:
-        _native().make_bend_program(np.array([[0.0, 0.0], [0.05, 0.0]]), machine_dict(profile))
-    except (ValueError, TypeError) as exc:
+        _native().validate_machine_profile({k: v for k, v in profile.items() if k not in PROFILE_FILE_KEYS})
+    except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None
     return profile
 
 
 def save_profile(profile, path):
-    p = {k: v for k, v in profile.items() if k not in ("format", "version")}
+    p = {k: v for k, v in profile.items() if k not in FILE_MARKERS}
     validate_profile(p)
     write_atomic(path, json.dumps({"format": PROFILE_FORMAT, "version": 1, **p}, indent=2) + "\n")
     return path
 
 
 def load_profile(path):
-    """The default profile updated by the file's keys (a file may give only some)."""
+    """The default profile updated by the file's keys (a file may give only some). ValueError
+    starting with the file's name when it is not JSON, not an object, or a key is at fault."""
     try:
         with open(path, encoding="utf-8") as f:
             data = json.load(f)
     except json.JSONDecodeError as exc:
         raise ValueError(f"{os.path.basename(path)}: not JSON (line {exc.lineno}: {exc.msg})") from None
+    except UnicodeDecodeError:
+        raise ValueError(f"{os.path.basename(path)}: not a UTF-8 text (JSON) file") from None
     if not isinstance(data, dict):
         raise ValueError(f"{os.path.basename(path)}: expected a JSON object")
     profile = default_profile()
-    profile.update({k: v for k, v in data.items() if k not in ("format", "version")})
+    profile.update({k: v for k, v in data.items() if k not in FILE_MARKERS})
     return validate_profile(profile, os.path.basename(path))
 
 

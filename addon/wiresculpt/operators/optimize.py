@@ -5,7 +5,13 @@ operator with a timer: progress in the panel and the status bar, Esc or Cancel s
 leaves the scene exactly as before. Nothing is written to the scene until the solver is done,
 and then in the modal's last step, so one Undo removes the whole result. In background mode
 (batch, tests) there is no event loop and execute() solves inline.
+
+Cancelling never freezes Blender: it signals the worker (every native stage polls the signal
+between steps), waits at most JOIN_SECONDS, and if the worker is still inside a native step the
+job stays "cancelling…" (the modal, or after Blender removed the modal a timer, polls it) until
+the worker ends; its result is then dropped, so nothing of a cancelled run reaches the scene.
 """
+import functools
 import threading
 import time
 
@@ -14,9 +20,10 @@ import bpy
 from .. import cut_handles, mesh_data, native, pipeline, scene_results
 from ..core.design import new_design, wire_entry
 from ..props import material_of, solver_settings
-from .progress import WorkerModal
+from .progress import TIMER_SECONDS, WorkerModal
 from .slicing import handle_plane, handles, target_problem
 
+JOIN_SECONDS = 0.2  # the longest a cancel waits for the worker in Blender's UI thread
 STAGE_LABELS = {"slicing": "Slicing", "layering": "Layering", "target_shape": "Target shape",
                 "forces": "Forces", "rest_shape": "Rest shape", "writing": "Writing results"}
 
@@ -121,6 +128,12 @@ class Job:
         except Exception as exc:  # a bug of ours: reported, never raised into Blender's UI thread
             self.error = f"internal error ({type(exc).__name__}: {exc}); please report it"
 
+    def stop(self, timeout=JOIN_SECONDS):
+        """Asks the worker to stop and waits at most `timeout` seconds; True when it has ended."""
+        self.cancel_event.set()
+        self.thread.join(timeout)
+        return not self.thread.is_alive()
+
     def status(self):
         label = STAGE_LABELS.get(self.stage, self.stage)
         if self.cancel_event.is_set():
@@ -134,6 +147,40 @@ JOB = None  # the Job while an Optimize runs in the UI, else None
 
 def running():
     return JOB is not None
+
+
+def _redraw_3d_views():
+    for window in bpy.context.window_manager.windows:
+        for area in (window.screen.areas if window.screen else []):
+            if area.type == 'VIEW_3D':
+                area.tag_redraw()
+
+
+def _wait_for_worker(job):
+    """A timer after the modal is gone: polls the cancelled job until its worker ends, then
+    drops it (its result is never written)."""
+    global JOB
+    if job.thread.is_alive():
+        return TIMER_SECONDS
+    if JOB is job:
+        JOB = None
+    try:
+        _redraw_3d_views()
+    except (AttributeError, ReferenceError):  # no window (closing, background)
+        pass
+    return None
+
+
+def _abandon(job):
+    """Cancels `job` without waiting for it: the worker is left to end on its own (the panel
+    says cancelling… meanwhile) and is then dropped by a timer."""
+    global JOB
+    if job.stop():
+        if JOB is job:
+            JOB = None
+        return
+    bpy.app.timers.register(functools.partial(_wait_for_worker, job), first_interval=TIMER_SECONDS,
+                            persistent=True)
 
 
 # --- operators --------------------------------------------------------------------------------
@@ -198,9 +245,8 @@ class WIRESCULPT_OT_optimize(WorkerModal, bpy.types.Operator):
             return self._modal(context, event)
         except Exception as exc:  # never leave a half-finished modal behind in the UI
             if JOB is not None:
-                JOB.cancel_event.set()
-                JOB.thread.join()
-                self._cleanup(context)
+                self.end_watch(context)
+                _abandon(JOB)
             self.report({'ERROR'}, f"Optimize failed: internal error ({type(exc).__name__}: {exc}); "
                                    "the scene is unchanged")
             return {'CANCELLED'}
@@ -210,7 +256,7 @@ class WIRESCULPT_OT_optimize(WorkerModal, bpy.types.Operator):
         if job is None:  # cancelled from outside and already cleaned up
             return {'CANCELLED'}
         if event.type == 'ESC' and event.value == 'PRESS':
-            job.cancel_event.set()
+            job.stop()  # the next timer tick finishes the modal once the worker has ended
             self._show(context)
             return {'RUNNING_MODAL'}
         if event.type == 'Z' and (event.ctrl or event.oskey):
@@ -237,9 +283,11 @@ class WIRESCULPT_OT_optimize(WorkerModal, bpy.types.Operator):
     def cancel(self, context):  # Blender closes the window or the file under the modal
         job = JOB
         if job is not None:
-            job.cancel_event.set()
-            job.thread.join()
-            self._cleanup(context)
+            try:
+                self.end_watch(context)
+            except (AttributeError, ReferenceError, RuntimeError):  # the window is going away
+                pass
+            _abandon(job)
 
 
 class WIRESCULPT_OT_optimize_cancel(bpy.types.Operator):
@@ -252,7 +300,7 @@ class WIRESCULPT_OT_optimize_cancel(bpy.types.Operator):
         if JOB is None:
             self.report({'INFO'}, "Nothing to cancel: no Optimize is running")
             return {'CANCELLED'}
-        JOB.cancel_event.set()
+        JOB.stop()  # the Optimize modal finishes once the worker has ended
         self.report({'INFO'}, "Cancelling Optimize…")
         return {'FINISHED'}
 

@@ -53,9 +53,9 @@ def run(design, material, settings, native_progress=None):
             f"({stats['seconds']:.3f} s)")
 
 
-def recheck(design, material, settings):
+def recheck(design, material, settings, native_progress=None):
     """Eq. 1 for every prefix of the design's assembly with its current hooks (after a later
-    stage nulled crossings). Returns the native verdict dict."""
+    stage nulled crossings). Returns the native verdict dict; `native_progress` as for run()."""
     hooks = [c["hook"] for c in design["crossings"]]
     return native.require().check_assembly(wire_specs(design), hooks, design["assembly_steps"],
-                                            settings_for(material, settings))
+                                            settings_for(material, settings), native_progress)

@@ -213,7 +213,7 @@ def run(design, material, settings, native_progress=None, memo=None):
     if memo is not None:
         memo.nulled = [dict(n) for n in nulled]
     if nulled:
-        verdict = layering.recheck(design, material, settings)
+        verdict = layering.recheck(design, material, settings, native_progress)
         design["stages"]["target_shape"]["recheck_lp_solves"] = verdict["lp_solves"]
         if not verdict["stable"] and design["stable"]:
             step = design["assembly_steps"][verdict["failed_step"]]

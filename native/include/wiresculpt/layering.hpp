@@ -98,4 +98,23 @@ struct LayeringResult {
 /// invalid options.
 LayeringResult layering(const Network& net, const LayeringOptions& options = {}, const ProgressFn& progress = {});
 
+/// The verdict of Eq. 1 for every prefix of a given assembly.
+struct AssemblyCheck {
+  bool stable = false;
+  int failed_step = -1;  ///< index into `steps` of the first unstable prefix; -1 when stable
+  /// The wire whose unit load could not be balanced in that prefix (-1 when stable or when the
+  /// failing load was the negative sum of the basis loads).
+  int failed_wire = -1;
+  long lp_solves = 0;  ///< GLPK simplex calls
+};
+
+/// Eq. 1 for every prefix of the assembly `steps` (lists of wire ids added together) under
+/// `hooks` (one of -1, 0, 1 per crossing of `net`): the check after a later stage changed
+/// hooks. The first pair is judged under forces only (Sec. 4.2). Reports progress as stage
+/// "check_assembly" once per step and honours cancellation (throws Cancelled). Throws
+/// InputError for a wrong number of hooks or a bad wire id (check_stability's messages).
+AssemblyCheck check_assembly(const Network& net, const std::vector<int>& hooks,
+                             const std::vector<std::vector<int>>& steps, const ContactOptions& contact = {},
+                             const ProgressFn& progress = {});
+
 }  // namespace wiresculpt

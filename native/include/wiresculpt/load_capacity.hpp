@@ -57,8 +57,10 @@ struct LoadCapacityResult {
 
 /// Load capacity of the sculpture `net` (target shapes) with hooks, cuts and the pre-stress
 /// coefficients `a0` of `problem` (the ForceProblem optimize_forces solved; a0 has
-/// problem.columns() entries). Throws InputError for bad options or sizes.
+/// problem.columns() entries). Throws InputError for bad options or sizes. Reports progress as
+/// stage "load_capacity" before each direction's LP and honours cancellation (throws Cancelled).
 LoadCapacityResult load_capacity(const Network& net, const std::vector<int>& cuts, const ForceProblem& problem,
-                                 const Eigen::VectorXd& a0, const LoadCapacityOptions& options = {});
+                                 const Eigen::VectorXd& a0, const LoadCapacityOptions& options = {},
+                                 const ProgressFn& progress = {});
 
 }  // namespace wiresculpt

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "wiresculpt/geometry.hpp"
+#include "wiresculpt/progress.hpp"
 
 namespace wiresculpt {
 
@@ -80,6 +81,9 @@ struct Network {
 ///   its first has the repeat dropped.
 /// Throws InputError naming the wire for too few points, non-finite coordinates or points
 /// farther than `tolerance` from the wire's plane.
-Network build_network(const std::vector<WireSpec>& wires, const NetworkOptions& options = {});
+/// Reports progress as stage "network" once per pair of wires and once per wire, and honours
+/// cancellation (throws Cancelled).
+Network build_network(const std::vector<WireSpec>& wires, const NetworkOptions& options = {},
+                      const ProgressFn& progress = {});
 
 }  // namespace wiresculpt
