@@ -6,6 +6,8 @@
 #include <limits>
 #include <numbers>
 #include <random>
+#include <set>
+#include <utility>
 
 #include "wire_fixtures.hpp"
 #include "wiresculpt/contact.hpp"
@@ -395,6 +397,27 @@ TEST_CASE("forces: the 3D polytope lies inside the ball and touches it at +-n", 
   CHECK(highest <= 1 + 1e-12);
   CHECK(lowest >= 1 - poly.gap - 1e-12);
   CHECK(lowest < 1 - 0.5 * poly.gap);  // the gap is real: some direction falls short of the ball
+  // The lazy loop (rows added as solutions violate them) reaches the same support from a box
+  // much larger than the ball, with a torque that is an affine map of the columns.
+  Eigen::Matrix3d A;
+  A << 0.5, 0.2, 0.0, -0.1, 1.0, 0.3, 0.0, 0.4, 2.0;
+  const Vec3 c0(0.1, -0.2, 0.05);
+  detail::TorqueBlocks blocks{A, c0};
+  for (int i = 0; i < 50; ++i) {
+    const Vec3 d = Vec3(normal(rng), normal(rng), normal(rng)).normalized();
+    detail::LinearProgram lp;
+    const Vec3 obj = A.transpose() * d;  // maximise d·t(x)
+    lp.obj = {obj.x(), obj.y(), obj.z()};
+    lp.col_lo.assign(3, -100.0);
+    lp.col_hi.assign(3, 100.0);
+    std::set<std::pair<int, int>> added;
+    int rounds = 0;
+    const detail::LpSolution sol = detail::solve_lp_with_torque_rows(lp, blocks, poly, t_max, added, &rounds);
+    REQUIRE(sol.status == detail::LpSolution::optimal);
+    CHECK(sol.objective + d.dot(c0) == Approx(support(poly, d)).epsilon(1e-9));
+    CHECK(rounds >= 2);
+    CHECK(added.size() < 60);  // a few of the 180 rows
+  }
   // Finer polytopes close the gap; every facet's neighbours share a vertex with it.
   CHECK(geodesic_polytope(4).gap < poly.gap);
   CHECK(geodesic_polytope(4).rows.size() == 320);
