@@ -51,6 +51,14 @@ class ForcesStageTest(unittest.TestCase):
             self.assertGreaterEqual(d["stages"][stage]["seconds"], 0.0)
         self.assertLess(d["stages"]["forces"]["equilibrium_residual"], 1e-9)
         self.assertTrue(d["stages"]["forces"]["torque_active"])
+        # The paper's 3D bound |t_v| <= t_max (docs/method-forces.md §3): every wire's 3D torque
+        # is within t_max, and the LP took its polytope's rows in more than one solve.
+        self.assertEqual(d["stages"]["forces"]["torque_bound"], "3d")
+        self.assertGreaterEqual(d["stages"]["forces"]["lp_rounds"], 2)
+        t_max = d["stages"]["forces"]["t_max"]
+        for w in d["wires"]:
+            self.assertLessEqual(w["max_torque_3d"], t_max * (1 + 1e-7), w["name"])
+        self.assertFalse([m for m in d.get("warnings", []) if "twist together reach" in m], d.get("warnings"))
         self.assertAlmostEqual(d["stages"]["forces"]["t_max"], d["material"]["max_torque"] * d["torque_fraction"])
         lines = [line for line in self.batch.stdout.splitlines() if line.startswith("wiresculpt:")]
         self.assertTrue(any(line.startswith("wiresculpt: forces:") for line in lines), lines)

@@ -115,10 +115,13 @@ py::dict forces_and_rest_py(const py::object& wire_list, const py::object& cross
               {field::number("torque_fraction", fo.torque_fraction), field::number("max_bend", ro.max_bend),
                field::number("assembly_weight", fo.assembly_weight), field::number("gravity", lo.gravity),
                field::integer("max_iterations", fo.max_iterations),
+               field::choice("torque_bound", fo.torque_bound,
+                             {{"3d", TorqueBound::full_3d}, {"in_plane", TorqueBound::in_plane}}),
                field::choice("algorithm", fo.algorithm,
                              {{"lp_then_slsqp", ForceAlgorithm::lp_then_slsqp},
                               {"lp", ForceAlgorithm::lp},
                               {"slsqp", ForceAlgorithm::slsqp}})});
+  lo.torque_bound = fo.torque_bound;  // load capacity holds the same bound as the forces
 
   PythonProgress reporter(progress);
   const ProgressFn fn = reporter.fn();
@@ -178,19 +181,24 @@ py::dict forces_and_rest_py(const py::object& wire_list, const py::object& cross
     d["base"] = base;
     d["status"] = status;
     d["seconds"] = lc->seconds;
+    int rounds = 0;
+    for (const LoadDirection& ld : lc->directions) rounds += ld.lp_rounds;
+    d["lp_rounds"] = rounds;
     load = d;
   }
   py::dict summary(py::arg("g_stb") = fr.g_stb, py::arg("g_asm") = fr.g_asm,
                    py::arg("assembly_residual") = fr.assembly_residual,
                    py::arg("equilibrium_residual") = fr.equilibrium_residual, py::arg("t_max") = fr.t_max,
-                   py::arg("torque_active") = fr.torque_active, py::arg("method") = fr.method,
+                   py::arg("torque_active") = fr.torque_active,
+                   py::arg("torque_bound") = torque_bound_name(fr.torque_bound), py::arg("method") = fr.method,
                    py::arg("nlopt_result") = fr.nlopt_result, py::arg("mean_out_of_plane") = fr.mean_out_of_plane,
                    py::arg("max_out_of_plane") = fr.max_out_of_plane,
                    py::arg("mean_out_of_plane_to_max_force") = fr.mean_out_of_plane_to_max_force,
                    py::arg("max_out_of_plane_to_max_force") = fr.max_out_of_plane_to_max_force);
   py::dict stats(py::arg("forces_seconds") = fr.seconds, py::arg("lp_seconds") = fr.lp_seconds,
                  py::arg("nlp_seconds") = fr.nlp_seconds, py::arg("rest_seconds") = rest_seconds,
-                 py::arg("lp_iterations") = fr.lp_iterations, py::arg("iterations") = fr.iterations,
+                 py::arg("lp_iterations") = fr.lp_iterations, py::arg("lp_rounds") = fr.lp_rounds,
+                 py::arg("iterations") = fr.iterations,
                  py::arg("working_set_rounds") = fr.working_set_rounds,
                  py::arg("working_set_rows") = fr.working_set_rows);
   return py::dict(py::arg("crossings") = crossings, py::arg("wires") = wires, py::arg("forces") = summary,
@@ -211,18 +219,19 @@ steps: the assembly, lists of wire ids (G_asm; may be empty);
 material: {"bending_stiffness" N m^2, "max_torque" N m, "friction", "wire_diameter" m,
 "density" kg/m^3 (without it no load capacity), "name" (ignored)};
 settings: {"torque_fraction" (1), "max_bend" rad (2pi/3), "assembly_weight" (0.05),
-"algorithm" ("lp_then_slsqp" | "lp" | "slsqp"), "gravity" m/s^2 (9.81), "max_iterations"}.
+"algorithm" ("lp_then_slsqp" | "lp" | "slsqp"), "gravity" m/s^2 (9.81), "max_iterations",
+"torque_bound" ("3d": |t_v| <= t_max, default | "in_plane": its plane-normal part only)}.
 progress(stage, fraction) -> False cancels (raises Cancelled).
 Returns {"crossings": [{"force": [3] N on wires[0] by wires[1], "normal": N, "out_of_plane":
 (share on wires[0], on wires[1])}], "wires": [{"cut", "rest": (m, 2) metres in the plane frame,
 "walk", "rest_angles", "target_angles" (rad, per rest point), "closure_gap" m, "max_torque" N m,
 "max_torque_vertex", "max_out_of_plane_torque" N m, "max_torque_3d" N m, "over_bend": [{"vertex", "angle"}]}],
 "forces": {g_stb, g_asm, assembly_residual, equilibrium_residual, t_max, torque_active, method,
-nlopt_result, mean_out_of_plane, max_out_of_plane, mean_out_of_plane_to_max_force,
+torque_bound, nlopt_result, mean_out_of_plane, max_out_of_plane, mean_out_of_plane_to_max_force,
 max_out_of_plane_to_max_force}, "load_capacity": {"weight_N", "length",
 "+x", "-x", "+y", "-y", "+z", "-z" (multiples of the weight; None when unbounded), "base",
-"status", "seconds"} or None, "stats": {forces_seconds, lp_seconds, nlp_seconds, rest_seconds,
-lp_iterations, iterations, working_set_rounds, working_set_rows}, "warnings": [str]}.
+"status", "seconds", "lp_rounds"} or None, "stats": {forces_seconds, lp_seconds, nlp_seconds,
+rest_seconds, lp_iterations, lp_rounds, iterations, working_set_rounds, working_set_rows}, "warnings": [str]}.
 Bad input raises ValueError naming the wire, crossing or key, e.g. "material['friction']:
 expected a number, got str"; unknown keys are named too.)");
 }

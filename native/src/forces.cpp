@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <nlopt.hpp>
+#include <set>
 #include <string>
 
 #include "glpk_guard.hpp"
@@ -32,6 +33,9 @@ void validate(const ForceOptions& o) {
   if (!std::isfinite(o.assembly_weight) || o.assembly_weight < 0)
     throw InputError("assembly_weight must be a finite number >= 0");
   if (o.max_iterations < 1) throw InputError("max_iterations must be at least 1");
+  if (!(o.working_set_margin >= 0) || !(o.working_set_margin_3d >= 0) || !std::isfinite(o.working_set_margin) ||
+      !std::isfinite(o.working_set_margin_3d))
+    throw InputError("working_set_margin and working_set_margin_3d must be finite numbers >= 0");
   if (!finite_pos(o.ftol_rel) || !finite_pos(o.xtol_rel) || !finite_pos(o.constraint_tol))
     throw InputError("ftol_rel, xtol_rel and constraint_tol must be finite numbers > 0");
 }
@@ -271,6 +275,7 @@ ForceProblem::ForceProblem(const Network& net, const std::vector<int>& hooks,
   if (!(L_ > 1e-9)) L_ = 1.0;
   t_max_ = options.max_torque * options.torque_fraction;
   w_ = options.assembly_weight * L_ / t_max_;
+  bound_ = options.torque_bound;
 
   // M (6P × K) and the normal weights.
   M_ = Eigen::MatrixXd::Zero(6 * P, K);
@@ -291,11 +296,13 @@ ForceProblem::ForceProblem(const Network& net, const std::vector<int>& hooks,
     c_(j) = 2.0 * nk;
   }
 
-  // Torque rows: walk each wire from its cut; row v holds n·Σ_{k after v} (x_v - x_k) × b_j.
+  // Torque rows: walk each wire from its cut; row v holds n·Σ_{k after v} (x_v - x_k) × b_j,
+  // and the frame rows its components along n, u and v.
   std::vector<std::vector<std::array<int, 2>>> on_wire(P);  // (column start, side) per hooked crossing
   for (int h = 0; h < static_cast<int>(hooked.size()); ++h)
     for (int k = 0; k < 2; ++k) on_wire[net.crossings[hooked[h]].wires[k]].push_back({4 * h, k});
   std::vector<Eigen::RowVectorXd> rows;
+  std::vector<Eigen::MatrixXd> frame_rows;
   for (int w = 0; w < P; ++w) {
     const WireSpec& s = net.wires[w];
     const int n = static_cast<int>(s.points.size());
@@ -305,6 +312,7 @@ ForceProblem::ForceProblem(const Network& net, const std::vector<int>& hooks,
     const int last = static_cast<int>(walk.size()) - (s.closed ? 1 : 0);  // the repeated cut has no tail
     for (int v = 0; v < last; ++v) {
       Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(K);
+      Eigen::MatrixXd frame = Eigen::MatrixXd::Zero(3, K);
       const Vec3& xv = s.points[walk[v]];
       for (const auto& [col, side] : on_wire[w]) {
         const int c = column_crossing_[col];
@@ -313,15 +321,22 @@ ForceProblem::ForceProblem(const Network& net, const std::vector<int>& hooks,
         const Vec3 lever = xv - s.points[vk];
         for (int j = 0; j < 4; ++j) {
           const Vec3 f = side == 0 ? pyramid_[c][j] : Vec3(-pyramid_[c][j]);
-          row(col + j) = lever.cross(f).dot(s.plane.normal);
+          const Vec3 t = lever.cross(f);
+          row(col + j) = t.dot(s.plane.normal);
+          frame.col(col + j) << row(col + j), t.dot(s.plane.u), t.dot(s.plane.v);
         }
       }
       rows.push_back(row);
+      frame_rows.push_back(frame);
       torque_vertex_.push_back({w, walk[v]});
     }
   }
   T_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), K);
-  for (std::size_t r = 0; r < rows.size(); ++r) T_.row(static_cast<Eigen::Index>(r)) = rows[r];
+  T3_ = Eigen::MatrixXd::Zero(3 * static_cast<Eigen::Index>(rows.size()), K);
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    T_.row(static_cast<Eigen::Index>(r)) = rows[r];
+    T3_.middleRows(3 * static_cast<Eigen::Index>(r), 3) = frame_rows[r];
+  }
 
   // Q = Σ_s R_sᵀ R_s over assembly prefixes (torque rows scaled by 1/L).
   Q_ = Eigen::MatrixXd::Zero(K, K);
@@ -347,6 +362,13 @@ double ForceProblem::objective(const Eigen::VectorXd& a, Eigen::VectorXd* grad) 
   const Eigen::VectorXd Qa = Q_ * a;
   if (grad) *grad = c_ - 2.0 * w_ * Qa;
   return c_.dot(a) - w_ * a.dot(Qa);
+}
+
+Eigen::VectorXd ForceProblem::torque_gauges(const Eigen::VectorXd& a) const {
+  const Eigen::VectorXd t = T3_ * a;
+  Eigen::VectorXd g(T_.rows());
+  for (Eigen::Index r = 0; r < g.size(); ++r) g(r) = torque_gauge(polytope(), t.segment<3>(3 * r), t_max_);
+  return g;
 }
 
 std::vector<Vec3> ForceProblem::forces(const Eigen::VectorXd& a) const {
@@ -400,7 +422,7 @@ double violation(const ForceProblem& p, const Eigen::VectorXd& a, double force_s
   double v = 0.0;
   if (a.size() == 0) return 0.0;
   v = std::max(v, -a.minCoeff() / force_scale);
-  if (p.torque_rows().rows() > 0) v = std::max(v, ((p.torque_rows() * a).cwiseAbs().maxCoeff() - p.t_max()) / p.t_max());
+  if (p.torque_rows().rows() > 0) v = std::max(v, p.torque_gauges(a).maxCoeff() - 1.0);
   if (p.normal_rows().rows() > 0) v = std::max(v, -(p.normal_rows() * a).minCoeff() / force_scale);
   return v;
 }
@@ -451,25 +473,37 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
       }
     };
     add_rows(M, 0.0, 0.0);
-    add_rows(T, -problem.t_max(), problem.t_max());
+    add_rows(T, -problem.t_max(), problem.t_max());  // |n·t_v| <= t_max: implied by either bound
     add_rows(Nk, 0.0, kInf);
-    detail::LpSolution sol = detail::solve_lp(lp);
+    // The other rows of the bound's polytope join as solutions violate them.
+    const detail::TorqueBlocks blocks{problem.torque_frame_rows(), Eigen::VectorXd::Zero(problem.torque_frame_rows().rows())};
+    std::set<std::pair<int, int>> added;
+    detail::LpSolution sol =
+        detail::solve_lp_with_torque_rows(lp, blocks, problem.polytope(), problem.t_max(), added, &r.lp_rounds);
     r.lp_iterations = sol.iterations;
     if (sol.status == detail::LpSolution::unbounded) {
-      // Name the crossings whose force no torque limits: bound every coefficient and look.
+      // Bound every coefficient: when the optimum then keeps away from the cap, it is the
+      // problem's (rows not yet added had left a force free); otherwise name the crossings
+      // whose force no torque limits.
       const double cap = 1e6 * F_ref;
       lp.col_hi.assign(K, cap);
       report_progress(progress, "forces", 0.25);  // between the two LPs
-      const detail::LpSolution capped = detail::solve_lp(lp);
+      const detail::LpSolution capped =
+          detail::solve_lp_with_torque_rows(lp, blocks, problem.polytope(), problem.t_max(), added, &r.lp_rounds);
+      r.lp_iterations += capped.iterations;
       std::string names;
       if (capped.status == detail::LpSolution::optimal)
         for (int j = 0; j < K; ++j)
           if (capped.x[j] > 0.5 * cap && names.find(" " + std::to_string(r.column_crossing[j]) + ",") == std::string::npos)
             names += " " + std::to_string(r.column_crossing[j]) + ",";
-      if (!names.empty()) names.pop_back();
-      throw SolverError("the contact forces are unbounded: no wire's bending torque limits the force at crossing" +
-                        (names.empty() ? std::string("s") : names) +
-                        "; check the cuts and that every wire has more than one crossing");
+      if (capped.status == detail::LpSolution::optimal && names.empty()) {
+        sol = capped;
+      } else {
+        if (!names.empty()) names.pop_back();
+        throw SolverError("the contact forces are unbounded: no wire's bending torque limits the force at crossing" +
+                          (names.empty() ? std::string("s") : names) +
+                          "; check the cuts and that every wire has more than one crossing");
+      }
     }
     if (sol.status != detail::LpSolution::optimal)
       throw SolverError("the force LP could not be solved (GLPK " +
@@ -493,30 +527,59 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
     const Eigen::MatrixXd N = svd.matrixV().rightCols(K - rank);
     const int k = static_cast<int>(N.cols());
     if (k > 0) {
-      // Every constraint row in z (c(z) = G z - h <= 0), scaled to O(1): signs by F_ref, torques
-      // by t_max.
-      const Eigen::Index m = K + 2 * T.rows() + Nk.rows();
-      Eigen::MatrixXd G_all(m, k);
-      Eigen::VectorXd h_all(m);
-      G_all.topRows(K) = -N / F_ref;
-      h_all.head(K).setZero();
-      const Eigen::MatrixXd TN = T * N / problem.t_max();
-      G_all.middleRows(K, T.rows()) = TN;
-      G_all.middleRows(K + T.rows(), T.rows()) = -TN;
-      h_all.segment(K, 2 * T.rows()).setOnes();
-      G_all.bottomRows(Nk.rows()) = -Nk * N / F_ref;
-      h_all.tail(Nk.rows()).setZero();
+      // Constraint rows in z (c(z) = G z - h <= 0), scaled to O(1): signs and normal forces by
+      // F_ref (always in the set), torque rows e·t_v <= t_max of the bound's polytope by t_max
+      // (a working set of them; c = e·t_v / t_max - 1).
+      Eigen::MatrixXd G_fixed(K + Nk.rows(), k);
+      G_fixed.topRows(K) = -N / F_ref;
+      G_fixed.bottomRows(Nk.rows()) = -Nk * N / F_ref;
+      const TorquePolytope& poly = problem.polytope();
+      const int F = static_cast<int>(poly.rows.size());
+      const Eigen::Index V = T.rows();
+      const Eigen::MatrixXd TF = problem.torque_frame_rows() * N / problem.t_max();  // 3V × k
       std::vector<double> z(static_cast<std::size_t>(k));
       Eigen::Map<Eigen::VectorXd>(z.data(), k) = N.transpose() * a;
-      // The working set: sign and normal rows always; torque rows within the margin of their
-      // bound at the start (the LP's optimum sits on many of them), later any row the solution
-      // violates.
-      const double kNear = -options.working_set_margin;
-      std::vector<char> in_set(static_cast<std::size_t>(m), 1);
+      // c of every torque row at z: F × V.
+      auto torque_values = [&]() {
+        const Eigen::VectorXd t = TF * Eigen::Map<const Eigen::VectorXd>(z.data(), k);
+        Eigen::MatrixXd c(F, V);
+        for (Eigen::Index v = 0; v < V; ++v)
+          for (int e = 0; e < F; ++e) c(e, v) = poly.rows[e].dot(t.segment<3>(3 * v)) - 1.0;
+        return c;
+      };
+      // The working set, as (polytope row, vertex) pairs: torque rows within the margin of their
+      // bound at the start (the LP's optimum sits on many of them), at most kTopRows per vertex
+      // (the facets around its torque's direction: a polytope vertex joins 5 or 6), later any
+      // row the solution violates. For in_plane (rows ±n) this is every row within the margin.
+      constexpr int kTopRows = 6;
+      const double kNear =
+          -(problem.torque_bound() == TorqueBound::full_3d ? options.working_set_margin_3d : options.working_set_margin);
+      std::set<std::pair<int, int>> in_set;
+      auto add_near = [&](const Eigen::MatrixXd& c) {
+        std::vector<int> order(static_cast<std::size_t>(F));
+        for (Eigen::Index v = 0; v < V; ++v) {
+          if (c.col(v).maxCoeff() < kNear) continue;
+          for (int e = 0; e < F; ++e) order[e] = e;
+          const int top = std::min(F, kTopRows);
+          std::partial_sort(order.begin(), order.begin() + top, order.end(),
+                            [&](int x, int y) { return c(x, v) > c(y, v); });
+          for (int i = 0; i < top && c(order[i], v) >= kNear; ++i) in_set.insert({order[i], static_cast<int>(v)});
+        }
+      };
+      // The rows through ±n t_max at every vertex: they bound every torque component (for
+      // in_plane they are every row).
+      auto add_apex = [&]() {
+        for (Eigen::Index v = 0; v < V; ++v)
+          for (int e : poly.apex) in_set.insert({e, static_cast<int>(v)});
+      };
       bool partial = options.working_set && use_lp;  // from zero nothing is near a bound yet
-      if (partial) {
-        const Eigen::VectorXd c0 = G_all * Eigen::Map<const Eigen::VectorXd>(z.data(), k) - h_all;
-        for (Eigen::Index i = K; i < K + 2 * T.rows(); ++i) in_set[i] = c0(i) >= kNear;
+      if (!options.working_set) {
+        for (int e = 0; e < F; ++e)
+          for (Eigen::Index v = 0; v < V; ++v) in_set.insert({e, static_cast<int>(v)});
+      } else if (partial) {
+        add_near(torque_values());
+      } else {
+        add_apex();
       }
       SlsqpData data{&problem, &N, {}, {}, &progress};
       const Eigen::VectorXd a_start = a;
@@ -524,19 +587,20 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
       double g = 0.0;
       nlopt::result res = nlopt::FAILURE;
       for (int round = 0;; ++round) {
-        std::vector<Eigen::Index> rows;
-        for (Eigen::Index i = 0; i < m; ++i)
-          if (in_set[i]) rows.push_back(i);
-        data.G.resize(static_cast<Eigen::Index>(rows.size()), k);
-        data.h.resize(static_cast<Eigen::Index>(rows.size()));
-        for (std::size_t i = 0; i < rows.size(); ++i) {
-          data.G.row(static_cast<Eigen::Index>(i)) = G_all.row(rows[i]);
-          data.h(static_cast<Eigen::Index>(i)) = h_all(rows[i]);
+        const Eigen::Index rows = K + static_cast<Eigen::Index>(in_set.size()) + Nk.rows();
+        data.G.resize(rows, k);
+        data.h = Eigen::VectorXd::Zero(rows);
+        data.G.topRows(K) = G_fixed.topRows(K);
+        Eigen::Index i = K;
+        for (const auto& [e, v] : in_set) {
+          data.G.row(i) = poly.rows[e].transpose() * TF.middleRows(3 * v, 3);
+          data.h(i++) = 1.0;
         }
+        data.G.bottomRows(Nk.rows()) = G_fixed.bottomRows(Nk.rows());
         nlopt::opt opt(nlopt::LD_SLSQP, static_cast<unsigned>(k));
         opt.set_max_objective(slsqp_objective, &data);
         opt.add_inequality_mconstraint(slsqp_constraints, &data,
-                                       std::vector<double>(rows.size(), options.constraint_tol));
+                                       std::vector<double>(static_cast<std::size_t>(rows), options.constraint_tol));
         opt.set_ftol_rel(options.ftol_rel);
         opt.set_xtol_rel(options.xtol_rel);
         opt.set_maxeval(std::max(1, options.max_iterations - data.evaluations));
@@ -551,23 +615,26 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
           if (data.cancelled) throw Cancelled();
           r.nlopt_result = std::string("NLOPT_FAILURE (") + e.what() + ")";
           if (!partial) break;
-          // A partial set may leave the relaxed problem unbounded: start again with every row.
+          // A partial set may leave the relaxed problem unbounded: start again with the rows
+          // that bound every torque (for in_plane: every row).
           partial = false;
-          std::fill(in_set.begin(), in_set.end(), 1);
+          add_apex();
           Eigen::Map<Eigen::VectorXd>(z.data(), k) = N.transpose() * a_start;
           continue;
         }
         r.working_set_rounds = round + 1;
-        r.working_set_rows = static_cast<int>(rows.size());
+        r.working_set_rows = static_cast<int>(rows);
         // Rows outside the set that the solution violates join it, with their near neighbours
         // in value; none violated: the relaxed optimum is feasible, hence the full optimum.
-        const Eigen::VectorXd c = G_all * Eigen::Map<const Eigen::VectorXd>(z.data(), k) - h_all;
-        bool added = false;
-        for (Eigen::Index i = 0; i < m; ++i)
-          if (!in_set[i] && c(i) > options.constraint_tol) added = true;
-        if (!added || data.evaluations >= options.max_iterations) break;
-        for (Eigen::Index i = 0; i < m; ++i)
-          if (!in_set[i] && c(i) >= kNear) in_set[i] = 1;
+        const Eigen::MatrixXd c = torque_values();
+        std::vector<std::pair<int, int>> violated;
+        for (Eigen::Index v = 0; v < V; ++v)
+          for (int e = 0; e < F; ++e)
+            if (c(e, v) > options.constraint_tol && !in_set.count({e, static_cast<int>(v)}))
+              violated.push_back({e, static_cast<int>(v)});
+        if (violated.empty() || data.evaluations >= options.max_iterations) break;
+        in_set.insert(violated.begin(), violated.end());
+        add_near(c);
       }
       if (data.cancelled) throw Cancelled();
       r.iterations = data.evaluations;
@@ -595,6 +662,17 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
   }
   if (r.method.empty()) r.method = use_lp ? "lp" : "slsqp";
   report_progress(progress, "forces", 0.9);
+
+  // Every constraint but the torque rows is homogeneous in a (M a = 0, a >= 0, N_k >= 0): forces
+  // that a solver's tolerance left outside the 3D bound's polytope (SLSQP's result is accepted
+  // up to 1e-7 relative) are scaled into it, so that |t_v| <= t_max holds to rounding.
+  Eigen::VectorXd gauges = problem.torque_gauges(a);
+  if (options.torque_bound == TorqueBound::full_3d && gauges.size() > 0 && gauges.maxCoeff() > 1.0) {
+    a /= gauges.maxCoeff();
+    gauges = problem.torque_gauges(a);
+  }
+  r.torque_bound = options.torque_bound;
+  r.torque_active = gauges.size() > 0 && gauges.maxCoeff() >= 1.0 - 1e-6;
 
   // Results.
   r.coefficients = a;
@@ -629,12 +707,10 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
     for (double t : rs.out_of_plane_torque) r.wires[w].max_out_of_plane = std::max(r.wires[w].max_out_of_plane, t);
     for (std::size_t k = 0; k < rs.torque.size(); ++k)
       r.wires[w].max_torque_3d = std::max(r.wires[w].max_torque_3d, std::hypot(rs.torque[k], rs.out_of_plane_torque[k]));
-    if (rs.max_torque >= (1.0 - 1e-6) * r.t_max) r.torque_active = true;
     if (r.wires[w].max_torque_3d > (1.0 + 1e-6) * r.t_max)
       r.warnings.push_back(wname(net, w) + ": in-plane bending, out-of-plane bending and twist together reach " +
                            std::to_string(r.wires[w].max_torque_3d) + " N m, above t_max = " + std::to_string(r.t_max) +
-                           " N m (only in-plane bending is bounded; see docs/method-forces.md, \"Out-of-plane share "
-                           "and closure gaps\")");
+                           " N m (torque_bound in_plane bounds in-plane bending only; see docs/method-forces.md, §3)");
   }
   r.seconds = since(start);
   report_progress(progress, "forces", 1.0);

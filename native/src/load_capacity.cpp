@@ -4,7 +4,9 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <set>
 #include <string>
+#include <utility>
 
 #include "wiresculpt/error.hpp"
 
@@ -51,8 +53,11 @@ LoadCapacityResult load_capacity(const Network& net, const std::vector<int>& cut
   out.weight = out.length * per_metre;
   const Eigen::MatrixXd& M = problem.equilibrium();
   const Eigen::MatrixXd& T = problem.torque_rows();
+  const Eigen::MatrixXd& T3 = problem.torque_frame_rows();
+  const TorquePolytope& polytope = torque_polytope(options.torque_bound);
   const Eigen::VectorXd Ma0 = M * a0;
   const Eigen::VectorXd Ta0 = T * a0;
+  const Eigen::VectorXd T3a0 = T3 * a0;
   const Vec3 ref = problem.reference();
   const double t_max = problem.t_max();
   // First torque row of each wire (rows are wire by wire, in walk order; see ForceProblem).
@@ -97,6 +102,9 @@ LoadCapacityResult load_capacity(const Network& net, const std::vector<int>& cut
     for (int j = 0; j < K; ++j) lp.col_lo[j] = -a0(j);
     lp.col_lo[K] = 0.0;
     int row = 0;
+    // Torques of the wires not held: t_v = T3_v (a0 + δ) + λ t_v^grav, frame components.
+    std::vector<int> torque_row;
+    std::vector<Vec3> torque_grav;
     auto entry = [&](int col, double v) {
       if (v == 0.0) return;
       lp.tri_row.push_back(row);
@@ -124,22 +132,55 @@ LoadCapacityResult load_capacity(const Network& net, const std::vector<int>& cut
       for (int v = 0; v < rows_w; ++v, ++row) {
         const int tr = first_row[w] + v;
         const Vec3& xv = s.points[walks[w][v]];
-        double grav = 0.0;
+        Vec3 tg = Vec3::Zero();
         for (std::size_t k = static_cast<std::size_t>(v); k < edges[w].size(); ++k)
-          grav += (xv - edges[w][k].mid).cross(edges[w][k].weight * g).dot(s.plane.normal);
+          tg += (xv - edges[w][k].mid).cross(edges[w][k].weight * g);
+        const double grav = tg.dot(s.plane.normal);
+        torque_row.push_back(tr);
+        torque_grav.emplace_back(grav, tg.dot(s.plane.u), tg.dot(s.plane.v));
         for (int j = 0; j < K; ++j) entry(j, T(tr, j));
         entry(K, grav);
         lp.row_lo.push_back(-t_max - Ta0(tr));
         lp.row_hi.push_back(t_max - Ta0(tr));
       }
     }
-    const detail::LpSolution sol = detail::solve_lp(lp);
+    // The slab rows above are implied by either bound; the polytope's other rows join as the
+    // solutions violate them.
+    detail::TorqueBlocks blocks;
+    blocks.A = Eigen::MatrixXd::Zero(3 * static_cast<Eigen::Index>(torque_row.size()), K + 1);
+    blocks.c.resize(blocks.A.rows());
+    for (std::size_t i = 0; i < torque_row.size(); ++i) {
+      const Eigen::Index b = 3 * static_cast<Eigen::Index>(i);
+      blocks.A.block(b, 0, 3, K) = T3.middleRows(3 * torque_row[i], 3);
+      blocks.A.block<3, 1>(b, K) = torque_grav[i];
+      blocks.c.segment<3>(b) = T3a0.segment<3>(3 * torque_row[i]);
+    }
+    std::set<std::pair<int, int>> added;
+    detail::LpSolution sol = detail::solve_lp_with_torque_rows(lp, blocks, polytope, t_max, added, &ld.lp_rounds);
     ld.lp_iterations = sol.iterations;
+    if (sol.status == detail::LpSolution::unbounded) {
+      // Cap λ: an optimum well below the cap is the problem's (rows not yet added had left λ
+      // free); one at the cap means that nothing but the cones limits the load.
+      const double cap = 1e8;
+      lp.col_hi[K] = cap;
+      const detail::LpSolution capped = detail::solve_lp_with_torque_rows(lp, blocks, polytope, t_max, added, &ld.lp_rounds);
+      ld.lp_iterations += capped.iterations;
+      if (capped.status == detail::LpSolution::optimal && capped.x[K] < 0.5 * cap) sol = capped;
+    }
     switch (sol.status) {
-      case detail::LpSolution::optimal:
+      case detail::LpSolution::optimal: {
         ld.status = "optimal";
-        ld.multiple = std::max(0.0, sol.x[K]);
+        // (a0 + δ, λ) scaled into the polytope when GLPK's tolerance left a torque outside it.
+        Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(sol.x.data(), K + 1);
+        x.head(K) += a0;
+        double worst = 0.0;
+        const Eigen::VectorXd t = blocks.A * x;  // c is T3 a0, already in x
+        for (Eigen::Index b = 0; b < t.size() / 3; ++b) worst = std::max(worst, torque_gauge(polytope, t.segment<3>(3 * b), t_max));
+        if (options.torque_bound == TorqueBound::full_3d && worst > 1.0) x /= worst;
+        ld.coefficients = x.head(K);
+        ld.multiple = std::max(0.0, x(K));
         break;
+      }
       case detail::LpSolution::unbounded:
         ld.status = "unbounded";
         ld.multiple = inf;

@@ -183,7 +183,7 @@ RestShapeResult rest_shape(const WireSpec& wire, int cut, const std::vector<Wire
     const double th = std::tan(0.5 * r.target_angles[k]);
     const double K = 4.0 * options.bending_stiffness / l_bar;
     r.rest_angles[k] = 2.0 * std::atan(th + r.torque[k] / (K * (1.0 + th * th)));
-    if (std::abs(r.rest_angles[k]) > options.max_bend) {
+    if (std::abs(r.rest_angles[k]) > options.max_bend + options.over_bend_tolerance) {
       r.over_bend.push_back(r.walk[k]);
       r.over_bend_angle.push_back(r.rest_angles[k]);
     }

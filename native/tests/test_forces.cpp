@@ -3,8 +3,11 @@
 // optimum, LP vs SLSQP as independent solvers, and finite-difference gradients.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
+#include <set>
+#include <utility>
 
 #include "wire_fixtures.hpp"
 #include "wiresculpt/contact.hpp"
@@ -179,25 +182,39 @@ TEST_CASE("forces: LP and SLSQP agree; the assembly term trades little G_stb", "
 }
 
 TEST_CASE("forces: the torque bound is active and G_stb drops with the torque fraction", "[forces]") {
+  // in_plane: the largest plane-normal torque reaches t_max. 3D (default): the largest 3D torque
+  // reaches the polytope's boundary, between (1 - gap) t_max and t_max.
   const Sphere s = hooked_sphere();
   const auto cuts = choose_cuts(s.net);
+  for (const TorqueBound bound : {TorqueBound::in_plane, TorqueBound::full_3d}) {
   double previous = 1e300;
   for (double fraction : {1.0, 0.6, 0.3}) {
     ForceOptions o;
     o.torque_fraction = fraction;
+    o.torque_bound = bound;
     const ForceResult r = optimize_forces(s.net, s.hooks, s.steps, cuts, o);
     CHECK(r.t_max == Approx(1.77 * fraction));
     CHECK(r.torque_active);
-    double worst = 0;
-    for (const WireTorque& w : r.wires) worst = std::max(worst, w.max_torque);
+    CHECK(r.torque_bound == bound);
+    double worst = 0, worst_3d = 0;
+    for (const WireTorque& w : r.wires) {
+      worst = std::max(worst, w.max_torque);
+      worst_3d = std::max(worst_3d, w.max_torque_3d);
+    }
     CHECK(worst <= r.t_max * (1 + 1e-7));
-    CHECK(worst >= r.t_max * (1 - 1e-6));
+    if (bound == TorqueBound::in_plane) {
+      CHECK(worst >= r.t_max * (1 - 1e-6));
+    } else {
+      CHECK(worst_3d <= r.t_max * (1 + 1e-7));
+      CHECK(worst_3d >= r.t_max * (1 - torque_polytope(bound).gap) * (1 - 1e-9));
+    }
     CHECK(r.g_stb < previous);
     previous = r.g_stb;
     CHECK(r.equilibrium_residual < 1e-9);
     // a >= 0 and every normal force >= 0.
     CHECK(r.coefficients.minCoeff() >= 0.0);
     for (double nk : r.normal) CHECK(nk >= -1e-9);
+  }
   }
 }
 
@@ -289,34 +306,24 @@ TEST_CASE("forces: the working set reaches the optimum of the full constraint se
   // Random sphere cuts with random hooks: SLSQP over every torque row (the reference) and over
   // the growing working set must agree on G, and the working-set result must satisfy every row.
   // With a tiny first margin the set starts from the LP's active rows alone and has to grow.
+  // Both bounds; the 3D reference holds all 180 rows of every vertex, so its wires are coarser.
+  for (const TorqueBound bound : {TorqueBound::in_plane, TorqueBound::full_3d})
   for (const double margin : {0.5, 1e-3}) {
+    const bool in_plane = bound == TorqueBound::in_plane;
     std::mt19937 rng(11);
-    std::uniform_real_distribution<double> unit(-1.0, 1.0);
-    const double R = 0.125;
     int tested = 0, grew = 0;
-    for (int attempt = 0; attempt < 400 && tested < 12; ++attempt) {
-      const int P = 3 + attempt % 3;
-      std::vector<fixtures::Cut> cuts;
-      for (int k = 0; k < P; ++k) {
-        Vec3 n(unit(rng), unit(rng), unit(rng));
-        if (n.norm() < 0.2) n = Vec3::UnitZ();
-        cuts.push_back({std::string(1, static_cast<char>('A' + k)), n.normalized(), 0.5 * R * unit(rng)});
-      }
-      Network net;
-      try {
-        net = build_network(fixtures::sphere_wires(cuts, R, 48));
-      } catch (const InputError&) {
-        continue;
-      }
-      const int C = static_cast<int>(net.crossings.size());
-      if (C < 4) continue;
-      std::vector<int> hooks;
-      for (int c = 0; c < C; ++c) hooks.push_back(rng() % 2 ? 1 : -1);
-      std::vector<std::vector<int>> steps{{0, 1}};
-      for (int w = 2; w < P; ++w) steps.push_back({w});
+    const int wanted = in_plane ? 12 : 5;
+    for (int attempt = 0; attempt < 400 && tested < wanted; ++attempt) {
+      fixtures::HookedNetwork h;
+      if (!fixtures::random_hooked_sphere(rng, attempt, in_plane ? 48 : 20, h)) continue;
+      const Network& net = h.net;
+      const std::vector<int>& hooks = h.hooks;
+      const auto& steps = h.steps;
+      const int P = static_cast<int>(net.wires.size()), C = static_cast<int>(net.crossings.size());
       ForceOptions o;
+      o.torque_bound = bound;
       o.torque_fraction = attempt % 2 ? 1.0 : 0.3;
-      o.working_set_margin = margin;
+      o.working_set_margin = o.working_set_margin_3d = margin;
       ForceResult full, ws;
       try {
         o.working_set = false;
@@ -328,22 +335,162 @@ TEST_CASE("forces: the working set reaches the optimum of the full constraint se
       }
       if (full.method != "lp+slsqp") continue;
       ++tested;
-      INFO("margin " << margin << ", attempt " << attempt << ", " << P << " wires, " << C << " crossings");
+      INFO(torque_bound_name(bound) << ", margin " << margin << ", attempt " << attempt << ", " << P << " wires, " << C
+                                    << " crossings");
       CHECK(ws.method == "lp+slsqp");
       const double G_full = full.g_stb + full.g_asm, G_ws = ws.g_stb + ws.g_asm;
       CHECK(G_ws == Approx(G_full).epsilon(1e-7));
       // every row of the full problem holds at the working-set optimum
       const ForceProblem p(net, hooks, steps, ws.cuts, o);
+      CHECK(p.torque_gauges(ws.coefficients).maxCoeff() <= 1 + 1e-7);
       CHECK((p.torque_rows() * ws.coefficients).cwiseAbs().maxCoeff() <= p.t_max() * (1 + 1e-7));
       CHECK(ws.coefficients.minCoeff() >= 0.0);
       CHECK(ws.equilibrium_residual < 1e-9);
       CHECK(ws.working_set_rows < full.working_set_rows);
       if (ws.working_set_rounds > 1) ++grew;
     }
-    INFO("margin " << margin);
-    CHECK(tested >= 10);
+    INFO(torque_bound_name(bound) << ", margin " << margin);
+    CHECK(tested >= wanted - 2);
     if (margin < 0.01) CHECK(grew > 0);
   }
+}
+
+TEST_CASE("forces: the 3D polytope lies inside the ball and touches it at +-n", "[forces][torque]") {
+  // Support of {t : e_k·t <= t_max} in direction d, by an LP over the rows alone (independent of
+  // how they were built): never more than t_max (inside the ball), t_max along ±n (pure in-plane
+  // bending reaches the limit), and at least (1 - gap) t_max (gap <= 3%).
+  const double t_max = 1.77;
+  auto support = [&](const TorquePolytope& poly, const Vec3& d) {
+    detail::LinearProgram lp;
+    lp.maximise = true;
+    lp.obj = {d.x(), d.y(), d.z()};
+    lp.col_lo.assign(3, -std::numeric_limits<double>::infinity());
+    lp.col_hi.assign(3, std::numeric_limits<double>::infinity());
+    for (std::size_t k = 0; k < poly.rows.size(); ++k) {
+      for (int i = 0; i < 3; ++i) {
+        lp.tri_row.push_back(static_cast<int>(k));
+        lp.tri_col.push_back(i);
+        lp.tri_val.push_back(poly.rows[k](i));
+      }
+      lp.row_lo.push_back(-std::numeric_limits<double>::infinity());
+      lp.row_hi.push_back(t_max);
+    }
+    const detail::LpSolution sol = detail::solve_lp(lp);
+    REQUIRE(sol.status == detail::LpSolution::optimal);
+    return sol.objective;
+  };
+  const TorquePolytope& poly = torque_polytope(TorqueBound::full_3d);
+  CHECK(poly.rows.size() == 180);
+  CHECK(poly.gap <= 0.03);
+  CHECK(poly.gap >= 0.02);
+  CHECK(support(poly, Vec3(1, 0, 0)) == Approx(t_max).epsilon(1e-12));
+  CHECK(support(poly, Vec3(-1, 0, 0)) == Approx(t_max).epsilon(1e-12));
+  std::mt19937 rng(5);
+  std::normal_distribution<double> normal;
+  double lowest = 1.0, highest = 0.0;
+  for (int i = 0; i < 2000; ++i) {
+    const Vec3 d = Vec3(normal(rng), normal(rng), normal(rng)).normalized();
+    const double h = support(poly, d) / t_max;
+    lowest = std::min(lowest, h);
+    highest = std::max(highest, h);
+  }
+  CHECK(highest <= 1 + 1e-12);
+  CHECK(lowest >= 1 - poly.gap - 1e-12);
+  CHECK(lowest < 1 - 0.5 * poly.gap);  // the gap is real: some direction falls short of the ball
+  // The lazy loop (rows added as solutions violate them) reaches the same support from a box
+  // much larger than the ball, with a torque that is an affine map of the columns.
+  Eigen::Matrix3d A;
+  A << 0.5, 0.2, 0.0, -0.1, 1.0, 0.3, 0.0, 0.4, 2.0;
+  const Vec3 c0(0.1, -0.2, 0.05);
+  detail::TorqueBlocks blocks{A, c0};
+  for (int i = 0; i < 50; ++i) {
+    const Vec3 d = Vec3(normal(rng), normal(rng), normal(rng)).normalized();
+    detail::LinearProgram lp;
+    const Vec3 obj = A.transpose() * d;  // maximise d·t(x)
+    lp.obj = {obj.x(), obj.y(), obj.z()};
+    lp.col_lo.assign(3, -100.0);
+    lp.col_hi.assign(3, 100.0);
+    std::set<std::pair<int, int>> added;
+    int rounds = 0;
+    const detail::LpSolution sol = detail::solve_lp_with_torque_rows(lp, blocks, poly, t_max, added, &rounds);
+    REQUIRE(sol.status == detail::LpSolution::optimal);
+    CHECK(sol.objective + d.dot(c0) == Approx(support(poly, d)).epsilon(1e-9));
+    CHECK(rounds >= 2);
+    CHECK(added.size() < 60);  // a few of the 180 rows
+  }
+  // Finer polytopes close the gap; every facet's neighbours share a vertex with it.
+  CHECK(geodesic_polytope(4).gap < poly.gap);
+  CHECK(geodesic_polytope(4).rows.size() == 320);
+  // The slab of in_plane: only ±n, not inside the ball.
+  const TorquePolytope& slab = torque_polytope(TorqueBound::in_plane);
+  CHECK(slab.rows.size() == 2);
+  CHECK(torque_gauge(slab, Vec3(0.5, 10.0, 10.0), 1.0) == Approx(0.5));
+  CHECK(torque_gauge(poly, Vec3(0.5, 10.0, 10.0), 1.0) > 14.0);
+  CHECK_THROWS_WITH(parse_torque_bound("2d", "settings: torque_bound"), Contains("settings: torque_bound"));
+  CHECK(parse_torque_bound("in_plane", "k") == TorqueBound::in_plane);
+  CHECK(parse_torque_bound(torque_bound_name(TorqueBound::full_3d), "k") == TorqueBound::full_3d);
+}
+
+TEST_CASE("forces: the 3D bound holds every 3D torque, which in_plane leaves above t_max", "[forces][torque]") {
+  // The symmetric three-circle sphere: with in_plane the forces leave the planes and the 3D
+  // torque exceeds t_max (docs/method-forces.md §9.4); with the 3D bound every 3D torque, summed
+  // directly, is at most t_max, the optimum differs and G_stb can only be lower (the polytope
+  // lies inside the slab).
+  const Sphere s = hooked_sphere();
+  const auto cuts = symmetric_cuts(s.net);
+  ForceOptions o;
+  o.torque_bound = TorqueBound::in_plane;
+  const ForceResult flat = optimize_forces(s.net, s.hooks, s.steps, cuts, o);
+  o.torque_bound = TorqueBound::full_3d;
+  const ForceResult full = optimize_forces(s.net, s.hooks, s.steps, cuts, o);
+  double flat_3d = 0.0, full_3d = 0.0, full_in = 0.0;
+  for (int w = 0; w < 3; ++w) {
+    flat_3d = std::max(flat_3d, fixtures::max_torque_3d(s.net.wires[w], cuts[w], wire_loads(s.net, s.hooks, flat.forces, w)));
+    full_3d = std::max(full_3d, fixtures::max_torque_3d(s.net.wires[w], cuts[w], wire_loads(s.net, s.hooks, full.forces, w)));
+    full_in = std::max(full_in, full.wires[w].max_torque);
+  }
+  CHECK(flat_3d > 1.05 * flat.t_max);
+  CHECK(full_3d <= full.t_max * (1 + 1e-7));
+  CHECK(full_3d >= full.t_max * (1 - torque_polytope(TorqueBound::full_3d).gap));
+  CHECK(full_in <= full.t_max * (1 + 1e-7));
+  CHECK(full.torque_active);
+  CHECK(full.g_stb <= flat.g_stb);
+  CHECK(full.g_stb < 0.99 * flat.g_stb);
+  CHECK(full.warnings.empty());
+  CHECK_FALSE(flat.warnings.empty());
+  CHECK(full.equilibrium_residual < 1e-9);
+}
+
+TEST_CASE("forces: on random networks every 3D torque stays within t_max", "[forces][torque]") {
+  std::mt19937 rng(23);
+  int tested = 0;
+  for (int attempt = 0; attempt < 300 && tested < 15; ++attempt) {
+    fixtures::HookedNetwork h;
+    if (!fixtures::random_hooked_sphere(rng, attempt, 40, h)) continue;
+    ForceOptions o;
+    o.torque_fraction = attempt % 2 ? 1.0 : 0.4;
+    o.algorithm = attempt % 3 == 0 ? ForceAlgorithm::lp : ForceAlgorithm::lp_then_slsqp;
+    const auto cuts = choose_cuts(h.net);
+    ForceResult r;
+    try {
+      r = optimize_forces(h.net, h.hooks, h.steps, cuts, o);
+    } catch (const SolverError&) {
+      continue;
+    }
+    ++tested;
+    INFO("attempt " << attempt);
+    double worst = 0.0;
+    for (int w = 0; w < static_cast<int>(h.net.wires.size()); ++w) {
+      const double t = fixtures::max_torque_3d(h.net.wires[w], cuts[w], wire_loads(h.net, h.hooks, r.forces, w));
+      CHECK(t <= r.t_max * (1 + 1e-7));
+      CHECK(r.wires[w].max_torque_3d == Approx(t).epsilon(1e-9).margin(1e-12));
+      worst = std::max(worst, t);
+    }
+    if (worst > 0) CHECK(r.torque_active);
+    CHECK(r.equilibrium_residual < 1e-9);
+    CHECK(r.coefficients.minCoeff() >= 0.0);
+  }
+  CHECK(tested >= 10);
 }
 
 TEST_CASE("forces: out-of-plane shares are per wire, in that wire's own plane", "[forces][share]") {

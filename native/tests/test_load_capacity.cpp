@@ -4,9 +4,13 @@
 // pyramid contains +z, so only B's bending torque limits the load: the largest torque is at B's
 // apex, the weight of one arm (W_B/2) at half the arm's horizontal reach (X/2), so
 // λ = t_max / (W_B X / 4). Under +z the force B would need (-z) lies outside the pyramid: λ = 0.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <numbers>
+#include <random>
+
+#include "wire_fixtures.hpp"
 
 #include "wiresculpt/error.hpp"
 #include "wiresculpt/load_capacity.hpp"
@@ -90,4 +94,53 @@ TEST_CASE("load: bad options and sizes are input errors", "[load]") {
   lo.density = -1;
   CHECK_THROWS_WITH(load_capacity(net, cuts, problem, Eigen::VectorXd::Zero(4), lo), Contains("density"));
   CHECK_THROWS_AS(load_capacity(net, cuts, problem, Eigen::VectorXd::Zero(3)), InputError);
+}
+
+TEST_CASE("load: on random networks every 3D torque at the limit load stays within t_max", "[load][torque]") {
+  // At each direction's limit load (the LP's contact coefficients and λ times the weight), every
+  // vertex of every wire not held has |t_v| <= t_max, summed directly with each edge's weight at
+  // its midpoint. The in_plane bound only limits n·t_v, so its capacities are never below the
+  // 3D ones (the pre-stress does not enter: δ is free).
+  std::mt19937 rng(31);
+  const double per_metre = std::numbers::pi * 0.25 * 0.003 * 0.003 * 7850.0 * 9.81;
+  int tested = 0, lower = 0;
+  for (int attempt = 0; attempt < 300 && tested < 10; ++attempt) {
+    fixtures::HookedNetwork h;
+    if (!fixtures::random_hooked_sphere(rng, attempt, 32, h)) continue;
+    const auto cuts = choose_cuts(h.net);
+    ForceOptions fo;
+    fo.torque_fraction = 0.5;
+    ForceResult pre;
+    try {
+      pre = optimize_forces(h.net, h.hooks, h.steps, cuts, fo);
+    } catch (const SolverError&) {
+      continue;
+    }
+    ++tested;
+    INFO("attempt " << attempt);
+    const ForceProblem problem(h.net, h.hooks, h.steps, cuts, fo);
+    LoadCapacityOptions lo;
+    lo.density = 7850.0;
+    const LoadCapacityResult r = load_capacity(h.net, cuts, problem, pre.coefficients, lo);
+    lo.torque_bound = TorqueBound::in_plane;
+    const LoadCapacityResult flat = load_capacity(h.net, cuts, problem, pre.coefficients, lo);
+    for (std::size_t d = 0; d < r.directions.size(); ++d) {
+      const LoadDirection& ld = r.directions[d];
+      INFO("gravity " << ld.name << " " << ld.status);
+      CHECK(ld.multiple <= flat.directions[d].multiple * (1 + 1e-9) + 1e-12);
+      if (ld.multiple < flat.directions[d].multiple * (1 - 1e-6)) ++lower;
+      if (ld.status != "optimal") continue;
+      REQUIRE(ld.coefficients.size() == problem.columns());
+      CHECK(ld.coefficients.minCoeff() >= -1e-12);
+      const std::vector<Vec3> forces = problem.forces(ld.coefficients);
+      for (int w = 0; w < static_cast<int>(h.net.wires.size()); ++w) {
+        if (std::find(ld.base.begin(), ld.base.end(), w) != ld.base.end()) continue;
+        const double t = fixtures::max_torque_3d(h.net.wires[w], cuts[w], wire_loads(h.net, h.hooks, forces, w),
+                                                 ld.multiple * per_metre * ld.gravity);
+        CHECK(t <= problem.t_max() * (1 + 1e-7));
+      }
+    }
+  }
+  CHECK(tested >= 8);
+  CHECK(lower > 0);
 }

@@ -248,6 +248,29 @@ TEST_CASE("rest: rest bends beyond the machine's limit are reported", "[rest]") 
   for (std::size_t i = 0; i < r.over_bend.size(); ++i) CHECK(std::abs(r.over_bend_angle[i]) > pi / 6);
 }
 
+TEST_CASE("rest: an unloaded bend at the limit is not an over-bend; one past the tolerance is", "[rest]") {
+  // An open rod with one target bend of exactly max_bend (+ rounding) at vertex 2 and no load:
+  // the rest angle is the target angle. Built by hand: edges along x, then turned by the angle.
+  auto rod = [](double turn) {
+    WireSpec w;
+    w.name = "rod";
+    w.plane = Plane::make(Vec3::Zero(), Vec3::UnitZ());
+    w.closed = false;
+    w.points = {Vec3(0, 0, 0), Vec3(0.02, 0, 0), Vec3(0.04, 0, 0),
+                Vec3(0.04 + 0.02 * std::cos(turn), 0.02 * std::sin(turn), 0),
+                Vec3(0.04 + 0.04 * std::cos(turn), 0.04 * std::sin(turn), 0)};
+    return w;
+  };
+  RestShapeOptions o;
+  o.max_bend = pi / 6;
+  const RestShapeResult at = rest_shape(rod(pi / 6 * (1 + 1e-14)), -1, {}, o);
+  CHECK(std::abs(std::abs(at.rest_angles[2]) - pi / 6) < 1e-12);
+  CHECK(at.over_bend.empty());
+  const RestShapeResult past = rest_shape(rod(pi / 6 + 10 * o.over_bend_tolerance), -1, {}, o);
+  REQUIRE(past.over_bend.size() == 1);
+  CHECK(past.over_bend[0] == 2);
+}
+
 TEST_CASE("rest: automatic cut in the middle of the longest piece between crossings", "[rest][cut]") {
   // A 12-gon with unit-ish edges; crossings at 0, 3, 5: pieces 0-3 (3 edges), 3-5 (2), 5-12 (7).
   WireSpec w;

@@ -5,12 +5,15 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "wiresculpt/geometry.hpp"
+#include "wiresculpt/error.hpp"
 #include "wiresculpt/network.hpp"
+#include "wiresculpt/rest_shape.hpp"
 
 namespace fixtures {
 
@@ -99,6 +102,62 @@ inline std::vector<WireSpec> sphere_wires(const std::vector<Cut>& cuts, double R
 /// Three orthogonal great circles: planes x = 0 ("X"), y = 0 ("Y"), z = 0 ("Z").
 inline std::vector<Cut> great_circle_cuts() {
   return {{"X", Vec3::UnitX(), 0.0}, {"Y", Vec3::UnitY(), 0.0}, {"Z", Vec3::UnitZ(), 0.0}};
+}
+
+/// A random hooked network for solver tests: 3 + attempt % 3 random cuts of the sphere of radius
+/// 0.125 m (n points per circle), random hooks, the first two wires assembled first. false when
+/// the cuts give no usable network (degenerate, or fewer than 4 crossings).
+struct HookedNetwork {
+  wiresculpt::Network net;
+  std::vector<int> hooks;
+  std::vector<std::vector<int>> steps;
+};
+template <class Rng>
+bool random_hooked_sphere(Rng& rng, int attempt, int n, HookedNetwork& out) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const double R = 0.125;
+  const int P = 3 + attempt % 3;
+  std::vector<Cut> cuts;
+  for (int k = 0; k < P; ++k) {
+    Vec3 nrm(unit(rng), unit(rng), unit(rng));
+    if (nrm.norm() < 0.2) nrm = Vec3::UnitZ();
+    cuts.push_back({std::string(1, static_cast<char>('A' + k)), nrm.normalized(), 0.5 * R * unit(rng)});
+  }
+  try {
+    out.net = wiresculpt::build_network(sphere_wires(cuts, R, n));
+  } catch (const wiresculpt::InputError&) {
+    return false;
+  }
+  const int C = static_cast<int>(out.net.crossings.size());
+  if (C < 4) return false;
+  out.hooks.clear();
+  for (int c = 0; c < C; ++c) out.hooks.push_back(rng() % 2 ? 1 : -1);
+  out.steps = {{0, 1}};
+  for (int w = 2; w < P; ++w) out.steps.push_back({w});
+  return true;
+}
+
+/// The largest 3D torque |Σ_{k after v} (x_v - x_k) × f_k| over the vertices of closed wire `w`
+/// walked from `cut` (the loads after v: those later in the walk), summed directly; with
+/// `weight` (N/m, a vector along gravity) every edge after v also carries its weight at its
+/// midpoint.
+inline double max_torque_3d(const WireSpec& w, int cut, const std::vector<wiresculpt::WireLoad>& loads,
+                            const Vec3& weight = Vec3::Zero()) {
+  const int n = static_cast<int>(w.points.size());
+  double largest = 0.0;
+  for (int pv = 0; pv < n; ++pv) {
+    const Vec3& xv = w.points[(cut + pv) % n];
+    Vec3 t = Vec3::Zero();
+    for (const wiresculpt::WireLoad& l : loads)
+      if ((l.vertex - cut + n) % n > pv) t += (xv - w.points[l.vertex]).cross(l.force);
+    for (int e = pv; e < n; ++e) {  // edge from walk position e to e + 1 (the last one closes)
+      const Vec3& p = w.points[(cut + e) % n];
+      const Vec3& q = w.points[(cut + e + 1) % n];
+      t += (xv - 0.5 * (p + q)).cross((q - p).norm() * weight);
+    }
+    largest = std::max(largest, t.norm());
+  }
+  return largest;
 }
 
 }  // namespace fixtures

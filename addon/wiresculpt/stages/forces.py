@@ -6,7 +6,8 @@ Fills, per crossing, `force` (N, on wires[0] by wires[1], FORMATS.md), `normal_f
 (2D, metres, in the wire's plane frame, from the cut in the direction of increasing target index),
 `rest_angles` and `target_angles` (radians, one per rest point), `closure_gap` (m),
 `max_torque` (N m) and `max_torque_vertex`, `max_out_of_plane_torque`, `max_torque_3d` (N m, in-plane
-and out-of-plane bending and twist together), `rest_over_bend`;
+and out-of-plane bending and twist together; bounded by t_max, stages.forces.torque_bound "3d"),
+`rest_over_bend`;
 `load_capacity` (weight_N and the multiple of it the sculpture holds with gravity along each
 axis direction; absent when the material has no density), `out_of_plane` statistics (mean and max of
 the shares; mean_to_max_force and max_to_max_force: |f.n| over the largest |f|, the paper's measure),
@@ -64,7 +65,10 @@ def run(design, material, settings, native_progress=None):
     wires, crossings = _inputs(design)
     mat = {k: material[k] for k in ("bending_stiffness", "max_torque", "friction", "wire_diameter", "density")
            if k in material}
-    options = {"torque_fraction": settings["torque_fraction"], "max_bend": math.radians(settings["max_bend_deg"])}
+    options = {"torque_fraction": settings["torque_fraction"], "max_bend": math.radians(settings["max_bend_deg"]),
+               # "3d" (default: |t_v| <= t_max, Sec. 4.4) or "in_plane" (the plane-normal part only,
+               # to compare with the earlier model); not a scene-file key
+               "torque_bound": settings.get("torque_bound", "3d")}
     steps = [list(s) for s in design.get("assembly_steps", [])]
     r = native.require().forces_and_rest(wires, crossings, steps, mat, options, native_progress)
 
@@ -105,12 +109,12 @@ def run(design, material, settings, native_progress=None):
     design.setdefault("warnings", []).extend(r["warnings"])
     design["stages"]["forces"] = {
         "seconds": stats["forces_seconds"], "lp_seconds": stats["lp_seconds"], "nlp_seconds": stats["nlp_seconds"],
-        "lp_iterations": stats["lp_iterations"], "iterations": stats["iterations"],
+        "lp_iterations": stats["lp_iterations"], "lp_rounds": stats["lp_rounds"], "iterations": stats["iterations"],
         "working_set_rounds": stats["working_set_rounds"], "working_set_rows": stats["working_set_rows"],
         "method": summary["method"],
         "nlopt_result": summary["nlopt_result"], "g_stb": summary["g_stb"], "g_asm": summary["g_asm"],
         "assembly_residual": summary["assembly_residual"], "equilibrium_residual": summary["equilibrium_residual"],
-        "t_max": summary["t_max"], "torque_active": summary["torque_active"],
+        "t_max": summary["t_max"], "torque_active": summary["torque_active"], "torque_bound": summary["torque_bound"],
         "load_capacity_seconds": r["load_capacity"]["seconds"] if r["load_capacity"] is not None else None,
     }
     gaps = [w["closure_gap"] for w in design["wires"] if w["closed"]]

@@ -24,10 +24,14 @@
 // bisector (the usual case), so N_k = |f_k · d_k|; the constraint N_k >= 0 keeps this identity
 // exact otherwise. G_stb (Eq. 7) counts every crossing once per wire: G_stb = 2 Σ_k N_k.
 //
-// Torque (Sec. 4.4): t_v = n_i · Σ_{k after v} (x_v - x_k) × f_k^(i), the component along the
-// wire's plane normal, the one that bends the wire in its plane (the only bending the planar
-// rest shape can store, Eq. 11); the in-plane components (out-of-plane bending and twist) are
-// reported per wire, not bounded.
+// Torque (Sec. 4.4): t_v = Σ_{k after v} (x_v - x_k) × f_k^(i), a 3D vector, bounded by the
+// rows of torque_bound.hpp in the wire's frame (n, u, v): by default the paper's |t_v| <= t_max
+// (a polytope inscribed in the ball, exact for pure in-plane bending ±n t_max, at most 2.84%
+// inside it elsewhere); ForceOptions::torque_bound = in_plane bounds only n·t_v, the component
+// that bends the wire in its plane (the only bending the planar rest shape stores, Eq. 11).
+// The LP takes the polytope's rows lazily (those a solution violates, until none is); SLSQP
+// keeps them in its working set; the result is scaled into the polytope when a solver's
+// tolerance left it outside (every constraint but the torque rows is homogeneous in a).
 //
 // G_asm (Eq. 8): -w Σ_s ||M_s a_s||² over the assembly prefixes s (each step of the assembly,
 // the last one included although M a = 0 makes it vanish), with torque rows about the crossings'
@@ -39,12 +43,15 @@
 // M a = 0 holds to rounding); ForceAlgorithm chooses.
 #include <Eigen/Core>
 #include <array>
+#include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "wiresculpt/network.hpp"
 #include "wiresculpt/progress.hpp"
 #include "wiresculpt/rest_shape.hpp"
+#include "wiresculpt/torque_bound.hpp"
 
 namespace wiresculpt {
 
@@ -78,8 +85,14 @@ struct ForceOptions {
   /// fraction of the cost. false: every row from the start (for tests). Default true.
   bool working_set = true;
   /// Relative to t_max: the torque rows within this of their bound at the start (the LP's
-  /// optimum) form the first working set. Default 0.5.
+  /// optimum) form the first working set (TorqueBound::in_plane). Default 0.5.
   double working_set_margin = 0.5;
+  /// The same for TorqueBound::full_3d, where each vertex near its bound brings up to 6 facet
+  /// rows, so a narrower margin keeps SLSQP's set small (docs/method-forces.md §3). Default 0.05.
+  double working_set_margin_3d = 0.05;
+  /// Which torque |t_v| <= t_max bounds (torque_bound.hpp): full_3d (default, the paper's 3D
+  /// norm) or in_plane (n·t_v only, the behaviour before).
+  TorqueBound torque_bound = TorqueBound::full_3d;
 };
 
 /// The four unit pyramid vectors of hooked crossing `c` (hook ±1) from the actual incident
@@ -99,8 +112,8 @@ struct WireTorque {
   int max_torque_vertex = -1;    ///< target index of that vertex (-1 when all are 0)
   double max_out_of_plane = 0.0; ///< max_v of the in-plane part of the 3D torque sum, N·m
   /// max_v of the whole 3D torque |Σ (x_v - x_k) × f_k| (in-plane bending, out-of-plane bending
-  /// and twist together; the paper's |t_v| of Eq. 6), N·m. Only the plane-normal part is bounded
-  /// by t_max here (docs/method-forces.md, "Out-of-plane share and closure gaps").
+  /// and twist together; the paper's |t_v| of Eq. 6), N·m. At most t_max with the default
+  /// TorqueBound::full_3d; with in_plane only the plane-normal part is bounded.
   double max_torque_3d = 0.0;
 };
 
@@ -147,7 +160,10 @@ struct ForceResult {
   /// relative equilibrium residual of the final structure.
   double assembly_residual = 0.0;
   double equilibrium_residual = 0.0;
-  bool torque_active = false;  ///< some |t_v| is within 1e-6 relative of t_max
+  /// Some t_v is within 1e-6 relative of the torque bound (its gauge, torque_bound.hpp, >= 1 - 1e-6).
+  bool torque_active = false;
+  TorqueBound torque_bound = TorqueBound::full_3d;  ///< the bound that was imposed
+  int lp_rounds = 0;           ///< GLPK solves (the torque rows are added as solutions violate them)
   std::string method;          ///< "lp", "lp+slsqp" or "slsqp" (what produced the result)
   std::string nlopt_result;    ///< NLopt's code as text, "" when NLopt did not run
   int lp_iterations = 0;       ///< GLPK simplex iterations
@@ -170,7 +186,14 @@ class ForceProblem {
   int columns() const { return static_cast<int>(column_crossing_.size()); }
   const std::vector<int>& column_crossing() const { return column_crossing_; }
   const Eigen::MatrixXd& equilibrium() const { return M_; }   ///< 6P × K, torques in N·m about reference()
-  const Eigen::MatrixXd& torque_rows() const { return T_; }   ///< #vertices × K: t_v per unit a_j, N·m
+  const Eigen::MatrixXd& torque_rows() const { return T_; }   ///< #vertices × K: n·t_v per unit a_j, N·m
+  /// 3 × #vertices rows × K: the components of t_v along its wire's n, u, v per unit a_j, N·m
+  /// (row 3r is torque_rows() row r).
+  const Eigen::MatrixXd& torque_frame_rows() const { return T3_; }
+  TorqueBound torque_bound() const { return bound_; }
+  const TorquePolytope& polytope() const { return torque_polytope(bound_); }
+  /// Per torque row: the gauge of t_v(a) in polytope() (<= 1: within the bound).
+  Eigen::VectorXd torque_gauges(const Eigen::VectorXd& a) const;
   const Eigen::VectorXd& normal_weights() const { return c_; } ///< c with G_stb = c·a
   const Eigen::MatrixXd& assembly_matrix() const { return Q_; } ///< Q with Σ_s ||M_s a_s||² = aᵀQa
   const Eigen::MatrixXd& normal_rows() const { return Nk_; }   ///< #hooked × K: N_k per unit a_j
@@ -191,7 +214,8 @@ class ForceProblem {
   std::vector<int> hooks_;
   std::vector<int> column_crossing_;
   std::vector<std::array<Vec3, 4>> pyramid_;
-  Eigen::MatrixXd M_, T_, Q_, Nk_;
+  Eigen::MatrixXd M_, T_, T3_, Q_, Nk_;
+  TorqueBound bound_ = TorqueBound::full_3d;
   Eigen::VectorXd c_;
   std::vector<std::array<int, 2>> torque_vertex_;
   Vec3 reference_ = Vec3::Zero();
@@ -228,6 +252,21 @@ struct LpSolution {
 };
 /// GLPK simplex (presolve on, terminal output off, errors never abort: they return `failed`).
 LpSolution solve_lp(const LinearProgram& lp);
+/// Torques linear in an LP's columns x: block v (rows 3v..3v+2) is t_v = A_v x + c_v, its
+/// components along the wire's n, u, v.
+struct TorqueBlocks {
+  Eigen::MatrixXd A;
+  Eigen::VectorXd c;
+};
+/// Solves `lp`, then adds to it, for every block whose torque lies outside `polytope` (gauge
+/// above 1 + 1e-9), the most violated row e_k·t_v <= t_max and the violated rows of its
+/// neighbours, and solves again until no block is outside: the optimum under every row of the
+/// polytope with only the rows that matter in the LP (a cutting-plane loop over a finite row
+/// set; torque_bound.cpp). `added` holds the (block, row) pairs already in `lp`; `rounds` counts
+/// the solves. Returns the last solution (when not optimal, GLPK's status with the rows so far),
+/// with the simplex iterations of every solve.
+LpSolution solve_lp_with_torque_rows(LinearProgram& lp, const TorqueBlocks& blocks, const TorquePolytope& polytope,
+                                     double t_max, std::set<std::pair<int, int>>& added, int* rounds);
 }  // namespace detail
 
 }  // namespace wiresculpt

@@ -11,13 +11,16 @@
 //
 //   maximise    λ
 //   subject to  M_i (a0 + δ) + λ W_i = 0               every wire i not held (6 rows)
-//               |t_v(a0 + δ) + λ t_v^grav| <= t_max    every vertex of every wire not held
+//               |t_v(a0 + δ) + λ t_v^grav| <= t_max    every vertex of every wire not held (3D,
+//                                                       or its n component: torque_bound)
 //               a0 + δ >= 0                             every pyramid coefficient
 //               λ >= 0
 //
 // with a0 the pre-stress of optimize_forces (M a0 = 0), W_i the weight wrench of wire i, t_v as
-// in forces.hpp (plane-normal component, walked from the cut) plus the torque of the weight of
-// the edges after v. λ is the largest multiple of the sculpture's weight the structure holds
+// in forces.hpp (walked from the cut) plus the torque of the weight of the edges after v, bounded
+// by the rows of torque_bound.hpp (added to each LP as its solutions violate them; the solution
+// is scaled into the polytope when GLPK's tolerance left it outside: the constraints are
+// homogeneous in (a0 + δ, λ)). λ is the largest multiple of the sculpture's weight the structure holds
 // with every contact force inside its pyramid and every wire below its torque limit (rigid
 // wires, Sec. 4.1). λ = 0 means the sculpture cannot stand that way up; an unbounded LP gives
 // λ = +inf (nothing but friction cones limit it, which scale with the load).
@@ -35,6 +38,8 @@ struct LoadCapacityOptions {
   double gravity = 9.81;         ///< m/s². Default 9.81.
   /// Metres: wires whose lowest point is this close to the lowest one are held too. Default 1e-6.
   double tie_tolerance = 1e-6;
+  /// Which torque is bounded by t_max: full_3d (default, |t_v|) or in_plane (n·t_v only).
+  TorqueBound torque_bound = TorqueBound::full_3d;
 };
 
 struct LoadDirection {
@@ -46,6 +51,10 @@ struct LoadDirection {
   /// "failed" (GLPK could not solve; λ = 0).
   std::string status;
   int lp_iterations = 0;
+  int lp_rounds = 0;  ///< GLPK solves (torque rows are added as solutions violate them)
+  /// The contact coefficients a = a0 + δ at the limit load (problem.columns(); empty unless
+  /// "optimal").
+  Eigen::VectorXd coefficients;
 };
 
 struct LoadCapacityResult {

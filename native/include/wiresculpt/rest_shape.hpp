@@ -49,6 +49,11 @@ struct RestShapeOptions {
   /// Radians: the machine's largest bend (Sec. 4.3 c_f,angle; FORMATS `max_bend_deg`). Rest
   /// turning angles beyond it are reported in RestShapeResult::over_bend. Default 2π/3.
   double max_bend = 2.0 * std::numbers::pi / 3.0;
+  /// Radians: a rest angle counts as over max_bend only beyond this. The target shape holds its
+  /// bends to max_bend within its constraint tolerance, so a vertex the forces leave unloaded can
+  /// sit at max_bend plus rounding; flagging it would ask for a needless coupling round.
+  /// Default 1e-6 (6e-5 degrees).
+  double over_bend_tolerance = 1e-6;
 };
 
 struct RestShapeResult {
