@@ -47,7 +47,9 @@ void read_settings(py::handle d, NetworkOptions& net, LayeringOptions& lay) {
                field::number("bisector_span", lay.contact.bisector_span),
                field::number("straight_angle", lay.contact.straight_angle),
                field::boolean("two_wire_steps", lay.two_wire_steps), field::integer("max_nodes", lay.max_nodes),
-               field::integer("max_step_crossings", lay.max_step_crossings)});
+               field::integer("max_step_crossings", lay.max_step_crossings),
+               field::boolean("in_plane_tiebreak", lay.in_plane_tiebreak),
+               field::integer("in_plane_nodes", lay.in_plane_nodes)});
 }
 
 py::dict network_dict(const Network& net, const std::vector<int>& hooks) {
@@ -97,8 +99,9 @@ py::dict layering_py(const py::object& wire_list, const py::object& settings, co
       py::arg("two_hand_steps") = r.two_hand_steps, py::arg("stable") = r.stable, py::arg("reason") = r.reason,
       py::arg("warnings") = warnings,
       py::arg("objective") = py::dict(py::arg("max_metric") = r.max_metric, py::arg("null_crossings") = r.null_crossings,
-                                      py::arg("sum_metric") = r.sum_metric),
-      py::arg("complete_search") = r.complete_search,
+                                      py::arg("sum_metric") = r.sum_metric,
+                                      py::arg("unbalanced_in_plane") = r.unbalanced_in_plane),
+      py::arg("complete_search") = r.complete_search, py::arg("in_plane_complete") = r.in_plane_complete,
       py::arg("stats") = py::dict(py::arg("seconds") = r.stats.seconds, py::arg("lp_solves") = r.stats.lp_solves,
                                   py::arg("nodes") = r.stats.nodes));
 }
@@ -145,15 +148,17 @@ wires: list of {"name": str, "origin": 3 floats, "normal": 3 floats, "points": f
 metres on the plane, "closed": bool (default True)}.
 settings (all optional): tolerance (m, 1e-5), min_segment (m, 0.015), friction (0.32),
 contact_angle (rad, 2pi/3), bisector_span (m, 0.005), straight_angle (rad, 1 degree),
-two_wire_steps (True), max_nodes (200000), max_step_crossings (20); unknown keys raise ValueError.
+two_wire_steps (True), max_nodes (200000), max_step_crossings (20), in_plane_tiebreak (False), in_plane_nodes (300);
+unknown keys raise ValueError.
 progress(stage, fraction) -> False cancels (raises _wiresculpt.Cancelled).
 Returns {"network": {"wires": [{id, name, origin, normal, closed, points (n, 3)}], "crossings":
 [{id, wires, vertices, point, hook}], "close_crossings": [...], "min_scale", "size",
 "required_size"}, "hook": [-1|0|1 per crossing], "metric": [e_c], "assembly_order": [wire ids],
 "steps": [[ids]], "two_hand_steps": [step indices], "stable": bool, "reason": str,
-"warnings": [str], "objective": {max_metric, null_crossings, sum_metric}, "complete_search": bool,
-"stats": {seconds, lp_solves, nodes}}. Bad input raises ValueError naming the wire or key, e.g.
-wires[1]['points']: expected an (n, 3) array of numbers, got shape (5, 2).)");
+"warnings": [str], "objective": {max_metric, null_crossings, sum_metric, unbalanced_in_plane},
+"complete_search": bool, "in_plane_complete": bool, "stats": {seconds, lp_solves, nodes}}. Bad
+input raises ValueError naming the wire or key, e.g. wires[1]['points']: expected an (n, 3) array
+of numbers, got shape (5, 2).)");
 }
 
 }  // namespace wiresculpt::python

@@ -5,9 +5,11 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "wiresculpt/error.hpp"
+#include "wiresculpt/in_plane.hpp"
 #include "wiresculpt/stability.hpp"
 
 namespace wiresculpt {
@@ -21,6 +23,7 @@ struct Key {
   int nulls = 0;
   double sum = 0.0;
   int two = 0;
+  int unbal = 0;  // key 5: wires whose crossings are all decided and that do not balance in plane
 };
 
 bool less(const Key& a, const Key& b) {
@@ -29,7 +32,8 @@ bool less(const Key& a, const Key& b) {
   if (a.nulls != b.nulls) return a.nulls < b.nulls;
   if (a.sum < b.sum - kEps) return true;
   if (a.sum > b.sum + kEps) return false;
-  return a.two < b.two;
+  if (a.two != b.two) return a.two < b.two;
+  return a.unbal < b.unbal;
 }
 
 std::string quoted(const Network& net, int w) { return "'" + net.wires[w].name + "'"; }
@@ -67,11 +71,18 @@ class Search {
       minhook_[c] = std::min(cost_[c][0], cost_[c][1]);
     }
     hooks_.assign(C_, 0);
+    neighbours_.assign(P_, 0);
+    for (int w = 0; w < P_; ++w) crossing_lists_.push_back(net.crossings_of(w));
+    for (const auto& x : net.crossings) {
+      neighbours_[x.wires[0]] |= std::uint64_t{1} << x.wires[1];
+      neighbours_[x.wires[1]] |= std::uint64_t{1} << x.wires[0];
+    }
   }
 
   // One full search; `pairs` allows two-wire steps after the first pair.
   void run(bool pairs) {
     pairs_ = pairs;
+    stopped_ = false;
     base_ = reported_;
     root_fraction_ = 0.0;
     visited_.clear();
@@ -95,6 +106,11 @@ class Search {
   std::uint64_t full_ = 0;
   std::vector<std::array<double, 2>> cost_;  // [c][0]: hook -1, [c][1]: hook +1
   std::vector<double> minhook_;
+  std::vector<std::uint64_t> neighbours_;  // per wire: the wires it crosses
+  // balances_in_plane per wire and hooks of its crossings (key: wire id, then hooks).
+  mutable std::unordered_map<std::string, bool> balance_memo_;
+  std::vector<std::vector<int>> crossing_lists_;  // per wire: Network::crossings_of
+  mutable std::vector<int> scratch_;              // hooks_ with a child's choice applied
 
   // Current path.
   bool pairs_ = false;
@@ -117,6 +133,8 @@ class Search {
   std::unordered_set<std::string> visited_;
   long nodes_ = 0;
   bool stopped_ = false;
+  long node_limit_ = 0;    // stop when nodes_ reaches it; 0 = no limit
+  bool in_plane_ = false;  // count key 5 (the second pass, layering())
   std::vector<std::string> warnings_;
   std::vector<int> oversized_warned_;
   double root_fraction_ = 0.0;
@@ -137,7 +155,21 @@ class Search {
     std::vector<int> fresh;        // crossings decided by this step, sorted by minhook descending
     std::vector<double> open_min;  // minhook of crossings still undecided after it, ascending
     std::vector<double> open_prefix;
+    std::vector<int> completes;    // wires whose crossings are all decided by this step
   };
+
+  bool complete(int w, std::uint64_t m) const { return in(w, m) && (neighbours_[w] & ~m) == 0; }
+
+  // Key 5 (layering.hpp): does wire w balance in plane under `hooks`? Memoised.
+  bool balanced(int w, const std::vector<int>& hooks) const {
+    std::string key(1, static_cast<char>(w));
+    for (int c : crossing_lists_[w]) key.push_back(static_cast<char>(hooks[c] + 1));
+    const auto it = balance_memo_.find(key);
+    if (it != balance_memo_.end()) return it->second;
+    const bool ok = balances_in_plane(net_, w, hooks);
+    balance_memo_.emplace(std::move(key), ok);
+    return ok;
+  }
 
   Key lower_bound(const Key& k, const Group& g) const {
     // Undecided crossings whose cheaper hook exceeds the maximum must be null if the maximum is
@@ -182,6 +214,9 @@ class Search {
     std::sort(g.open_min.begin(), g.open_min.end());
     g.open_prefix.assign(g.open_min.size() + 1, 0.0);
     for (std::size_t k = 0; k < g.open_min.size(); ++k) g.open_prefix[k + 1] = g.open_prefix[k] + g.open_min[k];
+    if (in_plane_)
+      for (int w = 0; w < P_; ++w)
+        if (complete(w, after) && !complete(w, mask_)) g.completes.push_back(w);
     g.wires = std::move(wires);
     return true;
   }
@@ -197,6 +232,7 @@ class Search {
     const double cap = have_best_ ? best_.max + kEps : 1e300;
     std::vector<std::array<signed char, 2>> options(m);
     std::vector<int> n_options(m), digit(m);
+    if (!g.completes.empty()) scratch_ = hooks_;
     for (int z = 0; z <= m; ++z) {
       if (z > 0) {
         const double lowest = minhook_[N[z - 1]];
@@ -235,6 +271,11 @@ class Search {
           k.max = std::max(k.max, e);
           k.sum += e;
         }
+        if (min_null > k.max + kEps && !g.completes.empty()) {
+          for (int q = 0; q < free; ++q) scratch_[N[z + q]] = options[q][digit[q]];
+          for (int q = 0; q < z; ++q) scratch_[N[q]] = 0;
+          for (int w : g.completes) k.unbal += balanced(w, scratch_) ? 0 : 1;
+        }
         if (min_null > k.max + kEps) {
           const Key lb = lower_bound(k, g);
           if (!have_best_ || less(lb, best_)) {
@@ -262,7 +303,7 @@ class Search {
       reported_ = std::max(reported_, base_ + (1.0 - base_) * root_fraction_);
       report_progress(progress_, "layering", std::min(reported_, 0.99));
     }
-    if (opt_.max_nodes > 0 && nodes_ >= opt_.max_nodes) stopped_ = true;
+    if (node_limit_ > 0 && nodes_ >= node_limit_) stopped_ = true;
   }
 
   std::string state_key() const {
@@ -439,6 +480,7 @@ LayeringResult layering(const Network& net, const LayeringOptions& options, cons
   if (P == 0) throw InputError("layering needs at least one wire");
   if (P > 64) throw InputError("layering handles at most 64 wires, got " + std::to_string(P));
   if (options.max_nodes < 0) throw InputError("max_nodes must be >= 0 (0 means no limit)");
+  if (options.in_plane_nodes < 0) throw InputError("in_plane_nodes must be >= 0 (0 means no limit)");
   if (options.max_step_crossings < 1 || options.max_step_crossings > 30)
     throw InputError("max_step_crossings must be between 1 and 30");
   for (const auto& x : net.crossings)
@@ -514,17 +556,38 @@ LayeringResult layering(const Network& net, const LayeringOptions& options, cons
       return finish();
     }
   }
+  s.node_limit_ = options.max_nodes;
   s.run(false);
   bool tried_pairs = false;
   if (!s.found() && !s.stopped() && options.two_wire_steps && P >= 4) {
     tried_pairs = true;
     s.run(true);
   }
+  const bool stopped = s.stopped();
+  // Key 5 (layering.hpp): a second pass among the structures equal to the best in keys 1-4,
+  // seeded with the best (so everything not at least as good in keys 1-4 is pruned at once) and
+  // bounded by its own node budget.
+  bool in_plane_complete = true;
+  if (options.in_plane_tiebreak && s.found() && !stopped) {
+    s.best_.unbal = unbalanced_in_plane(net, s.best_hooks_);
+    if (s.best_.unbal > 0) {
+      s.in_plane_ = true;
+      s.node_limit_ = options.in_plane_nodes > 0 ? s.nodes_ + options.in_plane_nodes : 0;
+      s.run(tried_pairs);
+      in_plane_complete = !s.stopped();
+    }
+  }
   r.warnings = s.warnings_;
   r.stats.lp_solves = s.checker_.lp_solves();
   r.stats.nodes = s.nodes_;
-  r.complete_search = !s.stopped();
-  if (s.stopped())
+  r.complete_search = !stopped;
+  r.in_plane_complete = in_plane_complete;
+  if (!in_plane_complete)
+    r.warnings.push_back("the in-plane tie-break (objective key 5) stopped after " +
+                         std::to_string(options.in_plane_nodes) + " nodes (in_plane_nodes); " +
+                         std::to_string(s.best_.unbal) + " wire" + (s.best_.unbal == 1 ? "" : "s") +
+                         " may not balance in plane where another hook pattern of equal cost would");
+  if (stopped)
     r.warnings.push_back("the layering search stopped after " + std::to_string(s.nodes_) +
                          " nodes (max_nodes); the result may not be optimal");
   if (s.found()) {
@@ -535,6 +598,7 @@ LayeringResult layering(const Network& net, const LayeringOptions& options, cons
     r.max_metric = s.best_.max;
     r.null_crossings = s.best_.nulls;
     r.sum_metric = s.best_.sum;
+    r.unbalanced_in_plane = unbalanced_in_plane(net, r.hooks);
     for (int c = 0; c < C; ++c) r.metric[c] = r.hooks[c] == 0 ? 0.0 : s.cost_[c][r.hooks[c] > 0 ? 1 : 0];
     for (int k = 0; k < static_cast<int>(r.steps.size()); ++k)
       if (r.steps[k].size() > (k == 0 ? 2u : 1u)) r.two_hand_steps.push_back(k);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "wiresculpt/geometry.hpp"
+#include "wiresculpt/contact.hpp"
 #include "wiresculpt/error.hpp"
 #include "wiresculpt/network.hpp"
 #include "wiresculpt/rest_shape.hpp"
@@ -21,6 +22,10 @@ using wiresculpt::Plane;
 using wiresculpt::Polyline3;
 using wiresculpt::Vec3;
 using wiresculpt::WireSpec;
+using wiresculpt::Network;
+using wiresculpt::ContactOptions;
+using wiresculpt::HookGeometry;
+using wiresculpt::hook_geometry;
 
 /// A cut of the sphere of radius R about the origin by the plane {x : n·x = h} (n unit).
 struct Cut {
@@ -158,6 +163,24 @@ inline double max_torque_3d(const WireSpec& w, int cut, const std::vector<wiresc
     largest = std::max(largest, t.norm());
   }
   return largest;
+}
+
+/// `net` with each hooked crossing's two neighbours on both wires moved to the kink of Fig. 6
+/// (hook_geometry), the target shape the force stage expects. Needs wiresculpt/contact.hpp.
+inline Network idealise_hooks(const Network& net, const std::vector<int>& hooks, const ContactOptions& co = {}) {
+  Network out = net;
+  for (std::size_t c = 0; c < net.crossings.size(); ++c) {
+    if (hooks[c] == 0) continue;
+    const HookGeometry g = hook_geometry(net, static_cast<int>(c), hooks[c], co);
+    for (int k = 0; k < 2; ++k) {
+      WireSpec& w = out.wires[net.crossings[c].wires[k]];
+      const int n = static_cast<int>(w.points.size());
+      const int v = net.crossings[c].vertices[k];
+      w.points[(v + n - 1) % n] = g.neighbours[k][0];
+      w.points[(v + 1) % n] = g.neighbours[k][1];
+    }
+  }
+  return out;
 }
 
 }  // namespace fixtures

@@ -46,7 +46,8 @@ def run(design, material, settings, native_progress=None):
     stats = result["stats"]
     design["stages"]["layering"] = {
         "seconds": stats["seconds"], "lp_solves": stats["lp_solves"], "nodes": stats["nodes"],
-        "complete_search": result["complete_search"], **result["objective"],
+        "complete_search": result["complete_search"], "in_plane_complete": result["in_plane_complete"],
+        **result["objective"],
     }
     return (f"{len(design['crossings'])} crossings, {'stable' if design['stable'] else 'not stable'}, "
             f"order {design['assembly_order']}, {stats['lp_solves']} LPs, {stats['nodes']} nodes "

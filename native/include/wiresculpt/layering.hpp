@@ -10,8 +10,11 @@
 //   2. number of null crossings        ties prefer more interlocked crossings (more stability)
 //   3. Σ_c e_c                         then the smallest total modification
 //   4. number of two-hand steps        (only when single-wire steps cannot work, see below)
-// Floating-point keys are equal when within 1e-9. Among configurations equal in all four keys
-// the first one found is returned (deterministic).
+//   5. number of wires that do not balance in plane (in_plane.hpp; beyond the paper, only with
+//      LayeringOptions::in_plane_tiebreak): among equal Eq. 2 costs, prefer hooks whose normal
+//      forces can hold every wire within its own plane
+// Floating-point keys are equal when within 1e-9. Among configurations equal in all keys the
+// first one found is returned (deterministic).
 //
 // Exactness: the search returns a configuration and order whose objective is the minimum over
 // every hook configuration (3^C) and every order of single-wire steps whose prefixes are all
@@ -24,7 +27,9 @@
 // fewer choices trying them one by one is cheaper); (e) before searching, the
 // finished sculpture with both pyramids at every crossing must be stable, else no configuration
 // is (the reason then names the wire that cannot be held); (f) a hook dearer than the best
-// structure's maximum is never enumerated. The search first follows the cheapest child of each
+// structure's maximum is never enumerated. Key 5 is counted for a wire once all its crossings
+// are decided (a wire's verdict depends only on its own crossings' hooks), so the partial count
+// is a lower bound and (a) stays exact. The search first follows the cheapest child of each
 // step to reach a complete structure (and so a bound) quickly, then tries every other child
 // that can still improve on the best.
 //
@@ -58,6 +63,16 @@ struct LayeringOptions {
   /// Steps with more new crossings than this are not enumerated (2^n hook choices each); a
   /// warning names the skipped wire. Default 20.
   int max_step_crossings = 20;
+  /// Objective key 5: among hook patterns equal in keys 1-4, prefer those in which more wires
+  /// balance in their own planes (in_plane.hpp). A second search after the first, seeded with
+  /// its best. Off by default: on boxy models it costs up to ~1.2 s of layering (bench chair)
+  /// against a 0.2 s target, and its gain was measured under the in-plane torque bound only
+  /// (docs/method-layering.md). Default false.
+  bool in_plane_tiebreak = false;
+  /// Node budget of that second search (0 = no limit); when reached, the best found so far is
+  /// kept (never worse than the first search's) with a warning and in_plane_complete = false.
+  /// Default 300 (about 1.5 s on the bench chair; docs/method-layering.md).
+  long in_plane_nodes = 300;
 };
 
 struct LayeringStats {
@@ -87,7 +102,11 @@ struct LayeringResult {
   double max_metric = 0.0;  ///< objective key 1
   int null_crossings = 0;   ///< objective key 2
   double sum_metric = 0.0;  ///< objective key 3
-  bool complete_search = true;  ///< false when max_nodes stopped the search
+  /// Objective key 5 of the returned hooks: wires that do not balance in plane (computed also
+  /// when in_plane_tiebreak is off; 0 when unstable).
+  int unbalanced_in_plane = 0;
+  bool complete_search = true;  ///< false when max_nodes stopped the search (keys 1-4)
+  bool in_plane_complete = true;  ///< false when in_plane_nodes stopped the key-5 search
   LayeringStats stats;
 };
 
