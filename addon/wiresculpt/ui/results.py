@@ -162,9 +162,9 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
         if gaps:
             row = layout.row()
             # how far the two ends of the largest rest shape stand apart before assembly
-            row.label(text="Max closure gap")
+            row.label(text="Closure gap")
             row.label(text=length_text(context.scene, max(gaps)))
-            layout.label(text="Move a sphere in Cuts to move a cut", icon='INFO')
+            layout.label(text="Cuts: drag a sphere", icon='INFO')
         capacity = load_capacity_rows(design)
         if capacity:
             col = layout.column(align=True)
