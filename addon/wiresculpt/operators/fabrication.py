@@ -196,15 +196,9 @@ class WIRESCULPT_OT_send_to_machine(WorkerModal, bpy.types.Operator):
         if job is None:
             return {'CANCELLED'}
         try:
-            if event.type == 'ESC' and event.value == 'PRESS':
-                job.cancel()
-                self._show(context)
-                return {'RUNNING_MODAL'}
-            if event.type != 'TIMER':
-                return {'PASS_THROUGH'}
-            if job.thread.is_alive():
-                self._show(context)
-                return {'PASS_THROUGH'}
+            answer = self.watch_event(context, event, job.thread, job.cancel)
+            if answer is not None:
+                return answer
             self._cleanup(context)
             return self._finish(job)
         except Exception as exc:  # never leave a half-finished modal behind in the UI

@@ -255,17 +255,12 @@ class WIRESCULPT_OT_optimize(WorkerModal, bpy.types.Operator):
         job = JOB
         if job is None:  # cancelled from outside and already cleaned up
             return {'CANCELLED'}
-        if event.type == 'ESC' and event.value == 'PRESS':
-            job.stop()  # the next timer tick finishes the modal once the worker has ended
-            self._show(context)
-            return {'RUNNING_MODAL'}
         if event.type == 'Z' and (event.ctrl or event.oskey):
             return {'RUNNING_MODAL'}  # no undo under a running solve
-        if event.type != 'TIMER':
-            return {'PASS_THROUGH'}
-        if job.thread.is_alive():
-            self._show(context)
-            return {'PASS_THROUGH'}
+        # Esc: stop; the next timer tick finishes the modal once the worker has ended
+        answer = self.watch_event(context, event, job.thread, job.stop)
+        if answer is not None:
+            return answer
         self._cleanup(context)
         if job.cancelled or job.cancel_event.is_set():
             self.report({'WARNING'}, "Optimize cancelled; the scene is unchanged")

@@ -26,6 +26,21 @@ class WorkerModal:
             if area.type == 'VIEW_3D':
                 area.tag_redraw()
 
+    def watch_event(self, context, event, thread, cancel):
+        """The common part of modal(): Esc calls `cancel()`, timer ticks refresh the progress (the
+        operator's `_show`) while `thread` runs. The modal's answer, or None once the worker has
+        ended (the caller finishes)."""
+        if event.type == 'ESC' and event.value == 'PRESS':
+            cancel()
+            self._show(context)
+            return {'RUNNING_MODAL'}
+        if event.type != 'TIMER':
+            return {'PASS_THROUGH'}
+        if thread.is_alive():
+            self._show(context)
+            return {'PASS_THROUGH'}
+        return None
+
     def end_watch(self, context):
         wm = context.window_manager
         if self._timer is not None:
