@@ -10,6 +10,7 @@ import sys
 import threading
 import time
 import tty
+import types
 
 import numpy as np
 
@@ -42,6 +43,31 @@ def run_under_xvfb(script, marker, timeout=180):
     result = subprocess.CompletedProcess(cmd, proc.returncode, out, err)
     lines = [line for line in out.splitlines() if line.startswith(marker)]
     return result, json.loads(lines[-1][len(marker):]) if lines else None
+
+
+class FakeLayout:
+    """Records what a draw function asks for; enough of UILayout to run panel code (attributes
+    such as `alert` may be set and are ignored)."""
+
+    def __init__(self, log):
+        self.log = log
+
+    def __getattr__(self, name):
+        def call(*args, **kwargs):
+            self.log.append((name, args, kwargs))
+            return FakeLayout(self.log)
+        return call
+
+    def __setattr__(self, name, value):
+        if name == "log":
+            object.__setattr__(self, name, value)
+
+
+def draw(panel_class, context):
+    """[(method, args, kwargs)] of what panel_class.draw asks of its layout."""
+    log = []
+    panel_class.draw(types.SimpleNamespace(layout=FakeLayout(log)), context)
+    return log
 
 
 def wiresculpt_lines(text):

@@ -15,6 +15,8 @@ from wiresculpt import native
 from wiresculpt.operators import slicing
 from wiresculpt.ui import panel
 
+from helpers import FakeLayout, draw
+
 
 def register_addon():
     if wiresculpt._modules:  # registered already (by another suite or a previous run)
@@ -290,24 +292,8 @@ class Refusals(AddonCase):
         self.assertIn("Slice A", reports[-1][1])
 
 
-class FakeLayout:
-    """Records what a draw function asks for; enough of UILayout to run panel code."""
-
-    def __init__(self, log):
-        self.log = log
-
-    def __getattr__(self, name):
-        def call(*args, **kwargs):
-            self.log.append((name, args, kwargs))
-            return FakeLayout(self.log)
-        return call
-
-
 def draw_panel():
-    log = []
-    fake = types.SimpleNamespace(layout=FakeLayout(log))
-    panel.VIEW3D_PT_wiresculpt.draw(fake, bpy.context)
-    return log
+    return draw(panel.VIEW3D_PT_wiresculpt, bpy.context)
 
 
 class Registration(AddonCase):

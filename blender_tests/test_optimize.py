@@ -19,6 +19,7 @@ from wiresculpt.operators import optimize
 from wiresculpt.ui import results as results_ui
 
 from helpers import ROOT
+from helpers import draw as helpers_draw
 
 GLOBE_OBJ = os.path.join(ROOT, "scripts", "examples", "globe", "globe.obj")
 GLOBE_RADIUS = 0.125  # globe.obj has radius 1; scaled like the example's size 0.25
@@ -90,27 +91,8 @@ def run(operator_class, context=None):
     return result, reports
 
 
-class FakeLayout:
-    """Records what a draw function asks for."""
-
-    def __init__(self, log):
-        self.log = log
-
-    def __getattr__(self, name):
-        def call(*args, **kwargs):
-            self.log.append((name, args, kwargs))
-            return FakeLayout(self.log)
-        return call
-
-    def __setattr__(self, name, value):
-        if name == "log":
-            object.__setattr__(self, name, value)
-
-
 def draw(panel_class):
-    log = []
-    panel_class.draw(types.SimpleNamespace(layout=FakeLayout(log)), bpy.context)
-    return log
+    return helpers_draw(panel_class, bpy.context)
 
 
 def labels(log):

@@ -395,6 +395,16 @@ def generate(out, names=None, run_check=True, say=print):
     def wanted(name):
         return not names or any(n in name for n in names)
 
+    sphere = None
+
+    def unit_sphere():
+        """The UV sphere the sweeps share, made and written to meshes/sphere.obj once."""
+        nonlocal sphere
+        if sphere is None:
+            sphere = uv_ellipsoid((1.0, 1.0, 1.0))
+            write_obj(os.path.join(out, "meshes", "sphere.obj"), *sphere, "UV sphere, radius 1")
+        return sphere
+
     for name, build in PAPER_SCENES.items():
         if not wanted(name):
             continue
@@ -405,36 +415,29 @@ def generate(out, names=None, run_check=True, say=print):
         path = sized(out, name, f"{name}.obj", V, planes, row["l_max_cm"] / 100)
         cases.append({"name": name, "kind": "paper", "scene": path, "P": row["P"], "C": row["C"],
                       "triangles": int(len(F)), "paper": row})
-    sphere = None
     for a, b, c in CROSSING_FAMILIES:
         name = f"sphere-{a}{b}{c}"
         if not wanted(name):
             continue
-        if sphere is None:
-            sphere = uv_ellipsoid((1.0, 1.0, 1.0))
-            write_obj(os.path.join(out, "meshes", "sphere.obj"), *sphere, "UV sphere, radius 1")
+        mesh = unit_sphere()
         path = write_scene(out, name, "sphere.obj", CROSSING_SIZE, family_planes(a, b, c))
         cases.append({"name": name, "kind": "crossings", "scene": path, "P": a + b + c,
-                      "C": expected_crossings(a, b, c), "triangles": int(len(sphere[1]))})
+                      "C": expected_crossings(a, b, c), "triangles": int(len(mesh[1]))})
     if wanted(SEARCH_STRESS["name"]):
-        if sphere is None:
-            sphere = uv_ellipsoid((1.0, 1.0, 1.0))
-            write_obj(os.path.join(out, "meshes", "sphere.obj"), *sphere, "UV sphere, radius 1")
+        mesh = unit_sphere()
         fams = SEARCH_STRESS["families"]
         path = write_scene(out, SEARCH_STRESS["name"], "sphere.obj", SEARCH_STRESS["size"],
                            family_planes(*fams, spread=SEARCH_STRESS["spread"]))
         cases.append({"name": SEARCH_STRESS["name"], "kind": "search", "scene": path, "P": sum(fams),
-                      "C": expected_crossings(*fams), "triangles": int(len(sphere[1]))})
+                      "C": expected_crossings(*fams), "triangles": int(len(mesh[1]))})
     for length in LENGTHS:
         name = f"length-{length:.1f}m"
         if not wanted(name):
             continue
-        if sphere is None:
-            sphere = uv_ellipsoid((1.0, 1.0, 1.0))
-            write_obj(os.path.join(out, "meshes", "sphere.obj"), *sphere, "UV sphere, radius 1")
-        path = sized(out, name, "sphere.obj", sphere[0], family_planes(*LENGTH_FAMILY), length)
+        mesh = unit_sphere()
+        path = sized(out, name, "sphere.obj", mesh[0], family_planes(*LENGTH_FAMILY), length)
         cases.append({"name": name, "kind": "length", "scene": path, "P": sum(LENGTH_FAMILY),
-                      "C": expected_crossings(*LENGTH_FAMILY), "triangles": int(len(sphere[1])),
+                      "C": expected_crossings(*LENGTH_FAMILY), "triangles": int(len(mesh[1])),
                       "target_length": length})
     for case in cases:
         case["scene"] = os.path.relpath(case["scene"], out)
