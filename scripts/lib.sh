@@ -5,6 +5,11 @@ BUILD_DIR=${WIRESCULPT_BUILD_DIR:-$ROOT/build/release}
 # Blender 3.4 from Debian embeds Debian's Python 3.11; another python3 may come first on PATH.
 PYTHON=/usr/bin/python3.11
 BLENDER=${BLENDER:-blender}
+# Debian's CMake and the pybind11 it packages: a pip-installed cmake (4.x) or pybind11 may come
+# first on PATH, and neither matches the Debian libraries the build links.
+CMAKE=/usr/bin/cmake
+CTEST=/usr/bin/ctest
+PYBIND11_DIR=/usr/lib/cmake/pybind11
 
 # Debian packages the build, the tests and the demo need.
 PACKAGES=(
@@ -40,10 +45,11 @@ ensure_packages() {
 
 # Configures (once) and builds the library, the Python module and the tests.
 build() {
-  if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
-    cmake -S "$ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE="$PYTHON" >/dev/null
+  if [ ! -f "$BUILD_DIR/Makefile" ]; then  # a failed configure leaves a cache but no Makefile
+    "$CMAKE" -S "$ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE="$PYTHON" \
+      -Dpybind11_DIR="$PYBIND11_DIR" >/dev/null
   fi
-  if ! cmake --build "$BUILD_DIR" -j"$(nproc)" >"$BUILD_DIR/build.log" 2>&1; then
+  if ! "$CMAKE" --build "$BUILD_DIR" -j"$(nproc)" >"$BUILD_DIR/build.log" 2>&1; then
     cat "$BUILD_DIR/build.log" >&2
     say "build failed (log: $BUILD_DIR/build.log)"
     return 1
@@ -53,19 +59,19 @@ build() {
 
 # The native tests built with AddressSanitizer and UBSan (no Python module).
 build_sanitize() {
-  if [ ! -f "$ROOT/build/sanitize/CMakeCache.txt" ]; then
-    cmake --preset sanitize -S "$ROOT" >/dev/null
+  if [ ! -f "$ROOT/build/sanitize/Makefile" ]; then
+    "$CMAKE" --preset sanitize -S "$ROOT" >/dev/null
   fi
-  cmake --build "$ROOT/build/sanitize" -j"$(nproc)" >"$ROOT/build/sanitize/build.log" 2>&1 ||
+  "$CMAKE" --build "$ROOT/build/sanitize" -j"$(nproc)" >"$ROOT/build/sanitize/build.log" 2>&1 ||
     { cat "$ROOT/build/sanitize/build.log" >&2; say "sanitizer build failed"; return 1; }
 }
 
 # The libFuzzer targets, built with clang.
 build_fuzz() {
-  if [ ! -f "$ROOT/build/fuzz/CMakeCache.txt" ]; then
-    cmake --preset fuzz -S "$ROOT" >/dev/null
+  if [ ! -f "$ROOT/build/fuzz/Makefile" ]; then
+    "$CMAKE" --preset fuzz -S "$ROOT" >/dev/null
   fi
-  cmake --build "$ROOT/build/fuzz" -j"$(nproc)" >"$ROOT/build/fuzz/build.log" 2>&1 ||
+  "$CMAKE" --build "$ROOT/build/fuzz" -j"$(nproc)" >"$ROOT/build/fuzz/build.log" 2>&1 ||
     { cat "$ROOT/build/fuzz/build.log" >&2; say "fuzz build failed"; return 1; }
 }
 
