@@ -11,12 +11,18 @@ import threading
 import time
 import tty
 import types
+import unittest
 
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BATCH = os.path.join(ROOT, "scripts", "wiresculpt_batch.py")
-BLENDER = os.environ.get("BLENDER") or sys.argv[0] or "blender"
+# Inside Blender, the running Blender itself; from the bpy-free suites (plain Python), the one on PATH.
+BLENDER = os.environ.get("BLENDER") or (sys.argv[0] if "blender" in os.path.basename(sys.argv[0]).lower()
+                                        else "blender")
+ADDON = os.path.join(ROOT, "addon")
+if ADDON not in sys.path:
+    sys.path.insert(0, ADDON)
 
 
 def run_blender(script, *args, env=None, timeout=300):
@@ -215,3 +221,108 @@ def circle(normal, radius=0.1, n=64):
     v = np.cross(normal, u)
     t = np.linspace(0, 2 * math.pi, n, endpoint=False)
     return radius * (np.outer(np.cos(t), u) + np.outer(np.sin(t), v))
+
+
+# --- shapes -------------------------------------------------------------------------------------
+
+def sphere(radius=0.125, segments=48, rings=24):
+    V = [(0.0, 0.0, radius)]
+    for r in range(1, rings):
+        th = math.pi * r / rings
+        V += [(radius * math.sin(th) * math.cos(2 * math.pi * s / segments),
+               radius * math.sin(th) * math.sin(2 * math.pi * s / segments), radius * math.cos(th)) for s in range(segments)]
+    V.append((0.0, 0.0, -radius))
+    at = lambda r, s: 1 + (r - 1) * segments + s % segments
+    F = [(0, at(1, s), at(1, s + 1)) for s in range(segments)]
+    for r in range(1, rings - 1):
+        for s in range(segments):
+            F += [(at(r, s), at(r + 1, s), at(r + 1, s + 1)), (at(r, s), at(r + 1, s + 1), at(r, s + 1))]
+    F += [(len(V) - 1, at(rings - 1, s + 1), at(rings - 1, s)) for s in range(segments)]
+    return np.array(V), np.array(F)
+
+
+def edge_lengths(points):
+    p = np.asarray(points, dtype=float)
+    return np.linalg.norm(np.diff(p, axis=0), axis=1)
+
+
+def _planes():
+    from wiresculpt.core.scene import PlaneSpec
+
+    return [PlaneSpec(n, (0, 0, 0), normal) for n, normal in (("A", (0, 0, 1)), ("B", (1, 0, 0)), ("C", (0, 1, 0)))]
+
+
+PLANES = _planes()  # three great circles through the origin
+
+
+# --- inside Blender (bpy is imported where it is used, so the bpy-free suites can import this) ---
+
+GLOBE_OBJ = os.path.join(ROOT, "scripts", "examples", "globe", "globe.obj")
+GLOBE_RADIUS = 0.125  # globe.obj has radius 1; scaled like the example's size 0.25
+
+
+def register_addon():
+    import wiresculpt
+
+    if wiresculpt._modules:
+        wiresculpt.unregister()
+    wiresculpt.register()
+
+
+def clear_scene():
+    import bpy
+
+    for collection in (bpy.data.objects, bpy.data.meshes, bpy.data.curves, bpy.data.collections,
+                       bpy.data.texts, bpy.data.materials, bpy.data.cameras):
+        for block in list(collection):
+            collection.remove(block)
+    ws = bpy.context.scene.wiresculpt
+    ws.contours.clear()
+    ws.target = None
+    ws.assembly_step = 0
+
+
+def add_handle(rotation=(0.0, 0.0, 0.0), location=(0.0, 0.0, 0.0)):
+    import bpy
+
+    assert bpy.ops.wiresculpt.add_plane() == {'FINISHED'}
+    handle = bpy.context.view_layer.objects.active
+    handle.location = location
+    handle.rotation_euler = rotation
+    return handle
+
+
+def globe(rotations=((0, 0, 0), (0, math.pi / 2, 0), (math.pi / 2, 0, 0))):
+    """The bundled example: globe.obj at radius 0.125 m, handles through its centre with normals
+    z, x and y (by default), sliced."""
+    import bpy
+
+    from wiresculpt.blend.mesh import import_mesh
+
+    _V, _F, objects = import_mesh(GLOBE_OBJ)
+    target = objects[0]
+    target.scale = (GLOBE_RADIUS,) * 3
+    bpy.context.view_layer.update()
+    bpy.context.scene.wiresculpt.target = target
+    for rotation in rotations:
+        add_handle(rotation)
+    assert bpy.ops.wiresculpt.slice() == {'FINISHED'}
+    return target
+
+
+class BlenderCase(unittest.TestCase):
+    """A suite inside Blender: the add-on registered, the scene cleared before each test."""
+
+    @classmethod
+    def setUpClass(cls):
+        register_addon()
+
+    @classmethod
+    def tearDownClass(cls):
+        import wiresculpt
+
+        clear_scene()
+        wiresculpt.unregister()
+
+    def setUp(self):
+        clear_scene()

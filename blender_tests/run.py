@@ -1,9 +1,15 @@
-"""Runs the Blender test suites inside Blender:
+"""Runs the add-on's Python test suites and prints one closing line `LABEL: N passed, N failed`,
+exiting non-zero on any failure.
+
+Inside Blender, the suites that need it (blender_tests/test_*.py):
 
     blender --background --factory-startup --python-exit-code 1 --python blender_tests/run.py [-- PATTERN...]
 
-Discovers blender_tests/test_*.py (or only the modules whose names contain a PATTERN), runs them
-with unittest, prints a closing line `N passed, N failed` and exits non-zero on any failure.
+With the system Python 3.11 (the one Blender embeds), the bpy-free suites (blender_tests/pure/test_*.py):
+
+    /usr/bin/python3.11 blender_tests/run.py pure [PATTERN...]
+
+Only the modules whose names contain a PATTERN run when patterns are given.
 """
 import os
 import sys
@@ -11,9 +17,6 @@ import unittest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-for path in (HERE, os.path.join(ROOT, "addon"), os.path.join(ROOT, "scripts")):
-    if path not in sys.path:
-        sys.path.insert(0, path)
 
 
 def native_missing():
@@ -25,13 +28,24 @@ def native_missing():
 
 
 def main():
-    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    inside_blender = "bpy" in sys.modules
+    if "--" in sys.argv:
+        argv = sys.argv[sys.argv.index("--") + 1:]
+    else:
+        argv = [] if inside_blender else sys.argv[1:]
+    pure = bool(argv) and argv[0] == "pure"
+    if pure:
+        argv = argv[1:]
+    label, folder = ("pure", os.path.join(HERE, "pure")) if pure else ("blender", HERE)
+    for path in (folder, HERE, os.path.join(ROOT, "addon"), os.path.join(ROOT, "scripts")):
+        if path not in sys.path:
+            sys.path.insert(0, path)
     missing = native_missing()
     if missing:
-        print(f"blender: the solver is missing: {missing}")
+        print(f"{label}: the solver is missing: {missing}")
     loader = unittest.TestLoader()
     suite = unittest.TestSuite()
-    for name in sorted(os.listdir(HERE)):
+    for name in sorted(os.listdir(folder)):
         if not (name.startswith("test_") and name.endswith(".py")):
             continue
         module = name[:-3]
@@ -43,8 +57,8 @@ def main():
     skipped = len(result.skipped)
     passed = max(0, result.testsRun - failed - skipped)  # a failed setUpClass is not a test run
     sys.stdout.flush()
-    print(f"blender: {passed} passed, {failed} failed, {skipped} skipped" if skipped
-          else f"blender: {passed} passed, {failed} failed")
+    print(f"{label}: {passed} passed, {failed} failed, {skipped} skipped" if skipped
+          else f"{label}: {passed} passed, {failed} failed")
     sys.stdout.flush()
     if failed or result.testsRun == 0:
         sys.exit(1)

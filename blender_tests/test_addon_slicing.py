@@ -12,6 +12,8 @@ from mathutils import Matrix, Vector
 
 import wiresculpt
 from wiresculpt import native
+from wiresculpt.blend import contours as blend_contours
+from wiresculpt.blend import handles as blend_handles
 from wiresculpt.operators import slicing
 from wiresculpt.ui import panel
 
@@ -76,7 +78,7 @@ def items_of(plane):
 
 
 def contour_objects():
-    return [o for o in bpy.data.objects if slicing.CONTOUR_KEY in o]
+    return [o for o in bpy.data.objects if blend_contours.CONTOUR_KEY in o]
 
 
 class AddonCase(unittest.TestCase):
@@ -128,7 +130,7 @@ class SliceSphere(AddonCase):
             curve = item.curve
             self.assertIsNotNone(curve)
             self.assertEqual(curve.type, 'CURVE')
-            self.assertIn(curve.name, bpy.data.collections[slicing.CONTOURS_COLLECTION].objects)
+            self.assertIn(curve.name, bpy.data.collections[blend_contours.CONTOURS_COLLECTION].objects)
             (spline,) = curve.data.splines
             self.assertEqual(spline.type, 'POLY')
             self.assertTrue(spline.use_cyclic_u)
@@ -139,7 +141,7 @@ class SliceSphere(AddonCase):
                 self.assertAlmostEqual((p - Vector(self.CENTRE)).length, self.R, delta=2e-3)
         self.assertEqual(len(contour_objects()), 3)
         for handle in handles:  # handles are never sliced themselves
-            self.assertNotIn(slicing.CONTOUR_KEY, handle)
+            self.assertNotIn(blend_contours.CONTOUR_KEY, handle)
 
     def test_reslice_updates_same_objects(self):
         _sphere, (a, b, c) = self.three_planes()
@@ -195,8 +197,8 @@ class SliceSphere(AddonCase):
         result, _reports = run(slicing.WIRESCULPT_OT_add_plane)
         self.assertEqual(result, {'FINISHED'})
         handle = bpy.data.objects["Slice A"]
-        self.assertTrue(handle[wiresculpt.props.HANDLE_KEY])
-        self.assertIn(handle.name, bpy.data.collections[slicing.PLANES_COLLECTION].objects)
+        self.assertTrue(handle[blend_handles.HANDLE_KEY])
+        self.assertIn(handle.name, bpy.data.collections[blend_handles.PLANES_COLLECTION].objects)
         self.assertLess((handle.location - Vector((1, 2, 3))).length, 1e-5)
         self.assertEqual(handle.display_type, 'WIRE')
         self.assertEqual(handle.type, 'MESH')

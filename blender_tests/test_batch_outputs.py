@@ -18,7 +18,7 @@ sys.path.insert(0, sys.argv[sys.argv.index("--") + 2])
 import bpy, wiresculpt
 wiresculpt.register()
 bpy.ops.wm.open_mainfile(filepath=sys.argv[sys.argv.index("--") + 1])
-from wiresculpt import scene_results
+from wiresculpt.blend import results as scene_results
 design = scene_results.stored_design()
 wires = [o for o in bpy.context.scene.objects if scene_results.WIRE_KEY in o]
 print("CHECK " + json.dumps({

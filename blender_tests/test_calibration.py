@@ -203,6 +203,8 @@ class OperatorTest(unittest.TestCase):
             ops.register()
             ui.register()
         cls.ops = ops
+        from wiresculpt.blend import calibration as store
+        cls.store = store
         cls.tmp = tempfile.TemporaryDirectory()
         os.environ["WIRESCULPT_CONFIG"] = os.path.join(cls.tmp.name, "config")
         cls.csv = os.path.join(cls.tmp.name, "cantilever.csv")
@@ -215,7 +217,7 @@ class OperatorTest(unittest.TestCase):
         scene = bpy.context.scene  # leave the scene as the other suites expect it
         for key in ("material_preset", "wire_diameter", "bending_stiffness", "max_torque", "friction", "density"):
             scene.wiresculpt.property_unset(key)
-        for key in (cls.ops.RESULTS_KEY, cls.ops.MATERIAL_NAME_KEY):
+        for key in (cls.store.RESULTS_KEY, cls.store.MATERIAL_NAME_KEY):
             if key in scene:
                 del scene[key]
         if cls.own:
@@ -229,9 +231,9 @@ class OperatorTest(unittest.TestCase):
         scene.wiresculpt.material_preset = "steel"
         scene.wiresculpt_calibration.include_weight = False
         self.assertEqual(bpy.ops.wiresculpt.calibration_load(filepath=self.csv, kind='CANTILEVER'), {'FINISHED'})
-        fit = self.ops.results(scene)["cantilever"]
+        fit = self.store.results(scene)["cantilever"]
         self.assertAlmostEqual(fit["bending_stiffness"] / 0.73, 1.0, delta=0.02)
-        image = bpy.data.images[self.ops.PLOT_IMAGE["CANTILEVER"]]
+        image = bpy.data.images[self.store.PLOT_IMAGE["CANTILEVER"]]
         self.assertEqual(tuple(image.size), (480, 320))
         scene.wiresculpt_calibration.material_name = "bench steel"
         self.assertEqual(bpy.ops.wiresculpt.calibration_save_material(), {'FINISHED'})
@@ -239,7 +241,7 @@ class OperatorTest(unittest.TestCase):
         self.assertEqual(bpy.ops.wiresculpt.calibration_use_material(material="bench steel"), {'FINISHED'})
         self.assertEqual(scene.wiresculpt.material_preset, 'CUSTOM')
         self.assertAlmostEqual(scene.wiresculpt.bending_stiffness, fit["bending_stiffness"], places=5)
-        self.assertEqual(scene[self.ops.MATERIAL_NAME_KEY], "bench steel")
+        self.assertEqual(scene[self.store.MATERIAL_NAME_KEY], "bench steel")
         from wiresculpt import props
         self.assertEqual(props.material_of(scene.wiresculpt)["name"], "bench steel")  # what design.json records
         self.assertEqual(bpy.ops.wiresculpt.calibration_use_material(material="brass"), {'FINISHED'})
@@ -251,7 +253,7 @@ class OperatorTest(unittest.TestCase):
         self.assertEqual(bpy.ops.wiresculpt.calibration_load(filepath=springback, kind='SPRINGBACK'), {'FINISHED'})
         out = os.path.join(self.tmp.name, "bender.json")
         self.assertEqual(bpy.ops.wiresculpt.calibration_save_profile(filepath=out), {'FINISHED'})
-        self.assertAlmostEqual(cal.load_profile(out)["springback_a"], self.ops.results(scene)["springback"]["springback_a"])
+        self.assertAlmostEqual(cal.load_profile(out)["springback_a"], self.store.results(scene)["springback"]["springback_a"])
 
     def test_malformed_capture_is_cancelled_naming_the_line(self):
         bad = os.path.join(self.tmp.name, "bad.csv")
@@ -259,4 +261,4 @@ class OperatorTest(unittest.TestCase):
             f.write("repeat,angle_deg\n1,17.5\n2,steep\n")
         with self.assertRaisesRegex(RuntimeError, r"bad.csv: line 3, column angle_deg"):
             bpy.ops.wiresculpt.calibration_load(filepath=bad, kind='TILT')
-        self.assertNotIn("tilt", self.ops.results(bpy.context.scene))
+        self.assertNotIn("tilt", self.store.results(bpy.context.scene))

@@ -8,10 +8,12 @@ import unittest
 import bpy
 import numpy as np
 
-from wiresculpt import cut_handles, native, scene_results
+from wiresculpt import native
+from wiresculpt.blend import cut_handles
+from wiresculpt.blend import results as scene_results
 from wiresculpt.core.frames import plane_frame
 
-from test_optimize import Case, globe
+from helpers import BlenderCase as Case, edge_lengths, globe
 
 
 def handles():
@@ -24,11 +26,6 @@ def wire_named(design, name):
 
 def crossing_vertices(design, wire):
     return {c["vertices"][k] for c in design["crossings"] for k in (0, 1) if c["wires"][k] == wire["id"]}
-
-
-def edge_lengths(points):
-    p = np.asarray(points, dtype=np.float64)
-    return np.linalg.norm(np.diff(p, axis=0), axis=1)
 
 
 def optimize():

@@ -20,7 +20,9 @@ import bpy
 
 import wiresculpt
 from helpers import ROOT, GrblEmulator, gcode_lines, run_under_xvfb
-from wiresculpt import export, native, pipeline, scene_results, streaming
+from wiresculpt import native, pipeline
+from wiresculpt.blend import results as scene_results
+from wiresculpt.fab import export, streaming
 from wiresculpt.core import calibration as cal
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.scene import PlaneSpec
@@ -34,7 +36,7 @@ FAST = {"settle": 0.05, "response_timeout": 2.0}
 
 def globe_design():
     """The three-wire globe solved by the pipeline (a sphere of 12.5 cm radius)."""
-    from test_export import sphere
+    from helpers import sphere
 
     V, F = sphere()
     planes = [PlaneSpec(n, (0, 0, 0), normal) for n, normal in

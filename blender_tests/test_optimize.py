@@ -12,57 +12,18 @@ import unittest
 import bpy
 
 import wiresculpt
-from wiresculpt import assembly_guide, native, overlay, pipeline, props, scene_results
+from wiresculpt import native, pipeline, props
+from wiresculpt.blend import guide as assembly_guide
+from wiresculpt.blend import results as scene_results
 from wiresculpt.core import materials, settings as settings_table
-from wiresculpt.mesh_import import import_mesh
+from wiresculpt.blend.mesh import import_mesh
 from wiresculpt.operators import optimize
+from wiresculpt.ui import overlay
 from wiresculpt.ui import results as results_ui
 
-from helpers import ROOT
+from helpers import GLOBE_OBJ, GLOBE_RADIUS, ROOT, add_handle, clear_scene, globe, register_addon
+from helpers import BlenderCase as Case
 from helpers import draw as helpers_draw
-
-GLOBE_OBJ = os.path.join(ROOT, "scripts", "examples", "globe", "globe.obj")
-GLOBE_RADIUS = 0.125  # globe.obj has radius 1; scaled like the example's size 0.25
-
-
-def register_addon():
-    if wiresculpt._modules:
-        wiresculpt.unregister()
-    wiresculpt.register()
-
-
-def clear_scene():
-    for collection in (bpy.data.objects, bpy.data.meshes, bpy.data.curves, bpy.data.collections,
-                       bpy.data.texts, bpy.data.materials, bpy.data.cameras):
-        for block in list(collection):
-            collection.remove(block)
-    ws = bpy.context.scene.wiresculpt
-    ws.contours.clear()
-    ws.target = None
-    ws.assembly_step = 0
-
-
-def add_handle(rotation=(0.0, 0.0, 0.0), location=(0.0, 0.0, 0.0)):
-    assert bpy.ops.wiresculpt.add_plane() == {'FINISHED'}
-    handle = bpy.context.view_layer.objects.active
-    handle.location = location
-    handle.rotation_euler = rotation
-    return handle
-
-
-def globe(rotations=((0, 0, 0), (0, math.pi / 2, 0), (math.pi / 2, 0, 0))):
-    """The bundled example: globe.obj at radius 0.125 m, handles through its centre with normals
-    z, x and y (by default), sliced."""
-    _V, _F, objects = import_mesh(GLOBE_OBJ)
-    target = objects[0]
-    target.scale = (GLOBE_RADIUS,) * 3
-    bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.target = target
-    for rotation in rotations:
-        add_handle(rotation)
-    assert bpy.ops.wiresculpt.slice() == {'FINISHED'}
-    return target
-
 
 def wire_objects():
     return [o for o in bpy.context.scene.objects if scene_results.WIRE_KEY in o]
@@ -97,20 +58,6 @@ def draw(panel_class):
 
 def labels(log):
     return [kw.get("text", "") for name, _a, kw in log if name == "label"]
-
-
-class Case(unittest.TestCase):
-    @classmethod
-    def setUpClass(cls):
-        register_addon()
-
-    @classmethod
-    def tearDownClass(cls):
-        clear_scene()
-        wiresculpt.unregister()
-
-    def setUp(self):
-        clear_scene()
 
 
 class Settings(Case):

@@ -17,7 +17,8 @@ import wiresculpt  # noqa: E402
 wiresculpt.register()
 from helpers import GrblEmulator, gcode_lines  # noqa: E402
 from ui_steps import guarded, report, start_watchdog  # noqa: E402
-from wiresculpt import scene_results, streaming  # noqa: E402
+from wiresculpt.blend import results as scene_results  # noqa: E402
+from wiresculpt.fab import streaming  # noqa: E402
 
 WIRE = "Ring/0"
 MODES = ("G21", "G91", "G94")

@@ -18,8 +18,9 @@ import bpy  # noqa: E402
 import wiresculpt  # noqa: E402
 
 wiresculpt.register()
-from wiresculpt import overlay, scene_results  # noqa: E402
-from wiresculpt.mesh_import import import_mesh  # noqa: E402
+from wiresculpt.blend import results as scene_results  # noqa: E402
+from wiresculpt.blend.mesh import import_mesh  # noqa: E402
+from wiresculpt.ui import overlay  # noqa: E402
 from wiresculpt.operators import optimize  # noqa: E402
 from ui_steps import guarded, report, start_watchdog  # noqa: E402
 from wiresculpt.stages import forces as forces_stage  # noqa: E402

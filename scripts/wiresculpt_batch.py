@@ -72,7 +72,8 @@ def write_scene_outputs(design, objects, planes, factor, out, say):
     from mathutils import Matrix
 
     import wiresculpt
-    from wiresculpt import assembly_guide, scene_results
+    from wiresculpt.blend import guide as assembly_guide
+    from wiresculpt.blend import results as scene_results
 
     if not wiresculpt._modules:
         wiresculpt.register()
@@ -107,7 +108,7 @@ def write_scene_outputs(design, objects, planes, factor, out, say):
 def write_fabrication(design, out, say):
     """svg/, dxf/, gcode/ and bends/ in `out` for every wire with a rest shape; the programs'
     summary goes into the design as `fabrication`."""
-    from wiresculpt import export
+    from wiresculpt.fab import export
 
     if not any("rest" in w for w in design["wires"]):
         return  # no folders: the earlier run's are removed with the rest of its set
@@ -130,7 +131,7 @@ def run(argv):
     from wiresculpt.core.design import write_design
     from wiresculpt.core.staging import staged
     from wiresculpt.core.scene import load_scene
-    from wiresculpt.mesh_import import import_mesh
+    from wiresculpt.blend.mesh import import_mesh
 
     def say(stage, message):
         print(f"wiresculpt: {stage}: {message}", flush=True)

@@ -9,14 +9,14 @@ import bpy
 from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, IntProperty,
                        PointerProperty, StringProperty)
 
+from . import native
+from .blend import results as scene_results
+from .blend.calibration import MATERIAL_NAME_KEY, config_folder
+from .blend.handles import is_handle
+from .blend.registration import classes_factory
+from .core import calibration as cal
 from .core import materials, settings as settings_table
-
-HANDLE_KEY = "wiresculpt_handle"  # custom property that marks an object as a slicing handle
-MATERIAL_NAME_KEY = "wiresculpt_material_name"  # scene custom property: name of the material in use
-
-
-def is_handle(obj):
-    return bool(obj.get(HANDLE_KEY))
+from .fab import streaming
 
 
 def _poll_target(_settings, obj):
@@ -104,16 +104,12 @@ SETTING_PROPS = ("min_segment", "max_bend_deg", "min_bend_deg", "contact_angle_d
 
 
 def _assembly_step_changed(settings, context):
-    from . import scene_results  # bpy-side module, imported lazily
-
     scene_results.apply_assembly_step(context.scene)
 
 
 def _port_suggestions(_settings, _context, _text):
     """Serial ports libserialport lists, offered while typing the port (any path may be typed:
     a pseudo-terminal, a udev symlink)."""
-    from . import native  # lazily: the compiled module may be missing
-
     if not native.available():
         return []
     return [p["name"] for p in native.require().list_ports()]
@@ -124,8 +120,6 @@ NO_WIRE = "__none__"  # the wire enum's only item when the design has no wire wi
 
 def _wire_items(_settings, _context):
     """The stored design's wires that have a rest shape; the enum's number is the wire's id."""
-    from . import scene_results, streaming  # bpy-side modules, imported lazily
-
     wires = streaming.rest_wires(scene_results.stored_design())
     items = [(w["name"], w["name"], f"Wire {w['name']} (id {w['id']}, {w.get('length', 0) * 1000:.0f} mm)", w["id"])
              for w in wires] or [(NO_WIRE, "(no wire with a rest shape)", "Optimize first", 0)]
@@ -222,18 +216,50 @@ class WiresculptSettings(bpy.types.PropertyGroup):
         description="Only check the program against the machine profile; nothing is sent")
 
 
-_classes = (WiresculptContour, WiresculptSettings)
+# --- calibration (Calibration panel) ------------------------------------------------------------
+
+KINDS = (("CANTILEVER", "Cantilever", "Bending stiffness and plastic limit (load_g, state, s_m, deflection_m)"),
+         ("TILT", "Tilt", "Friction coefficient (repeat, angle_deg)"),
+         ("SPRINGBACK", "Spring-back", "Machine spring-back line (commanded_deg, measured_deg)"))
 
 
-def register():
-    for cls in _classes:
-        bpy.utils.register_class(cls)
-    bpy.types.Scene.wiresculpt = PointerProperty(
-        type=WiresculptSettings, name="Wire Sculpture",
-        description="Settings and results of the wiresculpt add-on")
+def material_items(_self, _context):
+    try:
+        found, _errors = cal.list_materials(config_folder())
+    except OSError:
+        found = dict(materials.PRESETS)
+    items = []
+    for name, m in found.items():
+        kind = "preset (Table 1)" if name in materials.PRESETS else "calibrated"
+        items.append((name, name, f"{name}, {kind}: k_b {m['bending_stiffness']:.4g} N m², plastic torque "
+                                  f"{m['max_torque']:.4g} N m, friction {m['friction']:.3g}"))
+    material_items.cache = items  # Blender needs the strings kept alive
+    return items
 
 
-def unregister():
-    del bpy.types.Scene.wiresculpt
-    for cls in reversed(_classes):
-        bpy.utils.unregister_class(cls)
+class WiresculptCalibrationSettings(bpy.types.PropertyGroup):
+    overhang: FloatProperty(
+        name="Overhang", subtype='DISTANCE', unit='LENGTH', default=0.30, min=0.02, max=2.0, precision=3,
+        description="Free length of the cantilever from the clamp's edge to the load (metres; paper: 30 cm)")
+    include_weight: BoolProperty(
+        name="Wire's Own Weight", default=True,
+        description="Add the wire's weight (density and diameter of the material below) to the external "
+                    "torques of the cantilever fit")
+    plastic_tolerance: FloatProperty(
+        name="Return Tolerance", subtype='DISTANCE', unit='LENGTH', default=0.001, min=1e-5, max=0.05,
+        precision=4,
+        description="An unloaded wire has returned when no mark is farther than this from the initial shape")
+    material_name: StringProperty(
+        name="Name", default="calibrated steel",
+        description="Name of the calibrated material (saved as JSON in the user's config folder)")
+    plot: EnumProperty(name="Plot", items=KINDS, default="CANTILEVER", description="Which fit the panel shows")
+
+
+
+
+register, unregister = classes_factory(
+    (WiresculptContour, WiresculptSettings, WiresculptCalibrationSettings),
+    scene_properties=(("wiresculpt", WiresculptSettings, "Wire Sculpture",
+                       "Settings and results of the wiresculpt add-on"),
+                      ("wiresculpt_calibration", WiresculptCalibrationSettings, "Calibration",
+                       "Settings of the calibration captures")))

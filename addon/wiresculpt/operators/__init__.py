@@ -1,14 +1,5 @@
 """Operators, one module per concern, each with its own register/unregister."""
+from ..blend.registration import modules_factory
 from . import calibration, fabrication, optimize, results, slicing
 
-_modules = (slicing, optimize, results, calibration, fabrication)
-
-
-def register():
-    for module in _modules:
-        module.register()
-
-
-def unregister():
-    for module in reversed(_modules):
-        module.unregister()
+register, unregister = modules_factory((slicing, optimize, results, calibration, fabrication))

@@ -10,91 +10,16 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
 from .. import native
+from ..blend.calibration import PLOT_IMAGE, config_folder, load_plot, results, store, use_material
+from ..blend.registration import classes_factory
 from ..core import calibration as cal
-from ..core import materials
-from ..props import MATERIAL_NAME_KEY
+from ..props import KINDS, material_items, material_of, solver_settings
 
-RESULTS_KEY = "wiresculpt_calibration_results"  # scene custom property: JSON of the last fits
-KINDS = (("CANTILEVER", "Cantilever", "Bending stiffness and plastic limit (load_g, state, s_m, deflection_m)"),
-         ("TILT", "Tilt", "Friction coefficient (repeat, angle_deg)"),
-         ("SPRINGBACK", "Spring-back", "Machine spring-back line (commanded_deg, measured_deg)"))
-PLOT_IMAGE = {"CANTILEVER": "wiresculpt cantilever fit", "TILT": "wiresculpt tilt fit",
-              "SPRINGBACK": "wiresculpt spring-back fit"}
-
-
-def config_folder():
-    """The user's wiresculpt config folder (materials/, plots/); WIRESCULPT_CONFIG overrides it."""
-    folder = os.environ.get("WIRESCULPT_CONFIG")
-    if folder:
-        os.makedirs(folder, exist_ok=True)
-        return folder
-    return bpy.utils.user_resource('CONFIG', path="wiresculpt", create=True)
-
-
-def results(scene):
-    """The stored fits: {"cantilever", "tilt", "springback"} (each may be absent)."""
-    try:
-        return json.loads(scene.get(RESULTS_KEY, "{}"))
-    except (TypeError, ValueError):
-        return {}
-
-
-def store(scene, key, value):
-    r = results(scene)
-    r[key] = value
-    scene[RESULTS_KEY] = json.dumps(r)
 
 
 def base_material(scene):
     """The material in the Material & Machine panel (diameter and density for the weight)."""
-    from ..props import material_of
     return material_of(scene.wiresculpt)
-
-
-def load_plot(kind, png):
-    """Writes the plot into the config folder and (re)loads it as a Blender image."""
-    path = cal.write_plot(os.path.join(config_folder(), "plots", kind.lower() + ".png"), png)
-    name = PLOT_IMAGE[kind]
-    image = bpy.data.images.get(name)
-    if image is None:
-        image = bpy.data.images.load(path, check_existing=False)
-        image.name = name
-    else:
-        image.filepath = path
-        image.reload()
-    return image
-
-
-def _material_items(_self, _context):
-    try:
-        found, _errors = cal.list_materials(config_folder())
-    except OSError:
-        found = dict(materials.PRESETS)
-    items = []
-    for name, m in found.items():
-        kind = "preset (Table 1)" if name in materials.PRESETS else "calibrated"
-        items.append((name, name, f"{name}, {kind}: k_b {m['bending_stiffness']:.4g} N m², plastic torque "
-                                  f"{m['max_torque']:.4g} N m, friction {m['friction']:.3g}"))
-    _material_items.cache = items  # Blender needs the strings kept alive
-    return items
-
-
-class WiresculptCalibrationSettings(bpy.types.PropertyGroup):
-    overhang: FloatProperty(
-        name="Overhang", subtype='DISTANCE', unit='LENGTH', default=0.30, min=0.02, max=2.0, precision=3,
-        description="Free length of the cantilever from the clamp's edge to the load (metres; paper: 30 cm)")
-    include_weight: BoolProperty(
-        name="Wire's Own Weight", default=True,
-        description="Add the wire's weight (density and diameter of the material below) to the external "
-                    "torques of the cantilever fit")
-    plastic_tolerance: FloatProperty(
-        name="Return Tolerance", subtype='DISTANCE', unit='LENGTH', default=0.001, min=1e-5, max=0.05,
-        precision=4,
-        description="An unloaded wire has returned when no mark is farther than this from the initial shape")
-    material_name: StringProperty(
-        name="Name", default="calibrated steel",
-        description="Name of the calibrated material (saved as JSON in the user's config folder)")
-    plot: EnumProperty(name="Plot", items=KINDS, default="CANTILEVER", description="Which fit the panel shows")
 
 
 class WIRESCULPT_OT_calibration_load(bpy.types.Operator, ImportHelper):
@@ -172,21 +97,6 @@ class WIRESCULPT_OT_calibration_save_material(bpy.types.Operator):
         return {'FINISHED'}
 
 
-def use_material(scene, m):
-    """Sets the Material & Machine panel to material `m` (a preset by key, else Custom)."""
-    ws = scene.wiresculpt
-    if m["name"] in materials.PRESETS:
-        ws.material_preset = m["name"]
-        ws.wire_diameter = m["wire_diameter"]
-    else:
-        ws.material_preset = 'CUSTOM'
-        ws.wire_diameter = m["wire_diameter"]
-        for key in ("bending_stiffness", "max_torque", "friction", "density"):
-            if key in m:
-                setattr(ws, key, m[key])
-    scene[MATERIAL_NAME_KEY] = m["name"]
-
-
 class WIRESCULPT_OT_calibration_use_material(bpy.types.Operator):
     """Use a material: a Table 1 preset or one you calibrated"""
     bl_idname = "wiresculpt.calibration_use_material"
@@ -194,7 +104,7 @@ class WIRESCULPT_OT_calibration_use_material(bpy.types.Operator):
     bl_options = {'REGISTER', 'UNDO'}
     bl_property = "material"
 
-    material: EnumProperty(name="Material", items=_material_items)
+    material: EnumProperty(name="Material", items=material_items)
 
     def execute(self, context):
         found, _errors = cal.list_materials(config_folder())
@@ -221,7 +131,6 @@ class WIRESCULPT_OT_calibration_save_profile(bpy.types.Operator, ExportHelper):
             self.report({'ERROR'}, native.LOAD_ERROR)
             return {'CANCELLED'}
         scene = context.scene
-        from ..props import solver_settings
         try:
             profile = cal.default_profile()
             limits = solver_settings(scene.wiresculpt)
@@ -268,20 +177,6 @@ class WIRESCULPT_OT_calibration_show_plot(bpy.types.Operator):
         return {'FINISHED'}
 
 
-_classes = (WiresculptCalibrationSettings, WIRESCULPT_OT_calibration_load, WIRESCULPT_OT_calibration_save_material,
-            WIRESCULPT_OT_calibration_use_material, WIRESCULPT_OT_calibration_save_profile,
-            WIRESCULPT_OT_calibration_show_plot)
-
-
-def register():
-    for cls in _classes:
-        bpy.utils.register_class(cls)
-    bpy.types.Scene.wiresculpt_calibration = bpy.props.PointerProperty(
-        type=WiresculptCalibrationSettings, name="Calibration",
-        description="Settings of the calibration captures")
-
-
-def unregister():
-    del bpy.types.Scene.wiresculpt_calibration
-    for cls in reversed(_classes):
-        bpy.utils.unregister_class(cls)
+register, unregister = classes_factory(
+    (WIRESCULPT_OT_calibration_load, WIRESCULPT_OT_calibration_save_material, WIRESCULPT_OT_calibration_use_material,
+     WIRESCULPT_OT_calibration_save_profile, WIRESCULPT_OT_calibration_show_plot))

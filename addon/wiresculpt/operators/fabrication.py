@@ -10,7 +10,10 @@ import os
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, StringProperty
 
-from .. import export, native, scene_results, streaming
+from .. import native
+from ..blend import results as scene_results
+from ..blend.registration import classes_factory
+from ..fab import export, streaming
 from ..core import calibration as cal
 from ..props import NO_WIRE
 from .progress import WorkerModal
@@ -231,6 +234,6 @@ class WIRESCULPT_OT_send_cancel(bpy.types.Operator):
         return {'FINISHED'}
 
 
-register, unregister = bpy.utils.register_classes_factory(
+register, unregister = classes_factory(
     (WIRESCULPT_OT_export_fabrication, WIRESCULPT_OT_pick_port, WIRESCULPT_OT_send_to_machine,
      WIRESCULPT_OT_send_cancel))

@@ -17,11 +17,15 @@ import time
 
 import bpy
 
-from .. import cut_handles, mesh_data, native, pipeline, scene_results
-from ..core.design import new_design, wire_entry
+from .. import native, pipeline
+from ..blend import cut_handles, mesh
+from ..blend import results as scene_results
+from ..blend.handles import handle_plane, handles, target_problem
+from ..blend.registration import classes_factory
+from ..core.jobs import WorkerJob
+from ..core.scene import PlaneSpec
 from ..props import material_of, solver_settings
 from .progress import TIMER_SECONDS, WorkerModal
-from .slicing import handle_plane, handles, target_problem
 
 JOIN_SECONDS = 0.2  # the longest a cancel waits for the worker in Blender's UI thread
 STAGE_LABELS = {"slicing": "Slicing", "layering": "Layering", "target_shape": "Target shape",
@@ -46,30 +50,18 @@ def build_design(context):
         raise ValueError("No contour is ticked: Slice, then tick the contours that become wires")
     material, settings = material_of(ws), solver_settings(ws)
     by_name = {h.name: h for h in handles(scene)}
-    planes = []
-    for plane, _index in ticked:
+    rules = {}  # plane name -> its ticked contour indices, in the list's order
+    for plane, index in ticked:
         if plane not in by_name:
             raise ValueError(f"slicing plane {plane} of a ticked contour is gone: Slice again")
-        if plane not in planes:
-            planes.append(plane)
-    start = time.perf_counter()
+        rules.setdefault(plane, []).append(index)
     depsgraph = context.evaluated_depsgraph_get()
-    specs = [handle_plane(by_name[name], depsgraph) for name in planes]
-    V, F = mesh_data.object_triangles(ws.target, depsgraph)
-    result = native.slice_mesh(V, F, specs)
-    design = new_design(material, settings)
-    for (name, origin, normal), contours in zip(specs, result["contours"]):
-        for plane, index in ticked:
-            if plane != name:
-                continue
-            if index >= len(contours):
-                raise ValueError(f"contour {plane} #{index} no longer exists (plane {plane} now cuts "
-                                 f"{len(contours)}): Slice again")
-            c = contours[index]
-            design["wires"].append(wire_entry(len(design["wires"]), f"{plane}/{index}", origin, normal,
-                                              c["closed"], c["points"]))
-    design["stages"]["slicing"] = {"seconds": time.perf_counter() - start, "planes": len(planes),
-                                   "contours": sum(len(c) for c in result["contours"])}
+    planes = [PlaneSpec(*handle_plane(by_name[name], depsgraph), contours=indices) for name, indices in rules.items()]
+    V, F = mesh.object_triangles(ws.target, depsgraph)
+    try:
+        design = pipeline.slice_and_pick(V, F, planes, material, settings)
+    except ValueError as exc:  # a ticked contour the planes no longer cut
+        raise ValueError(f"{exc}: Slice again") from None
     cut_handles.apply_to_design(scene, design)
     return design, material, settings
 
@@ -94,20 +86,21 @@ def run_optimize(context, progress=None, cancel=None):
     return design
 
 
-class Job:
+class Job(WorkerJob):
     """The running optimisation: the worker thread and what the panel shows of it."""
 
+    name = "wiresculpt solve"
+
     def __init__(self, design, material, settings):
+        super().__init__()
         self.design, self.material, self.settings = design, material, settings
         self.stage = pipeline.ALL_STAGES[0]
         self.done = 0
         self.messages = []
-        self.error = None
         self.cancelled = False
         self.cancel_event = threading.Event()
         self.scene_name = ""  # set by the operator: the scene the results go to
         self.started = time.perf_counter()
-        self.thread = threading.Thread(target=self._work, name="wiresculpt solve", daemon=True)
 
     def _progress(self, stage, message):
         self.messages.append(f"{stage}: {message}")
@@ -117,16 +110,12 @@ class Job:
             if k < len(pipeline.ALL_STAGES):
                 self.stage = pipeline.ALL_STAGES[k]
 
-    def _work(self):
+    def work(self):
         try:
             pipeline.solve(self.design, self.material, self.settings, self._progress,
                            self.cancel_event.is_set)
         except pipeline.Cancelled:
             self.cancelled = True
-        except (ValueError, RuntimeError) as exc:
-            self.error = str(exc)
-        except Exception as exc:  # a bug of ours: reported, never raised into Blender's UI thread
-            self.error = f"internal error ({type(exc).__name__}: {exc}); please report it"
 
     def stop(self, timeout=JOIN_SECONDS):
         """Asks the worker to stop and waits at most `timeout` seconds; True when it has ended."""
@@ -300,5 +289,4 @@ class WIRESCULPT_OT_optimize_cancel(bpy.types.Operator):
         return {'FINISHED'}
 
 
-register, unregister = bpy.utils.register_classes_factory(
-    (WIRESCULPT_OT_optimize, WIRESCULPT_OT_optimize_cancel))
+register, unregister = classes_factory((WIRESCULPT_OT_optimize, WIRESCULPT_OT_optimize_cancel))

@@ -3,7 +3,9 @@ import os
 
 import bpy
 
-from .. import assembly_guide, scene_results
+from ..blend import guide as assembly_guide
+from ..blend import results as scene_results
+from ..blend.registration import classes_factory
 
 
 class WIRESCULPT_OT_assembly_guide(bpy.types.Operator):
@@ -48,5 +50,5 @@ class WIRESCULPT_OT_clear_results(bpy.types.Operator):
         return {'FINISHED'}
 
 
-register, unregister = bpy.utils.register_classes_factory(
+register, unregister = classes_factory(
     (WIRESCULPT_OT_assembly_guide, WIRESCULPT_OT_clear_results))

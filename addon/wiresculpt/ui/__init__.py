@@ -1,15 +1,5 @@
 """User interface, one module per concern, each with its own register/unregister."""
-from .. import overlay
-from . import calibration, fabrication, panel, results
+from ..blend.registration import modules_factory
+from . import calibration, fabrication, overlay, panel, results
 
-_modules = (panel, results, fabrication, calibration, overlay)
-
-
-def register():
-    for module in _modules:
-        module.register()
-
-
-def unregister():
-    for module in reversed(_modules):
-        module.unregister()
+register, unregister = modules_factory((panel, results, fabrication, calibration, overlay))

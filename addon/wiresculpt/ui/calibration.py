@@ -3,6 +3,7 @@ plot, save the material and the machine profile, pick a material (presets and ca
 import bpy
 
 from .. import native
+from ..blend.registration import classes_factory
 from ..operators import calibration as ops
 from .panel import VIEW3D_PT_wiresculpt
 
@@ -78,4 +79,4 @@ class VIEW3D_PT_wiresculpt_calibration(bpy.types.Panel):
         layout.operator(ops.WIRESCULPT_OT_calibration_save_profile.bl_idname, icon='EXPORT')
 
 
-register, unregister = bpy.utils.register_classes_factory((VIEW3D_PT_wiresculpt_calibration,))
+register, unregister = classes_factory((VIEW3D_PT_wiresculpt_calibration,))

@@ -2,7 +2,10 @@
 port, wire, progress, Cancel and Resume."""
 import bpy
 
-from .. import native, scene_results, streaming
+from .. import native
+from ..blend import results as scene_results
+from ..blend.registration import classes_factory
+from ..fab import streaming
 from ..operators import fabrication as ops
 from .results import _Child, _wrap
 
@@ -51,4 +54,4 @@ class VIEW3D_PT_wiresculpt_fabrication(_Child, bpy.types.Panel):
             _wrap(status, context, message, icon='INFO' if kind == {'INFO'} else 'ERROR')
 
 
-register, unregister = bpy.utils.register_classes_factory((VIEW3D_PT_wiresculpt_fabrication,))
+register, unregister = classes_factory((VIEW3D_PT_wiresculpt_fabrication,))

@@ -4,6 +4,7 @@ import textwrap
 import bpy
 
 from .. import native
+from ..blend.registration import classes_factory
 from ..operators.slicing import WIRESCULPT_OT_add_plane, WIRESCULPT_OT_slice
 
 CHARS_PER_PIXEL = 1 / 7  # rough width of a label character, for wrapping long messages
@@ -63,5 +64,5 @@ class VIEW3D_PT_wiresculpt(bpy.types.Panel):
                              settings, "active_contour", rows=4)
 
 
-register, unregister = bpy.utils.register_classes_factory(
+register, unregister = classes_factory(
     (WIRESCULPT_UL_contours, VIEW3D_PT_wiresculpt))

@@ -6,7 +6,9 @@ import textwrap
 
 import bpy
 
-from .. import native, scene_results
+from .. import native
+from ..blend import results as scene_results
+from ..blend.registration import classes_factory
 from ..operators import optimize
 from ..operators.results import WIRESCULPT_OT_assembly_guide, WIRESCULPT_OT_clear_results
 from .panel import BOX_MARGIN, CHARS_PER_PIXEL, VIEW3D_PT_wiresculpt, length_text
@@ -214,4 +216,4 @@ class VIEW3D_PT_wiresculpt_display(_Child, bpy.types.Panel):
 
 _classes = (VIEW3D_PT_wiresculpt_settings, VIEW3D_PT_wiresculpt_optimize, VIEW3D_PT_wiresculpt_report,
             VIEW3D_PT_wiresculpt_display)
-register, unregister = bpy.utils.register_classes_factory(_classes)
+register, unregister = classes_factory(_classes)

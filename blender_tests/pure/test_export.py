@@ -9,31 +9,13 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
-from wiresculpt import export, native, pipeline
+from wiresculpt import native, pipeline
+from wiresculpt.fab import export
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.scene import PlaneSpec
 from wiresculpt.core.settings import defaults
 
-
-def sphere(radius=0.125, segments=48, rings=24):
-    V = [(0.0, 0.0, radius)]
-    for r in range(1, rings):
-        th = math.pi * r / rings
-        V += [(radius * math.sin(th) * math.cos(2 * math.pi * s / segments),
-               radius * math.sin(th) * math.sin(2 * math.pi * s / segments), radius * math.cos(th)) for s in range(segments)]
-    V.append((0.0, 0.0, -radius))
-    at = lambda r, s: 1 + (r - 1) * segments + s % segments
-    F = [(0, at(1, s), at(1, s + 1)) for s in range(segments)]
-    for r in range(1, rings - 1):
-        for s in range(segments):
-            F += [(at(r, s), at(r + 1, s), at(r + 1, s + 1)), (at(r, s), at(r + 1, s + 1), at(r, s + 1))]
-    F += [(len(V) - 1, at(rings - 1, s + 1), at(rings - 1, s)) for s in range(segments)]
-    return np.array(V), np.array(F)
-
-
-def edge_lengths(points):
-    p = np.asarray(points, dtype=float)
-    return np.linalg.norm(np.diff(p, axis=0), axis=1)
+from helpers import edge_lengths, sphere
 
 
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)

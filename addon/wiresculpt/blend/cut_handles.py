@@ -9,7 +9,7 @@ Handles are matched to wires by name (custom property CUT_KEY), like the wire cu
 import bpy
 from mathutils import Vector
 
-from .operators.slicing import scene_collection
+from .objects import scene_collection, tagged
 
 CUT_KEY = "wiresculpt_cut"  # custom property on cut handles: the wire's name
 PLACED_KEY = "wiresculpt_cut_placed"  # where Optimize last put the handle (world, metres)
@@ -20,8 +20,6 @@ HANDLE_SIZE = 4.0  # the empty's display size in wire diameters
 
 
 def _tagged(scene):
-    from .scene_results import tagged  # scene_results imports this module
-
     return tagged(scene, CUT_KEY)
 
 

@@ -10,9 +10,9 @@ import bmesh
 import bpy
 import numpy as np
 
+from ..core.design import dumps
 from . import cut_handles
-from .core.design import dumps
-from .operators.slicing import remove_object, scene_collection, write_polyline
+from .objects import remove_object, scene_collection, tagged, write_polyline
 
 DESIGN_TEXT = "wiresculpt_design.json"  # Text datablock holding the last design
 WIRE_KEY = "wiresculpt_wire"  # custom property on wire curves: the wire's name
@@ -154,21 +154,6 @@ def _material(name, colour):
         bsdf.inputs["Metallic"].default_value = 0.3
         bsdf.inputs["Roughness"].default_value = 0.35
     return mat
-
-
-def tagged(scene, key):
-    """{tag value: object} of the scene's objects carrying custom property `key`; a duplicate
-    (Shift+D copies the tag) loses it and becomes the user's own object."""
-    found = {}
-    for obj in sorted(scene.objects, key=lambda o: o.name):
-        if key not in obj:
-            continue
-        value = obj[key]
-        if value in found:
-            del obj[key]
-        else:
-            found[value] = obj
-    return found
 
 
 def _marker_mesh():

@@ -7,11 +7,11 @@ cancel continues from the first unacknowledged line: no line is sent twice, none
 
 Free of bpy: the add-on's operators, and the tests, call it.
 """
-import threading
-
 import numpy as np
 
-from . import export, native
+from .. import native
+from ..core.jobs import WorkerJob
+from . import export
 
 PENDING = {}  # wire name -> Stopped: the program a Resume continues
 JOB = None  # the StreamJob while a wire is being sent, else None
@@ -61,33 +61,30 @@ def quoted(lines, index):
     return f"line {index + 1} (`{lines[index]}`)"
 
 
-class StreamJob:
+class StreamJob(WorkerJob):
     """One run of stream_program: started fresh (Send) or from a Stopped state (Resume)."""
+
+    name = "wiresculpt stream"
+    expected = (ValueError, RuntimeError, OSError)
 
     def __init__(self, wire, port, lines, profile, state, dry_run=False, settle=2.0, response_timeout=30.0,
                  resumed=False):
+        super().__init__()
         self.wire, self.port, self.lines, self.profile, self.state = wire, port, lines, profile, state
         self.dry_run, self.settle, self.response_timeout, self.resumed = dry_run, settle, response_timeout, resumed
         self.first = int(state.get("next_line", 0))
         self.fraction = self.first / len(lines) if lines else 1.0
         self.control = native.require().StreamControl()  # abort is one-shot: a fresh one per run
         self.result = None
-        self.error = None
-        self.thread = threading.Thread(target=self.run, name="wiresculpt stream", daemon=True)
 
     def _progress(self, _stage, fraction):
         self.fraction = fraction
         return True
 
-    def run(self):
-        try:
-            self.result = native.require().stream_program(
-                self.port, self.lines, self.profile, self.state, progress=self._progress, control=self.control,
-                dry_run=self.dry_run, response_timeout=self.response_timeout, settle=self.settle)
-        except (ValueError, RuntimeError, OSError) as exc:
-            self.error = str(exc)
-        except Exception as exc:  # a bug of ours: reported, never raised into Blender's UI thread
-            self.error = f"internal error ({type(exc).__name__}: {exc}); please report it"
+    def work(self):
+        self.result = native.require().stream_program(
+            self.port, self.lines, self.profile, self.state, progress=self._progress, control=self.control,
+            dry_run=self.dry_run, response_timeout=self.response_timeout, settle=self.settle)
 
     def cancel(self):
         self.control.abort()

@@ -9,7 +9,7 @@ import gpu
 import numpy as np
 from gpu_extras.batch import batch_for_shader
 
-from . import scene_results
+from ..blend import results
 
 ARROW_SHARE = 0.2
 HEAD_SHARE = 0.25  # arrow head length as a share of the arrow
@@ -38,7 +38,7 @@ def force_arrows(design, shown=None):
                  and (shown is None or all(w in shown for w in c["wires"]))]
     if not crossings:
         return None
-    points = np.concatenate([scene_results.wire_points(w) for w in design["wires"]])
+    points = np.concatenate([results.wire_points(w) for w in design["wires"]])
     size = float(np.max(points.max(axis=0) - points.min(axis=0))) or 1.0
     forces = np.asarray([c["force"] for c in crossings], dtype=np.float64)
     largest = float(np.max(np.linalg.norm(forces, axis=1)))
@@ -67,13 +67,13 @@ def draw():
     scene = bpy.context.scene
     if scene is None or not scene.wiresculpt.show_forces:
         return
-    design = scene_results.stored_design()
+    design = results.stored_design()
     if design is None:
         return
     step = scene.wiresculpt.assembly_step
     # stored_design() returns the same dict until the text changes
     if _arrows["design"] is not design or _arrows["step"] != step:
-        shown = scene_results.visible_wires(design, step) if step else None
+        shown = results.visible_wires(design, step) if step else None
         _arrows.update(design=design, step=step, lines=force_arrows(design, shown))
     lines = _arrows["lines"]
     if lines is None:

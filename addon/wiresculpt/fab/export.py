@@ -8,7 +8,8 @@ import re
 
 import numpy as np
 
-from . import native
+from .. import native
+from ..core.calibration import machine_dict
 
 FOLDERS = ("svg", "dxf", "gcode", "bends")
 
@@ -34,8 +35,6 @@ def machine_profile(design, profile=None):
     out = native.require().default_machine_profile()
     notes = []
     if profile is not None:
-        from .core.calibration import machine_dict
-
         out.update(machine_dict(profile))
     name = out.get("name") or "machine profile"
     for key, stricter in LIMITS:

@@ -7,12 +7,12 @@ import unittest
 
 import numpy as np
 
-from test_export import sphere
-from test_pipeline import PLANES
 from wiresculpt import native, pipeline
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.settings import defaults
 from wiresculpt.stages import layering, target_shape
+
+from helpers import PLANES, sphere
 
 
 def result(max_bend=1.0, feasible=True, nlopt="NLOPT_FTOL_REACHED", status="ok"):

@@ -4,15 +4,12 @@ import unittest
 
 import numpy as np
 
-from test_export import sphere
 from wiresculpt import native, pipeline
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.scene import PlaneSpec
 from wiresculpt.core.settings import defaults
 
-PLANES = [PlaneSpec(n, (0, 0, 0), normal) for n, normal in
-          (("A", (0, 0, 1)), ("B", (1, 0, 0)), ("C", (0, 1, 0)))]
-
+from helpers import PLANES, sphere
 
 def largest_rest_turn_deg(design):
     """The largest turning angle of any rest polyline, from its points alone."""

@@ -13,8 +13,9 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
-from . import scene_results
-from .core.files import write_atomic
+from ..core.files import write_atomic
+from . import results
+from .objects import tagged
 
 RESOLUTION = (480, 360)
 VIEW_DIRECTION = (1.0, -1.25, 0.9)  # from the sculpture's centre towards the camera
@@ -48,8 +49,8 @@ def crossing_sentence(design, crossing, centre=None):
     hook = crossing.get("hook", 0)
     if not hook:
         return f"{head}, {a} and {b} only touch: no hook, either wire may lie on top"
-    d = scene_results.hook_direction(design, crossing)
-    side = scene_results.side_of(crossing, 0)  # where wires[0] lies, in units of d
+    d = results.hook_direction(design, crossing)
+    side = results.side_of(crossing, 0)  # where wires[0] lies, in units of d
     push = d if side > 0 else -d  # the way wires[0] is pushed
     plus, minus = direction_words(push)
     if centre is not None:
@@ -90,7 +91,7 @@ def step_text(design, step):
 # --- pictures -------------------------------------------------------------------------------
 
 def sculpture_bounds(design):
-    points = np.concatenate([scene_results.wire_points(w) for w in design["wires"]])
+    points = np.concatenate([results.wire_points(w) for w in design["wires"]])
     low, high = points.min(axis=0), points.max(axis=0)
     centre = 0.5 * (low + high)
     radius = float(np.max(np.linalg.norm(points - centre, axis=1))) + design["material"]["wire_diameter"]
@@ -116,7 +117,7 @@ class _Borrowed:
                       (s.view_settings, "look", s.view_settings.look),
                       (s.wiresculpt, "assembly_step", s.wiresculpt.assembly_step)]
         self.hidden = [(o, o.hide_render) for o in s.objects]
-        self.scales = [(o, tuple(o.scale)) for o in scene_results.tagged(s, scene_results.CROSSING_KEY).values()]
+        self.scales = [(o, tuple(o.scale)) for o in tagged(s, results.CROSSING_KEY).values()]
         self.world = s.world
         self.temp_world = None
         if s.world is None:
@@ -143,7 +144,7 @@ class _Borrowed:
         data = self.camera.data
         bpy.data.objects.remove(self.camera, do_unlink=True)
         bpy.data.cameras.remove(data)
-        scene_results.apply_assembly_step(s)
+        results.apply_assembly_step(s)
         return False
 
 
@@ -181,8 +182,8 @@ def _render_to(scene, path):
 
 def render_pictures(scene, design, jobs, resolution=RESOLUTION):
     """Renders with Workbench: `jobs` is [(assembly step shown (0: all), path, marker crossing ids)]."""
-    wire_objects = scene_results.tagged(scene, scene_results.WIRE_KEY)
-    markers = scene_results.tagged(scene, scene_results.CROSSING_KEY)
+    wire_objects = tagged(scene, results.WIRE_KEY)
+    markers = tagged(scene, results.CROSSING_KEY)
     with _Borrowed(scene) as borrowed:
         r = scene.render
         r.engine = 'BLENDER_WORKBENCH'
@@ -221,7 +222,7 @@ PAGE_STYLE = """body{font-family:sans-serif;max-width:60em;margin:2em auto;color
 
 def _wire_html(design, wire_id):
     w = design["wires"][wire_id]
-    return (f'<span class="swatch" style="background:{scene_results.colour_hex(wire_id)}"></span>'
+    return (f'<span class="swatch" style="background:{results.colour_hex(wire_id)}"></span>'
             f"<b>{html.escape(w['name'])}</b>")
 
 
@@ -261,7 +262,7 @@ def page_html(design, pictures):
 
 def write_guide(scene, design, folder, resolution=RESOLUTION):
     """Writes folder/index.html and folder/step_NN.png (the design must be in the scene: see
-    scene_results.write_results). Returns the page's path. ValueError without an assembly order."""
+    results.write_results). Returns the page's path. ValueError without an assembly order."""
     steps = design.get("assembly_steps") or []
     if not steps:
         raise ValueError("the design has no assembly order (" + (design.get("reason") or "not solved") + ")")

@@ -1,0 +1,66 @@
+"""Calibration data kept in Blender: the user's config folder (calibrated materials, plots), the
+last fits stored on the scene, the plots as images, and a material put into the panel."""
+import json
+import os
+
+import bpy
+
+from ..core import calibration as cal
+from ..core import materials
+
+RESULTS_KEY = "wiresculpt_calibration_results"  # scene custom property: JSON of the last fits
+MATERIAL_NAME_KEY = "wiresculpt_material_name"  # scene custom property: name of the material in use
+PLOT_IMAGE = {"CANTILEVER": "wiresculpt cantilever fit", "TILT": "wiresculpt tilt fit",
+              "SPRINGBACK": "wiresculpt spring-back fit"}
+
+
+def config_folder():
+    """The user's wiresculpt config folder (materials/, plots/); WIRESCULPT_CONFIG overrides it."""
+    folder = os.environ.get("WIRESCULPT_CONFIG")
+    if folder:
+        os.makedirs(folder, exist_ok=True)
+        return folder
+    return bpy.utils.user_resource('CONFIG', path="wiresculpt", create=True)
+
+
+def results(scene):
+    """The stored fits: {"cantilever", "tilt", "springback"} (each may be absent)."""
+    try:
+        return json.loads(scene.get(RESULTS_KEY, "{}"))
+    except (TypeError, ValueError):
+        return {}
+
+
+def store(scene, key, value):
+    r = results(scene)
+    r[key] = value
+    scene[RESULTS_KEY] = json.dumps(r)
+
+
+def load_plot(kind, png):
+    """Writes the plot into the config folder and (re)loads it as a Blender image."""
+    path = cal.write_plot(os.path.join(config_folder(), "plots", kind.lower() + ".png"), png)
+    name = PLOT_IMAGE[kind]
+    image = bpy.data.images.get(name)
+    if image is None:
+        image = bpy.data.images.load(path, check_existing=False)
+        image.name = name
+    else:
+        image.filepath = path
+        image.reload()
+    return image
+
+
+def use_material(scene, m):
+    """Sets the Material & Machine panel to material `m` (a preset by key, else Custom)."""
+    ws = scene.wiresculpt
+    if m["name"] in materials.PRESETS:
+        ws.material_preset = m["name"]
+        ws.wire_diameter = m["wire_diameter"]
+    else:
+        ws.material_preset = 'CUSTOM'
+        ws.wire_diameter = m["wire_diameter"]
+        for key in ("bending_stiffness", "max_torque", "friction", "density"):
+            if key in m:
+                setattr(ws, key, m[key])
+    scene[MATERIAL_NAME_KEY] = m["name"]

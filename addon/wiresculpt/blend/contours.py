@@ -1,0 +1,63 @@
+"""The sliced contours in the scene: one curve object per contour, tagged with its plane and
+index, and the settings' contour list that the user ticks."""
+import bpy
+from mathutils import Matrix
+
+from ..core.contours import pick
+from .objects import remove_object, scene_collection, tagged, write_polyline
+
+CONTOUR_KEY = "wiresculpt_contour"  # custom property {"plane": name, "index": k} on curve objects
+CONTOURS_COLLECTION = "Contours"
+
+
+def contour_key(obj):
+    """(plane, index) of a contour curve object, or None when it is not one of ours."""
+    tag = obj.get(CONTOUR_KEY)
+    try:
+        return str(tag["plane"]), int(tag["index"])
+    except (TypeError, KeyError, ValueError):
+        return None
+
+
+def existing_curves(scene):
+    """{(plane, index): object} of the scene's contour curves. A copy of one (Shift+D copies
+    the tag) loses the tag and becomes the user's own curve."""
+    return tagged(scene, CONTOUR_KEY, contour_key, kind='CURVE')
+
+
+def contour_curve(scene, existing, plane, index):
+    """The curve object of contour (plane, index): the existing one, or a new one."""
+    obj = existing.get((plane, index))
+    if obj is None:
+        name = f"Contour {plane} #{index}"
+        curve = bpy.data.curves.new(name, 'CURVE')
+        curve.dimensions = '3D'
+        obj = bpy.data.objects.new(name, curve)
+        obj[CONTOUR_KEY] = {"plane": plane, "index": index}
+        scene_collection(scene, CONTOURS_COLLECTION).objects.link(obj)
+    return obj
+
+
+def apply_slice(scene, settings, names, per_plane):
+    """Make the scene's curves and the settings' list match the sliced `per_plane` contours,
+    keeping the user's ticks. Returns (contour count, ticked count, removed curve count)."""
+    ticks = {(item.plane, item.index): item.use for item in settings.contours}
+    existing = existing_curves(scene)
+    settings.contours.clear()
+    for plane, contours in zip(names, per_plane):
+        longest = set(pick(contours, "largest", plane))
+        for index, contour in enumerate(contours):
+            obj = contour_curve(scene, existing, plane, index)
+            existing.pop((plane, index), None)
+            write_polyline(obj.data, contour["points"], contour["closed"])
+            obj.matrix_world = Matrix.Identity(4)
+            item = settings.contours.add()
+            item.name = f"{plane} #{index}"
+            item.plane, item.index, item.curve = plane, index, obj
+            item.length, item.closed = contour["length"], contour["closed"]
+            item.use = ticks.get((plane, index), index in longest)
+    for obj in existing.values():  # contours that disappeared
+        remove_object(obj)
+    count = len(settings.contours)
+    settings.active_contour = min(settings.active_contour, max(count - 1, 0))
+    return count, sum(item.use for item in settings.contours), len(existing)

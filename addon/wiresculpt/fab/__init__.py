@@ -1,0 +1,1 @@
+"""Fabrication, free of bpy: export files and streaming to a bender (mirrors native/src/fab)."""
