@@ -16,7 +16,7 @@ sys.path.insert(0, os.path.join(ROOT, 'addon'))
 import bpy
 import wiresculpt
 wiresculpt.register()
-from wiresculpt.mesh_import import import_mesh
+from wiresculpt.blend.mesh import import_mesh
 OUT = os.environ.get("SHOT_DIR", HERE)
 for o in list(bpy.data.objects):
     bpy.data.objects.remove(o)
