@@ -17,6 +17,7 @@ PACKAGES=(
   blender python3.11 python3-dev python3-numpy
   libeigen3-dev pybind11-dev catch2
   libglpk-dev libnlopt-cxx-dev libserialport-dev
+  patchelf binutils  # scripts/package bundles the solver's libraries with an $ORIGIN run path
 )
 
 # The sanitizer and fuzz builds (scripts/test, scripts/fuzz).

@@ -24,7 +24,7 @@ if os.path.isdir(os.path.join(ADDON, "wiresculpt")) and ADDON not in sys.path:
 
 EXIT_STABLE, EXIT_FAILURE, EXIT_UNSTABLE = 0, 1, 2
 # What a run writes into DIR, replaced as one set (files, or folders that belong to the run).
-OUTPUTS = ("design.json", "sculpture.blend", "sculpture.blend1", "render.png", "assembly", "svg", "dxf",
+OUTPUTS = ("design.json", "sculpture.blend", "sculpture.blend1", "render.png", "assembly", "svg", "dxf", "templates",
            "gcode", "bends")
 
 
@@ -106,7 +106,7 @@ def write_scene_outputs(design, objects, planes, factor, out, say):
 
 
 def write_fabrication(design, out, say):
-    """svg/, dxf/, gcode/ and bends/ in `out` for every wire with a rest shape; the programs'
+    """svg/, dxf/, templates/, gcode/ and bends/ in `out` for every wire with a rest shape; the programs'
     summary goes into the design as `fabrication`."""
     from wiresculpt.fab import export
 
@@ -117,7 +117,7 @@ def write_fabrication(design, out, say):
     design["fabrication"] = {"wires": result["wires"], "errors": result["errors"]}
     minutes = sum(w["machine_seconds"] for w in result["wires"]) / 60
     say("fabrication", f"{len(result['wires'])} bend programs ({sum(w['bend_count'] for w in result['wires'])} "
-                       f"bends, about {minutes:.0f} min on the machine), {len(result['files'])} files in svg/, dxf/, "
+                       f"bends, about {minutes:.0f} min on the machine), {len(result['files'])} files in svg/, dxf/, templates/, "
                        f"gcode/, bends/ ({time.perf_counter() - start:.3f} s)")
     for error in result["errors"]:
         say("fabrication", error)

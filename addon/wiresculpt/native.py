@@ -5,17 +5,61 @@ shapes and types of arrays before anything crosses into C++ (a bad array is a Va
 never a crash inside the module), and when the module is missing it records a sentence the
 panel shows to the user instead of failing to register.
 """
+import os
+import re
+import sys
+
 import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def built_for():
+    """The Pythons the compiled modules beside this file were built for, e.g. ["3.11"], from their
+    file names (_wiresculpt.cpython-311-x86_64-linux-gnu.so)."""
+    try:
+        names = os.listdir(HERE)
+    except OSError:
+        return []
+    tags = (re.match(r"_wiresculpt\.cpython-(\d)(\d+)", n) for n in names)
+    return sorted({f"{t.group(1)}.{t.group(2)}" for t in tags if t}, key=lambda v: tuple(map(int, v.split("."))))
+
+
+def host_name():
+    """ "Blender 4.0.2" inside Blender (bpy already imported), else "this Python"."""
+    bpy = sys.modules.get("bpy")
+    version = getattr(getattr(bpy, "app", None), "version_string", None)
+    return f"Blender {version}" if version else "this Python"
+
+
+def explain_load_error(exc, builds, python=None, host=None):
+    """One sentence saying why the solver did not load and what to do: the Python the zip was
+    built for against the one running, or the shared library the loader could not find."""
+    python = python or f"{sys.version_info[0]}.{sys.version_info[1]}"
+    host = host or host_name()
+    text = str(exc)
+    if builds and python not in builds:
+        advice = ("use Blender 4.1+" if tuple(map(int, python.split("."))) < (3, 11) else
+                  "use a Blender whose Python is " + " or ".join(builds))
+        return (f"The wiresculpt solver did not load: this build is for Python {' and '.join(builds)}; "
+                f"{host} uses {python}: {advice} or build from source with scripts/package.")
+    missing = re.search(r"([\w.+-]+\.so[\w.]*): cannot open shared object file", text)
+    if missing:
+        return (f"The wiresculpt solver did not load: the library {missing.group(1)} is missing. The "
+                f"packaged zip carries it in wiresculpt/libs: install the zip again (Preferences > "
+                "Add-ons > Install), or install it on the system, or build from source with scripts/package.")
+    if not builds:
+        return ("The wiresculpt solver (_wiresculpt) is not built: build it with scripts/setup, or "
+                "install the packaged zip (scripts/package).")
+    return f"The wiresculpt solver (_wiresculpt) did not load in {host}: {text}"
+
 
 try:
     from . import _wiresculpt as module
     LOAD_ERROR = ""
-except ImportError as exc:  # not built, or built for another Python
+except ImportError as exc:  # not built, built for another Python, or a library missing
     module = None
-    LOAD_ERROR = (
-        "The wiresculpt solver (_wiresculpt) is not installed for this Blender's Python "
-        f"({exc}). Build it with scripts/test or install the packaged zip."
-    )
+    LOAD_ERROR = explain_load_error(exc, built_for())
 
 
 def available():

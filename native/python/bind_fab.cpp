@@ -162,14 +162,33 @@ std::string write_svg(const std::optional<std::string>& path, const py::object& 
   return text;
 }
 
-std::string write_dxf(const std::optional<std::string>& path, const py::object& wires, bool labels) {
+std::string write_dxf(const std::optional<std::string>& path, const py::object& wires, bool labels,
+                      const std::string& layout, double gap_mm) {
   const std::vector<TemplateWire> w = to_templates(wires);
+  DxfOptions o;
+  o.labels = labels;
+  o.gap_mm = gap_mm;
+  if (layout == "as_given") o.layout = DxfLayout::as_given;
+  else if (layout == "start_at_origin") o.layout = DxfLayout::start_at_origin;
+  else if (layout == "side_by_side") o.layout = DxfLayout::side_by_side;
+  else throw InputError("DXF layout must be \"as_given\", \"start_at_origin\" or \"side_by_side\", got \"" + layout + "\"");
   std::string text;
   {
     py::gil_scoped_release release;
-    DxfOptions o;
-    o.labels = labels;
     text = dxf_document(w, o);
+    maybe_write(path, text);
+  }
+  return text;
+}
+
+std::string write_machine_svg(const std::optional<std::string>& path, const py::object& wire, double stroke_mm) {
+  py::list one;
+  one.append(wire);
+  const std::vector<TemplateWire> w = to_templates(one);
+  std::string text;
+  {
+    py::gil_scoped_release release;
+    text = svg_machine(w[0], stroke_mm);
     maybe_write(path, text);
   }
   return text;
@@ -261,8 +280,14 @@ Returns {"steps": [{"feed_mm", "bend_deg", "commanded_deg", "vertex"}], "feeds_m
         py::arg("options") = py::dict(),
         R"(1:1 SVG template (mm). wires: [{"name", "points" (n, 2) m, "bend_points", "crossing_points"}].
 sheet: None = a sheet when more than one wire. Writes atomically when path is not None; returns the text.)");
-  m.def("write_dxf", &write_dxf, py::arg("path"), py::arg("wires"), py::arg("labels") = true,
-        "DXF R12, one layer per wire, mm. Writes atomically when path is not None; returns the text.");
+  m.def("write_dxf", &write_dxf, py::arg("path"), py::arg("wires"), py::arg("labels") = false,
+        py::arg("layout") = "as_given", py::arg("gap_mm") = 20.0,
+        R"(DXF R2000, $INSUNITS mm, one layer and one LWPOLYLINE per wire. layout: "as_given", "start_at_origin"
+(each wire's first point at 0,0) or "side_by_side" (bounding boxes gap_mm apart on the x axis).
+Writes atomically when path is not None; returns the text.)");
+  m.def("write_machine_svg", &write_machine_svg, py::arg("path"), py::arg("wire"), py::arg("stroke_mm") = 0.5,
+        R"(The machine SVG of one wire {"name", "points" (n, 2) m}: exactly one path, mm, origin at the first
+point. Writes atomically when path is not None; returns the text.)");
   m.def("write_gcode", &write_gcode, py::arg("path"), py::arg("points"), py::arg("profile") = py::dict(),
         py::arg("wire_name") = "", py::arg("material") = "", py::arg("sync_each_step") = true,
         "GRBL G-code for the wire. Writes atomically when path is not None; returns the text.");

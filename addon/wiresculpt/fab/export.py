@@ -1,5 +1,13 @@
-"""Fabrication files for a finished design (Sec. 5.1): per wire a bend program, a 1:1 SVG
-template, G-code and a CSV bend table, plus one SVG sheet and one DXF with a layer per wire.
+"""Fabrication files for a finished design (Sec. 5.1), for machines and for people, separately:
+
+    svg/NN-name.svg        machine file: the rest shape as one path, mm, origin at the start
+    dxf/NN-name.dxf        machine file: DXF R2000, $INSUNITS mm, one layer, one LWPOLYLINE, origin at the start
+    dxf/sculpture.dxf      every wire on its own layer, side by side without overlap
+    templates/NN-name.svg  the annotated 1:1 print template (bends, crossings, label)
+    templates/sheet.svg    every template on one sheet
+    gcode/NN-name.gcode    the bend program for a GRBL bender
+    bends/NN-name.csv      the bend table
+
 Free of bpy: the batch run and the add-on's Export operator both call it. Every file is written
 atomically by the native writers.
 """
@@ -11,7 +19,7 @@ import numpy as np
 from .. import native
 from ..core.calibration import machine_dict
 
-FOLDERS = ("svg", "dxf", "gcode", "bends")
+FOLDERS = ("svg", "dxf", "templates", "gcode", "bends")
 
 
 # The machine limits a design records, each with the function that picks the stricter of two values.
@@ -85,7 +93,7 @@ def crossing_indices(design, wire):
 
 def export(design, out_dir, profile=None):
     """Writes the fabrication files of every wire that has a rest shape into out_dir/{svg, dxf,
-    gcode, bends}, with the machine `profile` (None: the default; see machine_profile). Returns
+    templates, gcode, bends} (see the module's text), with the machine `profile` (None: the default; see machine_profile). Returns
     {"files": [paths], "wires": [per-wire program summary], "errors": [one sentence per wire that
     cannot be bent], "notes": [limits where the profile is stricter than the design]}."""
     w = native.require()
@@ -106,7 +114,9 @@ def export(design, out_dir, profile=None):
                     "crossing_points": crossing_indices(design, wire)}
         templates.append(template)
         for folder, name, write in (
-            ("svg", f"{stem}.svg", lambda p: w.write_svg(p, [template], False)),
+            ("svg", f"{stem}.svg", lambda p: w.write_machine_svg(p, template)),
+            ("dxf", f"{stem}.dxf", lambda p: w.write_dxf(p, [template], layout="start_at_origin")),
+            ("templates", f"{stem}.svg", lambda p: w.write_svg(p, [template], False)),
             ("gcode", f"{stem}.gcode", lambda p: w.write_gcode(p, rest, profile, wire["name"], material)),
             ("bends", f"{stem}.csv", lambda p: w.write_bend_table(p, rest, profile)),
         ):
@@ -118,8 +128,9 @@ def export(design, out_dir, profile=None):
                           "wire_length": program["wire_length"], "machine_seconds": program["machine_seconds"],
                           "shape_error": program["shape_error"]})
     if templates:
-        for folder, name, write in (("svg", "sheet.svg", lambda p: w.write_svg(p, templates, True)),
-                                    ("dxf", "sculpture.dxf", lambda p: w.write_dxf(p, templates))):
+        for folder, name, write in (("templates", "sheet.svg", lambda p: w.write_svg(p, templates, True)),
+                                    ("dxf", "sculpture.dxf",
+                                     lambda p: w.write_dxf(p, templates, layout="side_by_side"))):
             path = os.path.join(out_dir, folder, name)
             os.makedirs(os.path.dirname(path), exist_ok=True)
             write(path)

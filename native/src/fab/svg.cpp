@@ -125,6 +125,29 @@ std::string svg_wire(const TemplateWire& wire, const SvgOptions& options) {
   return svg_open(w, h) + wire_group(wire, 0, 0.0, 0.0, options) + "</svg>\n";
 }
 
+std::string svg_machine(const TemplateWire& wire, double stroke_mm) {
+  validate(wire, 0);
+  if (!(std::isfinite(stroke_mm) && stroke_mm > 0))
+    throw InputError("machine SVG of wire " + wire.name + ": stroke_mm must be a positive number of millimetres");
+  // page coordinates: mm from the first point, y down (the drawing seen from the same side as the template)
+  const Vec2 start = wire.points.front();
+  std::string d;
+  double min_x = 0, min_y = 0, max_x = 0, max_y = 0;
+  for (std::size_t i = 0; i < wire.points.size(); ++i) {
+    const double x = to_mm(wire.points[i].x() - start.x()), y = -to_mm(wire.points[i].y() - start.y());
+    min_x = std::min(min_x, x); max_x = std::max(max_x, x);
+    min_y = std::min(min_y, y); max_y = std::max(max_y, y);
+    d += (i == 0 ? "M " : " L ") + num(x) + " " + num(y);
+  }
+  const double pad = stroke_mm;
+  const double w = max_x - min_x + 2 * pad, h = max_y - min_y + 2 * pad;
+  return "<?xml version=\"1.0\" encoding=\"UTF-8\" standalone=\"no\"?>\n"
+         "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"" + num(w) + "mm\" height=\"" + num(h) +
+         "mm\" viewBox=\"" + num(min_x - pad) + " " + num(min_y - pad) + " " + num(w) + " " + num(h) + "\">\n"
+         "  <path id=\"" + xml_escape(wire.name) + "\" fill=\"none\" stroke=\"black\" stroke-width=\"" + num(stroke_mm) +
+         "\" d=\"" + d + "\"/>\n</svg>\n";
+}
+
 std::vector<SheetCell> sheet_layout(const std::vector<TemplateWire>& wires, const SvgOptions& options) {
   check_options(options);
   std::vector<SheetCell> cells;

@@ -34,6 +34,12 @@ struct SheetCell {
 /// One wire alone: width = bbox width + 2 margin, height = bbox height + 2 margin (mm).
 std::string svg_wire(const TemplateWire& wire, const SvgOptions& options = {});
 
+/// The machine file of one wire: its rest-shape centreline as exactly one <path> (M, then L per
+/// point), millimetres, the origin at the wire's first point (where the bender starts), y down as
+/// on the template; width/height in mm and a viewBox fitting the path plus stroke_mm. Nothing
+/// else is drawn: vector-to-bend importers read every path as a wire.
+std::string svg_machine(const TemplateWire& wire, double stroke_mm = 0.5);
+
 /// Cells of the sheet layout: rows left to right, a new row when the next cell would pass
 /// sheet_width_mm (a wider cell gets a row of its own). Cells never overlap.
 std::vector<SheetCell> sheet_layout(const std::vector<TemplateWire>& wires, const SvgOptions& options = {});
