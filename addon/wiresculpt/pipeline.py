@@ -5,6 +5,7 @@ GIL) with `cancel` wired to its Esc key.
 """
 from . import native
 from .core.design import new_design
+from .core.sizes import size_warnings
 from .stages import forces, layering, slicing, target_shape
 
 ALL_STAGES = ["layering", "target_shape", "forces", "rest_shape"]
@@ -49,6 +50,9 @@ def solve(design, material, settings, progress=None, cancel=None):
                             else "a sculpture needs at least two wires: add a plane or pick more contours")
         return design
     apply_cuts(design, settings.get("cuts"))
+    for warning in size_warnings(design):  # before the long work: the figure, at once
+        design.setdefault("warnings", []).append(warning)
+        say("size", warning)
     try:
         checkpoint()
         say("layering", layering.run(design, material, settings, native_progress))

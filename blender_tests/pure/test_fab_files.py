@@ -138,18 +138,19 @@ class FabFiles(unittest.TestCase):
         path = os.path.join(self.dir, "wires.dxf")
         self.w.write_dxf(path, self.wires)
         doc = self.ezdxf.readfile(path)
-        self.assertEqual(doc.dxfversion, "AC1009")
+        self.assertEqual(doc.dxfversion, "AC1015")
+        self.assertEqual(doc.header.get("$INSUNITS"), 4)
         auditor = doc.audit()
         self.assertEqual(len(auditor.errors), 0, [str(e) for e in auditor.errors])
         self.assertFalse(auditor.has_errors)
         msp = doc.modelspace()
-        polylines = list(msp.query("POLYLINE"))
+        polylines = list(msp.query("LWPOLYLINE"))
         self.assertEqual(len(polylines), len(self.wires))
         layers = {p.dxf.layer for p in polylines}
         self.assertEqual(len(layers), len(self.wires))  # one layer per wire
         for poly, wire in zip(polylines, self.wires):
             self.assertIn(poly.dxf.layer, [layer.dxf.name for layer in doc.layers])
-            found = np.array([[v[0], v[1]] for v in poly.points()])
+            found = np.array([[v[0], v[1]] for v in poly.get_points()])
             offset = self.assert_same_shape_mm(found, wire["points"], flip_y=False)
             self.assertLess(np.abs(offset).max(), TOL_MM)  # DXF keeps the wire's own coordinates
 

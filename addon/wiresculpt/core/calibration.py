@@ -300,7 +300,9 @@ def with_springback(profile, fit, source=""):
 
 
 FILE_MARKERS = ("format", "version")  # written by save_profile, dropped by load_profile
-PROFILE_FILE_KEYS = FILE_MARKERS + ("springback_fit",)  # in the file, not machine settings
+# Checked here, not by the native module: the wire stock's length (m, default core.sizes.STOCK_LENGTH).
+PYTHON_KEYS = ("stock_length",)
+PROFILE_FILE_KEYS = FILE_MARKERS + ("springback_fit",) + PYTHON_KEYS  # not native machine settings
 
 
 def validate_profile(profile, where="machine profile"):
@@ -308,6 +310,9 @@ def validate_profile(profile, where="machine profile"):
     key, a wrong type, a value out of range), prefixed with `where`."""
     if not isinstance(profile, dict):
         raise ValueError(f"{where}: expected a JSON object")
+    stock = profile.get("stock_length", 1.0)
+    if isinstance(stock, bool) or not isinstance(stock, (int, float)) or not 0 < stock < 100:
+        raise ValueError(f"{where}: stock_length must be a length in metres between 0 and 100, got {stock!r}")
     try:
         _native().validate_machine_profile({k: v for k, v in profile.items() if k not in PROFILE_FILE_KEYS})
     except ValueError as exc:

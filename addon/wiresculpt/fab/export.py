@@ -18,6 +18,7 @@ import numpy as np
 
 from .. import native
 from ..core.calibration import machine_dict
+from ..core.sizes import STOCK_LENGTH, size_warnings
 
 FOLDERS = ("svg", "dxf", "templates", "gcode", "bends")
 
@@ -98,7 +99,11 @@ def export(design, out_dir, profile=None):
     cannot be bent], "notes": [limits where the profile is stricter than the design]}."""
     w = native.require()
     clear(out_dir)
+    stock = float((profile or {}).get("stock_length", STOCK_LENGTH))
+    stock_notes = [n for n in size_warnings(design, stock, (profile or {}).get("name") or "the machine profile")
+                   if n.startswith("wire ")]
     profile, notes = machine_profile(design, profile)
+    notes += stock_notes
     material = design["material"].get("name", "")
     files, summaries, errors, templates = [], [], [], []
     wires = [x for x in design["wires"] if "rest" in x]
