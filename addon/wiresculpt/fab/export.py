@@ -92,6 +92,14 @@ def crossing_indices(design, wire):
     return sorted(out)
 
 
+def no_rest_reason(design):
+    """Why no wire has a rest shape, matching the design's state: an unstable result points at the
+    Stability report, an unfinished one at Optimize."""
+    if design.get("stable") is False and design.get("reason"):
+        return f"the design is not stable: see Stability ({design['reason']})"
+    return "no wire has a rest shape yet: optimize until the rest shape stage has run"
+
+
 def export(design, out_dir, profile=None):
     """Writes the fabrication files of every wire that has a rest shape into out_dir/{svg, dxf,
     templates, gcode, bends} (see the module's text), with the machine `profile` (None: the default; see machine_profile). Returns
@@ -140,7 +148,8 @@ def export(design, out_dir, profile=None):
             os.makedirs(os.path.dirname(path), exist_ok=True)
             write(path)
             files.append(path)
-    return {"files": files, "wires": summaries, "errors": errors, "notes": notes}
+    return {"files": files, "wires": summaries, "errors": errors, "notes": notes,
+            "empty_reason": "" if wires else no_rest_reason(design)}
 
 
 def summary(result, out_dir):
@@ -151,7 +160,8 @@ def summary(result, out_dir):
               for folder in FOLDERS}
     done, refused = result["wires"], result["errors"]
     if not done and not refused:
-        return "ERROR", "No wire has a rest shape: optimize until the rest shape stage has run"
+        reason = result.get("empty_reason") or "no wire has a rest shape yet: optimize until the rest shape stage has run"
+        return "ERROR", "Nothing to export: " + reason
     parts = [f"{w['name']}: {w['bend_count']} bends, {w['wire_length'] * 1000:.0f} mm, "
              f"about {w['machine_seconds']:.0f} s" for w in done]
     head = (f"Exported {len(done)} of {len(done) + len(refused)} wires to {out_dir} ("

@@ -31,7 +31,7 @@ def wire_program(design, wire_name, profile=None):
     if wire is None:
         raise ValueError(f"the design has no wire '{wire_name}'")
     if "rest" not in wire:
-        raise ValueError(f"wire {wire_name} has no rest shape: optimize until the rest shape stage has run")
+        raise ValueError(f"wire {wire_name} has no rest shape: {export.no_rest_reason(design)}")
     w = native.require()
     machine, notes = export.machine_profile(design, profile)
     material = design["material"].get("name", "")
