@@ -49,6 +49,29 @@ class ExportTest(unittest.TestCase):
         leftovers = [n for _d, _s, files in os.walk(self.tmp.name) for n in files if n.endswith(".tmp")]
         self.assertEqual(leftovers, [])
 
+    def test_templates_are_tiled_onto_pages(self):
+        from wiresculpt.fab import tiles
+
+        pages = os.path.join(self.tmp.name, "templates", "pages")
+        for w in self.design["wires"]:
+            stem = export.file_stem(w)
+            root = ET.parse(os.path.join(self.tmp.name, "templates", stem + ".svg")).getroot()
+            expected = tiles.layout(float(root.get("width")[:-2]), float(root.get("height")[:-2]))["tiles"]
+            found = sorted(n for n in os.listdir(pages) if n.startswith(stem + "-"))
+            self.assertEqual(found, sorted(f"{stem}-{t['name']}.svg" for t in expected))
+            for name in found:
+                self.assertIn(os.path.join(pages, name), self.result["files"])
+                page = ET.parse(os.path.join(pages, name)).getroot()
+                self.assertEqual((page.get("width"), page.get("height")), ("210.000mm", "297.000mm"))
+        level, text = export.summary(self.result, self.tmp.name)
+        self.assertIn(f"{len(os.listdir(pages))} {os.path.join('templates', 'pages')}", text)
+        with tempfile.TemporaryDirectory() as tmp:  # Letter on request; an unknown paper is refused
+            export.export(self.design, tmp, paper="Letter")
+            page = ET.parse(os.path.join(tmp, "templates", "pages", os.listdir(os.path.join(tmp, "templates", "pages"))[0])).getroot()
+            self.assertEqual(page.get("width"), "215.900mm")
+            with self.assertRaises(ValueError):
+                export.export(self.design, tmp, paper="A3")
+
     def test_file_names_stay_unique_and_old_files_go(self):
         self.assertEqual(export.file_stem({"id": 3, "name": "Equator/0"}), "03-Equator-0")
         names = ["\u5e73\u9762/0", "\u65ad\u9762/0", "Cut/1", "Cut-1"]  # collide once made safe

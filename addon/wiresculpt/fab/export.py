@@ -5,6 +5,8 @@
     dxf/sculpture.dxf      every wire on its own layer, side by side without overlap
     templates/NN-name.svg  the annotated 1:1 print template (bends, crossings, label)
     templates/sheet.svg    every template on one sheet
+    templates/pages/NN-name-A1.svg ...  each template tiled onto A4 (or Letter) pages, 1:1, with a
+                           100 mm scale bar and overlap marks (fab/tiles.py)
     gcode/NN-name.gcode    the bend program for a GRBL bender
     bends/NN-name.csv      the bend table
 
@@ -17,10 +19,11 @@ import re
 import numpy as np
 
 from .. import native
+from . import tiles
 from ..core.calibration import machine_dict
 from ..core.sizes import STOCK_LENGTH, size_warnings
 
-FOLDERS = ("svg", "dxf", "templates", "gcode", "bends")
+FOLDERS = ("svg", "dxf", "templates", os.path.join("templates", "pages"), "gcode", "bends")
 
 
 # The machine limits a design records, each with the function that picks the stricter of two values.
@@ -100,12 +103,16 @@ def no_rest_reason(design):
     return "no wire has a rest shape yet: optimize until the rest shape stage has run"
 
 
-def export(design, out_dir, profile=None):
+def export(design, out_dir, profile=None, paper=None):
     """Writes the fabrication files of every wire that has a rest shape into out_dir/{svg, dxf,
-    templates, gcode, bends} (see the module's text), with the machine `profile` (None: the default; see machine_profile). Returns
+    templates, templates/pages, gcode, bends} (see the module's text), with the machine `profile`
+    (None: the default; see machine_profile), the template pages on `paper` ("A4" or "Letter";
+    None: the profile's key "paper", else A4). Returns
     {"files": [paths], "wires": [per-wire program summary], "errors": [one sentence per wire that
     cannot be bent], "notes": [limits where the profile is stricter than the design]}."""
     w = native.require()
+    paper = paper or (profile or {}).get("paper") or "A4"
+    tiles.layout(1.0, 1.0, paper)  # an unknown paper is refused before anything is written
     clear(out_dir)
     stock = float((profile or {}).get("stock_length", STOCK_LENGTH))
     stock_notes = [n for n in size_warnings(design, stock, (profile or {}).get("name") or "the machine profile")
@@ -135,8 +142,10 @@ def export(design, out_dir, profile=None):
         ):
             path = os.path.join(out_dir, folder, name)
             os.makedirs(os.path.dirname(path), exist_ok=True)
-            write(path)
+            text = write(path)
             files.append(path)
+            if folder == "templates":
+                files += tiles.write_pages(text, os.path.join(out_dir, "templates", "pages"), stem, wire["name"], paper)
         summaries.append({"id": wire["id"], "name": wire["name"], "bend_count": program["bend_count"],
                           "wire_length": program["wire_length"], "machine_seconds": program["machine_seconds"],
                           "shape_error": program["shape_error"]})
@@ -156,7 +165,7 @@ def summary(result, out_dir):
     """(level, one message) of an export: counts per folder, then each wire's bends, length and
     machine time or the reason it cannot be bent, then the profile notes. level is "INFO",
     "WARNING" (some wire refused or a note) or "ERROR" (no wire written)."""
-    counts = {folder: sum(1 for p in result["files"] if os.path.basename(os.path.dirname(p)) == folder)
+    counts = {folder: sum(1 for p in result["files"] if os.path.relpath(os.path.dirname(p), out_dir) == folder)
               for folder in FOLDERS}
     done, refused = result["wires"], result["errors"]
     if not done and not refused:
