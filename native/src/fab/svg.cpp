@@ -134,7 +134,8 @@ std::string svg_machine(const TemplateWire& wire, double stroke_mm) {
   std::string d;
   double min_x = 0, min_y = 0, max_x = 0, max_y = 0;
   for (std::size_t i = 0; i < wire.points.size(); ++i) {
-    const double x = to_mm(wire.points[i].x() - start.x()), y = -to_mm(wire.points[i].y() - start.y());
+    // y = start - point rather than -(point - start): the first point is (0, 0), never "-0.0000"
+    const double x = to_mm(wire.points[i].x() - start.x()), y = to_mm(start.y() - wire.points[i].y());
     min_x = std::min(min_x, x); max_x = std::max(max_x, x);
     min_y = std::min(min_y, y); max_y = std::max(max_y, y);
     d += (i == 0 ? "M " : " L ") + num(x) + " " + num(y);
