@@ -33,11 +33,12 @@ def run_blender(script, *args, env=None, timeout=300):
                           env={**os.environ, **(env or {})})
 
 
-def run_under_xvfb(script, marker, timeout=180):
-    """Runs `script` in a Blender with a window under Xvfb (modal operators need the event loop);
-    returns (CompletedProcess, the JSON after the last stdout line starting with `marker`, or None)."""
+def run_under_xvfb(script, marker, timeout=180, args=()):
+    """Runs `script` in a Blender with a window under Xvfb (modal operators need the event loop),
+    `args` after "--"; returns (CompletedProcess, the JSON after the last stdout line starting
+    with `marker`, or None)."""
     cmd = ["xvfb-run", "-a", "-s", "-screen 0 1280x800x24", BLENDER, "--factory-startup",
-           "--python-exit-code", "1", "--python", script]
+           "--python-exit-code", "1", "--python", script] + (["--", *args] if args else [])
     # its own process group: on a timeout Blender goes too, not only xvfb-run
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             start_new_session=True)

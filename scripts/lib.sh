@@ -76,6 +76,33 @@ build_fuzz() {
     { cat "$ROOT/build/fuzz/build.log" >&2; say "fuzz build failed"; return 1; }
 }
 
+# The demo's closing lines: every file and folder a batch run wrote into $1 (exit status $2), one
+# line each with what it holds.
+summarize_outputs() {
+  local out=$1 code=${2:-0} entry name what
+  say "done: the results are in $out/"
+  for entry in "$out"/*; do
+    [ -e "$entry" ] || continue
+    name=$(basename "$entry")
+    case "$name" in
+      design.json) what="the design: wires, crossings, stability, assembly order" ;;
+      sculpture.blend) what="open in Blender: framed on the sculpture, sidebar on the Wire tab, first wire selected" ;;
+      sculpture.blend1) what="the previous sculpture.blend (Blender's backup)" ;;
+      render.png) what="a still of the wire sculpture" ;;
+      assembly) what="the printable assembly guide (index.html), one picture per step" ;;
+      svg) what="machine files: each wire's rest shape as one path, in mm, from its start" ;;
+      dxf) what="machine files: DXF R2000 in mm per wire, and sculpture.dxf with every wire side by side" ;;
+      templates) what="print templates at 1:1 (bends, crossings, labels); sheet.svg holds them all" ;;
+      gcode) what="bend programs for a GRBL wire bender (or send them from the Fabrication panel)" ;;
+      bends) what="bend tables (CSV): feed, bend angle and commanded angle per step" ;;
+      *) what="" ;;
+    esac
+    [ -d "$entry" ] && name="$name/"
+    say "$(printf '  %-20s %s' "$name" "$what")"
+  done
+  [ "$code" -eq 2 ] && say "  not stable: see \"reason\" in design.json or the Stability panel" || true
+}
+
 # Runs a Python file inside headless Blender; extra arguments follow "--".
 blender_run() {
   local file=$1; shift

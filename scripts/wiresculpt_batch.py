@@ -3,11 +3,13 @@
     blender --background --factory-startup --python scripts/wiresculpt_batch.py -- SCENE.json --out DIR
 
 Reads and validates the scene file, imports the mesh, runs the pipeline and writes DIR/design.json
-with the fabrication files beside it (svg/, dxf/, gcode/, bends/), then the results as a Blender
-user sees them: DIR/sculpture.blend (wires, crossing markers and the design in a scene),
+with the fabrication files beside it (svg/, dxf/, templates/, gcode/, bends/), then the results as
+a Blender user sees them: DIR/sculpture.blend (wires, crossing markers and the design in a scene;
+it opens with the 3D view framed on the sculpture, the sidebar on the Wire tab, the first wire
+selected),
 DIR/render.png (a Workbench still) and the assembly guide DIR/assembly/index.html with a picture
 per step. The outputs replace an earlier run's as one set, only once all are written (the folders
-svg/ dxf/ gcode/ bends/ assembly/ belong to the run; other files in DIR are left alone). One
+svg/ dxf/ templates/ gcode/ bends/ assembly/ belong to the run; other files in DIR are left alone). One
 progress line per stage on stdout. Exit status: 0 a stable design was written;
 2 the input was valid but no stable design exists (design.json still written, with the reason);
 1 bad input or failure, with one clear message on stderr.
@@ -74,6 +76,8 @@ def write_scene_outputs(design, objects, planes, factor, out, say):
     import wiresculpt
     from wiresculpt.blend import guide as assembly_guide
     from wiresculpt.blend import results as scene_results
+    from wiresculpt.blend import view as scene_view
+    from wiresculpt.core import blendfile
 
     if not wiresculpt._modules:
         wiresculpt.register()
@@ -99,10 +103,18 @@ def write_scene_outputs(design, objects, planes, factor, out, say):
         path = assembly_guide.write_guide(scene, design, os.path.join(out, "assembly"))
         say("guide", f"{os.path.relpath(path, out)}, {len(design['assembly_steps'])} steps "
                      f"({time.perf_counter() - start:.3f} s)")
+    # the file opens ready: the 3D views framed on the sculpture, the sidebar on the Wire tab,
+    # the first wire selected
+    ready = scene_view.open_ready(scene)
     path = os.path.abspath(os.path.join(out, "sculpture.blend"))
-    # Blender writes the .blend to a temporary name and renames it: atomic like the rest
-    bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False, compress=True)
-    say("blend", "sculpture.blend")
+    # Blender writes the .blend to a temporary name and renames it: atomic like the rest. Blender
+    # 3.4 cannot set the sidebar's tab from Python: it is written into the saved (uncompressed)
+    # file instead, atomically too.
+    bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False, compress=ready["tab_set"])
+    if not ready["tab_set"]:
+        blendfile.set_sidebar_tab(path, scene_view.TAB)
+    say("blend", f"sculpture.blend (opens on the {scene_view.TAB} tab, {ready['selected'] or 'no wire'} "
+                 f"selected, the view {ready['size'] * scene_view.DISTANCE_IN_SIZES:.3g} m from the centre)")
 
 
 def write_fabrication(design, out, say):
