@@ -333,6 +333,37 @@ class Registration(AddonCase):
         self.assertIn("1.25", labels[1])
         self.assertIn("m", labels[1])
 
+    def test_long_plane_names_show_in_full(self):
+        """A plane name the sidebar would cut ("Meri…") is shown whole in the details box of the
+        active contour, wrapped to lines that fit the region (issue 21, part 6)."""
+        settings = bpy.context.scene.wiresculpt
+        settings.contours.clear()
+        name = "Meridian through both poles at ninety degrees"
+        for k in range(2):
+            item = settings.contours.add()
+            item.plane, item.index, item.length, item.closed, item.use = name, k, 0.785, True, k == 1
+        settings.active_contour = 1
+        log = draw_panel()
+        boxed = [kw.get("text") for method, _a, kw in log if method == "label"]
+        text = " ".join(t for t in boxed if t)
+        self.assertIn(f'Plane "{name}", contour 1', text)
+        self.assertIn("ticked: it becomes a wire", text)
+        width = panel.line_chars(bpy.context)
+        for line in boxed:
+            self.assertLessEqual(len(line or ""), max(20, int(width)), line)
+        settings.active_contour = 0
+        self.assertIn("not ticked", " ".join(kw.get("text") or "" for m, _a, kw in draw_panel() if m == "label"))
+        # a row in Blender's default (narrow) sidebar: the name alone, the length is in the box
+        import types
+        for width, expected in ((200, 1), (400, 2)):
+            log = []
+            narrow = types.SimpleNamespace(region=types.SimpleNamespace(width=width), scene=bpy.context.scene)
+            panel.WIRESCULPT_UL_contours.draw_item(None, narrow, FakeLayout(log), settings,
+                                                    settings.contours[0], 0, settings, "active_contour")
+            labels = [kw.get("text") for method, _a, kw in log if method == "label"]
+            self.assertEqual(len(labels), expected, labels)
+            self.assertEqual(labels[0], f"{name} #0")
+
 
 class WithoutNative(AddonCase):
     """The add-on registers and explains itself when the compiled module is missing."""

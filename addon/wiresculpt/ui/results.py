@@ -2,7 +2,6 @@
 stability report of the stored design, and the display of the result (forces, assembly steps,
 assembly guide)."""
 import math
-import textwrap
 
 import bpy
 
@@ -11,7 +10,7 @@ from ..blend import results as scene_results
 from ..blend.registration import classes_factory
 from ..operators import optimize
 from ..operators.results import WIRESCULPT_OT_assembly_guide, WIRESCULPT_OT_clear_results
-from .panel import BOX_MARGIN, CHARS_PER_PIXEL, VIEW3D_PT_wiresculpt, length_text
+from .panel import VIEW3D_PT_wiresculpt, length_text, wrap_labels
 
 GRAVITY = 9.81  # m/s^2: weights in newtons to grams
 
@@ -72,11 +71,7 @@ def assembly_rows(design):
     return rows
 
 
-def _wrap(layout, context, text, icon='NONE'):
-    width = context.region.width if context.region else 280
-    lines = textwrap.wrap(text, max(20, int((width - BOX_MARGIN) * CHARS_PER_PIXEL))) or [""]
-    for i, line in enumerate(lines):
-        layout.label(text=line, icon=icon if i == 0 else 'BLANK1' if icon != 'NONE' else 'NONE')
+_wrap = wrap_labels
 
 
 # --- panels -------------------------------------------------------------------------------------
@@ -154,7 +149,7 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
             col = layout.column(align=True)
             col.label(text="Assembly order:")
             for row in rows:
-                col.label(text=row.strip(), icon='BLANK1' if row.startswith(" ") else 'FORWARD')
+                _wrap(col, context, row.strip(), icon='BLANK1' if row.startswith(" ") else 'FORWARD')
         distances = [w["target_max_distance"] for w in design["wires"] if "target_max_distance" in w]
         if distances:
             row = layout.row()
