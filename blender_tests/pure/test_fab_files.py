@@ -186,6 +186,37 @@ class FabFiles(unittest.TestCase):
                     self.assertAlmostEqual(0.92 * abs(c) - 1.5, abs(b), delta=1e-3)
         self.assertFalse([n for n in os.listdir(self.dir) if ".tmp-" in n])
 
+    def test_default_profile_moves_its_pin_at_each_change_of_bend_side(self):
+        """The default profile ducks its pin (Z) before every bend to the other side than the one
+        before (the pin starts on the left, positive side); the change count is read off the
+        polyline's turn signs, not off the program. A profile with "pin_axis": "" never moves Z
+        and is otherwise the same program."""
+        tested = 0
+        for wire in self.wires:
+            pts = np.asarray(wire["points"])
+            if np.allclose(pts[0], pts[-1]):
+                continue  # closed: the program's first bend depends on where it starts
+            edges = np.diff(pts, axis=0)
+            cross = edges[:-1, 0] * edges[1:, 1] - edges[:-1, 1] * edges[1:, 0]
+            sides = [1 if c > 0 else -1 for c in cross if abs(c) > 1e-12]
+            changes, side = 0, 1
+            for s_ in sides:
+                changes += s_ != side
+                side = s_
+            self.assertGreaterEqual(changes, 2, wire["name"])
+            lines = self.w.stream_lines(self.w.write_gcode(None, pts, {}, wire["name"], "steel"))
+            self.assertEqual(lines.count("G0 Z-5.0000"), changes)
+            self.assertEqual(lines.count("G0 Z5.0000"), changes)
+            for i, line in enumerate(lines):  # each duck is followed by the bend to the new side
+                if line == "G0 Z-5.0000":
+                    self.assertEqual(lines[i + 1], "G0 Z5.0000")
+                    self.assertTrue(lines[i + 2].startswith("G1 Y"), lines[i + 2])
+            pinless = self.w.stream_lines(self.w.write_gcode(None, pts, {"pin_axis": ""}, wire["name"], "steel"))
+            self.assertFalse([l for l in pinless if "Z" in l])
+            self.assertEqual(pinless, [l for l in lines if not l.startswith("G0 Z")])
+            tested += 1
+        self.assertGreaterEqual(tested, 1)
+
     def test_errors_name_the_path_and_leave_nothing(self):
         missing = os.path.join(self.dir, "no", "such", "folder", "w.svg")
         with self.assertRaises(ValueError) as ctx:

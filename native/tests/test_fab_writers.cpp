@@ -292,6 +292,16 @@ TEST_CASE("gcode: header, axis mapping, units and the bend table", "[fab][gcode]
                                           "G4 P0", "G1 X50.0000 F1200.0", "G4 P0", "M2"};
   CHECK(lines == expected);  // the default profile moves its pin (Z) before the bend to the other side
 
+  // A profile without a pin axis (a head that bends both ways) writes what every profile wrote
+  // before the pin became the default: the same program without the two pin moves.
+  MachineProfile no_pin = m;
+  no_pin.axes.pin_axis = '\0';
+  const std::vector<std::string> expected_no_pin{"G21", "G91", "G94",
+                                                 "G1 X50.0000 F1200.0", plus, minus, "G4 P0",
+                                                 "G1 X50.0000 F1200.0", minus, plus, "G4 P0",
+                                                 "G1 X50.0000 F1200.0", "G4 P0", "M2"};
+  CHECK(stream_lines(gcode_program(prog, no_pin, info)) == expected_no_pin);
+
   // Another mapping: feed on A in 0.5 units/mm, bend on B in 2 units/deg, left = negative, a pin on Z.
   m.axes.feed_axis = 'A';
   m.axes.bend_axis = 'B';
