@@ -91,7 +91,8 @@ class BatchTest(unittest.TestCase):
         for c in d["crossings"]:
             self.assertEqual(len(c["force"]), 3)
         self.check_targets(d)
-        for folder, ext in (("svg", ".svg"), ("dxf", ".dxf"), ("gcode", ".gcode"), ("bends", ".csv")):
+        for folder, ext in (("svg", ".svg"), ("dxf", ".dxf"), ("gcode", ".gcode"), ("bends", ".csv"),
+                            ("bendlist", ".txt")):
             names = os.listdir(os.path.join(self.out, folder))
             self.assertTrue(names and all(n.endswith(ext) for n in names), (folder, names))
         self.assertEqual(len(d["fabrication"]["wires"]), 3)

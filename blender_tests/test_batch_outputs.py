@@ -135,7 +135,7 @@ class BatchOutputs(unittest.TestCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         lines = r.stderr.splitlines()
         entries = sorted(os.listdir(self.out))
-        for folder in ("svg", "dxf", "templates", "gcode", "bends", "assembly"):
+        for folder in ("svg", "dxf", "templates", "gcode", "bends", "bendlist", "assembly"):
             self.assertIn(folder, entries)
         for name in entries:
             label = name + "/" if os.path.isdir(os.path.join(self.out, name)) else name

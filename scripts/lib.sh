@@ -95,6 +95,7 @@ summarize_outputs() {
       templates) what="print templates at 1:1 (bends, crossings, labels); sheet.svg holds them all" ;;
       gcode) what="bend programs for a GRBL wire bender (or send them from the Fabrication panel)" ;;
       bends) what="bend tables (CSV): feed, bend angle and commanded angle per step" ;;
+      bendlist) what="bend lists (UNIT/FEED/BEND) for a DIWire-class machine through FabMo's Bend List app" ;;
       *) what="" ;;
     esac
     [ -d "$entry" ] && name="$name/"

@@ -42,7 +42,8 @@ class ExportTest(unittest.TestCase):
         self.assertEqual(self.result["errors"], [])
         for w in self.design["wires"]:
             stem = export.file_stem(w)
-            for folder, ext in (("svg", "svg"), ("dxf", "dxf"), ("templates", "svg"), ("gcode", "gcode"), ("bends", "csv")):
+            for folder, ext in (("svg", "svg"), ("dxf", "dxf"), ("templates", "svg"), ("gcode", "gcode"), ("bends", "csv"),
+                                ("bendlist", "txt")):
                 self.assertTrue(os.path.isfile(os.path.join(self.tmp.name, folder, f"{stem}.{ext}")))
         for extra in ("templates/sheet.svg", "dxf/sculpture.dxf"):
             self.assertTrue(os.path.isfile(os.path.join(self.tmp.name, extra)))

@@ -9,6 +9,7 @@
                            100 mm scale bar and overlap marks (fab/tiles.py)
     gcode/NN-name.gcode    the bend program for a GRBL bender
     bends/NN-name.csv      the bend table
+    bendlist/NN-name.txt   the bend list for a DIWire-class machine (FabMo Bend List app; fab/bendlist.py)
 
 Free of bpy: the batch run and the add-on's Export operator both call it. Every file is written
 atomically by the native writers.
@@ -19,11 +20,15 @@ import re
 import numpy as np
 
 from .. import native
-from . import tiles
+from . import bendlist, tiles
 from ..core.calibration import machine_dict
 from ..core.sizes import STOCK_LENGTH, size_warnings
 
-FOLDERS = ("svg", "dxf", "templates", os.path.join("templates", "pages"), "gcode", "bends")
+# Each folder with the file types an export writes there (and removes from an earlier export).
+FOLDER_TYPES = {"svg": (".svg",), "dxf": (".dxf",), "templates": (".svg",),
+                os.path.join("templates", "pages"): (".svg",), "gcode": (".gcode",), "bends": (".csv",),
+                "bendlist": (".txt",)}
+FOLDERS = tuple(FOLDER_TYPES)
 
 
 # The machine limits a design records, each with the function that picks the stricter of two values.
@@ -62,9 +67,6 @@ def machine_profile(design, profile=None):
     return out, notes
 
 
-EXTENSIONS = (".svg", ".dxf", ".gcode", ".csv")
-
-
 def file_stem(wire):
     """A wire's file name: its id, then its name made safe ("Equator/0", id 3 -> "03-Equator-0").
     The id keeps names unique where the safe names of two wires would be the same."""
@@ -73,13 +75,14 @@ def file_stem(wire):
 
 
 def clear(out_dir):
-    """Removes the fabrication files of an earlier export from out_dir's four folders, so what is
-    there always belongs to the design written beside it. Other files are left alone."""
-    for folder in FOLDERS:
+    """Removes the fabrication files of an earlier export from out_dir's folders (the types an
+    export writes in each), so what is there always belongs to the design written beside it.
+    Other files are left alone."""
+    for folder, types in FOLDER_TYPES.items():
         path = os.path.join(out_dir, folder)
         if os.path.isdir(path):
             for name in os.listdir(path):
-                if name.endswith(EXTENSIONS):
+                if name.endswith(types):
                     os.remove(os.path.join(path, name))
 
 
@@ -105,7 +108,7 @@ def no_rest_reason(design):
 
 def export(design, out_dir, profile=None, paper=None):
     """Writes the fabrication files of every wire that has a rest shape into out_dir/{svg, dxf,
-    templates, templates/pages, gcode, bends} (see the module's text), with the machine `profile`
+    templates, templates/pages, gcode, bends, bendlist} (see the module's text), with the machine `profile`
     (None: the default; see machine_profile), the template pages on `paper` ("A4" or "Letter";
     None: the profile's key "paper", else A4). Returns
     {"files": [paths], "wires": [per-wire program summary], "errors": [one sentence per wire that
@@ -139,6 +142,8 @@ def export(design, out_dir, profile=None, paper=None):
             ("templates", f"{stem}.svg", lambda p: w.write_svg(p, [template], False)),
             ("gcode", f"{stem}.gcode", lambda p: w.write_gcode(p, rest, profile, wire["name"], material)),
             ("bends", f"{stem}.csv", lambda p: w.write_bend_table(p, rest, profile)),
+            ("bendlist", f"{stem}.txt",
+             lambda p: bendlist.write_bend_list(p, program, bool(profile.get("left_is_positive", True)))),
         ):
             path = os.path.join(out_dir, folder, name)
             os.makedirs(os.path.dirname(path), exist_ok=True)
