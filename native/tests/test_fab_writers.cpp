@@ -107,6 +107,45 @@ bool has_temp_files(const fs::path& dir) {
 }
 }  // namespace
 
+TEST_CASE("svg: the template marks the start, the feed direction and the cut", "[fab][svg]") {
+  auto number = [](const std::string& text, const std::string& re) {
+    std::smatch m;
+    REQUIRE(std::regex_search(text, m, std::regex(re)));
+    return std::stod(m[1]);
+  };
+  TemplateWire open;
+  open.name = "L";
+  open.points = {{0, 0}, {0.03, 0.04}, {0.09, 0.04}};  // first edge 3-4-5 up and right, last edge along +x
+  for (const TemplateWire& w : {open, square_wire()}) {
+    const std::string svg = svg_wire(w);
+    CHECK(balanced_tags(svg));
+    CHECK(count(svg, "class=\"start\"") == 1);
+    CHECK(count(svg, "class=\"feed\"") == 1);
+    CHECK(count(svg, "class=\"cut\"") == 1);
+    const auto q = polyline_points(svg);  // page coordinates, y down
+    const double cx = number(svg, "class=\"start\" cx=\"([-0-9.]+)\""), cy = number(svg, "class=\"start\"[^>]* cy=\"([-0-9.]+)\"");
+    CHECK(cx == Approx(q.front().x()).margin(1e-4));
+    CHECK(cy == Approx(q.front().y()).margin(1e-4));
+    const Vec2 feed(number(svg, "data-dx=\"([-0-9.]+)\""), number(svg, "data-dy=\"([-0-9.]+)\""));
+    CHECK(feed.dot((q[1] - q[0]).normalized()) == Approx(1).margin(1e-4));
+    // the arrow's line runs along the feed direction, beside the first segment
+    const std::regex line_re("class=\"feed\"[^>]*><line x1=\"([-0-9.]+)\" y1=\"([-0-9.]+)\" x2=\"([-0-9.]+)\" y2=\"([-0-9.]+)\"");
+    std::smatch m;
+    REQUIRE(std::regex_search(svg, m, line_re));
+    const Vec2 a(std::stod(m[1]), std::stod(m[2])), b(std::stod(m[3]), std::stod(m[4]));
+    CHECK((b - a).normalized().dot(feed) == Approx(1).margin(1e-3));
+    const std::regex cut_re("class=\"cut\" x1=\"([-0-9.]+)\" y1=\"([-0-9.]+)\" x2=\"([-0-9.]+)\" y2=\"([-0-9.]+)\"");
+    REQUIRE(std::regex_search(svg, m, cut_re));
+    const Vec2 c1(std::stod(m[1]), std::stod(m[2])), c2(std::stod(m[3]), std::stod(m[4]));
+    CHECK(((c1 + c2) / 2 - q.back()).norm() == Approx(0).margin(1e-3));  // across the last point
+    CHECK(std::abs((c2 - c1).normalized().dot((q.back() - q[q.size() - 2]).normalized())) < 1e-3);
+  }
+  // the open wire's numbers by hand: feed along (3, -4)/5 on the page (y down), cut across +x
+  const std::string svg = svg_wire(open);
+  CHECK(number(svg, "data-dx=\"([-0-9.]+)\"") == Approx(0.6).margin(1e-4));
+  CHECK(number(svg, "data-dy=\"([-0-9.]+)\"") == Approx(-0.8).margin(1e-4));
+}
+
 TEST_CASE("svg: one wire at 1:1 with width and height of the bounding box plus margins", "[fab][svg]") {
   SvgOptions o;
   o.margin_mm = 12.0;

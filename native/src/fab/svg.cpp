@@ -104,6 +104,41 @@ std::string wire_group(const TemplateWire& w, std::size_t index, double ox, doub
   s += "    <text class=\"label\" x=\"" + num(ox + m) + "\" y=\"" + num(oy + 0.75 * m) +
        "\" font-family=\"sans-serif\" font-size=\"" + num(o.label_mm) + "\">" + xml_escape(w.name) + "  (" + len +
        ")</text>\n";
+  // Where the bender starts (a dot on the first point), which way the wire comes out of it (an
+  // arrow beside the first segment, pointing along it) and where it is cut (a bar across the
+  // last point). All in green, away from the black centreline, ticks and rings.
+  const std::string mark = "#008060";
+  const double sw = o.stroke_mm * 0.6;
+  s += "    <circle class=\"start\" cx=\"" + num(q.front().x()) + "\" cy=\"" + num(q.front().y()) + "\" r=\"" +
+       num(1.5 * o.stroke_mm + 0.5) + "\" fill=\"" + mark + "\"/>\n";
+  if (q.size() >= 2) {
+    std::size_t j = 1;  // the first point apart from the start: the feed direction
+    while (j + 1 < q.size() && (q[j] - q[0]).norm() < 1e-9) ++j;
+    Vec2 d = q[j] - q[0];
+    const double seg = d.norm();
+    d = seg > 1e-12 ? Vec2(d / seg) : Vec2(1, 0);
+    const Vec2 n(-d.y(), d.x());
+    const double along = std::min(10.0, std::max(seg, 4.0));  // arrow length, mm
+    const Vec2 a = q[0] + o.tick_mm * n, tip = a + along * d;
+    const Vec2 h1 = tip - 1.5 * d + 0.8 * n, h2 = tip - 1.5 * d - 0.8 * n;
+    s += "    <g class=\"feed\" data-dx=\"" + num(d.x()) + "\" data-dy=\"" + num(d.y()) + "\">";
+    s += "<line x1=\"" + num(a.x()) + "\" y1=\"" + num(a.y()) + "\" x2=\"" + num(tip.x()) + "\" y2=\"" + num(tip.y()) +
+         "\" stroke=\"" + mark + "\" stroke-width=\"" + num(sw) + "\"/>";
+    s += "<polygon points=\"" + num(tip.x()) + "," + num(tip.y()) + " " + num(h1.x()) + "," + num(h1.y()) + " " +
+         num(h2.x()) + "," + num(h2.y()) + "\" fill=\"" + mark + "\"/></g>\n";
+    // the cut: a bar across the wire at its last point
+    std::size_t k = q.size() - 2;
+    while (k > 0 && (q.back() - q[k]).norm() < 1e-9) --k;
+    Vec2 e = q.back() - q[k];
+    e = e.norm() > 1e-12 ? Vec2(e.normalized()) : Vec2(1, 0);
+    const Vec2 en(-e.y(), e.x());
+    const Vec2 c1 = q.back() + o.tick_mm * en, c2 = q.back() - o.tick_mm * en;
+    s += "    <line class=\"cut\" x1=\"" + num(c1.x()) + "\" y1=\"" + num(c1.y()) + "\" x2=\"" + num(c2.x()) +
+         "\" y2=\"" + num(c2.y()) + "\" stroke=\"" + mark + "\" stroke-width=\"" + num(2 * sw) + "\"/>\n";
+    const Vec2 t = q.back() + (o.tick_mm + 1.0) * en;
+    s += "    <text class=\"cut-label\" x=\"" + num(t.x()) + "\" y=\"" + num(t.y()) +
+         "\" font-family=\"sans-serif\" font-size=\"" + num(0.6 * o.label_mm) + "\" fill=\"" + mark + "\">cut</text>\n";
+  }
   s += "  </g>\n";
   return s;
 }

@@ -8,6 +8,10 @@
 //   <line class="bend">            a tick across the wire at each bend point (bisector normal)
 //   <circle class="crossing">      a ring at each crossing point
 //   <text class="label">           "name  (length mm)" in the wire's top margin
+//   <circle class="start">         a dot on the first point: where the bender starts
+//   <g class="feed">               an arrow beside the first segment pointing along it (the way the
+//                                  wire leaves the bender); data-dx/data-dy its direction on the page
+//   <line class="cut">, <text class="cut-label">   a bar across the last point: where it is cut
 // A wire occupies a cell of (bounding box + 2 * margin) in each direction; the label, ticks and
 // rings stay inside the margin when tick_mm, crossing_radius_mm and label_mm are below margin_mm.
 #include <string>
