@@ -3,13 +3,13 @@
     blender --background --factory-startup --python scripts/wiresculpt_batch.py -- SCENE.json --out DIR
 
 Reads and validates the scene file, imports the mesh, runs the pipeline and writes DIR/design.json
-with the fabrication files beside it (svg/, dxf/, templates/, gcode/, bends/), then the results as
+with the fabrication files beside it (svg/, dxf/, templates/, gcode/, bends/, bendlist/), then the results as
 a Blender user sees them: DIR/sculpture.blend (wires, crossing markers and the design in a scene;
 it opens with the 3D view framed on the sculpture, the sidebar on the Wire tab, the first wire
 selected),
 DIR/render.png (a Workbench still) and the assembly guide DIR/assembly/index.html with a picture
 per step. The outputs replace an earlier run's as one set, only once all are written (the folders
-svg/ dxf/ templates/ gcode/ bends/ assembly/ belong to the run; other files in DIR are left alone). One
+svg/ dxf/ templates/ gcode/ bends/ bendlist/ assembly/ belong to the run; other files in DIR are left alone). One
 progress line per stage on stdout. Exit status: 0 a stable design was written;
 2 the input was valid but no stable design exists (design.json still written, with the reason);
 1 bad input or failure, with one clear message on stderr.
@@ -27,7 +27,7 @@ if os.path.isdir(os.path.join(ADDON, "wiresculpt")) and ADDON not in sys.path:
 EXIT_STABLE, EXIT_FAILURE, EXIT_UNSTABLE = 0, 1, 2
 # What a run writes into DIR, replaced as one set (files, or folders that belong to the run).
 OUTPUTS = ("design.json", "sculpture.blend", "sculpture.blend1", "render.png", "assembly", "svg", "dxf", "templates",
-           "gcode", "bends")
+           "gcode", "bends", "bendlist")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -111,14 +111,18 @@ def write_scene_outputs(design, objects, planes, factor, out, say):
     # 3.4 cannot set the sidebar's tab from Python: it is written into the saved (uncompressed)
     # file instead, atomically too.
     bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False, compress=ready["tab_set"])
+    tab = f"{scene_view.TAB} tab"
     if not ready["tab_set"]:
-        blendfile.set_sidebar_tab(path, scene_view.TAB)
-    say("blend", f"sculpture.blend (opens on the {scene_view.TAB} tab, {ready['selected'] or 'no wire'} "
+        try:
+            blendfile.set_sidebar_tab(path, scene_view.TAB)
+        except (ValueError, KeyError) as exc:  # a file layout this reader does not know: the file stays as saved
+            tab = f"last used tab (the {scene_view.TAB} tab could not be set: {exc})"
+    say("blend", f"sculpture.blend (opens on the {tab}, {ready['selected'] or 'no wire'} "
                  f"selected, the view {ready['size'] * scene_view.DISTANCE_IN_SIZES:.3g} m from the centre)")
 
 
 def write_fabrication(design, out, say):
-    """svg/, dxf/, templates/, gcode/ and bends/ in `out` for every wire with a rest shape; the programs'
+    """svg/, dxf/, templates/, gcode/, bends/ and bendlist/ in `out` for every wire with a rest shape; the programs'
     summary goes into the design as `fabrication`."""
     from wiresculpt.fab import export
 
@@ -130,7 +134,7 @@ def write_fabrication(design, out, say):
     minutes = sum(w["machine_seconds"] for w in result["wires"]) / 60
     say("fabrication", f"{len(result['wires'])} bend programs ({sum(w['bend_count'] for w in result['wires'])} "
                        f"bends, about {minutes:.0f} min on the machine), {len(result['files'])} files in svg/, dxf/, templates/, "
-                       f"gcode/, bends/ ({time.perf_counter() - start:.3f} s)")
+                       f"gcode/, bends/, bendlist/ ({time.perf_counter() - start:.3f} s)")
     for error in result["errors"]:
         say("fabrication", error)
 

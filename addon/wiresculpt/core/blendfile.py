@@ -31,6 +31,8 @@ class BlendFile:
             if data[:4] == b"\x28\xb5\x2f\xfd":
                 raise ValueError("this .blend file is zstd-compressed: save it without compression to read it")
             raise ValueError("not a .blend file (no BLENDER header)")
+        if data[7:8] not in (b"-", b"_") or data[8:9] not in (b"v", b"V"):
+            raise ValueError(f"a .blend header this reader does not know: {bytes(data[:17])!r}")
         self.pointer_size = 8 if data[7:8] == b"-" else 4
         self.endian = "<" if data[8:9] == b"v" else ">"
         self.version = data[9:12].decode()
