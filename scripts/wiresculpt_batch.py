@@ -1,6 +1,6 @@
 """The headless wiresculpt run (FORMATS.md):
 
-    blender --background --factory-startup --python scripts/wiresculpt_batch.py -- SCENE.json --out DIR
+    blender --background --factory-startup --python scripts/wiresculpt_batch.py -- SCENE.json --out DIR [--profile P.json]
 
 Reads and validates the scene file, imports the mesh, runs the pipeline and writes DIR/design.json
 with the fabrication files beside it (svg/, dxf/, templates/, gcode/, bends/, bendlist/), then the results as
@@ -32,13 +32,14 @@ OUTPUTS = ("design.json", "sculpture.blend", "sculpture.blend1", "render.png", "
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message):
-        raise ValueError(f"usage: wiresculpt_batch.py -- SCENE.json --out DIR ({message})")
+        raise ValueError(f"usage: wiresculpt_batch.py -- SCENE.json --out DIR [--profile PROFILE.json] ({message})")
 
 
 def parse_args(argv):
     parser = _Parser(prog="wiresculpt_batch.py", add_help=False)
     parser.add_argument("scene")
     parser.add_argument("--out", required=True)
+    parser.add_argument("--profile", default=None)
     return parser.parse_args(argv)
 
 
@@ -121,7 +122,22 @@ def write_scene_outputs(design, objects, planes, factor, out, say):
                  f"selected, the view {ready['size'] * scene_view.DISTANCE_IN_SIZES:.3g} m from the centre)")
 
 
-def write_fabrication(design, out, say):
+def machine_profile(scene, args, say):
+    """The machine profile of the run: --profile, else the scene's "machine_profile", else None
+    (the default profile); ValueError naming the file when it cannot be used."""
+    from wiresculpt.core.calibration import load_profile
+
+    path = args.profile or scene.machine_profile
+    if path is None:
+        return None
+    if not os.path.isfile(path):
+        raise ValueError(f"machine profile {path} does not exist (--profile or the scene's \"machine_profile\")")
+    profile = load_profile(path)
+    say("profile", f"{profile.get('name') or os.path.basename(path)} ({path})")
+    return profile
+
+
+def write_fabrication(design, out, say, profile=None):
     """svg/, dxf/, templates/, gcode/, bends/ and bendlist/ in `out` for every wire with a rest shape; the programs'
     summary goes into the design as `fabrication`."""
     from wiresculpt.fab import export
@@ -129,7 +145,7 @@ def write_fabrication(design, out, say):
     if not any("rest" in w for w in design["wires"]):
         return  # no folders: the earlier run's are removed with the rest of its set
     start = time.perf_counter()
-    result = export.export(design, out)
+    result = export.export(design, out, profile)
     design["fabrication"] = {"wires": result["wires"], "errors": result["errors"]}
     minutes = sum(w["machine_seconds"] for w in result["wires"]) / 60
     say("fabrication", f"{len(result['wires'])} bend programs ({sum(w['bend_count'] for w in result['wires'])} "
@@ -168,11 +184,12 @@ def run(argv):
     say("mesh", f"{len(V)} vertices, {len(F)} triangles, scale x{factor:g} "
                 f"({time.perf_counter() - start:.3f} s)")
     planes = scaled_planes(scene.planes, factor)
+    profile = machine_profile(scene, args, say)  # refused before the long work when it is wrong
     design = pipeline.run(V, F, planes, scene.material, scene.settings, say)
     # Everything is written into a hidden folder first and replaces the earlier run's outputs
     # only when all of it is there: a failure half-way leaves the earlier set as it was.
     with staged(args.out, OUTPUTS) as folder:
-        write_fabrication(design, folder, say)
+        write_fabrication(design, folder, say, profile)
         write_design(os.path.join(folder, "design.json"), design)
         write_scene_outputs(design, objects, planes, factor, folder, say)
     say("written", os.path.join(args.out, "design.json"))

@@ -300,8 +300,10 @@ def with_springback(profile, fit, source=""):
 
 
 FILE_MARKERS = ("format", "version")  # written by save_profile, dropped by load_profile
-# Checked here, not by the native module: the wire stock's length (m, default core.sizes.STOCK_LENGTH).
-PYTHON_KEYS = ("stock_length",)
+# Checked here, not by the native module: the wire stock's length (m, default core.sizes.STOCK_LENGTH)
+# and the paper the print templates are tiled onto ("A4", the default, or "Letter"; fab/tiles.py).
+PYTHON_KEYS = ("stock_length", "paper")
+PAPERS = ("A4", "Letter")
 PROFILE_FILE_KEYS = FILE_MARKERS + ("springback_fit",) + PYTHON_KEYS  # not native machine settings
 
 
@@ -313,6 +315,9 @@ def validate_profile(profile, where="machine profile"):
     stock = profile.get("stock_length", 1.0)
     if isinstance(stock, bool) or not isinstance(stock, (int, float)) or not 0 < stock < 100:
         raise ValueError(f"{where}: stock_length must be a length in metres between 0 and 100, got {stock!r}")
+    paper = profile.get("paper", "A4")
+    if not isinstance(paper, str) or paper.upper() not in (p.upper() for p in PAPERS):
+        raise ValueError(f"{where}: paper must be one of {', '.join(PAPERS)}, got {paper!r}")
     try:
         _native().validate_machine_profile({k: v for k, v in profile.items() if k not in PROFILE_FILE_KEYS})
     except ValueError as exc:
