@@ -69,7 +69,8 @@ class WIRESCULPT_OT_calibration_load(bpy.types.Operator, ImportHelper):
         except (OSError, RuntimeError) as exc:
             self.report({'WARNING'}, f"Cannot show the plot: {exc}")
         settings.plot = self.kind
-        self.report({'INFO'}, f"{name}: {text}")
+        warnings = fit.get("warnings") or []
+        self.report({'WARNING'} if warnings else {'INFO'}, "; ".join([f"{name}: {text}"] + warnings))
         return {'FINISHED'}
 
 
