@@ -302,6 +302,138 @@ def prepare(cache, only=()):
     return manifest
 
 
+# ---------------------------------------------------------------- bench
+
+BEGIN, END = "<!-- corpus:begin -->", "<!-- corpus:end -->"
+TIMEOUT = 600  # s per batch run
+
+
+def run_scene(entry, out_root):
+    """One batch run: rc, seconds, stable, reason, recheck problems (None when not re-checked)."""
+    sys.path.insert(0, os.path.join(ROOT, "blender_tests", "pure"))
+    from recheck import recheck
+
+    out = os.path.join(out_root, entry["name"])
+    cmd = [os.environ.get("BLENDER", "blender"), "--background", "--factory-startup", "--python-exit-code", "1",
+           "--python", os.path.join(ROOT, "scripts", "wiresculpt_batch.py"), "--", entry["scene"], "--out", out]
+    t0 = time.monotonic()
+    try:
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=TIMEOUT)
+        rc, err = proc.returncode, proc.stderr
+    except subprocess.TimeoutExpired:
+        rc, err = "timeout", ""
+    seconds = time.monotonic() - t0
+    row = dict(entry, rc=rc, seconds=round(seconds, 1), stable=None, reason="", recheck=None)
+    design_path = os.path.join(out, "design.json")
+    if rc in (0, 2) and os.path.exists(design_path):
+        with open(design_path) as f:
+            design = json.load(f)
+        row["stable"] = bool(design.get("stable"))
+        row["reason"] = design.get("reason", "")
+        row["wires"] = len(design.get("wires", []))
+        row["crossings"] = len(design.get("crossings", []))
+        row["solve_seconds"] = round(sum(v.get("seconds", 0.0) for v in design.get("stages", {}).values()
+                                         if isinstance(v, dict)), 2)
+        if row["stable"]:
+            row["recheck"] = recheck(design)
+    elif rc != "timeout":
+        lines = [ln for ln in err.strip().splitlines() if ln.strip()]
+        row["reason"] = lines[-1] if lines else f"exit {rc}"
+    return row
+
+
+def first_words(text, n=9):
+    words = text.replace("|", "/").split()
+    return " ".join(words[:n]) + (" ..." if len(words) > n else "")
+
+
+def section(results):
+    meshes, rows = results["meshes"], results["runs"]
+    lines = [BEGIN, "## Real-mesh corpus", "",
+             f"`scripts/bench corpus` ({results['date']}, commit {results['commit']}, before the re-layering "
+             "of issue 20): the batch on every scene of `scripts/corpus.py` (meshes from Debian packages, "
+             "fetched and converted under build/corpus; planes axis-aligned through the bounding box, "
+             "largest contour each: `xyz3` one plane per axis through the centre, `zzxxy5` z and x at "
+             "35% and 65% and y through the centre), then `blender_tests/pure/recheck.py` on every "
+             "stable design. Seconds: the whole Blender process (import, solve, fabrication files, "
+             "render, guide); solve: the design's `stages` seconds.", "",
+             "| mesh | kind | package (version) | licence | source | vertices | in the run |",
+             "|---|---|---|---|---|---|---|"]
+    for m in meshes:
+        lines.append(f"| {m['name']} | {m['kind']} | {m['package']} ({m.get('version', '?')}) | {m['licence']} | "
+                     f"`{m['source']}` | {m.get('vertices', '')} | {m.get('skipped', 'yes')} |")
+    ok = [r for r in rows if r["stable"]]
+    lines += ["", f"{len(ok)} of {len(rows)} runs stable; re-check ok on "
+              f"{sum(1 for r in ok if r['recheck'] == [])} of {len(ok)} stable designs; "
+              f"{sum(1 for r in rows if r['stable'] is None)} runs without a verdict (bad input, failure or "
+              f"timeout); total {sum(r['seconds'] for r in rows) / 60:.1f} min.", ""]
+    by_size = {}
+    for r in rows:
+        by_size.setdefault(r["size"], []).append(bool(r["stable"]))
+    lines += ["| size (m) | stable |", "|---|---|"]
+    lines += [f"| {s:g} | {sum(v)} / {len(v)} |" for s, v in sorted(by_size.items())]
+    lines += ["", "| mesh | planes | size (m) | wires / crossings | stable? | reason (first words) | seconds "
+              "(solve) | recheck ok? |", "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        stable = {True: "yes", False: "no", None: f"exit {r['rc']}"}[r["stable"]]
+        rec = "—" if r["recheck"] is None else ("ok" if not r["recheck"] else "NO: " + first_words(r["recheck"][0], 14))
+        wc = f"{r.get('wires', '')} / {r.get('crossings', '')}" if "wires" in r else ""
+        lines.append(f"| {r['mesh']} | {r['config']} ({r['planes']}) | {r['size']:g} | {wc} | {stable} | "
+                     f"{first_words(r['reason'])} | {r['seconds']:.1f} ({r.get('solve_seconds', '')}) | {rec} |")
+    lines += ["", END]
+    return "\n".join(lines) + "\n"
+
+
+def put_section(md_path, docs):
+    """Replaces (or appends) the corpus section of md_path with the one from DOCS/corpus.json."""
+    src = os.path.join(docs, "corpus.json")
+    if not os.path.exists(src) or not os.path.exists(md_path):
+        return 0
+    with open(src) as f:
+        text = section(json.load(f))
+    with open(md_path) as f:
+        md = f.read()
+    if BEGIN in md and END in md:
+        md = md[:md.index(BEGIN)] + text + md[md.index(END) + len(END) + 1:]
+    else:
+        md = md.rstrip("\n") + "\n\n" + text
+    with open(md_path + ".tmp", "w") as f:
+        f.write(md)
+    os.replace(md_path + ".tmp", md_path)
+    return 0
+
+
+def bench(cache, docs, only=()):
+    cache = os.path.abspath(cache)
+    manifest = prepare(cache, only)
+    out_root = os.path.join(cache, "out")
+    rows, t0 = [], time.monotonic()
+    for k, entry in enumerate(manifest["scenes"]):
+        row = run_scene(entry, out_root)
+        rows.append(row)
+        rec = "-" if row["recheck"] is None else ("ok" if not row["recheck"] else f"{len(row['recheck'])} problems")
+        say(f"[{k + 1}/{len(manifest['scenes'])}] {entry['name']}: stable={row['stable']} rc={row['rc']} "
+            f"{row['seconds']:.1f} s recheck={rec} {first_words(row['reason'], 12)}")
+    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
+                            text=True).stdout.strip()
+    results = {"date": time.strftime("%Y-%m-%d"), "commit": commit, "meshes": manifest["meshes"], "runs": rows,
+               "seconds": round(time.monotonic() - t0, 1)}
+    if only:  # a partial run does not replace the docs
+        docs = os.path.join(cache, "report")
+    os.makedirs(docs, exist_ok=True)
+    with open(os.path.join(docs, "corpus.json.tmp"), "w") as f:
+        json.dump(results, f, indent=1)
+    os.replace(os.path.join(docs, "corpus.json.tmp"), os.path.join(docs, "corpus.json"))
+    md = os.path.join(docs, "performance.md")
+    if not os.path.exists(md):
+        with open(md, "w") as f:
+            f.write("# Performance\n")
+    put_section(md, docs)
+    say(f"wrote {md} and {os.path.join(docs, 'corpus.json')}")
+    bad = [r for r in rows if r["stable"] and r["recheck"]]
+    return 1 if bad else 0
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("command", choices=("prepare", "bench", "section"))
