@@ -1,5 +1,10 @@
-"""Builds dist/wiresculpt-<version>-linux-x86_64.zip: the add-on folder with the compiled module,
-installable through Blender's Preferences > Add-ons > Install (3.4+) and as an extension (4.2+).
+"""Builds two zips in dist/, each with the compiled module inside:
+
+- wiresculpt-<version>-linux-x86_64.zip: the add-on folder, for Preferences > Add-ons > Install
+  (Blender 3.4 to 4.1, and 4.2+ as a legacy add-on);
+- wiresculpt-<version>-linux_x64.zip: the extension (Blender 4.2+, Install from Disk or
+  `blender --command extension install-file`): blender_manifest.toml and the package's files at
+  the top of the zip, as Blender's own `extension build` lays them out.
 
 The version is declared in three places Blender and CMake each read; this refuses to package
 when they disagree.
@@ -27,7 +32,26 @@ def versions():
             "bl_info": ".".join(str(x) for x in bl_info["version"])}
 
 
+def addon_files():
+    """(path on disk, path inside the add-on folder) of every file that ships."""
+    for folder, dirs, files in os.walk(ADDON):
+        dirs[:] = sorted(d for d in dirs if d != "__pycache__")
+        for name in sorted(files):
+            if name.endswith((".py", ".toml", ".so")):
+                full = os.path.join(folder, name)
+                yield full, os.path.relpath(full, ADDON)
+
+
+def write_zip(path, prefix):
+    tmp = path + ".tmp"
+    with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
+        for full, rel in addon_files():
+            z.write(full, os.path.join(prefix, rel))
+    os.replace(tmp, path)
+
+
 def package(out_dir):
+    """[the add-on zip, the extension zip]."""
     found = versions()
     if len(set(found.values())) != 1:
         raise SystemExit("wiresculpt: versions disagree: " + ", ".join(f"{k} {v}" for k, v in found.items()))
@@ -36,18 +60,13 @@ def package(out_dir):
     if not modules:
         raise SystemExit("wiresculpt: the compiled module is missing; run scripts/build first")
     os.makedirs(out_dir, exist_ok=True)
-    path = os.path.join(out_dir, f"wiresculpt-{version}-linux-x86_64.zip")
-    tmp = path + ".tmp"
-    with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
-        for folder, dirs, files in os.walk(ADDON):
-            dirs[:] = sorted(d for d in dirs if d != "__pycache__")
-            for name in sorted(files):
-                if name.endswith((".py", ".toml", ".so")):
-                    full = os.path.join(folder, name)
-                    z.write(full, os.path.join("wiresculpt", os.path.relpath(full, ADDON)))
-    os.replace(tmp, path)
-    return path
+    addon_zip = os.path.join(out_dir, f"wiresculpt-{version}-linux-x86_64.zip")
+    write_zip(addon_zip, "wiresculpt")
+    extension_zip = os.path.join(out_dir, f"wiresculpt-{version}-linux_x64.zip")
+    write_zip(extension_zip, "")
+    return [addon_zip, extension_zip]
 
 
 if __name__ == "__main__":
-    print(package(sys.argv[1] if len(sys.argv) > 1 else os.path.join(ROOT, "dist")))
+    for path in package(sys.argv[1] if len(sys.argv) > 1 else os.path.join(ROOT, "dist")):
+        print(path)
