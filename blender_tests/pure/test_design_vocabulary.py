@@ -1,23 +1,19 @@
 """The design's vocabulary (core/design.py KEYS) against docs/formats.md and a real design.
 
-bpy-free: runs under the system Python 3.11 (python3.11 -m unittest discover blender_tests/pure)
-as well as inside Blender. The check against a real design solves a small case (three great
-circles) through the pipeline when the native module is built, and is skipped otherwise.
+bpy-free (blender_tests/run.py pure). The check against a real design slices and solves a small
+case (three great circles of a UV sphere) through the pipeline when the native module is built,
+and is skipped otherwise.
 """
-import math
 import os
 import re
-import sys
 import unittest
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-if os.path.join(ROOT, "addon") not in sys.path:
-    sys.path.insert(0, os.path.join(ROOT, "addon"))
+from wiresculpt import native, pipeline
+from wiresculpt.core import design as vocabulary
+from wiresculpt.core.materials import PRESETS
+from wiresculpt.core.settings import defaults
 
-from wiresculpt import native, pipeline  # noqa: E402
-from wiresculpt.core import design as vocabulary  # noqa: E402
-from wiresculpt.core.materials import PRESETS  # noqa: E402
-from wiresculpt.core.settings import defaults  # noqa: E402
+from helpers import PLANES, ROOT, sphere
 
 FORMATS = os.path.join(ROOT, "docs", "formats.md")
 # Each bullet of the doc's design-file section and the writers (KEYS owners) it describes.
@@ -83,23 +79,12 @@ class DocumentedVocabulary(unittest.TestCase):
             self.assertLessEqual(keys, set(vocabulary.KEYS[part]))
 
 
-def circle(normal, radius=0.1, n=32):
-    """A great circle about the origin in the plane with this normal, counter-clockwise about it."""
-    n0 = [float(x) for x in normal]
-    _n, u, v = native.plane_frame(n0)
-    return [[radius * (math.cos(t) * u[k] + math.sin(t) * v[k]) for k in range(3)]
-            for t in (2 * math.pi * i / n for i in range(n))]
-
-
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)
 class RealDesign(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        material, settings = dict(PRESETS["steel"]), defaults()
-        design = vocabulary.new_design(material, settings)
-        for i, (name, normal) in enumerate((("X", (1, 0, 0)), ("Y", (0, 1, 0)), ("Z", (0, 0, 1)))):
-            design["wires"].append(vocabulary.wire_entry(i, f"{name}/0", (0, 0, 0), normal, True, circle(normal)))
-        cls.design = pipeline.solve(design, material, settings)
+        V, F = sphere()
+        cls.design = pipeline.run(V, F, PLANES, dict(PRESETS["steel"]), defaults())
 
     def test_the_case_solves(self):
         self.assertEqual(self.design["pending_stages"], [])
@@ -117,7 +102,6 @@ class RealDesign(unittest.TestCase):
         d = self.design
         parts = {"top": [d], "wire": d["wires"], "crossing": d["crossings"], "stages": [d["stages"]]}
         ran = {"design", "pipeline", "slicing", "layering", "target_shape", "forces"}
-        ran.discard("slicing")  # the case's wires are made by hand (wire_entry), not sliced
         for part, items in parts.items():
             wanted = {k for k, owner in vocabulary.KEYS[part].items()
                       if owner in ran and k not in vocabulary.OPTIONAL[part]}
@@ -133,7 +117,7 @@ class RealDesign(unittest.TestCase):
                 self.assertAlmostEqual(float(d @ self.design["wires"][w]["plane"]["normal"]), 0.0, places=12)
 
     def test_model_size(self):
-        self.assertAlmostEqual(vocabulary.model_size(self.design), 0.2, places=6)
+        self.assertAlmostEqual(vocabulary.model_size(self.design), 0.25, places=3)
 
 
 if __name__ == "__main__":
