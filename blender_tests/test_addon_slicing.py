@@ -17,22 +17,7 @@ from wiresculpt.blend import handles as blend_handles
 from wiresculpt.operators import slicing
 from wiresculpt.ui import panel
 
-from helpers import FakeLayout, draw
-
-
-def register_addon():
-    if wiresculpt._modules:  # registered already (by another suite or a previous run)
-        wiresculpt.unregister()
-    wiresculpt.register()
-
-
-def clear_scene():
-    for collection in (bpy.data.objects, bpy.data.meshes, bpy.data.curves, bpy.data.collections):
-        for block in list(collection):
-            collection.remove(block)
-    settings = bpy.context.scene.wiresculpt
-    settings.contours.clear()
-    settings.target = None
+from helpers import BlenderCase, FakeLayout, clear_scene, draw, register_addon
 
 
 def uv_sphere(radius=1.0, location=(0, 0, 0)):
@@ -81,19 +66,7 @@ def contour_objects():
     return [o for o in bpy.data.objects if blend_contours.CONTOUR_KEY in o]
 
 
-class AddonCase(unittest.TestCase):
-    @classmethod
-    def setUpClass(cls):
-        register_addon()
-
-    @classmethod
-    def tearDownClass(cls):
-        clear_scene()
-        wiresculpt.unregister()
-
-    def setUp(self):
-        clear_scene()
-
+class AddonCase(BlenderCase):
     def assertLengthNear(self, actual, expected, rel=0.01):
         self.assertLess(abs(actual - expected), rel * expected,
                         f"length {actual:.6f} differs from {expected:.6f} by more than {rel:.0%}")

@@ -16,6 +16,7 @@ from wiresculpt import native, pipeline, props
 from wiresculpt.blend import guide as assembly_guide
 from wiresculpt.blend import results as scene_results
 from wiresculpt.core import materials, settings as settings_table
+from wiresculpt.core.design import crossing_direction
 from wiresculpt.blend.mesh import import_mesh
 from wiresculpt.operators import optimize
 from wiresculpt.ui import overlay
@@ -136,7 +137,7 @@ class OptimizeGlobe(Case):
         for c in design["crossings"]:
             if not c["hook"]:
                 continue
-            dirn = scene_results.hook_direction(design, c)
+            dirn = crossing_direction(design, c)
             ends = []
             for k in (0, 1):
                 wire = design["wires"][c["wires"][k]]

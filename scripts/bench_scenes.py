@@ -379,7 +379,7 @@ def check(case):
 
     scene, _V, _F, _planes, design = load_and_slice(case["scene"])
     settings = dict(layering.settings_for(scene.material, scene.settings), max_nodes=1)
-    result = native.require().layering(layering.wire_specs(design), settings, None)
+    result = native.layering(layering.wire_specs(design), settings, None)
     P, C = len(design["wires"]), len(result["network"]["crossings"])
     if (P, C) != (case["P"], case["C"]):
         raise SystemExit(f"bench scene {case['name']}: the design has P={P} wires and C={C} crossings, "

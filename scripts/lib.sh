@@ -20,6 +20,15 @@ PACKAGES=(
   patchelf binutils  # scripts/package bundles the solver's libraries with an $ORIGIN run path
 )
 
+# Blender as a Python module (PyPI `bpy`, built for Python 3.11 like our module), one venv per
+# pinned version under BPY_CACHE, reused when present: 4.2 LTS (the first with extensions) and the
+# newest bpy release for Python 3.11. scripts/test runs the Blender suites against each.
+BPY_VERSIONS=(4.2.23 5.0.1)
+# The numpy they run with: what bpy 5.0 requires (<2) and what Blender bundles; bpy 4.2 would take
+# numpy 2, which our module (Debian's pybind11 2.10) predates.
+BPY_NUMPY=1.26.4
+BPY_CACHE=${WIRESCULPT_BPY_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/wiresculpt}
+
 # The sanitizer and fuzz builds (scripts/test, scripts/fuzz).
 FUZZ_PACKAGES=(clang libclang-rt-14-dev)
 
@@ -102,6 +111,24 @@ summarize_outputs() {
     say "$(printf '  %-20s %s' "$name" "$what")"
   done
   [ "$code" -eq 2 ] && say "  not stable: see \"reason\" in design.json or the Stability panel" || true
+}
+
+# Prints the python of a venv of $PYTHON holding bpy==$1, making it once (a ~350 MB download; the
+# wheel is kept in $BPY_CACHE/wheels); a venv is used only after its install finished.
+bpy_python() {
+  local version=$1 venv="$BPY_CACHE/bpy-$1"
+  if [ ! -f "$venv/.complete" ]; then
+    ensure_packages python3.11-venv
+    rm -rf "$venv"
+    mkdir -p "$BPY_CACHE/wheels"
+    say "installing bpy $version into $venv"
+    "$PYTHON" -m venv "$venv" >&2
+    "$venv/bin/python" -m pip download -q --no-deps -d "$BPY_CACHE/wheels" "bpy==$version" >&2
+    "$venv/bin/python" -m pip install -q --find-links "$BPY_CACHE/wheels" "bpy==$version" \
+      "numpy==$BPY_NUMPY" >&2
+    touch "$venv/.complete"
+  fi
+  echo "$venv/bin/python"
 }
 
 # Runs a Python file inside headless Blender; extra arguments follow "--".

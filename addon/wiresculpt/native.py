@@ -1,9 +1,14 @@
-"""The compiled solver, or the reason it cannot be loaded.
+"""The compiled solver, or the reason it cannot be loaded: the one door to `_wiresculpt`.
 
-Everything else in the add-on reaches the native module through this file. It validates the
-shapes and types of arrays before anything crosses into C++ (a bad array is a ValueError here,
-never a crash inside the module), and when the module is missing it records a sentence the
-panel shows to the user instead of failing to register.
+Everything else in the add-on reaches the native module through the wrappers below, one per
+function the module registers (native/python/module.cpp), in the potpourri3d manner: each checks
+the shapes and types of its arrays and raises ValueError before anything crosses into C++ (a bad
+array is a ValueError naming it, never a crash inside the module), then calls the module through
+require(). When the module is missing, LOAD_ERROR holds a sentence the panel shows to the user
+instead of failing to register, and every wrapper raises RuntimeError with it.
+
+The results are the module's dicts, in the design document's own key names (docs/formats.md):
+the stages copy them without renaming.
 """
 import os
 import re
@@ -62,6 +67,14 @@ except ImportError as exc:  # not built, built for another Python, or a library 
     LOAD_ERROR = explain_load_error(exc, built_for())
 
 
+class _NeverRaised(Exception):
+    """Stands for _wiresculpt.Cancelled when the module is missing (nothing can raise it then)."""
+
+
+# Raised by the module's stages when their progress callback returns False.
+Cancelled = module.Cancelled if module is not None else _NeverRaised
+
+
 def available():
     return module is not None
 
@@ -73,12 +86,17 @@ def require():
     return module
 
 
+# --- argument checks (the module's own wording, so a message reads the same from either side) ----
+
 def as_points(array, what, columns=3):
     """A C-contiguous float64 (n, columns) array, or ValueError naming `what`."""
-    a = np.asarray(array, dtype=np.float64)
+    expected = f"{what}: expected an (n, {columns}) array of numbers, got"
+    a = np.asarray(array)
+    if a.size and a.dtype.kind not in "iuf":
+        raise ValueError(f"{expected} an array of {a.dtype}")
     if a.ndim != 2 or a.shape[1] != columns:
-        raise ValueError(f"{what} must be an array of shape (n, {columns}), got {a.shape}")
-    return np.ascontiguousarray(a)
+        raise ValueError(f"{expected} shape {a.shape}")
+    return np.ascontiguousarray(a, dtype=np.float64)
 
 
 def as_triangles(array, vertex_count, what="faces"):
@@ -94,6 +112,35 @@ def as_triangles(array, vertex_count, what="faces"):
     return np.ascontiguousarray(a, dtype=np.int32)
 
 
+def _list(value, what):
+    """`value` itself when it is a list, tuple or 1-D array, else ValueError in the module's words."""
+    if isinstance(value, (str, bytes, dict)) or not hasattr(value, "__len__"):
+        raise ValueError(f"{what}: expected a list, got {type(value).__name__}")
+    return value
+
+
+def _with_points(items, what, key, columns=3):
+    """A list of dicts whose `key` (when present) is made an (n, columns) float64 array."""
+    out = []
+    for i, item in enumerate(_list(items, what)):
+        if isinstance(item, dict) and key in item:
+            item = dict(item, **{key: as_points(item[key], f"{what}[{i}]['{key}']", columns)})
+        out.append(item)
+    return out
+
+
+# --- geometry and slicing --------------------------------------------------------------------------
+
+def plane_frame(normal):
+    """(n, u, v) of a plane with this normal, float64 (3,) arrays, the solver's own frame
+    (Plane::make): n unit, u the world axis least aligned with n projected into the plane,
+    v = n x u. ValueError for a zero or non-finite normal."""
+    n = np.asarray(normal, dtype=np.float64)
+    if n.shape != (3,):
+        raise ValueError(f"normal: expected 3 numbers, got shape {n.shape}")
+    return require().plane_frame(n)
+
+
 def slice_mesh(vertices, faces, planes, weld_tolerance=-1.0):
     """Slice a triangle mesh by planes.
 
@@ -106,3 +153,135 @@ def slice_mesh(vertices, faces, planes, weld_tolerance=-1.0):
     for name, origin, normal in planes:
         specs.append((str(name), tuple(float(x) for x in origin), tuple(float(x) for x in normal)))
     return require().slice_mesh(V, F, specs, float(weld_tolerance))
+
+
+# --- the solver's stages ---------------------------------------------------------------------------
+
+def layering(wires, settings=None, progress=None):
+    """Crossings, hooks and assembly order (Sec. 4.1-4.2). wires: [{"name", "origin", "normal",
+    "points" (n, 3) m, "closed"}]; settings and the result: see _wiresculpt.layering. The network's
+    crossings come back with the design's keys (`contour_vertices`, `metric`)."""
+    return require().layering(_with_points(wires, "wires", "points"), {} if settings is None else settings, progress)
+
+
+def check_assembly(wires, hooks, steps, settings=None, progress=None):
+    """Eq. 1 for every prefix of `steps` with `hooks` (one per crossing of the wires' network)."""
+    return require().check_assembly(_with_points(wires, "wires", "points"), _list(hooks, "hooks"),
+                                    _list(steps, "steps"), {} if settings is None else settings, progress)
+
+
+def optimize_target_shape(points, closed, crossings, options=None, progress=None):
+    """One wire's target shape in its plane frame (Sec. 4.3). points: (n, 2) m."""
+    return require().optimize_target_shape(as_points(points, "points", 2), closed, _list(crossings, "crossings"),
+                                           {} if options is None else options, progress)
+
+
+def forces_and_rest(wires, crossings, steps, material, settings=None, progress=None):
+    """Forces, cuts, rest shapes and load capacity (Sec. 4.4), in the design's key names.
+    wires: [{"name", "origin", "normal", "target" (n, 3) m, "closed", "cut"}]."""
+    return require().forces_and_rest(_with_points(wires, "wires", "target"), _list(crossings, "crossings"),
+                                     _list(steps, "steps"), material, {} if settings is None else settings,
+                                     progress)
+
+
+# --- fabrication -----------------------------------------------------------------------------------
+
+def default_machine_profile():
+    """The default machine profile (edge units: m, deg, mm/s, deg/s)."""
+    return require().default_machine_profile()
+
+
+def validate_machine_profile(profile):
+    """The profile checked, defaults filled in; ValueError names the key at fault."""
+    return require().validate_machine_profile(profile)
+
+
+def make_bend_program(points, profile=None):
+    """Feeds and bends that make a 2D wire; points (n, 2) m from the cut."""
+    return require().make_bend_program(as_points(points, "points", 2), {} if profile is None else profile)
+
+
+def write_svg(path, wires, sheet=None, options=None):
+    """1:1 SVG template; wires [{"name", "points" (n, 2) m, ...}]. Returns the text."""
+    return require().write_svg(path, _with_points(wires, "wires", "points", 2), sheet,
+                               {} if options is None else options)
+
+
+def write_dxf(path, wires, labels=False, layout="as_given", gap_mm=20.0):
+    """DXF R2000 in mm, one layer and one LWPOLYLINE per wire; layout "as_given",
+    "start_at_origin" or "side_by_side" (gap_mm apart). Returns the text."""
+    return require().write_dxf(path, _with_points(wires, "wires", "points", 2), labels, layout, gap_mm)
+
+
+def write_machine_svg(path, wire, stroke_mm=0.5):
+    """The machine SVG of one wire {"name", "points" (n, 2) m}: one path in mm from its first
+    point. Returns the text."""
+    if isinstance(wire, dict) and "points" in wire:
+        wire = dict(wire, points=as_points(wire["points"], "wire['points']", 2))
+    return require().write_machine_svg(path, wire, stroke_mm)
+
+
+def write_gcode(path, points, profile=None, wire_name="", material="", sync_each_step=True):
+    """GRBL G-code for one wire; points (n, 2) m from the cut. Returns the text."""
+    return require().write_gcode(path, as_points(points, "points", 2), {} if profile is None else profile,
+                                 wire_name, material, sync_each_step)
+
+
+def write_bend_table(path, points, profile=None):
+    """CSV step,feed_mm,bend_deg,commanded_deg. Returns the text."""
+    return require().write_bend_table(path, as_points(points, "points", 2), {} if profile is None else profile)
+
+
+def write_file_atomic(path, text):
+    """Temporary file in the same folder, then rename."""
+    return require().write_file_atomic(str(path), text)
+
+
+def stream_lines(gcode):
+    """The lines of G-code text to stream (comments and blank lines removed)."""
+    return require().stream_lines(gcode)
+
+
+def list_ports():
+    """Serial ports: [{"name", "description"}]."""
+    return require().list_ports()
+
+
+def stream_control():
+    """A fresh StreamControl (pause / resume / abort a running stream_program from another thread)."""
+    return require().StreamControl()
+
+
+def stream_program(port, lines, profile=None, state=None, progress=None, control=None, dry_run=False,
+                   response_timeout=30.0, settle=2.0):
+    """Streams G-code lines to a GRBL bender; `state["next_line"]` resumes. See _wiresculpt."""
+    return require().stream_program(port, _list(lines, "lines"), {} if profile is None else profile, state,
+                                    progress=progress, control=control, dry_run=dry_run,
+                                    response_timeout=response_timeout, settle=settle)
+
+
+# --- calibration -----------------------------------------------------------------------------------
+
+def fit_cantilever(load_g, loaded, s, deflection, lines=None, **options):
+    """Bending stiffness and plastic limit from a cantilever capture (Sec. 5.2); options as
+    _wiresculpt.fit_cantilever (overhang, linear_density, plastic_tolerance, gravity, nodes,
+    smoothing_degree, noise_correction)."""
+    return require().fit_cantilever(_list(load_g, "load_g"), _list(loaded, "loaded"), _list(s, "s"),
+                                    _list(deflection, "deflection"), lines, **options)
+
+
+def simulate_cantilever(bending_stiffness, length=0.30, tip_load_g=0.0, linear_density=0.0, gravity=9.81,
+                        segments=150):
+    """The rod model clamped at the origin under a tip load: (segments+1, 2) m."""
+    return require().simulate_cantilever(bending_stiffness, length, tip_load_g, linear_density, gravity, segments)
+
+
+def fit_friction(angles_deg, lines=None):
+    """mu = tan(alpha) over the tilt repeats."""
+    return require().fit_friction(_list(angles_deg, "angles_deg"), lines)
+
+
+def fit_springback(commanded_deg, measured_deg, lines=None):
+    """measured = a * commanded + b (|angles|)."""
+    return require().fit_springback(_list(commanded_deg, "commanded_deg"), _list(measured_deg, "measured_deg"),
+                                    lines)

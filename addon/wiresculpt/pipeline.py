@@ -60,7 +60,7 @@ def solve(design, material, settings, progress=None, cancel=None):
         for message in design.get("close_crossings", []):
             say("layering", message)
         design = shape_and_rest(design, material, settings, say, native_progress, checkpoint)
-    except native.module.Cancelled:
+    except native.Cancelled:
         raise Cancelled() from None
     return design
 

@@ -112,7 +112,7 @@ def _port_suggestions(_settings, _context, _text):
     a pseudo-terminal, a udev symlink)."""
     if not native.available():
         return []
-    return [p["name"] for p in native.require().list_ports()]
+    return [p["name"] for p in native.list_ports()]
 
 
 NO_WIRE = "__none__"  # the wire enum's only item when the design has no wire with a rest shape

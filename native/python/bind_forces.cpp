@@ -1,13 +1,12 @@
-// Forces, rest shapes, cuts and load capacity (Sec. 4.4 and beyond): converts, releases the GIL
-// around the core work, converts back. SI units and radians, as the core.
+// Forces, rest shapes, cuts and load capacity (Sec. 4.4 and beyond; forces_and_rest.hpp composes
+// them): converts, releases the GIL around the core call, converts back to the design's own keys.
+// SI units and radians, as the core; degrees where the design's key says so (angle_deg).
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,9 +14,7 @@
 #include "convert.hpp"
 #include "progress.hpp"
 #include "wiresculpt/error.hpp"
-#include "wiresculpt/forces.hpp"
-#include "wiresculpt/load_capacity.hpp"
-#include "wiresculpt/rest_shape.hpp"
+#include "wiresculpt/forces_and_rest.hpp"
 
 namespace py = pybind11;
 
@@ -97,112 +94,99 @@ Input read_input(py::handle wire_list, py::handle crossing_list) {
   return in;
 }
 
+/// Radians to degrees as Python's math.degrees computes it (the design stores degrees).
+double degrees(double radians) { return radians / (3.14159265358979323846 / 180.0); }
+
+py::dict load_capacity_dict(const LoadCapacityResult& lc, const Network& net) {
+  py::dict d;
+  d["weight_N"] = lc.weight;
+  d["length"] = lc.length;
+  py::dict base, status;
+  for (const LoadDirection& ld : lc.directions) {
+    d[py::str(ld.name)] = std::isfinite(ld.multiple) ? py::object(py::float_(ld.multiple)) : py::object(py::none());
+    py::list names;
+    for (int w : ld.base) names.append(net.wires[w].name);
+    base[py::str(ld.name)] = names;
+    status[py::str(ld.name)] = ld.status;
+  }
+  d["base"] = base;
+  d["status"] = status;
+  return d;
+}
+
 py::dict forces_and_rest_py(const py::object& wire_list, const py::object& crossing_list, const py::object& step_list,
                             const py::object& material, const py::object& settings, const py::object& progress) {
   Input in = read_input(wire_list, crossing_list);
   const std::vector<std::vector<int>> steps = to_integer_lists(step_list, "steps");
-  ForceOptions fo;
-  RestShapeOptions ro;
-  LoadCapacityOptions lo;
+  ForcesAndRestOptions o;
   std::string material_name;  // shown by the caller only
   const auto given = read_fields(material, "material",
-                                 {field::number("bending_stiffness", ro.bending_stiffness),
-                                  field::number("max_torque", fo.max_torque), field::number("friction", fo.friction),
-                                  field::number("wire_diameter", lo.wire_diameter), field::number("density", lo.density),
-                                  field::text("name", material_name)});
-  const bool have_density = std::find(given.begin(), given.end(), "density") != given.end();
+                                 {field::number("bending_stiffness", o.rest.bending_stiffness),
+                                  field::number("max_torque", o.forces.max_torque),
+                                  field::number("friction", o.forces.friction),
+                                  field::number("wire_diameter", o.load.wire_diameter),
+                                  field::number("density", o.load.density), field::text("name", material_name)});
+  o.load_capacity = std::find(given.begin(), given.end(), "density") != given.end();
   read_fields(settings, "settings",
-              {field::number("torque_fraction", fo.torque_fraction), field::number("max_bend", ro.max_bend),
-               field::number("assembly_weight", fo.assembly_weight), field::number("gravity", lo.gravity),
-               field::integer("max_iterations", fo.max_iterations),
-               field::choice("torque_bound", fo.torque_bound,
+              {field::number("torque_fraction", o.forces.torque_fraction), field::number("max_bend", o.rest.max_bend),
+               field::number("assembly_weight", o.forces.assembly_weight), field::number("gravity", o.load.gravity),
+               field::integer("max_iterations", o.forces.max_iterations),
+               field::choice("torque_bound", o.forces.torque_bound,
                              {{"3d", TorqueBound::full_3d}, {"in_plane", TorqueBound::in_plane}}),
-               field::choice("algorithm", fo.algorithm,
+               field::choice("algorithm", o.forces.algorithm,
                              {{"lp_then_slsqp", ForceAlgorithm::lp_then_slsqp},
                               {"lp", ForceAlgorithm::lp},
                               {"slsqp", ForceAlgorithm::slsqp}})});
-  lo.torque_bound = fo.torque_bound;  // load capacity holds the same bound as the forces
 
   PythonProgress reporter(progress);
   const ProgressFn fn = reporter.fn();
-  std::vector<int> cuts;
-  ForceResult fr;
-  std::vector<RestShapeResult> rests;
-  std::optional<LoadCapacityResult> lc;
-  double rest_seconds = 0.0;
-  reporter.run([&] {
-    cuts = choose_cuts(in.net, in.requested_cuts);
-    fr = optimize_forces(in.net, in.hooks, steps, cuts, fo, fn);
-    const auto t0 = std::chrono::steady_clock::now();
-    const std::size_t P = in.net.wires.size();
-    for (std::size_t w = 0; w < P; ++w) {
-      report_progress(fn, "rest_shape", static_cast<double>(w) / static_cast<double>(P));
-      const int wi = static_cast<int>(w);
-      rests.push_back(rest_shape(in.net.wires[w], cuts[w], wire_loads(in.net, in.hooks, fr.forces, wi), ro));
-    }
-    rest_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    report_progress(fn, "rest_shape", 1.0);
-    if (have_density) {
-      const ForceProblem problem(in.net, in.hooks, steps, cuts, fo);
-      lc = load_capacity(in.net, cuts, problem, fr.coefficients, lo, fn);
-    }
-    return true;
-  });
+  const ForcesAndRestResult r =
+      reporter.run([&] { return forces_and_rest(in.net, in.hooks, steps, in.requested_cuts, o, fn); });
+  const ForceResult& fr = r.forces;
 
+  // Every key below is the design document's own (docs/formats.md): the forces stage copies them.
   py::list crossings;
-  for (std::size_t c = 0; c < in.net.crossings.size(); ++c)
-    crossings.append(py::dict(py::arg("force") = to_list(fr.forces[c]), py::arg("normal") = fr.normal[c],
-                              py::arg("out_of_plane") = py::make_tuple(fr.out_of_plane[c][0], fr.out_of_plane[c][1])));
+  for (std::size_t c = 0; c < in.net.crossings.size(); ++c) {
+    py::list share;
+    share.append(fr.out_of_plane[c][0]);
+    share.append(fr.out_of_plane[c][1]);
+    crossings.append(py::dict(py::arg("force") = to_list(fr.forces[c]), py::arg("normal_force") = fr.normal[c],
+                              py::arg("out_of_plane") = share));
+  }
   py::list wires;
-  for (std::size_t w = 0; w < rests.size(); ++w) {
-    const RestShapeResult& r = rests[w];
+  for (std::size_t w = 0; w < r.rests.size(); ++w) {
+    const RestShapeResult& rest = r.rests[w];
     py::list over;
-    for (std::size_t i = 0; i < r.over_bend.size(); ++i)
-      over.append(py::dict(py::arg("vertex") = r.over_bend[i], py::arg("angle") = r.over_bend_angle[i]));
-    wires.append(py::dict(py::arg("cut") = cuts[w], py::arg("rest") = to_array(r.rest), py::arg("walk") = r.walk,
-                          py::arg("rest_angles") = r.rest_angles, py::arg("target_angles") = r.target_angles,
-                          py::arg("closure_gap") = r.closure_gap, py::arg("max_torque") = fr.wires[w].max_torque,
+    for (std::size_t i = 0; i < rest.over_bend.size(); ++i)
+      over.append(py::dict(py::arg("vertex") = rest.over_bend[i], py::arg("angle_deg") = degrees(rest.over_bend_angle[i])));
+    wires.append(py::dict(py::arg("cut") = r.cuts[w], py::arg("rest") = to_lists(rest.rest),
+                          py::arg("rest_angles") = rest.rest_angles, py::arg("target_angles") = rest.target_angles,
+                          py::arg("closure_gap") = rest.closure_gap, py::arg("max_torque") = fr.wires[w].max_torque,
                           py::arg("max_torque_vertex") = fr.wires[w].max_torque_vertex,
                           py::arg("max_out_of_plane_torque") = fr.wires[w].max_out_of_plane,
-                          py::arg("max_torque_3d") = fr.wires[w].max_torque_3d,
-                          py::arg("over_bend") = over));
+                          py::arg("max_torque_3d") = fr.wires[w].max_torque_3d, py::arg("rest_over_bend") = over));
   }
-  py::object load = py::none();
-  if (lc) {
-    py::dict d;
-    d["weight_N"] = lc->weight;
-    d["length"] = lc->length;
-    py::dict base, status;
-    for (const LoadDirection& ld : lc->directions) {
-      d[py::str(ld.name)] = std::isfinite(ld.multiple) ? py::object(py::float_(ld.multiple)) : py::object(py::none());
-      base[py::str(ld.name)] = ld.base;
-      status[py::str(ld.name)] = ld.status;
-    }
-    d["base"] = base;
-    d["status"] = status;
-    d["seconds"] = lc->seconds;
-    int rounds = 0;
-    for (const LoadDirection& ld : lc->directions) rounds += ld.lp_rounds;
-    d["lp_rounds"] = rounds;
-    load = d;
-  }
-  py::dict summary(py::arg("g_stb") = fr.g_stb, py::arg("g_asm") = fr.g_asm,
-                   py::arg("assembly_residual") = fr.assembly_residual,
-                   py::arg("equilibrium_residual") = fr.equilibrium_residual, py::arg("t_max") = fr.t_max,
-                   py::arg("torque_active") = fr.torque_active,
-                   py::arg("torque_bound") = torque_bound_name(fr.torque_bound), py::arg("method") = fr.method,
-                   py::arg("nlopt_result") = fr.nlopt_result, py::arg("mean_out_of_plane") = fr.mean_out_of_plane,
-                   py::arg("max_out_of_plane") = fr.max_out_of_plane,
-                   py::arg("mean_out_of_plane_to_max_force") = fr.mean_out_of_plane_to_max_force,
-                   py::arg("max_out_of_plane_to_max_force") = fr.max_out_of_plane_to_max_force);
-  py::dict stats(py::arg("forces_seconds") = fr.seconds, py::arg("lp_seconds") = fr.lp_seconds,
-                 py::arg("nlp_seconds") = fr.nlp_seconds, py::arg("rest_seconds") = rest_seconds,
-                 py::arg("lp_iterations") = fr.lp_iterations, py::arg("lp_rounds") = fr.lp_rounds,
-                 py::arg("iterations") = fr.iterations,
-                 py::arg("working_set_rounds") = fr.working_set_rounds,
-                 py::arg("working_set_rows") = fr.working_set_rows);
-  return py::dict(py::arg("crossings") = crossings, py::arg("wires") = wires, py::arg("forces") = summary,
-                  py::arg("load_capacity") = load, py::arg("stats") = stats, py::arg("warnings") = fr.warnings);
+  const py::object load_seconds = r.load_capacity ? py::object(py::float_(r.load_capacity->seconds)) : py::none();
+  py::dict forces_stage(
+      py::arg("seconds") = fr.seconds, py::arg("lp_seconds") = fr.lp_seconds, py::arg("nlp_seconds") = fr.nlp_seconds,
+      py::arg("lp_iterations") = fr.lp_iterations, py::arg("lp_rounds") = fr.lp_rounds,
+      py::arg("iterations") = fr.iterations, py::arg("working_set_rounds") = fr.working_set_rounds,
+      py::arg("working_set_rows") = fr.working_set_rows, py::arg("method") = fr.method,
+      py::arg("nlopt_result") = fr.nlopt_result, py::arg("g_stb") = fr.g_stb, py::arg("g_asm") = fr.g_asm,
+      py::arg("assembly_residual") = fr.assembly_residual, py::arg("equilibrium_residual") = fr.equilibrium_residual,
+      py::arg("t_max") = fr.t_max, py::arg("torque_active") = fr.torque_active,
+      py::arg("torque_bound") = torque_bound_name(fr.torque_bound), py::arg("load_capacity_seconds") = load_seconds);
+  py::dict rest_stage(py::arg("seconds") = r.rest_seconds, py::arg("max_closure_gap") = r.max_closure_gap,
+                      py::arg("over_bend") = r.over_bend);
+  py::dict out_of_plane(py::arg("mean") = fr.mean_out_of_plane, py::arg("max") = fr.max_out_of_plane,
+                        py::arg("mean_to_max_force") = fr.mean_out_of_plane_to_max_force,
+                        py::arg("max_to_max_force") = fr.max_out_of_plane_to_max_force,
+                        py::arg("crossings") = r.hooked_crossings);
+  return py::dict(py::arg("crossings") = crossings, py::arg("wires") = wires, py::arg("out_of_plane") = out_of_plane,
+                  py::arg("load_capacity") = r.load_capacity ? py::object(load_capacity_dict(*r.load_capacity, in.net))
+                                                             : py::object(py::none()),
+                  py::arg("stages") = py::dict(py::arg("forces") = forces_stage, py::arg("rest_shape") = rest_stage),
+                  py::arg("warnings") = fr.warnings);
 }
 
 }  // namespace
@@ -222,16 +206,18 @@ settings: {"torque_fraction" (1), "max_bend" rad (2pi/3), "assembly_weight" (0.0
 "algorithm" ("lp_then_slsqp" | "lp" | "slsqp"), "gravity" m/s^2 (9.81), "max_iterations",
 "torque_bound" ("3d": |t_v| <= t_max, default | "in_plane": its plane-normal part only)}.
 progress(stage, fraction) -> False cancels (raises Cancelled).
-Returns {"crossings": [{"force": [3] N on wires[0] by wires[1], "normal": N, "out_of_plane":
-(share on wires[0], on wires[1])}], "wires": [{"cut", "rest": (m, 2) metres in the plane frame,
-"walk", "rest_angles", "target_angles" (rad, per rest point), "closure_gap" m, "max_torque" N m,
-"max_torque_vertex", "max_out_of_plane_torque" N m, "max_torque_3d" N m, "over_bend": [{"vertex", "angle"}]}],
-"forces": {g_stb, g_asm, assembly_residual, equilibrium_residual, t_max, torque_active, method,
-torque_bound, nlopt_result, mean_out_of_plane, max_out_of_plane, mean_out_of_plane_to_max_force,
-max_out_of_plane_to_max_force}, "load_capacity": {"weight_N", "length",
-"+x", "-x", "+y", "-y", "+z", "-z" (multiples of the weight; None when unbounded), "base",
-"status", "seconds", "lp_rounds"} or None, "stats": {forces_seconds, lp_seconds, nlp_seconds,
-rest_seconds, lp_iterations, lp_rounds, iterations, working_set_rounds, working_set_rows}, "warnings": [str]}.
+Returns the design document's own keys (docs/formats.md), for the forces stage to copy:
+{"crossings": [{"force": [3] N on wires[0] by wires[1], "normal_force": N, "out_of_plane":
+[share on wires[0], on wires[1]]}], "wires": [{"cut", "rest": [[x, y]] metres in the plane frame,
+"rest_angles", "target_angles" (rad, per rest point), "closure_gap" m, "max_torque" N m,
+"max_torque_vertex", "max_out_of_plane_torque" N m, "max_torque_3d" N m, "rest_over_bend":
+[{"vertex", "angle_deg"}]}], "out_of_plane": {mean, max, mean_to_max_force, max_to_max_force,
+crossings}, "load_capacity": {"weight_N", "length", "+x", "-x", "+y", "-y", "+z", "-z"
+(multiples of the weight; None when unbounded), "base" (wire names per direction), "status"} or
+None, "stages": {"forces": {seconds, lp_seconds, nlp_seconds, lp_iterations, lp_rounds,
+iterations, working_set_rounds, working_set_rows, method, nlopt_result, g_stb, g_asm,
+assembly_residual, equilibrium_residual, t_max, torque_active, torque_bound,
+load_capacity_seconds}, "rest_shape": {seconds, max_closure_gap, over_bend}}, "warnings": [str]}.
 Bad input raises ValueError naming the wire, crossing or key, e.g. "material['friction']:
 expected a number, got str"; unknown keys are named too.)");
 }

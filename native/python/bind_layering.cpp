@@ -52,19 +52,27 @@ void read_settings(py::handle d, NetworkOptions& net, LayeringOptions& lay) {
                field::integer("in_plane_nodes", lay.in_plane_nodes)});
 }
 
-py::dict network_dict(const Network& net, const std::vector<int>& hooks) {
+/// The network in the design document's own keys (docs/formats.md): a wire's points are its
+/// `contour` (with the crossing points inserted); a crossing's indices into those contours are
+/// its `contour_vertices` (`vertices` always indexes the target, set by the target shape).
+py::dict network_dict(const Network& net, const std::vector<int>& hooks, const std::vector<double>& metric) {
   py::list wires, crossings, close;
   for (std::size_t w = 0; w < net.wires.size(); ++w) {
     const WireSpec& s = net.wires[w];
     wires.append(py::dict(py::arg("id") = w, py::arg("name") = s.name, py::arg("origin") = to_list(s.plane.origin),
                           py::arg("normal") = to_list(s.plane.normal), py::arg("closed") = s.closed,
-                          py::arg("points") = to_array(s.points)));
+                          py::arg("contour") = to_lists(s.points)));
   }
   for (std::size_t c = 0; c < net.crossings.size(); ++c) {
     const Crossing& x = net.crossings[c];
-    crossings.append(py::dict(py::arg("id") = c, py::arg("wires") = py::make_tuple(x.wires[0], x.wires[1]),
-                              py::arg("vertices") = py::make_tuple(x.vertices[0], x.vertices[1]),
-                              py::arg("point") = to_list(x.point), py::arg("hook") = hooks[c]));
+    py::list pair_wires, pair_vertices;
+    for (int k = 0; k < 2; ++k) {
+      pair_wires.append(x.wires[k]);
+      pair_vertices.append(x.vertices[k]);
+    }
+    crossings.append(py::dict(py::arg("id") = c, py::arg("wires") = pair_wires,
+                              py::arg("contour_vertices") = pair_vertices, py::arg("point") = to_list(x.point),
+                              py::arg("hook") = hooks[c], py::arg("metric") = metric[c]));
   }
   for (const CrossingGap& g : net.close_crossings)
     close.append(py::dict(py::arg("wire") = g.wire, py::arg("crossings") = py::make_tuple(g.crossings[0], g.crossings[1]),
@@ -94,7 +102,7 @@ py::dict layering_py(const py::object& wire_list, const py::object& settings, co
   for (const auto& g : net.close_crossings) warnings.append(g.message);
   for (const auto& w : r.warnings) warnings.append(w);
   return py::dict(
-      py::arg("network") = network_dict(net, r.hooks), py::arg("hook") = r.hooks, py::arg("metric") = r.metric,
+      py::arg("network") = network_dict(net, r.hooks, r.metric), py::arg("hook") = r.hooks, py::arg("metric") = r.metric,
       py::arg("assembly_order") = r.assembly_order, py::arg("steps") = r.steps,
       py::arg("two_hand_steps") = r.two_hand_steps, py::arg("stable") = r.stable, py::arg("reason") = r.reason,
       py::arg("warnings") = warnings,
@@ -151,8 +159,9 @@ contact_angle (rad, 2pi/3), bisector_span (m, 0.005), straight_angle (rad, 1 deg
 two_wire_steps (True), max_nodes (200000), max_step_crossings (20), in_plane_tiebreak (False), in_plane_nodes (300);
 unknown keys raise ValueError.
 progress(stage, fraction) -> False cancels (raises _wiresculpt.Cancelled).
-Returns {"network": {"wires": [{id, name, origin, normal, closed, points (n, 3)}], "crossings":
-[{id, wires, vertices, point, hook}], "close_crossings": [...], "min_scale", "size",
+Returns {"network": {"wires": [{id, name, origin, normal, closed, contour [[x, y, z]] (the points
+with the crossing points inserted)}], "crossings": [{id, wires, contour_vertices (indices into
+the wires' contours), point, hook, metric}] (the design document's keys, docs/formats.md), "close_crossings": [...], "min_scale", "size",
 "required_size"}, "hook": [-1|0|1 per crossing], "metric": [e_c], "assembly_order": [wire ids],
 "steps": [[ids]], "two_hand_steps": [step indices], "stable": bool, "reason": str,
 "warnings": [str], "objective": {max_metric, null_crossings, sum_metric, unbalanced_in_plane},

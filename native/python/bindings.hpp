@@ -4,6 +4,7 @@
 
 namespace wiresculpt::python {
 
+void bind_geometry(pybind11::module_& m);
 void bind_slicing(pybind11::module_& m);
 void bind_fab(pybind11::module_& m);
 void bind_layering(pybind11::module_& m);

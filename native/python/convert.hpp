@@ -253,9 +253,19 @@ py::array_t<double> to_array(const std::vector<Point>& points) {
   return out;
 }
 
-inline py::list to_list(const Eigen::Vector3d& v) {
+/// A fixed-size vector as a list of floats.
+template <class Derived>
+py::list to_list(const Eigen::MatrixBase<Derived>& v) {
   py::list out;
-  for (int k = 0; k < 3; ++k) out.append(v[k]);
+  for (Eigen::Index k = 0; k < v.size(); ++k) out.append(v[k]);
+  return out;
+}
+
+/// Points as a list of lists of floats (the design document's polylines).
+template <class Point>
+py::list to_lists(const std::vector<Point>& points) {
+  py::list out;
+  for (const Point& p : points) out.append(to_list(p));
   return out;
 }
 

@@ -32,6 +32,7 @@ PYBIND11_MODULE(_wiresculpt, m) {
     }
   });
 
+  wiresculpt::python::bind_geometry(m);
   wiresculpt::python::bind_slicing(m);
   wiresculpt::python::bind_fab(m);
   wiresculpt::python::bind_layering(m);

@@ -1,7 +1,5 @@
 #include "wiresculpt/forces.hpp"
 
-#include <glpk.h>
-
 #include <Eigen/SVD>
 #include <algorithm>
 #include <chrono>
@@ -11,7 +9,7 @@
 #include <set>
 #include <string>
 
-#include "glpk_guard.hpp"
+#include "lp.hpp"
 #include "nlopt_text.hpp"
 #include "wiresculpt/error.hpp"
 
@@ -71,92 +69,6 @@ void validate_network(const Network& net, const std::vector<int>& hooks) {
 }
 
 }  // namespace
-
-namespace detail {
-
-LpSolution solve_lp(const LinearProgram& in) {
-  LpSolution out;
-  const int K = static_cast<int>(in.obj.size());
-  const int R = static_cast<int>(in.row_lo.size());
-  auto bound_type = [](double lo, double hi) {
-    const bool l = std::isfinite(lo), h = std::isfinite(hi);
-    if (l && h) return lo == hi ? GLP_FX : GLP_DB;
-    if (l) return GLP_LO;
-    if (h) return GLP_UP;
-    return GLP_FR;
-  };
-  // Entries below 1e-13 of their column's largest are rounding noise of cross products (a
-  // structural zero computed as 1e-19 would otherwise pin a variable); rows left empty become
-  // free when their bounds admit 0 up to rounding, else the LP is infeasible.
-  std::vector<double> col_max(K, 0.0);
-  for (std::size_t t = 0; t < in.tri_val.size(); ++t)
-    col_max[in.tri_col[t]] = std::max(col_max[in.tri_col[t]], std::abs(in.tri_val[t]));
-  std::vector<int> ia{0}, ja{0};
-  std::vector<double> ar{0.0};
-  std::vector<char> row_used(R, 0);
-  for (std::size_t t = 0; t < in.tri_val.size(); ++t) {
-    if (!(std::abs(in.tri_val[t]) > 1e-13 * col_max[in.tri_col[t]])) continue;
-    ia.push_back(in.tri_row[t] + 1);
-    ja.push_back(in.tri_col[t] + 1);
-    ar.push_back(in.tri_val[t]);
-    row_used[in.tri_row[t]] = 1;
-  }
-  for (int r = 0; r < R; ++r)
-    if (!row_used[r] && (in.row_lo[r] > 1e-9 * (1.0 + std::abs(in.row_lo[r])) ||
-                         in.row_hi[r] < -1e-9 * (1.0 + std::abs(in.row_hi[r])))) {
-      out.status = LpSolution::infeasible;
-      return out;
-    }
-  glp_prob* lp = glp_create_prob();
-  glp_set_obj_dir(lp, in.maximise ? GLP_MAX : GLP_MIN);
-  if (R > 0) glp_add_rows(lp, R);
-  if (K > 0) glp_add_cols(lp, K);
-  for (int r = 0; r < R; ++r)
-    glp_set_row_bnds(lp, r + 1, row_used[r] ? bound_type(in.row_lo[r], in.row_hi[r]) : GLP_FR, std::isfinite(in.row_lo[r]) ? in.row_lo[r] : 0.0,
-                     std::isfinite(in.row_hi[r]) ? in.row_hi[r] : 0.0);
-  for (int j = 0; j < K; ++j) {
-    glp_set_col_bnds(lp, j + 1, bound_type(in.col_lo[j], in.col_hi[j]), std::isfinite(in.col_lo[j]) ? in.col_lo[j] : 0.0,
-                     std::isfinite(in.col_hi[j]) ? in.col_hi[j] : 0.0);
-    glp_set_obj_coef(lp, j + 1, in.obj[j]);
-  }
-  glp_load_matrix(lp, static_cast<int>(ar.size()) - 1, ia.data(), ja.data(), ar.data());
-  glp_scale_prob(lp, GLP_SF_AUTO);
-  glp_smcp parm;
-  glp_init_smcp(&parm);
-  parm.msg_lev = GLP_MSG_OFF;
-  parm.presolve = GLP_ON;
-  int ret = detail::guarded_simplex(lp, &parm);
-  if (ret == -1) {  // GLPK's environment (and with it `lp`) is gone
-    out.status = LpSolution::failed;
-    return out;
-  }
-  if (ret != 0 && ret != GLP_ENOPFS && ret != GLP_ENODFS) {  // retry without presolve
-    parm.presolve = GLP_OFF;
-    glp_adv_basis(lp, 0);
-    ret = detail::guarded_simplex(lp, &parm);
-    if (ret == -1) {
-      out.status = LpSolution::failed;
-      return out;
-    }
-  }
-  if (ret == 0 || ret == GLP_ENOPFS || ret == GLP_ENODFS) {
-    const int status = glp_get_status(lp);
-    if (ret == GLP_ENOPFS || status == GLP_NOFEAS) out.status = LpSolution::infeasible;
-    else if (ret == GLP_ENODFS || status == GLP_UNBND) out.status = LpSolution::unbounded;
-    else if (status == GLP_OPT) out.status = LpSolution::optimal;
-    else out.status = LpSolution::failed;
-  }
-  if (out.status == LpSolution::optimal) {
-    out.x.resize(K);
-    for (int j = 0; j < K; ++j) out.x[j] = glp_get_col_prim(lp, j + 1);
-    out.objective = glp_get_obj_val(lp);
-  }
-  out.iterations = glp_get_it_cnt(lp);
-  glp_delete_prob(lp);
-  return out;
-}
-
-}  // namespace detail
 
 std::array<Vec3, 4> target_pyramid(const Network& net, int c, int hook, double friction) {
   if (c < 0 || c >= static_cast<int>(net.crossings.size()))

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "lp.hpp"
 #include "wiresculpt/contact.hpp"
-#include "wiresculpt/forces.hpp"
 
 namespace wiresculpt {
 

@@ -8,6 +8,7 @@
 #include <string>
 #include <utility>
 
+#include "lp.hpp"
 #include "wiresculpt/error.hpp"
 
 namespace wiresculpt {

@@ -1,27 +1,13 @@
 #include "wiresculpt/stability.hpp"
 
-#include <glpk.h>
-
 #include <cmath>
 #include <string>
 
-#include "glpk_guard.hpp"
+#include "lp.hpp"
 #include "wiresculpt/error.hpp"
 
 namespace wiresculpt {
 namespace {
-
-struct Lp {
-  glp_prob* p = nullptr;
-  unsigned generation = 0;
-  Lp() : p(glp_create_prob()), generation(detail::glpk_generation()) {}
-  ~Lp() {
-    if (p && generation == detail::glpk_generation()) glp_delete_prob(p);
-  }
-  Lp(const Lp&) = delete;
-  Lp& operator=(const Lp&) = delete;
-  bool alive() const { return generation == detail::glpk_generation(); }
-};
 
 std::string wire_name(const Network& net, int w) { return "'" + net.wires[w].name + "'"; }
 
@@ -138,8 +124,8 @@ StabilityResult StabilityChecker::check(const std::vector<int>& wires, const std
   for (int k = 0; k < P; ++k) pos[wires[k]] = k;
 
   // Sparse columns; rows of wires[0] (the reference) are dropped.
-  std::vector<int> ia{0}, ja{0};
-  std::vector<double> ar{0.0};
+  std::vector<int> tri_row, tri_col;
+  std::vector<double> tri_val;
   int K = 0;
   for (int c = 0; c < static_cast<int>(net.crossings.size()); ++c) {
     const auto& x = net.crossings[c];
@@ -148,7 +134,6 @@ StabilityResult StabilityChecker::check(const std::vector<int>& wires, const std
     const bool both = hooks[c] == 2;
     for (int k = 0; k < (both ? 8 : 4); ++k) {
       const auto& column = columns_[c][both ? k / 4 : (hooks[c] > 0 ? 1 : 0)][k % 4];
-      ++K;
       for (int side = 0; side < 2; ++side) {
         const int p = side == 0 ? p0 : p1;
         if (p == 0) continue;
@@ -156,11 +141,12 @@ StabilityResult StabilityChecker::check(const std::vector<int>& wires, const std
         for (int r = 0; r < q; ++r) {
           const double v = sign * column[r];
           if (v == 0.0) continue;
-          ia.push_back((p - 1) * q + r + 1);
-          ja.push_back(K);
-          ar.push_back(v);
+          tri_row.push_back((p - 1) * q + r);
+          tri_col.push_back(K);
+          tri_val.push_back(v);
         }
       }
+      ++K;
     }
   }
   if (K == 0) {  // nothing holds the wires together: no load but zero can be balanced
@@ -169,50 +155,23 @@ StabilityResult StabilityChecker::check(const std::vector<int>& wires, const std
     return result;
   }
 
-  detail::configure_glpk();
-  Lp lp;
-  glp_set_obj_dir(lp.p, GLP_MIN);
-  glp_add_rows(lp.p, R);
-  glp_add_cols(lp.p, K);
-  for (int r = 1; r <= R; ++r) glp_set_row_bnds(lp.p, r, GLP_FX, 0.0, 0.0);
-  for (int j = 1; j <= K; ++j) {
-    glp_set_col_bnds(lp.p, j, GLP_LO, 0.0, 0.0);
-    // Eq. 1 minimises Σ a; the verdict only needs feasibility (see stability.hpp).
-    glp_set_obj_coef(lp.p, j, minimise_sum_ ? 1.0 : 0.0);
-  }
-  glp_load_matrix(lp.p, static_cast<int>(ar.size()) - 1, ia.data(), ja.data(), ar.data());
-
-  glp_smcp parm;
-  glp_init_smcp(&parm);
-  parm.msg_lev = GLP_MSG_OFF;
-  parm.presolve = GLP_OFF;
-  parm.pricing = GLP_PT_STD;  // textbook pricing: these LPs are small, steepest edge does not pay
-  parm.meth = GLP_DUALP;  // costs >= 0: the slack basis and every optimal basis stay dual feasible
-                          // when the right-hand side changes
-
-  std::vector<double> rhs(R, 0.0);
+  // Eq. 1 minimises Σ a; the verdict only needs feasibility (see stability.hpp).
+  detail::EqualityLp lp(R, K, tri_row, tri_col, tri_val, std::vector<double>(K, minimise_sum_ ? 1.0 : 0.0));
   auto solve = [&](const std::vector<double>& want) -> bool {
-    parm.meth = GLP_DUALP;
-    for (int r = 0; r < R; ++r)
-      if (want[r] != rhs[r]) {
-        glp_set_row_bnds(lp.p, r + 1, GLP_FX, want[r], want[r]);
-        rhs[r] = want[r];
-      }
-    for (int attempt = 0; attempt < 2; ++attempt) {
-      ++result.lp_solves;
-      ++lp_solves_;
-      const int ret = detail::guarded_simplex(lp.p, &parm);
-      if (ret == -1 || !lp.alive())
+    int attempts = 0;
+    const detail::EqualityLp::Outcome outcome = lp.solve(want, &attempts);
+    result.lp_solves += attempts;
+    lp_solves_ += attempts;
+    switch (outcome) {
+      case detail::EqualityLp::Outcome::feasible:
+        return true;
+      case detail::EqualityLp::Outcome::infeasible:
+        return false;
+      case detail::EqualityLp::Outcome::internal_error:
         throw SolverError("GLPK stopped with an internal error while checking the stability of wire " +
                           wire_name(net, wires.back()) + "; please report this input");
-      if (ret == 0) {
-        const int status = glp_get_status(lp.p);
-        if (status == GLP_OPT || status == GLP_FEAS) return true;
-        if (status == GLP_NOFEAS || glp_get_prim_stat(lp.p) == GLP_NOFEAS) return false;
-      }
-      // A singular or ill-conditioned basis: restart from the slack basis with the primal simplex.
-      glp_std_basis(lp.p);
-      parm.meth = GLP_PRIMAL;
+      case detail::EqualityLp::Outcome::failed:
+        break;
     }
     throw SolverError("the stability LP could not be solved (GLPK failed twice) while checking wire " +
                       wire_name(net, wires.back()));

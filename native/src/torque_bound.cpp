@@ -7,7 +7,6 @@
 #include <set>
 
 #include "wiresculpt/error.hpp"
-#include "wiresculpt/forces.hpp"
 
 namespace wiresculpt {
 
@@ -110,50 +109,5 @@ double torque_gauge(const TorquePolytope& polytope, const Vec3& t_frame, double 
   if (row) *row = arg;
   return best / t_max;
 }
-
-namespace detail {
-
-LpSolution solve_lp_with_torque_rows(LinearProgram& lp, const TorqueBlocks& blocks, const TorquePolytope& polytope,
-                                     double t_max, std::set<std::pair<int, int>>& added, int* rounds) {
-  const Eigen::Index V = blocks.A.rows() / 3, cols = blocks.A.cols();
-  int iterations = 0;
-  for (;;) {
-    LpSolution sol = solve_lp(lp);
-    if (rounds) ++*rounds;
-    iterations += sol.iterations;
-    sol.iterations = iterations;
-    if (sol.status != LpSolution::optimal) return sol;
-    const Eigen::Map<const Eigen::VectorXd> x(sol.x.data(), cols);
-    const Eigen::VectorXd t = blocks.A * x + blocks.c;
-    bool grew = false;
-    auto add = [&](Eigen::Index v, int k) {
-      if (!added.insert({static_cast<int>(v), k}).second) return;
-      const Eigen::RowVectorXd row = polytope.rows[k].transpose() * blocks.A.middleRows(3 * v, 3);
-      const int r = static_cast<int>(lp.row_lo.size());
-      for (Eigen::Index j = 0; j < cols; ++j)
-        if (row(j) != 0.0) {
-          lp.tri_row.push_back(r);
-          lp.tri_col.push_back(static_cast<int>(j));
-          lp.tri_val.push_back(row(j));
-        }
-      lp.row_lo.push_back(-std::numeric_limits<double>::infinity());
-      lp.row_hi.push_back(t_max - polytope.rows[k].dot(blocks.c.segment<3>(3 * v)));
-      grew = true;
-    };
-    for (Eigen::Index v = 0; v < V; ++v) {
-      const Vec3 tv = t.segment<3>(3 * v);
-      int k = -1;
-      if (torque_gauge(polytope, tv, t_max, &k) <= 1.0 + 1e-9) continue;
-      // The most violated row, and those of its neighbours that are violated too (the optimum
-      // slides to them next otherwise).
-      add(v, k);
-      for (int nb : polytope.neighbours[k])
-        if (polytope.rows[nb].dot(tv) > t_max * (1.0 + 1e-9)) add(v, nb);
-    }
-    if (!grew) return sol;
-  }
-}
-
-}  // namespace detail
 
 }  // namespace wiresculpt

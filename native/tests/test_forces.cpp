@@ -9,6 +9,7 @@
 #include <set>
 #include <utility>
 
+#include "lp.hpp"  // native/src: the core's LP layer
 #include "wire_fixtures.hpp"
 #include "wiresculpt/contact.hpp"
 #include "wiresculpt/error.hpp"

@@ -22,6 +22,7 @@ import zlib
 
 import numpy as np
 
+from .. import native
 from . import materials
 from .files import write_atomic
 
@@ -176,11 +177,6 @@ def springback_warnings(commanded_deg):
 
 # --- fits -------------------------------------------------------------------------------------------
 
-def _native():
-    from .. import native  # imported lazily: core stays importable without the compiled module
-    return native.require()
-
-
 def linear_density(material):
     """kg/m of a round wire of the material (0 when it has no density)."""
     if not material or not material.get("density"):
@@ -199,9 +195,9 @@ def fit_cantilever(source, overhang=0.30, linear_density=0.0, plastic_tolerance=
             state = "loaded" if loaded else "unloaded"
             raise CaptureError(f"the {load:g} g {state} frame has {len(lines)} mark{'s' if len(lines) > 1 else ''}; "
                                "at least 3 points along the wire are needed", lines[0])
-    fit = _native().fit_cantilever(c["load_g"], c["loaded"], c["s"], c["deflection"], c["lines"],
-                                   overhang=overhang, linear_density=linear_density,
-                                   plastic_tolerance=plastic_tolerance)
+    fit = native.fit_cantilever(c["load_g"], c["loaded"], c["s"], c["deflection"], c["lines"],
+                                overhang=overhang, linear_density=linear_density,
+                                plastic_tolerance=plastic_tolerance)
     fit.update(overhang=overhang, linear_density=linear_density, plastic_tolerance=plastic_tolerance,
                warnings=cantilever_warnings(c, overhang))
     return fit
@@ -209,14 +205,14 @@ def fit_cantilever(source, overhang=0.30, linear_density=0.0, plastic_tolerance=
 
 def fit_friction(source):
     t = read_tilt(source)
-    fit = _native().fit_friction(t["angle_deg"], t["lines"])
+    fit = native.fit_friction(t["angle_deg"], t["lines"])
     fit["warnings"] = tilt_warnings(t["angle_deg"])
     return fit
 
 
 def fit_springback(source):
     t = read_springback(source)
-    fit = _native().fit_springback(t["commanded_deg"], t["measured_deg"], t["lines"])
+    fit = native.fit_springback(t["commanded_deg"], t["measured_deg"], t["lines"])
     fit["warnings"] = springback_warnings(t["commanded_deg"])
     return fit
 
@@ -328,7 +324,7 @@ PROFILE_KEYS = ("name", "min_segment", "max_bend_deg", "min_bend_deg", "max_comm
 
 def default_profile():
     """The DIWire-class default (l_min 1.5 cm, 1 deg minimum bend) from the native module."""
-    return dict(_native().default_machine_profile())
+    return dict(native.default_machine_profile())
 
 
 def machine_dict(profile):
@@ -365,7 +361,7 @@ def validate_profile(profile, where="machine profile"):
     if not isinstance(paper, str) or paper.upper() not in (p.upper() for p in PAPERS):
         raise ValueError(f"{where}: paper must be one of {', '.join(PAPERS)}, got {paper!r}")
     try:
-        _native().validate_machine_profile({k: v for k, v in profile.items() if k not in PROFILE_FILE_KEYS})
+        native.validate_machine_profile({k: v for k, v in profile.items() if k not in PROFILE_FILE_KEYS})
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None
     return profile

@@ -1,4 +1,11 @@
-"""The design document (`design.json`, FORMATS.md): built as a plain dict, written atomically.
+"""The design document (`design.json`, FORMATS.md): its vocabulary, built as a plain dict,
+written atomically.
+
+This module owns the design's vocabulary: which stage writes which key (KEYS, checked by
+blender_tests/pure/test_design_vocabulary.py against docs/formats.md and a real design), and the
+few facts every reader derives the same way (crossing_direction, model_size). The solver's
+binding answers in these names, so no stage renames a key. One name, one meaning: a crossing's
+`vertices` index its wires' `target`, `contour_vertices` their `contour`.
 
 Only stages that ran put values in it: a key a stage owns is absent until that stage exists, and
 `pending_stages` names the stages that did not run.
@@ -6,10 +13,81 @@ Only stages that ran put values in it: a key a stage owns is absent until that s
 import json
 import re
 
+import numpy as np
+
 from .files import write_atomic
 
 FORMAT = "wiresculpt-design"
 VERSION = 1
+
+
+# Who writes each key: "design" (new_design), a stage of the pipeline ("slicing", "layering",
+# "target_shape", "forces" with the rest shape and load capacity, all from one native call),
+# "pipeline" (pipeline.py itself), "user" (what the user asked for, kept for the next solve),
+# "fabrication" (the batch's exports) or "every stage" (appended to by each).
+# `stable`/`reason` are the layering's verdict (new_design's default until it runs; the pipeline
+# answers when there are fewer than two wires; layering.recheck_verdict after a later stage nulls
+# crossings). A crossing's `hook` and `metric` are the layering's; the target shape sets both to
+# 0 for a crossing it cannot realise.
+KEYS = {
+    "top": {
+        "format": "design", "version": "design", "units": "design", "material": "design",
+        "torque_fraction": "design", "machine": "design", "wires": "design", "stages": "design",
+        "stable": "layering", "reason": "layering",
+        "pending_stages": "pipeline", "warnings": "every stage",
+        "crossings": "layering", "assembly_order": "layering", "assembly_steps": "layering",
+        "two_hand_steps": "layering", "close_crossings": "layering", "required_size": "layering",
+        "out_of_plane": "forces", "load_capacity": "forces",
+        "fabrication": "fabrication",
+    },
+    "wire": {
+        "id": "slicing", "name": "slicing", "plane": "slicing", "closed": "slicing", "contour": "slicing",
+        "target": "target_shape", "length": "target_shape", "target_max_distance": "target_shape",
+        "target_rms_distance": "target_shape",
+        "cut": "forces", "rest": "forces", "rest_angles": "forces", "target_angles": "forces",
+        "closure_gap": "forces", "max_torque": "forces", "max_torque_vertex": "forces",
+        "max_out_of_plane_torque": "forces", "max_torque_3d": "forces", "rest_over_bend": "forces",
+        "cut_override": "user", "cut_point": "user",
+    },
+    "crossing": {
+        "id": "layering", "wires": "layering", "contour_vertices": "layering", "point": "layering",
+        "hook": "layering", "metric": "layering",
+        "vertices": "target_shape",
+        "force": "forces", "normal_force": "forces", "out_of_plane": "forces",
+    },
+    "stages": {
+        "slicing": "slicing", "layering": "layering", "target_shape": "target_shape",
+        "forces": "forces", "rest_shape": "forces",
+    },
+}
+
+# Keys written only in some cases (a stage that ran may leave them out): close crossings, a
+# material without density, a user's cut, the batch's exports.
+OPTIONAL = {
+    "top": {"close_crossings", "required_size", "load_capacity", "fabrication", "warnings"},
+    "wire": {"cut_override", "cut_point"},
+    "crossing": set(),
+    "stages": set(),
+}
+
+
+def written_by(stage):
+    """{"top": [...], "wire": [...], "crossing": [...], "stages": [...]}: the keys `stage` writes."""
+    return {part: [k for k, owner in table.items() if owner == stage] for part, table in KEYS.items()}
+
+
+def crossing_direction(design, crossing):
+    """d = normalize(n0 x n1), n0 and n1 the plane normals of the crossing's wires as written in
+    the design (FORMATS.md `hook`: hook 1 opens the kink of wires[0] towards +d)."""
+    n0, n1 = (np.asarray(design["wires"][w]["plane"]["normal"], dtype=np.float64) for w in crossing["wires"])
+    d = np.cross(n0, n1)
+    return d / np.linalg.norm(d)
+
+
+def model_size(design):
+    """The largest side of the bounding box of every wire's contour (m)."""
+    points = np.concatenate([np.asarray(w["contour"]) for w in design["wires"]])
+    return float(np.max(points.max(axis=0) - points.min(axis=0)))
 
 
 def new_design(material, settings):

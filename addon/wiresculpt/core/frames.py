@@ -1,17 +1,14 @@
-"""A plane's 2D frame, the same one the native core uses (Plane::make in geometry.hpp): u is the
-world axis least aligned with the normal, projected into the plane; v = n x u."""
+"""A plane's 2D frame: the native core's own (Plane::make in geometry.hpp, through
+native.plane_frame), so the frame is defined once; u is the world axis least aligned with the
+normal, projected into the plane; v = n x u."""
 import numpy as np
+
+from .. import native
 
 
 def plane_frame(normal):
-    """(n, u, v): unit normal and in-plane axes with u x v = n."""
-    n = np.asarray(normal, dtype=np.float64)
-    n = n / np.linalg.norm(n)
-    seed = np.zeros(3)
-    seed[int(np.argmin(np.abs(n)))] = 1.0
-    u = seed - seed.dot(n) * n
-    u /= np.linalg.norm(u)
-    return n, u, np.cross(n, u)
+    """(n, u, v): unit normal and in-plane axes with u x v = n (float64 arrays of shape (3,))."""
+    return native.plane_frame(normal)
 
 
 def to_2d(points, origin, u, v):

@@ -49,7 +49,7 @@ def machine_profile(design, profile=None):
     machine changes nothing, while a machine stricter than the design must never be commanded
     beyond what it can do. Each limit where the profile is stricter gives a note (the wires
     that break it are then refused by the bend program, naming the bend or step)."""
-    out = native.require().default_machine_profile()
+    out = native.default_machine_profile()
     notes = []
     if profile is not None:
         out.update(machine_dict(profile))
@@ -113,22 +113,21 @@ def export(design, out_dir, profile=None, paper=None):
     None: the profile's key "paper", else A4). Returns
     {"files": [paths], "wires": [per-wire program summary], "errors": [one sentence per wire that
     cannot be bent], "notes": [limits where the profile is stricter than the design]}."""
-    w = native.require()
     paper = paper or (profile or {}).get("paper") or "A4"
     tiles.layout(1.0, 1.0, paper)  # an unknown paper is refused before anything is written
-    clear(out_dir)
     stock = float((profile or {}).get("stock_length", STOCK_LENGTH))
     stock_notes = [n for n in size_warnings(design, stock, (profile or {}).get("name") or "the machine profile")
                    if n.startswith("wire ")]
-    profile, notes = machine_profile(design, profile)
+    profile, notes = machine_profile(design, profile)  # and a missing module (RuntimeError)
     notes += stock_notes
+    clear(out_dir)
     material = design["material"].get("name", "")
     files, summaries, errors, templates = [], [], [], []
     wires = [x for x in design["wires"] if "rest" in x]
     for wire in wires:
         rest = np.asarray(wire["rest"], dtype=np.float64)
         try:
-            program = w.make_bend_program(rest, profile)
+            program = native.make_bend_program(rest, profile)
         except ValueError as exc:
             errors.append(f"wire {wire['name']}: {exc}")
             continue
@@ -137,11 +136,11 @@ def export(design, out_dir, profile=None, paper=None):
                     "crossing_points": crossing_indices(design, wire)}
         templates.append(template)
         for folder, name, write in (
-            ("svg", f"{stem}.svg", lambda p: w.write_machine_svg(p, template)),
-            ("dxf", f"{stem}.dxf", lambda p: w.write_dxf(p, [template], layout="start_at_origin")),
-            ("templates", f"{stem}.svg", lambda p: w.write_svg(p, [template], False)),
-            ("gcode", f"{stem}.gcode", lambda p: w.write_gcode(p, rest, profile, wire["name"], material)),
-            ("bends", f"{stem}.csv", lambda p: w.write_bend_table(p, rest, profile)),
+            ("svg", f"{stem}.svg", lambda p: native.write_machine_svg(p, template)),
+            ("dxf", f"{stem}.dxf", lambda p: native.write_dxf(p, [template], layout="start_at_origin")),
+            ("templates", f"{stem}.svg", lambda p: native.write_svg(p, [template], False)),
+            ("gcode", f"{stem}.gcode", lambda p: native.write_gcode(p, rest, profile, wire["name"], material)),
+            ("bends", f"{stem}.csv", lambda p: native.write_bend_table(p, rest, profile)),
             ("bendlist", f"{stem}.txt",
              lambda p: bendlist.write_bend_list(p, program, bool(profile.get("left_is_positive", True)))),
         ):
@@ -155,9 +154,9 @@ def export(design, out_dir, profile=None, paper=None):
                           "wire_length": program["wire_length"], "machine_seconds": program["machine_seconds"],
                           "shape_error": program["shape_error"]})
     if templates:
-        for folder, name, write in (("templates", "sheet.svg", lambda p: w.write_svg(p, templates, True)),
+        for folder, name, write in (("templates", "sheet.svg", lambda p: native.write_svg(p, templates, True)),
                                     ("dxf", "sculpture.dxf",
-                                     lambda p: w.write_dxf(p, templates, layout="side_by_side"))):
+                                     lambda p: native.write_dxf(p, templates, layout="side_by_side"))):
             path = os.path.join(out_dir, folder, name)
             os.makedirs(os.path.dirname(path), exist_ok=True)
             write(path)

@@ -70,65 +70,31 @@ def run(design, material, settings, native_progress=None):
                # to compare with the earlier model); not a scene-file key
                "torque_bound": settings.get("torque_bound", "3d")}
     steps = [list(s) for s in design.get("assembly_steps", [])]
-    r = native.require().forces_and_rest(wires, crossings, steps, mat, options, native_progress)
+    r = native.forces_and_rest(wires, crossings, steps, mat, options, native_progress)
 
+    # The solver answers in the design's own keys (docs/formats.md): copied, never renamed.
     for c, out in zip(design["crossings"], r["crossings"]):
-        c["force"] = [float(x) for x in out["force"]]
-        c["normal_force"] = float(out["normal"])
-        c["out_of_plane"] = [float(x) for x in out["out_of_plane"]]
+        c.update(out)
     for w, out in zip(design["wires"], r["wires"]):
-        w["cut"] = int(out["cut"])
-        w["rest"] = np.asarray(out["rest"]).tolist()
-        w["rest_angles"] = [float(a) for a in out["rest_angles"]]
-        w["target_angles"] = [float(a) for a in out["target_angles"]]
-        w["closure_gap"] = float(out["closure_gap"])
-        w["max_torque"] = float(out["max_torque"])
-        w["max_torque_vertex"] = int(out["max_torque_vertex"])
-        w["max_out_of_plane_torque"] = float(out["max_out_of_plane_torque"])
-        w["max_torque_3d"] = float(out["max_torque_3d"])
-        w["rest_over_bend"] = [{"vertex": int(o["vertex"]), "angle_deg": math.degrees(o["angle"])}
-                               for o in out["over_bend"]]
-        for o in out["over_bend"]:
+        w.update(out)
+        for o in out["rest_over_bend"]:
             design.setdefault("warnings", []).append(
-                f"wire {w['name']}: the rest shape bends {math.degrees(abs(o['angle'])):.1f} deg at vertex "
+                f"wire {w['name']}: the rest shape bends {abs(o['angle_deg']):.1f} deg at vertex "
                 f"{o['vertex']}, more than the machine's {settings['max_bend_deg']:g} deg; lower the torque "
                 "fraction or the maximum bend of the target shape and solve again")
-    summary, stats = r["forces"], r["stats"]
-    hooked = [c for c in design["crossings"] if c["hook"] != 0]
-    design["out_of_plane"] = {"mean": summary["mean_out_of_plane"], "max": summary["max_out_of_plane"],
-                              "mean_to_max_force": summary["mean_out_of_plane_to_max_force"],
-                              "max_to_max_force": summary["max_out_of_plane_to_max_force"],
-                              "crossings": len(hooked)}
+    design["out_of_plane"] = r["out_of_plane"]
     if r["load_capacity"] is not None:
-        lc = r["load_capacity"]
-        design["load_capacity"] = {"weight_N": lc["weight_N"], "length": lc["length"],
-                                   **{axis: lc[axis] for axis in AXES},
-                                   "base": {axis: [design["wires"][i]["name"] for i in lc["base"][axis]]
-                                            for axis in AXES},
-                                   "status": dict(lc["status"])}
+        design["load_capacity"] = r["load_capacity"]
     design.setdefault("warnings", []).extend(r["warnings"])
-    design["stages"]["forces"] = {
-        "seconds": stats["forces_seconds"], "lp_seconds": stats["lp_seconds"], "nlp_seconds": stats["nlp_seconds"],
-        "lp_iterations": stats["lp_iterations"], "lp_rounds": stats["lp_rounds"], "iterations": stats["iterations"],
-        "working_set_rounds": stats["working_set_rounds"], "working_set_rows": stats["working_set_rows"],
-        "method": summary["method"],
-        "nlopt_result": summary["nlopt_result"], "g_stb": summary["g_stb"], "g_asm": summary["g_asm"],
-        "assembly_residual": summary["assembly_residual"], "equilibrium_residual": summary["equilibrium_residual"],
-        "t_max": summary["t_max"], "torque_active": summary["torque_active"], "torque_bound": summary["torque_bound"],
-        "load_capacity_seconds": r["load_capacity"]["seconds"] if r["load_capacity"] is not None else None,
-    }
-    gaps = [w["closure_gap"] for w in design["wires"] if w["closed"]]
-    design["stages"]["rest_shape"] = {
-        "seconds": stats["rest_seconds"],
-        "max_closure_gap": max(gaps) if gaps else 0.0,
-        "over_bend": sum(len(w["rest_over_bend"]) for w in design["wires"]),
-    }
+    design["stages"].update(r["stages"])
+    hooked = [c for c in design["crossings"] if c["hook"] != 0]
+    summary, out_of_plane = design["stages"]["forces"], design["out_of_plane"]
     normals = [c["normal_force"] for c in hooked]
     line = (f"{len(hooked)} loaded crossings, normal forces {min(normals, default=0):.2f}-"
             f"{max(normals, default=0):.2f} N (sum {summary['g_stb'] / 2:.2f} N), out of plane "
-            f"{100 * summary['mean_out_of_plane']:.1f}% mean, {100 * summary['max_out_of_plane']:.1f}% max "
-            f"({100 * summary['mean_out_of_plane_to_max_force']:.1f}% mean of the largest force), "
-            f"{summary['method']} ({stats['forces_seconds']:.3f} s)")
+            f"{100 * out_of_plane['mean']:.1f}% mean, {100 * out_of_plane['max']:.1f}% max "
+            f"({100 * out_of_plane['mean_to_max_force']:.1f}% mean of the largest force), "
+            f"{summary['method']} ({summary['seconds']:.3f} s)")
     if "load_capacity" in design:
         lc = design["load_capacity"]
         held = [lc[a] for a in AXES if lc[a] is not None]

@@ -25,15 +25,11 @@ def wire_specs(design, key="contour"):
 def run(design, material, settings, native_progress=None):
     """Fills crossings, assembly order, stable/reason and stages.layering. Returns a progress line.
     `native_progress(stage, fraction) -> bool` (False cancels) is handed to the solver."""
-    result = native.require().layering(wire_specs(design), settings_for(material, settings), native_progress)
+    result = native.layering(wire_specs(design), settings_for(material, settings), native_progress)
     net = result["network"]
     for wire, solved in zip(design["wires"], net["wires"]):
-        wire["contour"] = solved["points"].tolist()  # the sliced contour with its crossing points inserted
-    design["crossings"] = [
-        {"id": c["id"], "wires": list(c["wires"]), "contour_vertices": list(c["vertices"]),
-         "point": list(c["point"]), "hook": c["hook"], "metric": result["metric"][c["id"]]}
-        for c in net["crossings"]
-    ]
+        wire["contour"] = solved["contour"]  # the sliced contour with its crossing points inserted
+    design["crossings"] = net["crossings"]  # the design's keys (contour_vertices, metric, ...)
     design["assembly_order"] = list(result["assembly_order"])
     design["assembly_steps"] = [list(s) for s in result["steps"]]
     design["two_hand_steps"] = list(result["two_hand_steps"])
@@ -58,5 +54,20 @@ def recheck(design, material, settings, native_progress=None):
     """Eq. 1 for every prefix of the design's assembly with its current hooks (after a later
     stage nulled crossings). Returns the native verdict dict; `native_progress` as for run()."""
     hooks = [c["hook"] for c in design["crossings"]]
-    return native.require().check_assembly(wire_specs(design), hooks, design["assembly_steps"],
-                                            settings_for(material, settings), native_progress)
+    return native.check_assembly(wire_specs(design), hooks, design["assembly_steps"],
+                                 settings_for(material, settings), native_progress)
+
+
+def recheck_verdict(design, material, settings, cause, count, native_progress=None):
+    """The layering's verdict after a later stage nulled `count` crossings for `cause` (a
+    sentence naming them): re-checks the assembly (recheck) and, when it no longer stands, sets
+    `stable` false with a `reason` naming the cause and the step that fails. Returns the number
+    of LPs the re-check solved."""
+    verdict = recheck(design, material, settings, native_progress)
+    if not verdict["stable"] and design["stable"]:
+        step = design["assembly_steps"][verdict["failed_step"]]
+        names = " and ".join(design["wires"][w]["name"] for w in step)
+        design["stable"] = False
+        design["reason"] = (f"{cause}; without {'them' if count > 1 else 'it'} the assembly is no longer stable "
+                            f"when adding {names}")
+    return verdict["lp_solves"]

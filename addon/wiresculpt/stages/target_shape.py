@@ -15,6 +15,7 @@ import time
 import numpy as np
 
 from .. import native
+from ..core.design import crossing_direction, model_size
 from ..core.frames import plane_frame, to_2d, to_3d
 from ..core.polylines import polyline_length
 from . import layering
@@ -29,23 +30,11 @@ REALISED_LENGTH = 1e-5  # metres
 MAX_ROUNDS = 4  # solve, null what cannot be realised, solve again (each round nulls at least one)
 
 
-def crossing_direction(design, crossing):
-    """d = normalize(n0 x n1), n0 and n1 the plane normals of the crossing's wires."""
-    n0, n1 = (np.asarray(design["wires"][w]["plane"]["normal"], dtype=np.float64) for w in crossing["wires"])
-    d = np.cross(n0, n1)
-    return d / np.linalg.norm(d)
-
-
 def desired_bisector(design, crossing, k):
     """The 3D direction wire k (0 or 1) of `crossing` must open towards: hook * d for wires[0],
     -hook * d for wires[1] (d itself for a null crossing, which is not constrained)."""
     sign = crossing["hook"] if k == 0 else -crossing["hook"]
     return (sign or 1) * crossing_direction(design, crossing)
-
-
-def model_size(design):
-    points = np.concatenate([np.asarray(w["contour"]) for w in design["wires"]])
-    return float(np.max(points.max(axis=0) - points.min(axis=0)))
 
 
 def solve_wire(design, wire, material, settings, size, native_progress=None, memo=None):
@@ -71,7 +60,7 @@ def solve_wire(design, wire, material, settings, size, native_progress=None, mem
     key = Memo.key(contour, wire["closed"], specs, options) if memo is not None else None
     result = memo.reusable(key, options["max_bend"]) if memo is not None else None
     if result is None:
-        result = native.require().optimize_target_shape(contour, wire["closed"], specs, options, native_progress)
+        result = native.optimize_target_shape(contour, wire["closed"], specs, options, native_progress)
         if memo is not None:
             memo.remember(key, options["max_bend"], result)
     return result, refs, (origin, u, v)
@@ -212,16 +201,9 @@ def run(design, material, settings, native_progress=None, memo=None):
                                         "wires": per_wire, "nulled_crossings": nulled}
     if memo is not None:
         memo.nulled = [dict(n) for n in nulled]
-    if nulled:
-        verdict = layering.recheck(design, material, settings, native_progress)
-        design["stages"]["target_shape"]["recheck_lp_solves"] = verdict["lp_solves"]
-        if not verdict["stable"] and design["stable"]:
-            step = design["assembly_steps"][verdict["failed_step"]]
-            names = " and ".join(design["wires"][w]["name"] for w in step)
-            design["stable"] = False
-            design["reason"] = (f"{unrealised_summary(nulled, size)}; without "
-                                f"{'them' if len(nulled) > 1 else 'it'} the assembly is no longer stable when "
-                                f"adding {names}")
+    if nulled:  # the verdict is the layering's: it re-checks the assembly without them
+        design["stages"]["target_shape"]["recheck_lp_solves"] = layering.recheck_verdict(
+            design, material, settings, unrealised_summary(nulled, size), len(nulled), native_progress)
     worst = max(w["max_distance"] for w in per_wire)
     return (f"{len(per_wire)} wires, largest distance to the contour {worst * 1000:.2f} mm, "
             f"{len(nulled)} crossings nulled, {iterations} iterations ({seconds:.3f} s)")

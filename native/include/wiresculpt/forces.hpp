@@ -43,9 +43,7 @@
 // M a = 0 holds to rounding); ForceAlgorithm chooses.
 #include <Eigen/Core>
 #include <array>
-#include <set>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "wiresculpt/network.hpp"
@@ -234,39 +232,5 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks,
 /// wires[0], -f on wires[1]; null crossings skipped.
 std::vector<WireLoad> wire_loads(const Network& net, const std::vector<int>& hooks,
                                  const std::vector<Vec3>& forces, int wire);
-
-namespace detail {
-/// A small linear program for GLPK: maximise or minimise obj·x with bounds on columns and on
-/// rows r = A x (A given as triplets). ±infinity marks a missing bound.
-struct LinearProgram {
-  bool maximise = true;
-  std::vector<double> obj, col_lo, col_hi, row_lo, row_hi;
-  std::vector<int> tri_row, tri_col;
-  std::vector<double> tri_val;
-};
-struct LpSolution {
-  enum Status { optimal, infeasible, unbounded, failed } status = failed;
-  std::vector<double> x;
-  double objective = 0.0;
-  int iterations = 0;
-};
-/// GLPK simplex (presolve on, terminal output off, errors never abort: they return `failed`).
-LpSolution solve_lp(const LinearProgram& lp);
-/// Torques linear in an LP's columns x: block v (rows 3v..3v+2) is t_v = A_v x + c_v, its
-/// components along the wire's n, u, v.
-struct TorqueBlocks {
-  Eigen::MatrixXd A;
-  Eigen::VectorXd c;
-};
-/// Solves `lp`, then adds to it, for every block whose torque lies outside `polytope` (gauge
-/// above 1 + 1e-9), the most violated row e_k·t_v <= t_max and the violated rows of its
-/// neighbours, and solves again until no block is outside: the optimum under every row of the
-/// polytope with only the rows that matter in the LP (a cutting-plane loop over a finite row
-/// set; torque_bound.cpp). `added` holds the (block, row) pairs already in `lp`; `rounds` counts
-/// the solves. Returns the last solution (when not optimal, GLPK's status with the rows so far),
-/// with the simplex iterations of every solve.
-LpSolution solve_lp_with_torque_rows(LinearProgram& lp, const TorqueBlocks& blocks, const TorquePolytope& polytope,
-                                     double t_max, std::set<std::pair<int, int>>& added, int* rounds);
-}  // namespace detail
 
 }  // namespace wiresculpt

@@ -1,0 +1,88 @@
+"""native.py, the one door: a wrapper for every function the module registers, each refusing a
+bad array with ValueError before C++ (in the binding's words) and passing good input through."""
+import os
+import tempfile
+import unittest
+
+import numpy as np
+
+from helpers import circle
+from wiresculpt import native
+
+# Module names whose wrapper has another name.
+RENAMED = {"StreamControl": "stream_control", "Cancelled": "Cancelled"}
+LINE = np.array([[0.0, 0.0], [0.05, 0.0], [0.1, 0.02]])
+
+
+def wire(name, normal, key="points"):
+    return {"name": name, "origin": [0, 0, 0], "normal": normal, key: circle(normal, n=32), "closed": True}
+
+
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class Wrappers(unittest.TestCase):
+    def test_every_module_function_has_a_wrapper(self):
+        for name in dir(native.module):
+            if name.startswith("_") or not callable(getattr(native.module, name)):
+                continue
+            with self.subTest(name):
+                self.assertTrue(callable(getattr(native, RENAMED.get(name, name), None)), f"native.{name} is missing")
+
+    def test_bad_arrays_are_refused_in_the_bindings_words(self):
+        x, y = wire("X", [1, 0, 0]), wire("Y", [0, 1, 0])
+        cases = [
+            (lambda: native.layering([x, dict(y, points=np.zeros((5, 2)))]),
+             "wires[1]['points']: expected an (n, 3) array of numbers, got shape (5, 2)"),
+            (lambda: native.layering([x, dict(y, points=[["a", "b", "c"]])]),
+             "wires[1]['points']: expected an (n, 3) array of numbers, got an array of <U1"),
+            (lambda: native.optimize_target_shape(np.zeros((4, 3)), False, []),
+             "points: expected an (n, 2) array of numbers, got shape (4, 3)"),
+            (lambda: native.forces_and_rest([dict(wire("X", [1, 0, 0], "target"), target=np.zeros(3))], [], [], {}),
+             "wires[0]['target']: expected an (n, 3) array of numbers, got shape (3,)"),
+            (lambda: native.make_bend_program(np.zeros((3, 3))),
+             "points: expected an (n, 2) array of numbers, got shape (3, 3)"),
+            (lambda: native.check_assembly("X", [], []), "wires: expected a list, got str"),
+            (lambda: native.plane_frame([0, 1]), "normal: expected 3 numbers, got shape (2,)"),
+        ]
+        for call, message in cases:
+            with self.subTest(message):
+                with self.assertRaises(ValueError) as ctx:
+                    call()
+                self.assertEqual(str(ctx.exception), message)
+
+    def test_good_input_reaches_the_module(self):
+        x, y, z = wire("X", [1, 0, 0]), wire("Y", [0, 1, 0]), wire("Z", [0, 0, 1])
+        r = native.layering([x, y, z])
+        direct = native.module.layering([x, y, z])
+        self.assertEqual(r["network"], direct["network"])
+        self.assertEqual(r["hook"], direct["hook"])
+        verdict = native.check_assembly([x, y, z], r["hook"], r["steps"])
+        self.assertTrue(verdict["stable"])
+        program, direct = native.make_bend_program(LINE.tolist()), native.module.make_bend_program(LINE)
+        self.assertEqual(program["bends_deg"], direct["bends_deg"])
+        np.testing.assert_array_equal(program["rebuilt"], direct["rebuilt"])
+        self.assertEqual(native.default_machine_profile(), native.module.default_machine_profile())
+        with tempfile.TemporaryDirectory() as out:
+            path = os.path.join(out, "w.gcode")
+            text = native.write_gcode(path, LINE, None, "X", "steel")
+            with open(path) as f:
+                self.assertEqual(f.read(), text)
+            self.assertTrue(native.stream_lines(text))
+            template = [{"name": "X", "points": LINE.tolist()}]
+            self.assertIn("<svg", native.write_svg(None, template))
+            self.assertIn("SECTION", native.write_dxf(None, template))
+            self.assertIn("step", native.write_bend_table(None, LINE))
+        control = native.stream_control()
+        control.abort()
+        self.assertTrue(control.aborted)
+
+    def test_plane_frame_is_right_handed_and_unit(self):
+        n, u, v = native.plane_frame([0.0, 0.0, 2.0])
+        np.testing.assert_allclose(n, [0, 0, 1])
+        np.testing.assert_allclose(np.cross(u, v), n, atol=1e-15)
+        self.assertAlmostEqual(float(u @ n), 0.0)
+        with self.assertRaises(ValueError):
+            native.plane_frame([0.0, 0.0, 0.0])
+
+
+if __name__ == "__main__":
+    unittest.main()

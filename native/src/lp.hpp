@@ -1,0 +1,89 @@
+#pragma once
+// The one linear-programming layer of the core, over GLPK (through glpk_guard, the only place
+// that runs GLPK's simplex). Private to the core: stability (Eq. 1), forces (Eq. 6-7), the lazy
+// torque rows of torque_bound.hpp, the in-plane balance of in_plane.hpp and load capacity all
+// state their LPs here. Method notes: docs/method-forces.md (forces, torque rows, load capacity)
+// and docs/method-layering.md (stability); GLPK's failure modes: docs/robustness.md.
+//
+// Two shapes of problem:
+//   LinearProgram / solve_lp      one LP, built and solved once (presolve on): forces, torque
+//                                 rows, in-plane balance, load capacity.
+//   EqualityLp                    min c·x subject to A x = b, x >= 0, kept alive between solves
+//                                 so that a new right-hand side b restarts from the last basis
+//                                 (dual simplex): the stability checks of Eq. 1, which solve one
+//                                 system for many unit loads.
+#include <Eigen/Core>
+#include <memory>
+#include <set>
+#include <utility>
+#include <vector>
+
+#include "wiresculpt/torque_bound.hpp"
+
+namespace wiresculpt::detail {
+
+/// A small linear program for GLPK: maximise or minimise obj·x with bounds on columns and on
+/// rows r = A x (A given as triplets). ±infinity marks a missing bound.
+struct LinearProgram {
+  bool maximise = true;
+  std::vector<double> obj, col_lo, col_hi, row_lo, row_hi;
+  std::vector<int> tri_row, tri_col;
+  std::vector<double> tri_val;
+};
+
+struct LpSolution {
+  enum Status { optimal, infeasible, unbounded, failed } status = failed;
+  std::vector<double> x;
+  double objective = 0.0;
+  int iterations = 0;
+};
+
+/// GLPK simplex (presolve on, terminal output off, errors never abort: they return `failed`).
+/// Matrix entries below 1e-13 of their column's largest are dropped as rounding noise.
+LpSolution solve_lp(const LinearProgram& lp);
+
+/// Torques linear in an LP's columns x: block v (rows 3v..3v+2) is t_v = A_v x + c_v, its
+/// components along the wire's n, u, v.
+struct TorqueBlocks {
+  Eigen::MatrixXd A;
+  Eigen::VectorXd c;
+};
+
+/// Solves `lp`, then adds to it, for every block whose torque lies outside `polytope` (gauge
+/// above 1 + 1e-9), the most violated row e_k·t_v <= t_max and the violated rows of its
+/// neighbours, and solves again until no block is outside: the optimum under every row of the
+/// polytope with only the rows that matter in the LP (a cutting-plane loop over a finite row
+/// set). `added` holds the (block, row) pairs already in `lp`; `rounds` counts the solves.
+/// Returns the last solution (when not optimal, GLPK's status with the rows so far), with the
+/// simplex iterations of every solve.
+LpSolution solve_lp_with_torque_rows(LinearProgram& lp, const TorqueBlocks& blocks, const TorquePolytope& polytope,
+                                     double t_max, std::set<std::pair<int, int>>& added, int* rounds);
+
+/// min c·x subject to A x = b, x >= 0 (A rows × cols, given as triplets with 0-based indices),
+/// kept in GLPK between solves: solve(b) changes only the rows whose b changed and restarts the
+/// dual simplex from the last basis (with c >= 0 every basis stays dual feasible when b changes).
+class EqualityLp {
+ public:
+  enum class Outcome {
+    feasible,        ///< an optimal (or feasible) x exists
+    infeasible,      ///< no x >= 0 with A x = b
+    failed,          ///< GLPK failed twice (a singular basis, then again from the slack basis)
+    internal_error,  ///< GLPK hit an internal error; its environment (and this problem) is gone
+  };
+  EqualityLp(int rows, int cols, const std::vector<int>& tri_row, const std::vector<int>& tri_col,
+             const std::vector<double>& tri_val, const std::vector<double>& cost);
+  ~EqualityLp();
+  EqualityLp(const EqualityLp&) = delete;
+  EqualityLp& operator=(const EqualityLp&) = delete;
+
+  /// Solves for right-hand side `b` (one entry per row). A failed attempt restarts once from the
+  /// slack basis with the primal simplex. `attempts` (when given) is increased by the simplex
+  /// runs made.
+  Outcome solve(const std::vector<double>& b, int* attempts = nullptr);
+
+ private:
+  struct State;
+  std::unique_ptr<State> s_;
+};
+
+}  // namespace wiresculpt::detail

@@ -1,0 +1,75 @@
+// forces_and_rest: the composition of cuts, forces, rest shapes and load capacity equals the
+// stages called one by one, and its summaries (closure gap, over-bends, loaded crossings) are
+// those of the per-wire results.
+#include <algorithm>
+#include <catch2/catch.hpp>
+#include <random>
+
+#include "wire_fixtures.hpp"
+#include "wiresculpt/error.hpp"
+#include "wiresculpt/forces_and_rest.hpp"
+
+using namespace wiresculpt;
+
+TEST_CASE("forces_and_rest: the same as the stages one by one", "[forces][rest]") {
+  std::mt19937 rng(41);
+  int tested = 0;
+  for (int attempt = 0; attempt < 200 && tested < 4; ++attempt) {
+    fixtures::HookedNetwork h;
+    if (!fixtures::random_hooked_sphere(rng, attempt, 24, h)) continue;
+    ForcesAndRestOptions o;
+    o.forces.algorithm = ForceAlgorithm::lp;
+    o.forces.torque_bound = attempt % 2 ? TorqueBound::in_plane : TorqueBound::full_3d;
+    o.load.torque_bound = TorqueBound::full_3d;  // overridden by the forces' bound
+    o.rest.max_bend = 0.05;                      // some rest bends exceed it
+    o.load_capacity = tested % 2 == 0;
+    std::vector<int> requested(h.net.wires.size(), -1);
+    ForcesAndRestResult r;
+    try {
+      r = forces_and_rest(h.net, h.hooks, h.steps, requested, o);
+    } catch (const SolverError&) {
+      continue;
+    }
+    ++tested;
+    INFO("attempt " << attempt);
+    const std::vector<int> cuts = choose_cuts(h.net, requested);
+    CHECK(r.cuts == cuts);
+    const ForceResult f = optimize_forces(h.net, h.hooks, h.steps, cuts, o.forces);
+    REQUIRE(r.forces.forces.size() == f.forces.size());
+    for (std::size_t c = 0; c < f.forces.size(); ++c) CHECK((r.forces.forces[c] - f.forces[c]).norm() <= 1e-12);
+    REQUIRE(r.rests.size() == h.net.wires.size());
+    double gap = 0.0;
+    int over = 0;
+    for (std::size_t w = 0; w < h.net.wires.size(); ++w) {
+      const int wi = static_cast<int>(w);
+      const RestShapeResult one = rest_shape(h.net.wires[w], cuts[w], wire_loads(h.net, h.hooks, f.forces, wi), o.rest);
+      REQUIRE(r.rests[w].rest.size() == one.rest.size());
+      for (std::size_t i = 0; i < one.rest.size(); ++i) CHECK((r.rests[w].rest[i] - one.rest[i]).norm() <= 1e-12);
+      if (h.net.wires[w].closed) gap = std::max(gap, one.closure_gap);
+      over += static_cast<int>(one.over_bend.size());
+    }
+    CHECK(r.max_closure_gap == Approx(gap).margin(1e-15));
+    CHECK(r.over_bend == over);
+    CHECK(r.hooked_crossings == static_cast<int>(std::count_if(h.hooks.begin(), h.hooks.end(), [](int k) { return k != 0; })));
+    CHECK(r.rest_seconds >= 0.0);
+    CHECK(r.load_capacity.has_value() == o.load_capacity);
+    if (r.load_capacity) {
+      LoadCapacityOptions lo = o.load;
+      lo.torque_bound = o.forces.torque_bound;
+      const ForceProblem problem(h.net, h.hooks, h.steps, cuts, o.forces);
+      const LoadCapacityResult lc = load_capacity(h.net, cuts, problem, f.coefficients, lo);
+      REQUIRE(r.load_capacity->directions.size() == lc.directions.size());
+      for (std::size_t d = 0; d < lc.directions.size(); ++d)
+        CHECK(r.load_capacity->directions[d].multiple == Approx(lc.directions[d].multiple).epsilon(1e-9));
+    }
+  }
+  CHECK(tested >= 2);
+}
+
+TEST_CASE("forces_and_rest: bad input is an input error naming the crossing", "[forces][rest]") {
+  Network net = build_network(fixtures::sphere_wires(fixtures::great_circle_cuts(), 0.1, 32));
+  std::vector<int> hooks(net.crossings.size(), 1);
+  hooks[2] = 3;
+  CHECK_THROWS_AS(forces_and_rest(net, hooks, {}, {}), InputError);
+  CHECK_THROWS_WITH(forces_and_rest(net, hooks, {}, {}), Catch::Matchers::Contains("crossing 2"));
+}
