@@ -75,6 +75,7 @@ def write_scene_outputs(design, objects, planes, factor, out, say):
     from mathutils import Matrix
 
     import wiresculpt
+    from wiresculpt.blend import compat
     from wiresculpt.blend import guide as assembly_guide
     from wiresculpt.blend import results as scene_results
     from wiresculpt.blend import view as scene_view
@@ -112,12 +113,12 @@ def write_scene_outputs(design, objects, planes, factor, out, say):
     # 3.4 cannot set the sidebar's tab from Python: it is written into the saved (uncompressed)
     # file instead, atomically too.
     bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False, compress=ready["tab_set"])
-    tab = f"{scene_view.TAB} tab"
+    tab = f"{compat.SIDEBAR_TAB} tab"
     if not ready["tab_set"]:
         try:
-            blendfile.set_sidebar_tab(path, scene_view.TAB)
+            blendfile.set_sidebar_tab(path, compat.SIDEBAR_TAB)
         except (ValueError, KeyError) as exc:  # a file layout this reader does not know: the file stays as saved
-            tab = f"last used tab (the {scene_view.TAB} tab could not be set: {exc})"
+            tab = f"last used tab (the {compat.SIDEBAR_TAB} tab could not be set: {exc})"
     say("blend", f"sculpture.blend (opens on the {tab}, {ready['selected'] or 'no wire'} "
                  f"selected, the view {ready['size'] * scene_view.DISTANCE_IN_SIZES:.3g} m from the centre)")
 

@@ -3,16 +3,17 @@ the Wire tab, the first wire selected and active.
 
 Blender keeps each 3D view's camera (SpaceView3D.region_3d: view_location, view_distance,
 view_rotation) and whether its sidebar shows (show_region_ui) in the screens it saves, so setting
-them before saving is enough, also in a background run. The sidebar's tab is
-Region.active_panel_category from Blender 4.2 (set here when the API has it); Blender 3.4's Python
-cannot set it, so the batch run writes it into the saved file (core.blendfile.set_sidebar_tab).
+them before saving is enough, also in a background run. The sidebar's tab is set through
+blend.compat.show_wire_tab where the API allows it (Region.active_panel_category, 4.x, in a drawn
+sidebar); where it does not (Blender 3.4's Python cannot set it; a background 4.x Blender's
+sidebars are never drawn and have no tabs), the batch run writes it into the saved file
+(core.blendfile.set_sidebar_tab).
 """
 import bpy
 from mathutils import Vector
 
-from . import results
+from . import compat, results
 
-TAB = "Wire"  # the bl_category of the add-on's panels
 # Distance from the view's centre to the eye, in model sizes (the largest side of the wires'
 # bounding box): with the 3D view's default 50 mm lens the whole sculpture shows, with a margin.
 DISTANCE_IN_SIZES = 1.6
@@ -73,23 +74,15 @@ def frame(objects, distance_in_sizes=DISTANCE_IN_SIZES):
     return centre, size, count
 
 
-def open_sidebar(tab=TAB):
-    """Shows every 3D view's sidebar, on `tab` where Blender's Python can set it (4.2+). Returns
-    True when the tab was set through the API (else core.blendfile.set_sidebar_tab does it in the
-    saved file)."""
-    set_tab = True
+def open_sidebar():
+    """Shows every 3D view's sidebar, on the Wire tab where Blender's Python can set it
+    (compat.show_wire_tab). Returns True when the tab was set in every sidebar through the API
+    (else core.blendfile.set_sidebar_tab does it in the saved file)."""
+    sidebars = 0
     for _screen, area, space in view3d_spaces():
         space.show_region_ui = True
-        for region in area.regions:
-            if region.type == 'UI':
-                if not hasattr(region, "active_panel_category"):
-                    set_tab = False
-                    continue
-                try:
-                    region.active_panel_category = tab
-                except (AttributeError, TypeError, ValueError):
-                    set_tab = False
-    return set_tab
+        sidebars += sum(1 for region in area.regions if region.type == 'UI')
+    return compat.show_wire_tab() == sidebars
 
 
 def select_first_wire(scene):
