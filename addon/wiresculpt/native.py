@@ -51,8 +51,9 @@ def explain_load_error(exc, builds, python=None, host=None):
     missing = re.search(r"([\w.+-]+\.so[\w.]*): cannot open shared object file", text)
     if missing:
         return (f"The wiresculpt solver did not load: the library {missing.group(1)} is missing. The "
-                f"packaged zip carries it in wiresculpt/libs: install the zip again (Preferences > "
-                "Add-ons > Install), or install it on the system, or build from source with scripts/package.")
+                f"packaged zip carries it in libs/ beside the module: install the zip again (Preferences > "
+                "Add-ons > Install, or Get Extensions > Install from Disk for the extension), or install it on "
+                "the system, or build from source with scripts/package.")
     if not builds:
         return ("The wiresculpt solver (_wiresculpt) is not built: build it with scripts/setup, or "
                 "install the packaged zip (scripts/package).")
