@@ -3,6 +3,7 @@ circle, a GRBL emulator on a pseudo-terminal."""
 import json
 import math
 import os
+import random
 import select
 import signal
 import subprocess
@@ -258,6 +259,19 @@ def sphere(radius=0.125, segments=48, rings=24):
 def edge_lengths(points):
     p = np.asarray(points, dtype=float)
     return np.linalg.norm(np.diff(p, axis=0), axis=1)
+
+
+def random_walk(seed, n=14, start=(0.0, 0.0), steps=(0.02, 0.05), turns_deg=(5, 100)):
+    """A 2D wire of n segments ((n+1, 2) m) from `start`: each segment's length drawn from `steps`,
+    then a turn left or right by an angle drawn from `turns_deg`; one seed, one wire."""
+    rng = random.Random(seed)
+    p, h, pts = np.array(start, dtype=float), rng.uniform(0, 2 * math.pi), []
+    pts.append(p.copy())
+    for _ in range(n):
+        p = p + rng.uniform(*steps) * np.array([math.cos(h), math.sin(h)])
+        pts.append(p.copy())
+        h += math.radians(rng.choice([-1, 1]) * rng.uniform(*turns_deg))
+    return np.array(pts)
 
 
 def _planes():

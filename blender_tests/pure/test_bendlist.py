@@ -4,13 +4,13 @@ rewritten here from that source, not from ours) and bent on paper: walking the F
 (spring-back applied to the commanded angle) redraws the wire's rest shape."""
 import math
 import os
-import random
 import re
 import tempfile
 import unittest
 
 import numpy as np
 
+from helpers import random_walk
 from wiresculpt import native
 from wiresculpt.fab import bendlist
 
@@ -54,17 +54,6 @@ def fabmo_ducks(commands):
                 ducks += 1
             current = arg
     return ducks
-
-
-def random_walk(seed, n=14):
-    rng = random.Random(seed)
-    p, h, pts = np.array([0.0, 0.0]), rng.uniform(0, 2 * math.pi), []
-    pts.append(p.copy())
-    for _ in range(n):
-        p = p + rng.uniform(0.02, 0.05) * np.array([math.cos(h), math.sin(h)])
-        pts.append(p.copy())
-        h += math.radians(rng.choice([-1, 1]) * rng.uniform(5, 100))
-    return np.array(pts)
 
 
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)

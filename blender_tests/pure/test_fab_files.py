@@ -7,7 +7,6 @@ The polylines must be found at 1:1 in millimetres within 0.01 mm.
 import csv
 import math
 import os
-import random
 import shutil
 import struct
 import subprocess
@@ -18,7 +17,7 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
-from helpers import GrblEmulator
+from helpers import GrblEmulator, random_walk
 from wiresculpt import native
 
 SVG = "{http://www.w3.org/2000/svg}"
@@ -32,17 +31,6 @@ def square(a=0.06):
 def polygon(n=9, r=0.08, centre=(0.3, 0.1)):
     return np.array([[centre[0] + r * math.cos(2 * math.pi * i / n), centre[1] + r * math.sin(2 * math.pi * i / n)]
                      for i in range(n + 1)])
-
-
-def random_walk(seed=7, n=14):
-    rng = random.Random(seed)
-    p, h, pts = np.array([-0.2, 0.05]), rng.uniform(0, 2 * math.pi), []
-    pts.append(p.copy())
-    for i in range(n):
-        p = p + rng.uniform(0.016, 0.05) * np.array([math.cos(h), math.sin(h)])
-        pts.append(p.copy())
-        h += math.radians(rng.choice([-1, 1]) * rng.uniform(3, 100))
-    return np.array(pts)
 
 
 def png_size(path):
@@ -68,7 +56,8 @@ class FabFiles(unittest.TestCase):
         self.dir = tempfile.mkdtemp(prefix="wiresculpt_fab_")
         self.addCleanup(shutil.rmtree, self.dir, True)
         self.wires = []
-        for k, (name, pts) in enumerate([("A/0", square()), ("B/1", polygon()), ("C/2", random_walk())]):
+        walk = random_walk(7, start=(-0.2, 0.05), steps=(0.016, 0.05), turns_deg=(3, 100))
+        for k, (name, pts) in enumerate([("A/0", square()), ("B/1", polygon()), ("C/2", walk)]):
             prog = self.w.make_bend_program(pts, {})
             self.wires.append({"name": name, "points": pts, "bend_points": prog["bend_vertices"],
                                "crossing_points": [0, len(pts) // 2]})
