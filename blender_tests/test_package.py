@@ -224,22 +224,21 @@ class LoadErrorTest(unittest.TestCase):
             zip_path, _extension = package(tmp)
             folder = os.path.join(tmp, "unpacked")
             shutil.unpack_archive(zip_path, folder)
-            package = os.path.join(folder, "wiresculpt")
-            module = next(n for n in os.listdir(package) if n.startswith("_wiresculpt"))
+            addon = os.path.join(folder, "wiresculpt")
+            module = next(n for n in os.listdir(addon) if n.startswith("_wiresculpt"))
             self.assertEqual(self.load_error(folder), "")
             # the module's NEEDED entry for GLPK renamed to a library that exists nowhere
-            glpk = next(n for n in readelf(os.path.join(package, module))[0] if n.startswith("libglpk"))
-            subprocess.run(["patchelf", "--replace-needed", glpk, "libglpk_gone.so.40", os.path.join(package, module)],
+            glpk = next(n for n in readelf(os.path.join(addon, module))[0] if n.startswith("libglpk"))
+            subprocess.run(["patchelf", "--replace-needed", glpk, "libglpk_gone.so.40", os.path.join(addon, module)],
                            check=True)
             message = self.load_error(folder)
             self.assertIn("libglpk_gone.so.40 is missing", message)
             self.assertIn("install the zip again", message)
             # the same module named for Python 3.10: Python 3.11 does not import it
-            os.rename(os.path.join(package, module), os.path.join(package, "_wiresculpt.cpython-310-x86_64-linux-gnu.so"))
+            os.rename(os.path.join(addon, module), os.path.join(addon, "_wiresculpt.cpython-310-x86_64-linux-gnu.so"))
             message = self.load_error(folder)
             self.assertIn("this build is for Python 3.10; this Python uses 3.11", message)
             self.assertIn("build from source with scripts/package", message)
-
 
 
 class ExtensionTest(unittest.TestCase):
