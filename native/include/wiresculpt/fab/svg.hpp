@@ -7,6 +7,7 @@
 //   <polyline class="wire-path">   the centreline, absolute coordinates in mm
 //   <line class="bend">            a tick across the wire at each bend point (bisector normal)
 //   <circle class="crossing">      a ring at each crossing point
+//   <g class="self-crossing">      an orange ring and "crosses itself" where the wire crosses itself
 //   <text class="label">           "name  (length mm)" in the wire's top margin
 // A wire occupies a cell of (bounding box + 2 * margin) in each direction; the label, ticks and
 // rings stay inside the margin when tick_mm, crossing_radius_mm and label_mm are below margin_mm.
