@@ -453,3 +453,35 @@ TEST_CASE("target shape: contact constraints that cannot hold together are repor
   CHECK(failed >= 1);
   CHECK_FALSE(r.feasible);
 }
+
+TEST_CASE("target shape: a per-point bend limit holds at that point, the others keep max_bend", "[target]") {
+  // A square of side 0.1 m: its corners are the sharpest bends of the target.
+  Polyline2 contour;
+  const Vec2 corner[4] = {{0, 0}, {0.1, 0}, {0.1, 0.1}, {0, 0.1}};
+  for (int s = 0; s < 4; ++s)
+    for (int k = 0; k < 50; ++k) contour.push_back(corner[s] + (corner[(s + 1) % 4] - corner[s]) * (k / 50.0));
+  TargetShapeOptions o;
+  const TargetShapeResult free = optimize_target_shape(contour, true, {}, o);
+  const int m = static_cast<int>(free.points.size());
+  auto bend = [&](const Polyline2& p, int i) {
+    return angle_between(p[i] - p[(i + m - 1) % m], p[(i + 1) % m] - p[i]);
+  };
+  int sharpest = 0;
+  for (int i = 0; i < m; ++i)
+    if (bend(free.points, i) > bend(free.points, sharpest)) sharpest = i;
+  const double before = bend(free.points, sharpest);
+  REQUIRE(before > 20.0 * pi / 180.0);
+
+  o.vertex_max_bend.assign(static_cast<std::size_t>(m), 0.0);
+  o.vertex_max_bend[static_cast<std::size_t>(sharpest)] = before - 10.0 * pi / 180.0;
+  const TargetShapeResult limited = optimize_target_shape(contour, true, {}, o);
+  REQUIRE(static_cast<int>(limited.points.size()) == m);  // the same points, so the index still means it
+  CHECK(limited.feasible);
+  CHECK(bend(limited.points, sharpest) <= before - 10.0 * pi / 180.0 + 1e-6);
+  for (int i = 0; i < m; ++i) CHECK(bend(limited.points, i) <= o.max_bend + 1e-6);
+  CHECK(bend_limit(o, sharpest) == Approx(before - 10.0 * pi / 180.0));
+  CHECK(bend_limit(o, m + 5) == o.max_bend);
+
+  o.vertex_max_bend = {std::nan("")};
+  CHECK_THROWS_WITH(optimize_target_shape(contour, true, {}, o), Contains("vertex_max_bend[0]"));
+}
