@@ -37,7 +37,7 @@ KEYS = {
         "pending_stages": "pipeline", "warnings": "every stage",
         "crossings": "layering", "assembly_order": "layering", "assembly_steps": "layering",
         "two_hand_steps": "layering", "close_crossings": "layering", "required_size": "layering",
-        "out_of_plane": "forces", "load_capacity": "forces",
+        "out_of_plane": "forces", "load_capacity": "forces", "buildability": "pipeline",
         "fabrication": "fabrication",
     },
     "wire": {
@@ -64,7 +64,7 @@ KEYS = {
 # Keys written only in some cases (a stage that ran may leave them out): close crossings, a
 # material without density, a user's cut, the batch's exports.
 OPTIONAL = {
-    "top": {"close_crossings", "required_size", "load_capacity", "fabrication", "warnings"},
+    "top": {"close_crossings", "required_size", "load_capacity", "fabrication", "warnings", "buildability"},
     "wire": {"cut_override", "cut_point"},
     "crossing": set(),
     "stages": set(),

@@ -10,6 +10,7 @@ import numpy as np
 
 from .. import native
 from ..core.calibration import machine_dict
+from ..core.polylines import self_crossings
 
 FOLDERS = ("svg", "dxf", "gcode", "bends")
 
@@ -104,6 +105,9 @@ def export(design, out_dir, profile=None):
         stem = file_stem(wire)
         template = {"name": wire["name"], "points": rest, "bend_points": list(program["bend_vertices"]),
                     "crossing_points": crossing_indices(design, wire)}
+        crosses = self_crossings(rest, wire["closed"])
+        if crosses:  # marked on the template: the wire must pass over itself there
+            template["self_crossings"] = np.array([c[2] for c in crosses], dtype=np.float64)
         templates.append(template)
         for folder, name, write in (
             ("svg", f"{stem}.svg", lambda p: w.write_svg(p, [template], False)),
