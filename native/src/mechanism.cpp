@@ -165,6 +165,8 @@ PlaneMove plane_move(const Network& net, int wire, const std::vector<int>& joine
   double best = std::numeric_limits<double>::infinity();
   for (int k = 0; k < static_cast<int>(net.wires.size()); ++k) {
     if (k == wire || std::find(joined.begin(), joined.end(), k) != joined.end()) continue;
+    // A wire of a parallel plane is never crossed by moving this plane along its normal.
+    if (std::abs(net.wires[k].plane.normal.dot(w.plane.normal)) > 1.0 - 1e-9) continue;
     for (const Vec3& q : net.wires[k].points) {
       const double s = w.plane.signed_distance(q);
       if (std::abs(s) < 1e-9 || std::abs(s) >= best || !inside(outline, w.plane.to_2d(q))) continue;

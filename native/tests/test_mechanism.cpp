@@ -90,6 +90,15 @@ TEST_CASE("mechanism: a wire crossing one other wire twice is a hinge, named wit
   CHECK(move.distance > 0.0954 - H - 1e-3);
   CHECK(move.distance < R - H);
 
+  // A ring in a plane parallel to W's, just above it inside its outline, is nearer but can never
+  // be reached by moving W's plane: still Y.
+  Network with_ring = net;
+  WireSpec ring = fixtures::circle_wire({"P", Vec3::UnitZ(), 0.0}, 0.01, 16);
+  for (auto& q : ring.points) q.z() = H + 0.005;
+  ring.plane = Plane::make({0, 0, H + 0.005}, Vec3::UnitZ());
+  with_ring.wires.push_back(ring);
+  CHECK(plane_move(with_ring, 3, {0}).towards_wire == 1);
+
   // The layering's reason names W as the hinge, not the LP's reference wire.
   const LayeringResult r = layering(net);
   CHECK_FALSE(r.stable);

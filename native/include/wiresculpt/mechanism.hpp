@@ -44,7 +44,7 @@ struct MovingPart {
 
 /// For a part that is one wire hinged or pivoting: a move of its plane that brings it to a wire
 /// it does not cross yet (the nearest point of another wire, within the wire's outline seen
-/// along the plane's normal).
+/// along the plane's normal; wires of parallel planes never count).
 struct PlaneMove {
   bool found = false;
   int towards_wire = -1;   ///< the wire the moved plane would reach
