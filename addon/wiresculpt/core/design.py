@@ -27,7 +27,8 @@ VERSION = 1
 # "fabrication" (the batch's exports) or "every stage" (appended to by each).
 # `stable`/`reason` are the layering's verdict (new_design's default until it runs; the pipeline
 # answers when there are fewer than two wires; layering.recheck_verdict after a later stage nulls
-# crossings). A crossing's `hook` and `metric` are the layering's; the target shape sets both to
+# crossings; fab/buildability.apply, through the pipeline, when a wire's bend program cannot be
+# made: "stable" means buildable). A crossing's `hook` and `metric` are the layering's; the target shape sets both to
 # 0 for a crossing it cannot realise.
 KEYS = {
     "top": {
