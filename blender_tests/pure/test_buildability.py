@@ -69,6 +69,13 @@ class Verdict(unittest.TestCase):
         self.assertIn("scale the model up at least 3.00 times (largest side 0.1 m -> 0.3 m)", design["reason"])
         self.assertEqual(design["buildability"]["problems"][0]["crossings"], [0, 1])
 
+    def test_a_rest_shape_the_bend_program_cannot_read_is_a_reason_not_a_crash(self):
+        rest = walk([0.02, 0.02, 0.02], [30.0, 30.0])
+        design = design_of(np.vstack([rest[:2], rest[1:]]))  # point 1 repeated: a zero-length segment
+        buildability.apply(design)
+        self.assertFalse(design["stable"])
+        self.assertIn("wire T/0: segment 1 (points 1 and 2) has zero length", design["reason"])
+
     def test_an_unstable_design_keeps_its_own_reason(self):
         design = design_of(walk([0.02, 0.02, 0.02], [30.0, 125.0]))
         design.update(stable=False, reason="the layering's reason")

@@ -69,7 +69,11 @@ def check(design, profile=None):
             continue
         rest = np.asarray(wire["rest"], dtype=np.float64)
         order = walk(wire)
-        found = native.bend_program_problems(rest, machine)
+        try:
+            found = native.bend_program_problems(rest, machine)
+        except ValueError as exc:  # a rest shape the bend program cannot read (a repeated point)
+            found = [{"kind": "input", "number": 0, "from": 0, "to": 0, "at": 0.0, "value": 0.0, "limit": 0.0,
+                      "message": str(exc)}]
         bends = [] if found else list(native.make_bend_program(rest, machine)["bend_vertices"])
         for p in found:
             entry = {"wire": wire["id"], **p}
