@@ -124,13 +124,33 @@ Mechanism find_mechanism(const Network& net) {
     if (k == best) continue;
     MovingPart part;
     part.wires = parts[k];
-    std::vector<Vec3> points;
+    const int self = static_cast<int>(k), rest = static_cast<int>(best);
+    std::vector<Vec3> points, to_rest;
+    std::vector<int> neighbours;  // other moving parts joined to this one
     for (int c = 0; c < C; ++c) {
       const auto& x = net.crossings[c];
-      if ((part_of[x.wires[0]] == static_cast<int>(k)) == (part_of[x.wires[1]] == static_cast<int>(k))) continue;
+      const int p0 = part_of[x.wires[0]], p1 = part_of[x.wires[1]];
+      if ((p0 == self) == (p1 == self)) continue;
       part.crossings.push_back(c);
       points.push_back(x.point);
+      const int other = p0 == self ? p1 : p0;
+      if (other == rest) {
+        part.to_rest.push_back(c);
+        to_rest.push_back(x.point);
+      } else {
+        neighbours.push_back(other);
+      }
     }
+    // When the other moving parts it holds hang on it alone (joined to nothing else), they cannot
+    // stop it: how it moves against the rest is decided by its joints to the rest.
+    bool dangling = !to_rest.empty();
+    for (int c = 0; c < C && dangling; ++c) {
+      const int p0 = part_of[net.crossings[c].wires[0]], p1 = part_of[net.crossings[c].wires[1]];
+      for (int j : neighbours)
+        if ((p0 == j && p1 != j && p1 != self) || (p1 == j && p0 != j && p0 != self)) dangling = false;
+    }
+    if (dangling && to_rest.size() < points.size()) points = to_rest;
+    else part.to_rest.clear();
     if (points.empty()) {
       part.kind = MovingPart::Kind::loose;
     } else {
@@ -185,20 +205,27 @@ std::string mechanism_message(const Network& net, const Mechanism& m) {
   for (const MovingPart& part : m.moving) {
     const bool one = part.wires.size() == 1;
     const std::string who = names(net, part.wires);
-    const std::string held = std::string(one ? " is" : " are") + " held" + (one ? "" : " to the other wires") +
-                             " only at crossing" + (part.crossings.size() == 1 ? " " : "s ") + crossing_list(part.crossings);
+    const std::vector<int>& joints = part.to_rest.empty() ? part.crossings : part.to_rest;
+    const std::string held = std::string(one ? " is" : " are") + " held" +
+                             (!part.to_rest.empty() ? " to the rest" : one ? "" : " to the other wires") +
+                             " only at crossing" + (joints.size() == 1 ? " " : "s ") + crossing_list(joints);
+    std::vector<int> hanging;
+    for (int c : part.crossings)
+      if (std::find(part.to_rest.begin(), part.to_rest.end(), c) == part.to_rest.end()) hanging.push_back(c);
+    const std::string also = part.to_rest.empty() ? "" : " (its crossing" + std::string(hanging.size() == 1 ? " " : "s ") +
+                                                            crossing_list(hanging) + " hold only wires that hang on it)";
     std::string s;
     switch (part.kind) {
       case MovingPart::Kind::loose:
         s = who + (one ? " is" : " are") + " joined to no other wire";
         break;
       case MovingPart::Kind::pivot:
-        s = who + held + (part.crossings.size() == 1 ? "" : ", all at one point") + ", so " + (one ? "it" : "they") +
-            " can turn about that point";
+        s = who + held + (joints.size() == 1 ? "" : ", all at one point") + ", so " + (one ? "it" : "they") +
+            " can turn about that point" + also;
         break;
       case MovingPart::Kind::hinge:
         s = who + held + ", which lie on one line, so " + (one ? "it" : "they") +
-            " can turn about that line like a hinge";
+            " can turn about that line like a hinge" + also;
         break;
       case MovingPart::Kind::general:
         s = who + " can move against the other wires although held at crossings " + crossing_list(part.crossings) +
@@ -206,7 +233,7 @@ std::string mechanism_message(const Network& net, const Mechanism& m) {
         break;
     }
     if (one && (part.kind == MovingPart::Kind::hinge || part.kind == MovingPart::Kind::pivot)) {
-      std::vector<int> joined;
+      std::vector<int> joined;  // every wire it crosses
       for (int c : part.crossings) {
         const auto& x = net.crossings[c];
         joined.push_back(x.wires[0] == part.wires[0] ? x.wires[1] : x.wires[0]);

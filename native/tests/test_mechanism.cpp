@@ -107,3 +107,32 @@ TEST_CASE("mechanism: a wire crossing one other wire twice is a hinge, named wit
                            Contains("towards wire 'Y'"));
   CHECK_THAT(r.reason, !Contains("wire 'X' is") && !Contains("wire 'Z' is") && !Contains("cannot balance"));
 }
+
+TEST_CASE("mechanism: a hinged wire carrying a wire that hangs on it alone is still named a hinge") {
+  // D: a rectangle in the plane x = 0.01 whose sides cross W's long edges (nothing else): it
+  // hangs on W, which stays hinged on X.
+  Network net = hinged();
+  std::vector<WireSpec> wires = net.wires;
+  const double b = std::sqrt(R * R - H * H);
+  WireSpec d;
+  d.name = "D";
+  d.plane = Plane::make({0.01, 0, 0}, Vec3::UnitX());
+  for (const Vec2& q : {Vec2(b, H + 0.01), Vec2(-b, H + 0.01), Vec2(-b, H - 0.01), Vec2(b, H - 0.01)})
+    d.points.push_back(Vec3(0.01, q.x(), q.y()));
+  wires.push_back(d);
+  net = build_network(wires);
+  const Mechanism m = find_mechanism(net);
+  REQUIRE(m.moving.size() == 2);
+  CHECK(m.rest == std::vector<int>{0, 1, 2});
+  const MovingPart& w = m.moving[0];
+  CHECK(w.wires == std::vector<int>{3});
+  CHECK(w.crossings.size() == 4);
+  CHECK(w.to_rest.size() == 2);
+  CHECK(w.kind == MovingPart::Kind::hinge);
+  CHECK(std::abs((w.axis_to - w.axis_from).normalized().y()) == Approx(1.0).margin(1e-9));
+  CHECK(m.moving[1].wires == std::vector<int>{4});
+  CHECK(m.moving[1].kind == MovingPart::Kind::hinge);
+  const std::string text = mechanism_message(net, m);
+  CHECK_THAT(text, Contains("wire 'W' is held to the rest only at crossings") && Contains("hang on it") &&
+                       Contains("wire 'D' is held only at crossings"));
+}

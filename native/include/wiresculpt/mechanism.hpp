@@ -38,6 +38,9 @@ struct MovingPart {
   Kind kind = Kind::general;
   std::vector<int> wires;      ///< wire ids of the part, ascending
   std::vector<int> crossings;  ///< crossing ids joining the part to wires outside it, ascending
+  /// When every other moving part it is joined to hangs on it alone: its crossings with the rest,
+  /// which then decide `kind` (empty otherwise: `kind` is decided by all of `crossings`).
+  std::vector<int> to_rest;
   /// hinge: two points on the axis (the joining points farthest apart); pivot: the point twice.
   Vec3 axis_from = Vec3::Zero(), axis_to = Vec3::Zero();
 };
