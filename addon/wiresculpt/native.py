@@ -202,6 +202,11 @@ def make_bend_program(points, profile=None):
     return require().make_bend_program(as_points(points, "points", 2), {} if profile is None else profile)
 
 
+def bend_program_problems(points, profile=None):
+    """Everything that keeps a 2D wire from being bent (make_bend_program's refusals, all listed)."""
+    return require().bend_program_problems(as_points(points, "points", 2), {} if profile is None else profile)
+
+
 def write_svg(path, wires, sheet=None, options=None):
     """1:1 SVG template; wires [{"name", "points" (n, 2) m, ...}]. Returns the text."""
     return require().write_svg(path, _with_points(wires, "wires", "points", 2), sheet,

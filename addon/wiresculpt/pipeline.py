@@ -3,9 +3,12 @@ stage that exists so far, producing the design document. Free of bpy: the batch 
 add-on's operators both call it, the add-on from a worker thread (the native stages release the
 GIL) with `cancel` wired to its Esc key.
 """
+import math
+
 from . import native
 from .core.design import new_design
 from .core.sizes import size_warnings
+from .fab import buildability
 from .stages import forces, layering, slicing, target_shape
 
 ALL_STAGES = ["layering", "target_shape", "forces", "rest_shape"]
@@ -76,18 +79,74 @@ def apply_cuts(design, cuts):
 
 
 def _largest_over_bend(design, limit_deg):
-    """The largest rest bend beyond the machine's limit (degrees over it), 0 when none."""
-    over = [o["angle_deg"] for w in design["wires"] for o in w.get("rest_over_bend", [])]
-    return max((abs(a) - limit_deg for a in over), default=0.0)
+    """The largest rest bend beyond the machine's limit (degrees over it), 0 when none. Taken from
+    the rest angles with no tolerance: the bend program refuses anything over the limit."""
+    return max((math.degrees(abs(a)) - limit_deg for w in design["wires"] for a in w.get("rest_angles", [])),
+               default=0.0)
+
+
+def rest_angle(target, k):
+    """Eq. 12 for one vertex with the torque it carries as k = t / (4 k_b / l): the rest angle
+    2 atan(tan(a/2) + k / (1 + tan^2(a/2))) of a target angle a (radians, signed)."""
+    tan = math.tan(0.5 * target)
+    return 2.0 * math.atan(tan + k / (1.0 + tan * tan))
+
+
+def target_limit_for(target, rest, wanted):
+    """The largest target bend |a'| <= |target| whose rest angle, under the torque this vertex
+    carries now (read back from its target and rest angles through Eq. 12), has |rest| <= wanted
+    (radians). None when no such bend of the same sign exists (the torque alone bends it further)."""
+    sign = 1.0 if rest >= 0.0 else -1.0
+    a, r = sign * target, sign * rest  # mirrored so that the rest angle is positive
+    tan = math.tan(0.5 * a)
+    k = (math.tan(0.5 * r) - tan) * (1.0 + tan * tan)
+    if a <= 0.0 or rest_angle(0.0, k) > wanted:
+        return None
+    lo, hi = 0.0, a  # rest_angle increases with the target angle for the torques of a wire (k << 1)
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if rest_angle(mid, k) <= wanted else (lo, mid)
+    return lo
+
+
+def _tighten(design, memo, machine_limit_deg, floor_deg):
+    """The coupling's step (Sec. 4.3): at every rest vertex bent beyond the machine, the target
+    bend that brings it to COUPLING_MARGIN_DEG inside the machine's limit under the torque it
+    carries becomes that vertex's own limit for the next target shape (memo.vertex_limits, per
+    wire name and target index; only ever lowered, never below `floor_deg`, the bend of a hooked
+    kink). Returns (how many vertices got a new limit, the largest excess in degrees of those that
+    could not: a hooked kink already at its least bend, whose torque only the forces change)."""
+    wanted = math.radians(machine_limit_deg - COUPLING_MARGIN_DEG)
+    floor = math.radians(floor_deg)
+    changed, stuck = 0, 0.0
+    for w in design["wires"]:
+        m = len(w["target"])
+        for position, (rest, target) in enumerate(zip(w["rest_angles"], w["target_angles"])):
+            if abs(rest) <= math.radians(machine_limit_deg):
+                continue
+            vertex = (w["cut"] + position) % m if w["closed"] else position
+            limit = target_limit_for(target, rest, wanted)
+            limits = memo.vertex_limits.setdefault(w["name"], {})
+            new = max(floor, min(limit if limit is not None else 0.0, limits.get(vertex, math.pi)))
+            if new < min(limits.get(vertex, math.pi), abs(target)):
+                limits[vertex] = new
+                changed += 1
+            else:
+                stuck = max(stuck, math.degrees(abs(rest)) - machine_limit_deg)
+    return changed, stuck
 
 
 def shape_and_rest(design, material, settings, say, native_progress, checkpoint):
     """Target shape, then forces and rest shape, with the coupling of Sec. 4.3: the machine's
-    maximum bend limits the rest shape, which is only known after the forces; when a rest bend
-    exceeds it, the target's limit is lowered by the excess (plus COUPLING_MARGIN_DEG) and the
-    shape is solved again from the same layering, at most COUPLING_ROUNDS times. Each round starts
-    from what the previous one learnt (target_shape.Memo): its nulled crossings, and the wires whose
-    optimum the lower limit leaves optimal."""
+    maximum bend limits the rest shape, which is only known after the forces. A rest bend beyond
+    it comes from the torque its vertex carries (Eq. 12), so the target shape is solved again with
+    that vertex's own bend limit lowered until its rest bend is COUPLING_MARGIN_DEG inside the
+    machine's (_tighten); where that cannot act (a hooked kink at its least bend), the limit of
+    every other bend is lowered by the excess, which changes the forces; from the same layering,
+    at most COUPLING_ROUNDS times. Each round starts
+    from what the previous one learnt (target_shape.Memo): its nulled crossings, its vertex limits,
+    and the wires whose optimum the new limits leave optimal. Then the buildability verdict
+    (fab/buildability.py): a bend still over the limit makes the design not stable, by name."""
     import copy
 
     def fresh(d):
@@ -97,6 +156,7 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint)
 
     machine_limit = settings["max_bend_deg"]
     target_limit = machine_limit
+    kink = 180.0 - settings["contact_angle_deg"]  # a hooked crossing bends at least this much
     before = fresh(design)
     memo = target_shape.Memo()
     totals = dict.fromkeys(("seconds", "iterations", "wire_solves", "reused_wires"), 0)
@@ -111,8 +171,9 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint)
         for key in totals:  # the stage's cost over every coupling round; its shapes are the last round's
             totals[key] += stage[key]
             stage[key] = totals[key]
-        design["stages"]["target_shape"]["max_bend_deg"] = target_limit
-        design["stages"]["target_shape"]["coupling_rounds"] = round_ + 1
+        stage["max_bend_deg"] = target_limit
+        stage["vertex_limits"] = sum(len(v) for v in memo.vertex_limits.values())
+        stage["coupling_rounds"] = round_ + 1
         if not design["stable"]:  # forces need the hooks of a complete stable assembly
             return design
         checkpoint()
@@ -121,12 +182,20 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint)
         say("rest_shape", forces.rest_summary(design))
         design["pending_stages"].remove("rest_shape")
         excess = _largest_over_bend(design, machine_limit)
-        if excess <= 0.0:
-            return design
-        if round_ + 1 < COUPLING_ROUNDS:
-            target_limit = max(1.0, target_limit - excess - COUPLING_MARGIN_DEG)
-            say("target_shape", f"a rest bend exceeds the machine's {machine_limit:g} deg by {excess:.4f} deg; "
-                                f"solving again with target bends up to {target_limit:.2f} deg (Sec. 4.3)")
+        stage["rest_excess_deg"] = max(excess, 0.0)
+        if excess <= 0.0 or round_ + 1 == COUPLING_ROUNDS:
+            break
+        changed, stuck = _tighten(design, memo, machine_limit, kink + 0.01)
+        if stuck > 0.0:  # a kink's torque: only other bends, through the forces they lead to, can change it
+            target_limit = max(1.0, kink + 0.01, target_limit - stuck - COUPLING_MARGIN_DEG)
+        if not changed and stuck <= 0.0:
+            break
+        say("target_shape", f"a rest bend exceeds the machine's {machine_limit:g} deg by {excess:.4f} deg; "
+                            f"solving again with {changed} vertex bend limit{'s' if changed != 1 else ''} lowered so "
+                            f"that the rest bends stay {COUPLING_MARGIN_DEG:g} deg inside, other bends up to "
+                            f"{target_limit:.2f} deg (Sec. 4.3)")
+    # "Stable" means buildable: the bend program of every wire, with the machine profile in use.
+    buildability.apply(design)
     return design
 
 

@@ -10,7 +10,9 @@
 
 #include "wiresculpt/error.hpp"
 #include "wiresculpt/in_plane.hpp"
+#include "wiresculpt/mechanism.hpp"
 #include "wiresculpt/stability.hpp"
+#include "wire_names.hpp"
 
 namespace wiresculpt {
 namespace {
@@ -36,26 +38,10 @@ bool less(const Key& a, const Key& b) {
   return a.unbal < b.unbal;
 }
 
-std::string quoted(const Network& net, int w) { return "'" + net.wires[w].name + "'"; }
-
-std::string join(const std::vector<std::string>& items) {
-  std::string out;
-  for (std::size_t k = 0; k < items.size(); ++k)
-    out += (k == 0 ? "" : (k + 1 == items.size() ? " and " : ", ")) + items[k];
-  return out;
-}
-
-std::string wire_list(const Network& net, const std::vector<int>& wires) {
-  std::vector<std::string> names;
-  for (int w : wires) names.push_back(quoted(net, w));
-  return join(names);
-}
-
-std::string crossing_list(const std::vector<int>& crossings) {
-  std::vector<std::string> ids;
-  for (int c : crossings) ids.push_back(std::to_string(c));
-  return join(ids);
-}
+using detail::crossing_list;
+using detail::join;
+using detail::quoted;
+using detail::wire_list;
 
 class Search {
  public:
@@ -536,22 +522,31 @@ LayeringResult layering(const Network& net, const LayeringOptions& options, cons
     for (int w = 0; w < P; ++w) all[w] = w;
     const StabilityResult relaxed = s.checker_.check(all, std::vector<int>(C, 2), P == 2);
     if (!relaxed.stable) {
-      int w = relaxed.failed_wire;
-      if (w < 0) {  // the combined load failed: name the wire with the fewest crossings
-        std::vector<int> count(P, 0);
-        for (const auto& x : net.crossings) ++count[x.wires[0]], ++count[x.wires[1]];
-        w = static_cast<int>(std::min_element(count.begin(), count.end()) - count.begin());
-      }
-      std::vector<int> cs;
-      for (int c = 0; c < C; ++c)
-        if (net.crossings[c].wires[0] == w || net.crossings[c].wires[1] == w) cs.push_back(c);
-      static const char* what[6] = {"a force along x", "a force along y", "a force along z",
-                                    "a torque about x", "a torque about y", "a torque about z"};
+      // Name what moves, from the null space of the crossings as ball joints (mechanism.hpp),
+      // rather than the LP's failing load, whose wire need not be the one that moves.
+      const Mechanism mechanism = find_mechanism(net);
       r.reason = "no hook configuration can make the finished sculpture stable: even with both hook directions "
-                 "allowed at every crossing, the wires cannot balance " +
-                 (relaxed.failed_component >= 0 ? std::string(what[relaxed.failed_component]) : std::string("every load")) +
-                 " on wire " + quoted(net, w) + " (its crossing" + (cs.size() == 1 ? " " : "s ") + crossing_list(cs) +
-                 "): the wires are held at too few crossings or can move as a mechanism";
+                 "allowed at every crossing, ";
+      if (!mechanism.moving.empty()) {
+        r.reason += mechanism_message(net, mechanism);
+      } else {  // the joints are rigid, yet the pyramids do not span (degenerate contact angle)
+        int w = relaxed.failed_wire;
+        if (w < 0) {  // the combined load failed: name the wire with the fewest crossings
+          std::vector<int> count(P, 0);
+          for (const auto& x : net.crossings) ++count[x.wires[0]], ++count[x.wires[1]];
+          w = static_cast<int>(std::min_element(count.begin(), count.end()) - count.begin());
+        }
+        std::vector<int> cs;
+        for (int c = 0; c < C; ++c)
+          if (net.crossings[c].wires[0] == w || net.crossings[c].wires[1] == w) cs.push_back(c);
+        static const char* what[6] = {"a force along x", "a force along y", "a force along z",
+                                      "a torque about x", "a torque about y", "a torque about z"};
+        r.reason += "the wires cannot balance " +
+                    (relaxed.failed_component >= 0 ? std::string(what[relaxed.failed_component])
+                                                   : std::string("every load")) +
+                    " on wire " + quoted(net, w) + " (its crossing" + (cs.size() == 1 ? " " : "s ") +
+                    crossing_list(cs) + "): the wires are held at too few crossings";
+      }
       r.stats.lp_solves = s.checker_.lp_solves();
       return finish();
     }

@@ -23,6 +23,7 @@ from .. import native
 from . import bendlist, tiles
 from ..core.calibration import machine_dict
 from ..core.sizes import STOCK_LENGTH, size_warnings
+from ..core.polylines import self_crossings
 
 # Each folder with the file types an export writes there (and removes from an earlier export).
 FOLDER_TYPES = {"svg": (".svg",), "dxf": (".dxf",), "templates": (".svg",),
@@ -134,6 +135,9 @@ def export(design, out_dir, profile=None, paper=None):
         stem = file_stem(wire)
         template = {"name": wire["name"], "points": rest, "bend_points": list(program["bend_vertices"]),
                     "crossing_points": crossing_indices(design, wire)}
+        crosses = self_crossings(rest, wire["closed"])
+        if crosses:  # marked on the template: the wire must pass over itself there
+            template["self_crossings"] = np.array([c[2] for c in crosses], dtype=np.float64)
         templates.append(template)
         for folder, name, write in (
             ("svg", f"{stem}.svg", lambda p: native.write_machine_svg(p, template)),

@@ -56,6 +56,9 @@ def solve_wire(design, wire, material, settings, size, native_progress=None, mem
     options = {"min_segment": settings["min_segment"], "max_bend": math.radians(settings["max_bend_deg"]),
                "friction": 0.0, "model_size": size, "wire_name": wire["name"],
                "angle_tolerance": REALISED_ANGLE, "length_tolerance": REALISED_LENGTH}
+    limits = memo.vertex_limits.get(wire["name"]) if memo is not None else None
+    if limits:  # the coupling's own limits at some points (pipeline._tighten), radians by target index
+        options["vertex_max_bend"] = tuple(limits.get(i, 0.0) for i in range(max(limits) + 1))
     contour = to_2d(wire["contour"], origin, u, v)
     key = Memo.key(contour, wire["closed"], specs, options) if memo is not None else None
     result = memo.reusable(key, options["max_bend"]) if memo is not None else None
@@ -73,6 +76,8 @@ class Memo:
     - `nulled`: the crossings it could not realise. A lower bend limit only shrinks each wire's
       feasible set, so they are nulled from the start of the next round instead of being solved
       (and failing) again.
+    - `vertex_limits`: {wire name: {target index: radians}}, the bend limits the coupling set at
+      single points (pipeline._tighten); they only ever go down, so the same argument holds.
     - every wire's solve. A result that was a converged, feasible optimum with every active crossing
       realised under the old limit and whose bends all lie within the new one is still a local
       optimum of the tighter problem (the same point, feasible, in a smaller feasible set): it is
@@ -83,6 +88,7 @@ class Memo:
 
     def __init__(self):
         self.nulled = []
+        self.vertex_limits = {}
         self.solves = {}  # key -> (max_bend, result)
         self.reused = 0
 

@@ -174,7 +174,12 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
         pending = design.get("pending_stages") or []
         if pending:
             layout.label(text="Pending: " + ", ".join(p.replace("_", " ") for p in pending), icon='INFO')
-        warnings = design.get("warnings") or []
+        crossing = [c["message"] for c in (design.get("buildability") or {}).get("self_crossings", [])]
+        if crossing:  # a rest shape that crosses itself: shown first, the maker must see it before bending
+            col = layout.column(align=True)
+            for message in crossing:
+                _wrap(col, context, message, icon='ERROR')
+        warnings = [w for w in design.get("warnings") or [] if w not in crossing]
         if warnings:
             col = layout.column(align=True)
             for warning in warnings[:3]:

@@ -99,6 +99,18 @@ std::string wire_group(const TemplateWire& w, std::size_t index, double ox, doub
     s += "    <circle class=\"crossing\" data-point=\"" + std::to_string(i) + "\" cx=\"" + num(q[i].x()) +
          "\" cy=\"" + num(q[i].y()) + "\" r=\"" + num(o.crossing_radius_mm) +
          "\" fill=\"none\" stroke=\"#0050d0\" stroke-width=\"" + num(o.stroke_mm * 0.6) + "\"/>\n";
+  for (std::size_t k = 0; k < w.self_crossings.size(); ++k) {
+    const Vec2& p = w.self_crossings[k];
+    const Vec2 c(ox + m + to_mm(p.x()) - b.min_x, oy + m + b.max_y - to_mm(p.y()));
+    const double r = 1.5 * o.crossing_radius_mm;
+    s += "    <g class=\"self-crossing\" data-index=\"" + std::to_string(k) + "\">\n";
+    s += "      <circle cx=\"" + num(c.x()) + "\" cy=\"" + num(c.y()) + "\" r=\"" + num(r) +
+         "\" fill=\"none\" stroke=\"#ff8000\" stroke-width=\"" + num(o.stroke_mm) + "\"/>\n";
+    s += "      <text x=\"" + num(c.x() + r) + "\" y=\"" + num(c.y() - r) +
+         "\" font-family=\"sans-serif\" font-size=\"" + num(0.6 * o.label_mm) +
+         "\" fill=\"#ff8000\">crosses itself</text>\n";
+    s += "    </g>\n";
+  }
   char len[64];
   std::snprintf(len, sizeof len, "%.1f mm", wire_length_mm(w));
   s += "    <text class=\"label\" x=\"" + num(ox + m) + "\" y=\"" + num(oy + 0.75 * m) +

@@ -7,6 +7,7 @@
 //   <polyline class="wire-path">   the centreline, absolute coordinates in mm
 //   <line class="bend">            a tick across the wire at each bend point (bisector normal)
 //   <circle class="crossing">      a ring at each crossing point
+//   <g class="self-crossing">      an orange ring and "crosses itself" where the wire crosses itself
 //   <text class="label">           "name  (length mm)" in the wire's top margin
 //   <circle class="start">         a dot on the first point: where the bender starts
 //   <g class="feed">               an arrow beside the first segment pointing along it (the way the
