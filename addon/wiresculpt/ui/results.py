@@ -6,7 +6,7 @@ import textwrap
 
 import bpy
 
-from .. import native
+from .. import native, props
 from ..blend import results as scene_results
 from ..blend.registration import classes_factory
 from ..operators import optimize
@@ -110,6 +110,11 @@ class VIEW3D_PT_wiresculpt_settings(_Child, bpy.types.Panel):
         col = layout.column(align=True)
         col.prop(ws, "contact_angle_deg")
         col.prop(ws, "torque_fraction")
+        box = layout.box()  # the layering's search knobs (docs/user-guide.md, Advanced)
+        box.prop(ws, "show_advanced", icon='TRIA_DOWN' if ws.show_advanced else 'TRIA_RIGHT', emboss=False)
+        if ws.show_advanced:
+            for key in props.ADVANCED_PROPS:
+                box.prop(ws, key)
 
 
 class VIEW3D_PT_wiresculpt_optimize(_Child, bpy.types.Panel):
