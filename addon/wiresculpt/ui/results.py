@@ -152,7 +152,8 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
             box.label(text="Stable", icon='CHECKMARK')
         else:
             box.alert = True
-            box.label(text="Not stable", icon='ERROR')
+            # max_nodes stopped the layering: a stable design may exist (the reason says how to go on)
+            box.label(text="Search incomplete" if design.get("search_incomplete") else "Not stable", icon='ERROR')
             _wrap(box, context, design.get("reason") or "no reason given")
         rows = assembly_rows(design)
         if rows:
