@@ -86,7 +86,7 @@ def relayer(design, material, settings, say, native_progress, checkpoint):
         began = time.perf_counter()
         checkpoint()
         attempt = design if round_ == 0 else _copy_sharing_contours(pristine)
-        say("layering", layering.run(attempt, material, settings, native_progress, forbidden))
+        say("layering", layering.run(attempt, material, settings, native_progress, forbidden=forbidden))
         attempt["pending_stages"].remove("layering")
         for message in attempt.get("close_crossings", []):
             say("layering", message)
