@@ -207,6 +207,15 @@ bool random_small_network(std::mt19937& rng, int attempt, Network& net) {
   return C >= 2 && C <= 8;
 }
 
+// The default contact, and a grippy one (more friction, sharper kinks) under which many
+// configurations are stable, so the first structure found is often not the best.
+std::vector<ContactOptions> default_and_grippy() {
+  ContactOptions grippy;
+  grippy.friction = 0.8;
+  grippy.contact_angle = 80.0 * std::numbers::pi / 180.0;
+  return {ContactOptions{}, grippy};
+}
+
 Network great_circles(int count) {
   auto cuts = fixtures::great_circle_cuts();
   cuts.resize(count);
@@ -320,12 +329,8 @@ TEST_CASE("layering: a four-wire cage needs a step with two hands") {
 }
 
 TEST_CASE("layering: branch and bound finds the brute-force optimum on random small networks") {
-  // Two contact settings: the default, and a grippy one (more friction, sharper kinks) under
-  // which many configurations are stable, so the first structure found is often not the best.
-  ContactOptions grippy;
-  grippy.friction = 0.8;
-  grippy.contact_angle = 80.0 * std::numbers::pi / 180.0;
-  for (const ContactOptions& co : {ContactOptions{}, grippy}) {
+  // Two contact settings (default_and_grippy).
+  for (const ContactOptions& co : default_and_grippy()) {
     std::mt19937 rng(20160724);
     int tested = 0, stable = 0;
     for (int attempt = 0; attempt < 1500 && tested < 30; ++attempt) {
@@ -365,10 +370,7 @@ TEST_CASE("layering: forbidden hooks never appear and the optimum over the allow
   // Random small networks and random masks (each hook forbidden with probability 1/3, both at
   // some crossings): the search must stay exact under every pruning with the mask (layering.hpp
   // (b) dominance with the cheaper allowed hook, (d)/(e) with the allowed pyramids only).
-  ContactOptions grippy;
-  grippy.friction = 0.8;
-  grippy.contact_angle = 80.0 * std::numbers::pi / 180.0;
-  for (const ContactOptions& co : {ContactOptions{}, grippy}) {
+  for (const ContactOptions& co : default_and_grippy()) {
     std::mt19937 rng(20200520);
     int tested = 0, stable = 0, changed = 0, forbidden_used_before = 0;
     for (int attempt = 0; attempt < 1500 && tested < 30; ++attempt) {
