@@ -190,14 +190,8 @@ std::vector<WireSpec> random_polygons(std::mt19937& rng, int P) {
 // (every third attempt) random polygons, with 2 to 8 crossings (small enough for brute_force);
 // false when this attempt gives none.
 bool random_small_network(std::mt19937& rng, int attempt, Network& net) {
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
   const int P = 3 + attempt % 2;
-  std::vector<Cut> cuts;
-  for (int k = 0; k < P; ++k) {
-    Vec3 n(unit(rng), unit(rng), unit(rng));
-    if (n.norm() < 0.2) n = Vec3::UnitZ();
-    cuts.push_back({std::string(1, static_cast<char>('A' + k)), n.normalized(), 0.7 * R * unit(rng)});
-  }
+  const std::vector<Cut> cuts = fixtures::random_cuts(rng, P, 0.7 * R);
   try {
     net = build_network(attempt % 3 == 2 ? random_polygons(rng, P) : fixtures::sphere_wires(cuts, R, 48));
   } catch (const InputError&) {
