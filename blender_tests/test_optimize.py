@@ -394,6 +394,24 @@ class Panels(Case):
                 ws.property_unset(key)
 
     @unittest.skipUnless(native.available(), "the native module is not built")
+    def test_max_nodes_reached_reads_search_incomplete(self):
+        # The panel's node budget reaches the layering; one node cannot finish three rings.
+        globe()
+        ws = bpy.context.scene.wiresculpt
+        ws.max_nodes = 1
+        try:
+            bpy.ops.wiresculpt.optimize()
+        finally:
+            ws.property_unset("max_nodes")
+        design = scene_results.stored_design()
+        self.assertFalse(design["stable"])
+        self.assertTrue(design.get("search_incomplete"))
+        self.assertTrue(design["reason"].startswith("search incomplete"), design["reason"])
+        shown = labels(draw(results_ui.VIEW3D_PT_wiresculpt_report))
+        self.assertIn("Search incomplete", shown)
+        self.assertNotIn("Not stable", shown)
+
+    @unittest.skipUnless(native.available(), "the native module is not built")
     def test_result_panel_shows_forces_toggle_only_with_forces(self):
         globe()
         bpy.ops.wiresculpt.optimize()
