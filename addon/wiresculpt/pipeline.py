@@ -3,7 +3,9 @@ stage that exists so far, producing the design document. Free of bpy: the batch 
 add-on's operators both call it, the add-on from a worker thread (the native stages release the
 GIL) with `cancel` wired to its Esc key.
 """
+import copy
 import math
+import time
 
 from . import native
 from .core.design import new_design
@@ -33,9 +35,10 @@ def slice_and_pick(vertices, faces, planes, material, settings, progress=None):
 
 
 def solve(design, material, settings, progress=None, cancel=None):
-    """Runs every stage after slicing on `design` (its wires' contours set). `progress(stage,
-    message)` is called once per finished stage; `cancel()` returning True stops at the next safe
-    point with Cancelled. `pending_stages` names the stages that did not run."""
+    """Runs every stage after slicing on `design` (its wires' contours set), re-layering while the
+    target shape cannot realise a hook (relayer). `progress(stage, message)` is called once per
+    finished stage; `cancel()` returning True stops at the next safe point with Cancelled.
+    `pending_stages` names the stages that did not run."""
     say = progress or _quiet
     cancelled = cancel or (lambda: False)
 
@@ -57,15 +60,66 @@ def solve(design, material, settings, progress=None, cancel=None):
         design.setdefault("warnings", []).append(warning)
         say("size", warning)
     try:
-        checkpoint()
-        say("layering", layering.run(design, material, settings, native_progress))
-        design["pending_stages"].remove("layering")
-        for message in design.get("close_crossings", []):
-            say("layering", message)
-        design = shape_and_rest(design, material, settings, say, native_progress, checkpoint)
+        return relayer(design, material, settings, say, native_progress, checkpoint)
     except native.Cancelled:
         raise Cancelled() from None
-    return design
+
+
+def _copy_sharing_contours(design):
+    """A deep copy of `design` whose wires share their contour lists with it."""
+    return copy.deepcopy(design, {id(w["contour"]): w["contour"] for w in design["wires"]})
+
+
+def _pairs(pairs):
+    return [[c, h] for c, h in sorted(pairs)]
+
+
+def relayer(design, material, settings, say, native_progress, checkpoint):
+    """Layering, then target shape, forces and rest shape (shape_and_rest); while the result is not
+    stable because the target shape could not realise some crossing's hook, forbid those (crossing,
+    hook) pairs (target_shape.unrealisable: the failed hook, or both hooks of a crossing too close to
+    a neighbour) and layer again from the same contours, with a fresh target-shape memo. Stops when
+    the design is stable, when nothing new can be forbidden, when the layering finds no stable
+    assembly under the forbidden hooks or stops at max_nodes (search incomplete), or after
+    `relayer_rounds` re-layerings. Records every round in stages.relayering. Returns the design of
+    the last round, or, when the last layering found no stable assembly under the forbidden hooks,
+    of the last round that reached the target shape (its shapes and reason show why), saying so."""
+    extra_rounds = int(layering.knob(settings, "relayer_rounds"))
+    # Layering replaces (never edits) each wire's contour, so the copies share the contours.
+    pristine = _copy_sharing_contours(design) if extra_rounds else None
+    forbidden, rounds, start, shaped = set(), [], time.perf_counter(), None
+    for round_ in range(extra_rounds + 1):
+        began = time.perf_counter()
+        checkpoint()
+        attempt = design if round_ == 0 else _copy_sharing_contours(pristine)
+        say("layering", layering.run(attempt, material, settings, native_progress, forbidden=forbidden))
+        attempt["pending_stages"].remove("layering")
+        for message in attempt.get("close_crossings", []):
+            say("layering", message)
+        if attempt["stable"]:
+            attempt = shape_and_rest(attempt, material, settings, say, native_progress, checkpoint)
+            shaped = attempt
+        learnt = target_shape.unrealisable(attempt) - forbidden
+        rounds.append({"forbidden": _pairs(forbidden), "stable": attempt["stable"],
+                       "verdict": "stable" if attempt["stable"] else attempt["reason"],
+                       "unrealised": _pairs(learnt), "seconds": time.perf_counter() - began})
+        if attempt["stable"] or not learnt or attempt.get("search_incomplete") or round_ == extra_rounds:
+            break
+        forbidden |= learnt
+        say("relayering", f"round {round_ + 1}: the target shape cannot realise "
+                          f"{', '.join(f'hook {h:+d} at crossing {c}' for c, h in sorted(learnt))}; "
+                          f"layering again without {'them' if len(learnt) > 1 else 'it'} "
+                          f"({len(forbidden)} hooks forbidden)")
+    if "target_shape" in attempt["pending_stages"] and shaped is not None and not attempt.get("search_incomplete"):
+        shaped["reason"] += (f"; layering again without the {len(forbidden)} hooks the target shape cannot realise "
+                             f"finds no stable assembly (stages.relayering)")
+        attempt = shaped
+    attempt["stages"]["relayering"] = {"rounds": rounds, "forbidden": _pairs(forbidden),
+                                       "max_rounds": extra_rounds, "seconds": time.perf_counter() - start}
+    if not attempt["stable"] and learnt and round_ == extra_rounds and extra_rounds:
+        attempt["reason"] += (f" (re-layering stopped after relayer_rounds = {extra_rounds}; more rounds may "
+                              f"find a stable design)")
+    return attempt
 
 
 def apply_cuts(design, cuts):

@@ -29,9 +29,14 @@ REFERENCE = materials.PRESETS["steel"]  # the custom material starts from steel'
 
 
 def _setting(key, name, **kw):
-    """A FloatProperty for core/settings.py's `key`: default, bounds and text from the table.
-    Degrees are stored as radians (subtype ANGLE) so Blender shows the user's unit."""
+    """A property for core/settings.py's `key`: default, bounds and text from the table; a
+    BoolProperty or IntProperty for the "bool" and "int" keys, else a FloatProperty. Degrees are
+    stored as radians (subtype ANGLE) so Blender shows the user's unit."""
     default, low, high, unit, text = settings_table.SETTINGS[key]
+    if unit == "bool":
+        return BoolProperty(name=name, description=text, default=default, **kw)
+    if unit == "int":
+        return IntProperty(name=name, description=text, default=default, min=low, max=high, **kw)
     if unit == "deg":
         kw.update(subtype='ANGLE', default=math.radians(default), min=math.radians(low),
                   max=math.radians(high))
@@ -93,14 +98,19 @@ def solver_settings(settings):
         if key not in SETTING_PROPS:
             continue
         value = getattr(settings, key)
-        out[key] = _f(math.degrees(value) if unit == "deg" else value)
+        if unit in ("bool", "int"):
+            out[key] = bool(value) if unit == "bool" else int(value)
+        else:
+            out[key] = _f(math.degrees(value) if unit == "deg" else value)
     if out["min_bend_deg"] >= out["max_bend_deg"]:
         raise ValueError("the smallest bend must be smaller than the largest bend (Machine settings)")
     return out
 
 
 # core/settings.py keys shown in the panel (weld_tolerance stays automatic)
-SETTING_PROPS = ("min_segment", "max_bend_deg", "min_bend_deg", "contact_angle_deg", "torque_fraction")
+SETTING_PROPS = ("min_segment", "max_bend_deg", "min_bend_deg", "contact_angle_deg", "torque_fraction",
+                 "in_plane_tiebreak", "max_nodes", "relayer_rounds")
+ADVANCED_PROPS = ("in_plane_tiebreak", "max_nodes", "relayer_rounds")  # the panel's Advanced box
 
 
 def _assembly_step_changed(settings, context):
@@ -182,6 +192,12 @@ class WiresculptSettings(bpy.types.PropertyGroup):
     min_bend_deg: _setting("min_bend_deg", "Min Bend")
     contact_angle_deg: _setting("contact_angle_deg", "Contact Angle")
     torque_fraction: _setting("torque_fraction", "Torque Fraction")
+    in_plane_tiebreak: _setting("in_plane_tiebreak", "In-Plane Tie-Break")
+    max_nodes: _setting("max_nodes", "Max Search Nodes")
+    relayer_rounds: _setting("relayer_rounds", "Re-Layering Rounds")
+    show_advanced: BoolProperty(
+        name="Advanced", default=False,
+        description="Show the layering's search settings (tie-break, node budget, re-layering rounds)")
 
     # results display
     show_forces: BoolProperty(

@@ -38,6 +38,7 @@ KEYS = {
         "pending_stages": "pipeline", "warnings": "every stage",
         "crossings": "layering", "assembly_order": "layering", "assembly_steps": "layering",
         "two_hand_steps": "layering", "close_crossings": "layering", "required_size": "layering",
+        "search_incomplete": "layering",
         "out_of_plane": "forces", "load_capacity": "forces", "buildability": "pipeline",
         "fabrication": "fabrication",
     },
@@ -58,14 +59,15 @@ KEYS = {
     },
     "stages": {
         "slicing": "slicing", "layering": "layering", "target_shape": "target_shape",
-        "forces": "forces", "rest_shape": "forces",
+        "forces": "forces", "rest_shape": "forces", "relayering": "pipeline",
     },
 }
 
 # Keys written only in some cases (a stage that ran may leave them out): close crossings, a
 # material without density, a user's cut, the batch's exports.
 OPTIONAL = {
-    "top": {"close_crossings", "required_size", "load_capacity", "fabrication", "warnings", "buildability"},
+    "top": {"close_crossings", "required_size", "load_capacity", "fabrication", "warnings", "buildability",
+            "search_incomplete"},
     "wire": {"cut_override", "cut_point"},
     "crossing": set(),
     "stages": set(),

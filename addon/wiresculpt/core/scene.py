@@ -131,8 +131,17 @@ def _settings(value):
         if key == "cuts":
             out["cuts"] = _cuts(raw)
             continue
-        _default, low, high, _unit, _text = settings_table.SETTINGS[key]
-        out[key] = None if raw is None and _default is None else _number(raw, f"settings.{key}", low, high)
+        _default, low, high, unit, _text = settings_table.SETTINGS[key]
+        if unit == "bool":
+            if not isinstance(raw, bool):
+                raise ValueError(f'scene key "settings.{key}" must be true or false, got {json.dumps(raw)}')
+            out[key] = raw
+        elif unit == "int":
+            if isinstance(raw, bool) or not isinstance(raw, int):
+                raise ValueError(f'scene key "settings.{key}" must be a whole number, got {json.dumps(raw)}')
+            out[key] = int(_number(raw, f"settings.{key}", low, high))
+        else:
+            out[key] = None if raw is None and _default is None else _number(raw, f"settings.{key}", low, high)
     if out["min_bend_deg"] >= out["max_bend_deg"]:
         raise ValueError('scene key "settings.min_bend_deg" must be smaller than "settings.max_bend_deg"')
     return out

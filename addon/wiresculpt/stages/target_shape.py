@@ -117,6 +117,36 @@ class Memo:
         self.solves[key] = (max_bend, result)
 
 
+def unrealisable(design):
+    """The (crossing id, hook) pairs this stage could not realise (stages.target_shape's nulled
+    crossings), for the re-layering loop (pipeline.relayer) to forbid: the hook that failed, or
+    both hooks of a crossing "too_close" to a neighbour along its wire whose straight piece is
+    shorter than min_segment (the solver marks both ends of such a piece whatever their hooks). A
+    "too_close" crossing with a longer piece failed because that piece, fixed between the two
+    crossings, lies outside the kink this hook needs: the other hook may hold it. Empty when the
+    stage did not run."""
+    pairs = set()
+    for n in design["stages"].get("target_shape", {}).get("nulled_crossings", []):
+        short = n["status"] == "too_close" and _shortest_piece(design, n) < design["machine"]["min_segment"]
+        pairs.update((n["crossing"], h) for h in ((-1, 1) if short else (n["hook"],)))
+    return pairs
+
+
+def _shortest_piece(design, failure):
+    """The shorter straight piece (m) from a nulled crossing to its neighbouring crossings along the
+    wire it failed on (`failure["wire"]`, a name)."""
+    wire = next(w for w in design["wires"] if w["name"] == failure["wire"])
+    along = sorted((c["contour_vertices"][c["wires"].index(wire["id"])], c["id"]) for c in design["crossings"]
+                   if wire["id"] in c["wires"])
+    ids = [cid for _v, cid in along]
+    k = ids.index(failure["crossing"])
+    neighbours = [ids[k - 1] if k > 0 or wire["closed"] else None, ids[(k + 1) % len(ids)]
+                  if k + 1 < len(ids) or wire["closed"] else None]
+    point = np.asarray(design["crossings"][failure["crossing"]]["point"])
+    return min((float(np.linalg.norm(np.asarray(design["crossings"][o]["point"]) - point))
+                for o in neighbours if o is not None and o != failure["crossing"]), default=math.inf)
+
+
 def _ids(numbers):
     numbers = sorted(numbers)
     return ", ".join(map(str, numbers[:-1])) + f" and {numbers[-1]}" if len(numbers) > 1 else str(numbers[0])
@@ -167,7 +197,8 @@ def run(design, material, settings, native_progress=None, memo=None):
         for wire, (r, refs, _frame) in zip(design["wires"], solved):
             for (c, _k), status in zip(refs, r["crossings"]):
                 if c["hook"] != 0 and status["status"] in FAILED:
-                    failing.setdefault(c["id"], {"crossing": c["id"], "wire": wire["name"], "status": status["status"],
+                    failing.setdefault(c["id"], {"crossing": c["id"], "hook": c["hook"], "wire": wire["name"],
+                                                 "status": status["status"],
                                                  "scale": status["scale"], "message": status["message"]})
         if not failing:
             break

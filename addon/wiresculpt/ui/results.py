@@ -5,7 +5,7 @@ import math
 
 import bpy
 
-from .. import native
+from .. import native, props
 from ..blend import results as scene_results
 from ..blend.registration import classes_factory
 from ..operators import optimize
@@ -105,6 +105,11 @@ class VIEW3D_PT_wiresculpt_settings(_Child, bpy.types.Panel):
         col = layout.column(align=True)
         col.prop(ws, "contact_angle_deg")
         col.prop(ws, "torque_fraction")
+        box = layout.box()  # the layering's search knobs (docs/user-guide.md, Advanced)
+        box.prop(ws, "show_advanced", icon='TRIA_DOWN' if ws.show_advanced else 'TRIA_RIGHT', emboss=False)
+        if ws.show_advanced:
+            for key in props.ADVANCED_PROPS:
+                box.prop(ws, key)
 
 
 class VIEW3D_PT_wiresculpt_optimize(_Child, bpy.types.Panel):
@@ -142,7 +147,8 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
             box.label(text="Stable", icon='CHECKMARK')
         else:
             box.alert = True
-            box.label(text="Not stable", icon='ERROR')
+            # max_nodes stopped the layering: a stable design may exist (the reason says how to go on)
+            box.label(text="Search incomplete" if design.get("search_incomplete") else "Not stable", icon='ERROR')
             _wrap(box, context, design.get("reason") or "no reason given")
         rows = assembly_rows(design)
         if rows:
