@@ -100,8 +100,11 @@ def write_scene_outputs(design, objects, planes, factor, out, say):
         say("guide", f"{os.path.relpath(path, out)}, {len(design['assembly_steps'])} steps "
                      f"({time.perf_counter() - start:.3f} s)")
     path = os.path.abspath(os.path.join(out, "sculpture.blend"))
-    # Blender writes the .blend to a temporary name and renames it: atomic like the rest
-    bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False, compress=True)
+    # Blender writes the .blend to a temporary name and renames it: atomic like the rest.
+    # Uncompressed, so that the set's verification (core/staging.py) can see its end block.
+    if bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False, compress=False) != {'FINISHED'}:
+        raise OSError(f"Blender could not save {os.path.basename(path)} (is the disk full?); "
+                      "the earlier outputs are kept")
     say("blend", "sculpture.blend")
 
 
@@ -129,6 +132,7 @@ def run(argv):
 
     from wiresculpt import native, pipeline
     from wiresculpt.core.design import write_design
+    from wiresculpt.core.meshcheck import check_output_folder, check_vertices
     from wiresculpt.core.staging import staged
     from wiresculpt.core.scene import load_scene
     from wiresculpt.blend.mesh import import_mesh
@@ -137,11 +141,13 @@ def run(argv):
         print(f"wiresculpt: {stage}: {message}", flush=True)
 
     args = parse_args(argv)
+    check_output_folder(args.out)  # before any work: a full solve must not end in "cannot write"
     scene = load_scene(args.scene)
     native.require()
     bpy.ops.wm.read_factory_settings(use_empty=True)
     start = time.perf_counter()
     V, F, objects = import_mesh(scene.mesh)
+    check_vertices(V, scene.mesh, scene.size)  # NaN/inf, magnitudes, millimetres, before scaling
     factor = 1.0
     if scene.size is not None:
         extent = float(np.max(V.max(axis=0) - V.min(axis=0)))
