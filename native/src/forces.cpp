@@ -245,7 +245,7 @@ ForceProblem::ForceProblem(const Network& net, const std::vector<int>& hooks,
   }
   T_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), K);
   T3_ = Eigen::MatrixXd::Zero(3 * static_cast<Eigen::Index>(rows.size()), K);
-  for (std::size_t r = 0; r < rows.size(); ++r) {
+  for (std::size_t r = 0; K > 0 && r < rows.size(); ++r) {  // K = 0: nothing to copy (no data to index)
     T_.row(static_cast<Eigen::Index>(r)) = rows[r];
     T3_.middleRows(3 * static_cast<Eigen::Index>(r), 3) = frame_rows[r];
   }

@@ -15,6 +15,10 @@ void on_glpk_error(void*) {
   // reached; returning would let GLPK abort.
 }
 
+// GLPK prints its error messages even with terminal output off (it turns it on to report an
+// error); a terminal hook that claims every line keeps the core silent.
+int swallow_output(void*, const char*) { return 1; }
+
 }  // namespace
 
 unsigned glpk_generation() { return t_generation; }
@@ -22,6 +26,7 @@ unsigned glpk_generation() { return t_generation; }
 void configure_glpk() {
   if (t_configured == t_generation) return;
   glp_term_out(GLP_OFF);
+  glp_term_hook(swallow_output, nullptr);
   t_configured = t_generation;
 }
 

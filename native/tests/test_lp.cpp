@@ -4,8 +4,10 @@
 // guard covered the problem's construction and scaling, the 1e±300 cases below aborted this
 // binary in glp_set_rii / glp_set_sjj ("invalid scale factor").
 #include <glpk.h>
+#include <unistd.h>
 
 #include <catch2/catch.hpp>
+#include <cstdio>
 #include <limits>
 #include <vector>
 
@@ -88,7 +90,27 @@ TEST_CASE("lp: a GLPK internal error inside the guard returns, frees GLPK's envi
   // A warm-started problem made before the error loses its GLPK object with the environment.
   EqualityLp held(1, 2, {0, 0}, {0, 1}, {1.0, 1.0}, {1.0, 1.0});
   REQUIRE(held.solve({1.0}) == EqualityLp::Outcome::feasible);
-  CHECK_FALSE(run_guarded(bad_glpk_call, nullptr));
+  // The core never prints: GLPK's error report (it switches its terminal output on to print it)
+  // must reach neither stdout (where GLPK writes) nor stderr. Capture fds 1 and 2 around the call.
+  std::FILE* capture = std::tmpfile();
+  REQUIRE(capture);
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const int saved_out = ::dup(1), saved_err = ::dup(2);
+  ::dup2(::fileno(capture), 1);
+  ::dup2(::fileno(capture), 2);
+  const bool returned = run_guarded(bad_glpk_call, nullptr);
+  std::fflush(stdout);
+  std::fflush(stderr);
+  ::dup2(saved_out, 1);
+  ::dup2(saved_err, 2);
+  ::close(saved_out);
+  ::close(saved_err);
+  std::fseek(capture, 0, SEEK_END);
+  const long printed = std::ftell(capture);
+  std::fclose(capture);
+  CHECK_FALSE(returned);
+  CHECK(printed == 0);
   CHECK(glpk_generation() == before + 1);
   CHECK(held.solve({2.0}) == EqualityLp::Outcome::internal_error);  // and its destructor must not free it
   check_textbook();
