@@ -400,8 +400,14 @@ double TargetShapeProblem::imls(const Vec2& q, Vec2* grad) const {
   const double h2 = h_ * h_;
   double Phi = 0.0, N = 0.0;
   Vec2 dPhi = Vec2::Zero(), dN = Vec2::Zero();
-  const int cx = static_cast<int>(std::floor((q.x() - grid_origin_.x()) / cell_));
-  const int cy = static_cast<int>(std::floor((q.y() - grid_origin_.y()) / cell_));
+  // The cell of q; a point far outside the grid (or not finite, as an optimiser's trial point can
+  // be) maps to -2, so the loops below visit no cell (and no double is cast out of int's range).
+  const auto cell_of = [](double t, int n) {
+    const double f = std::floor(t);
+    return f >= -2.0 && f <= static_cast<double>(n) + 1.0 ? static_cast<int>(f) : -2;
+  };
+  const int cx = cell_of((q.x() - grid_origin_.x()) / cell_, grid_nx_);
+  const int cy = cell_of((q.y() - grid_origin_.y()) / cell_, grid_ny_);
   for (int iy = std::max(cy - 1, 0); iy <= std::min(cy + 1, grid_ny_ - 1); ++iy)
     for (int ix = std::max(cx - 1, 0); ix <= std::min(cx + 1, grid_nx_ - 1); ++ix) {
       const int cell = iy * grid_nx_ + ix;
