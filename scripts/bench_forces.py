@@ -43,7 +43,11 @@ def main(paths):
     for path in paths:
         scene, _V, _F, _planes, sliced = bench_scenes.load_and_slice(path)
         name = os.path.splitext(os.path.basename(path))[0]
-        for label, overrides, patterns in (("today", {"torque_fraction": 1.0}, 1), ("load factor 3", {}, None)):
+        if name == "scene":  # scripts/examples/NAME/scene.json
+            name = os.path.basename(os.path.dirname(os.path.abspath(path)))
+        # today: the plastic limit, the layering's first pattern, the force LP's vertex
+        today = {"torque_fraction": 1.0, "least_out_of_plane": False}
+        for label, overrides, patterns in (("today", today, 1), ("load factor 3", {}, None)):
             settings = {**scene.settings, **overrides}
             saved = pipeline.HOOK_PATTERNS
             if patterns is not None:
