@@ -199,7 +199,8 @@ def hooks_by_forces(design, material, settings, say, native_progress, checkpoint
     capacity, then the paper's out-of-plane measure. Bounded: at most `patterns` patterns, none
     started after `seconds`; `stages.hook_search` records patterns (equal cost, in all), checked,
     stable, solved, the chosen pattern's index (0: the layering's), its score, seconds and
-    `complete` (false, with a warning, when a bound cut the choice). `patterns` and `seconds`
+    `complete` (false, with a warning, when a bound cut the choice). The result is written into
+    `design` itself (and returned), as the stages do. `patterns` and `seconds`
     default to HOOK_PATTERNS and HOOK_SECONDS (read at the call)."""
     import copy
     import time
@@ -248,7 +249,9 @@ def hooks_by_forces(design, material, settings, say, native_progress, checkpoint
         say("forces", f"hooks by forces: pattern {chosen} of {checked} tried (weakest load "
                       f"{best_score[0]:.2f}x the weight at the plastic limit, out of plane "
                       f"{100 * best_score[1]:.1f}% of the largest force)")
-    return best
+    design.clear()  # callers keep the dict they passed (operators/optimize.py)
+    design.update(best)
+    return design
 
 
 def run(vertices, faces, planes, material, settings, progress=None, cancel=None):
