@@ -271,6 +271,12 @@ class OptimizeGlobe(Case):
                 self.assertIn(f"step_{k + 1:02d}.png", text)
             self.assertIn("Step 1: hold", text)
             self.assertTrue("passes" in text, text)
+            # how to close each loop: the gap between the rest shape's two ends, in mm and % of
+            # the wire's length, a sleeve up to 5% of it, else an overlap
+            for w in design["wires"]:
+                gap = math.dist(w["rest"][0], w["rest"][-1])
+                self.assertIn(f"stand {gap * 1000:.1f} mm apart ({100 * gap / w['length']:.1f}% of its length)", text)
+                self.assertIn("with a sleeve" if gap <= 0.05 * w["length"] else "with an overlap", text)
             self.assertFalse([n for n in os.listdir(folder) if n.endswith(".tmp") or n.startswith(".")])
         self.assertEqual(snapshot(), before, "rendering the guide must put the scene back")
 
