@@ -4,20 +4,14 @@
 #include <numbers>
 #include <vector>
 
+#include "wire_fixtures.hpp"
 #include "wiresculpt/deflection.hpp"
 #include "wiresculpt/error.hpp"
 
 using namespace wiresculpt;
 
 namespace {
-WireSpec open_wire(const Polyline3& points) {
-  WireSpec w;
-  w.name = "test";
-  w.plane = Plane::make(Vec3::Zero(), Vec3::UnitZ());
-  w.points = points;
-  w.closed = false;
-  return w;
-}
+WireSpec open_wire(const Polyline3& points) { return fixtures::flat_wire("test", points); }
 }  // namespace
 
 TEST_CASE("deflection: cantilever tip deflection P L^3 / (3 E I) out of plane", "[deflection]") {
