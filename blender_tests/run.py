@@ -9,6 +9,14 @@ With the system Python 3.11 (the one Blender embeds), the bpy-free suites (blend
 
     /usr/bin/python3.11 blender_tests/run.py pure [PATTERN...]
 
+With a Python that has the PyPI `bpy` (Blender as a module; scripts/test makes one venv per
+pinned version), the same Blender suites against that Blender:
+
+    VENV/bin/python blender_tests/run.py bpy [PATTERN...]
+
+There the tests that start a blender process or need a window are skipped (the module has neither);
+each reason is printed once with its count. The closing label is `bpy VERSION`.
+
 Only the modules whose names contain a PATTERN run when patterns are given.
 """
 import os
@@ -27,19 +35,34 @@ def native_missing():
     return "" if native.available() else native.LOAD_ERROR
 
 
+def bpy_module():
+    """Imports the PyPI bpy (before anything else touches Blender), marks the suites' helpers
+    so the tests needing the blender executable or a window skip, and returns the label."""
+    try:
+        import bpy
+    except ImportError as exc:
+        sys.exit(f"bpy: this Python ({sys.executable}) has no bpy module: {exc}")
+    import helpers
+
+    helpers.BPY_MODULE = True
+    return "bpy " + ".".join(map(str, bpy.app.version))
+
+
 def main():
     inside_blender = "bpy" in sys.modules
     if "--" in sys.argv:
         argv = sys.argv[sys.argv.index("--") + 1:]
     else:
         argv = [] if inside_blender else sys.argv[1:]
-    pure = bool(argv) and argv[0] == "pure"
-    if pure:
+    mode = argv[0] if argv and argv[0] in ("pure", "bpy") else ""
+    if mode:
         argv = argv[1:]
-    label, folder = ("pure", os.path.join(HERE, "pure")) if pure else ("blender", HERE)
+    label, folder = ("pure", os.path.join(HERE, "pure")) if mode == "pure" else ("blender", HERE)
     for path in (folder, HERE, os.path.join(ROOT, "addon"), os.path.join(ROOT, "scripts")):
         if path not in sys.path:
             sys.path.insert(0, path)
+    if mode == "bpy":
+        label = bpy_module()
     missing = native_missing()
     if missing:
         print(f"{label}: the solver is missing: {missing}")
@@ -55,12 +78,25 @@ def main():
     result = unittest.TextTestRunner(stream=sys.stdout, verbosity=2).run(suite)
     failed = len(result.failures) + len(result.errors) + len(result.unexpectedSuccesses) + bool(missing)
     skipped = len(result.skipped)
+    reasons = {}
+    for _test, reason in result.skipped:
+        reasons[reason] = reasons.get(reason, 0) + 1
+    if mode == "bpy":  # the per-test lines above say it too; this is the summary, once a reason
+        for reason, n in sorted(reasons.items()):
+            print(f"{label}: {n} skipped: {reason}")
     passed = max(0, result.testsRun - failed - skipped)  # a failed setUpClass is not a test run
     sys.stdout.flush()
     print(f"{label}: {passed} passed, {failed} failed, {skipped} skipped" if skipped
           else f"{label}: {passed} passed, {failed} failed")
     sys.stdout.flush()
-    if failed or result.testsRun == 0:
+    code = 1 if failed or result.testsRun == 0 else 0
+    if mode == "bpy":
+        # The PyPI bpy (4.2 and later) crashes while Python shuts down once a scene PropertyGroup
+        # has a dynamic EnumProperty (items=callback), ours or not (a 7-line script does it); the
+        # results are all written, so leave without the interpreter's teardown.
+        sys.stderr.flush()
+        os._exit(code)
+    if code:
         sys.exit(1)
 
 

@@ -17,22 +17,7 @@ from wiresculpt.blend import handles as blend_handles
 from wiresculpt.operators import slicing
 from wiresculpt.ui import panel
 
-from helpers import FakeLayout, draw
-
-
-def register_addon():
-    if wiresculpt._modules:  # registered already (by another suite or a previous run)
-        wiresculpt.unregister()
-    wiresculpt.register()
-
-
-def clear_scene():
-    for collection in (bpy.data.objects, bpy.data.meshes, bpy.data.curves, bpy.data.collections):
-        for block in list(collection):
-            collection.remove(block)
-    settings = bpy.context.scene.wiresculpt
-    settings.contours.clear()
-    settings.target = None
+from helpers import BlenderCase, FakeLayout, clear_scene, draw, register_addon
 
 
 def uv_sphere(radius=1.0, location=(0, 0, 0)):
@@ -81,19 +66,7 @@ def contour_objects():
     return [o for o in bpy.data.objects if blend_contours.CONTOUR_KEY in o]
 
 
-class AddonCase(unittest.TestCase):
-    @classmethod
-    def setUpClass(cls):
-        register_addon()
-
-    @classmethod
-    def tearDownClass(cls):
-        clear_scene()
-        wiresculpt.unregister()
-
-    def setUp(self):
-        clear_scene()
-
+class AddonCase(BlenderCase):
     def assertLengthNear(self, actual, expected, rel=0.01):
         self.assertLess(abs(actual - expected), rel * expected,
                         f"length {actual:.6f} differs from {expected:.6f} by more than {rel:.0%}")
@@ -332,6 +305,37 @@ class Registration(AddonCase):
         self.assertEqual(labels[0], "Slice A #0")
         self.assertIn("1.25", labels[1])
         self.assertIn("m", labels[1])
+
+    def test_long_plane_names_show_in_full(self):
+        """A plane name the sidebar would cut ("Meri…") is shown whole in the details box of the
+        active contour, wrapped to lines that fit the region (issue 21, part 6)."""
+        settings = bpy.context.scene.wiresculpt
+        settings.contours.clear()
+        name = "Meridian through both poles at ninety degrees"
+        for k in range(2):
+            item = settings.contours.add()
+            item.plane, item.index, item.length, item.closed, item.use = name, k, 0.785, True, k == 1
+        settings.active_contour = 1
+        log = draw_panel()
+        boxed = [kw.get("text") for method, _a, kw in log if method == "label"]
+        text = " ".join(t for t in boxed if t)
+        self.assertIn(f'Plane "{name}", contour 1', text)
+        self.assertIn("ticked: it becomes a wire", text)
+        width = panel.line_chars(bpy.context)
+        for line in boxed:
+            self.assertLessEqual(len(line or ""), max(20, int(width)), line)
+        settings.active_contour = 0
+        self.assertIn("not ticked", " ".join(kw.get("text") or "" for m, _a, kw in draw_panel() if m == "label"))
+        # a row in Blender's default (narrow) sidebar: the name alone, the length is in the box
+        import types
+        for width, expected in ((200, 1), (400, 2)):
+            log = []
+            narrow = types.SimpleNamespace(region=types.SimpleNamespace(width=width), scene=bpy.context.scene)
+            panel.WIRESCULPT_UL_contours.draw_item(None, narrow, FakeLayout(log), settings,
+                                                    settings.contours[0], 0, settings, "active_contour")
+            labels = [kw.get("text") for method, _a, kw in log if method == "label"]
+            self.assertEqual(len(labels), expected, labels)
+            self.assertEqual(labels[0], f"{name} #0")
 
 
 class WithoutNative(AddonCase):

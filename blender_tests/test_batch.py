@@ -91,7 +91,8 @@ class BatchTest(unittest.TestCase):
         for c in d["crossings"]:
             self.assertEqual(len(c["force"]), 3)
         self.check_targets(d)
-        for folder, ext in (("svg", ".svg"), ("dxf", ".dxf"), ("gcode", ".gcode"), ("bends", ".csv")):
+        for folder, ext in (("svg", ".svg"), ("dxf", ".dxf"), ("gcode", ".gcode"), ("bends", ".csv"),
+                            ("bendlist", ".txt")):
             names = os.listdir(os.path.join(self.out, folder))
             self.assertTrue(names and all(n.endswith(ext) for n in names), (folder, names))
         self.assertEqual(len(d["fabrication"]["wires"]), 3)
@@ -188,6 +189,41 @@ class BatchTest(unittest.TestCase):
                 with open(os.path.join(self.dir.name, name), "w") as f:
                     f.write(text)
                 self.assertFailsWith(fragment, self.scene(mesh=name, planes=[{"origin": [0, 0, 0], "normal": [0, 0, 1]}]))
+
+    def test_machine_profile_from_the_scene_or_the_command_line(self):
+        """A saved machine profile reaches the fabrication files: the scene's "machine_profile"
+        (relative to the scene file), overridden by --profile; a missing one is refused first."""
+        with open(GLOBE) as f:
+            globe = json.load(f)
+        globe["mesh"] = os.path.join(os.path.dirname(GLOBE), globe["mesh"])
+        for name, a, paper in (("scene.json-bender", 0.9, "Letter"), ("option-bender", 0.95, "A4")):
+            with open(os.path.join(self.dir.name, name + ".json"), "w") as f:
+                json.dump({"format": "wiresculpt-machine-profile", "version": 1, "name": name,
+                           "springback_a": a, "springback_b_deg": -2.0, "paper": paper}, f)
+        scene = self.scene(**globe, machine_profile="scene.json-bender.json")
+        runs = (((), "scene.json-bender", 0.9, "215.900mm"),
+                (("--profile", os.path.join(self.dir.name, "option-bender.json")), "option-bender", 0.95, "210.000mm"))
+        for extra, name, a, width in runs:
+            with self.subTest(name):
+                r = run_blender(BATCH, scene, "--out", self.out, *extra)
+                self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+                self.assertIn(f"wiresculpt: profile: {name} (", r.stdout)
+                gcode = os.path.join(self.out, "gcode")
+                for g in os.listdir(gcode):
+                    with open(os.path.join(gcode, g)) as f:
+                        self.assertIn(f"measured = {a:.4f} * commanded + -2.000 deg", f.read())
+                pages = os.path.join(self.out, "templates", "pages")
+                with open(os.path.join(pages, sorted(os.listdir(pages))[0])) as f:
+                    self.assertIn(f'width="{width}"', f.read())
+        missing = self.scene(**globe, machine_profile="nowhere.json")
+        self.out = os.path.join(self.dir.name, "out-missing")
+        self.assertFailsWith('"machine_profile": file not found', missing)
+        os.remove(os.path.join(self.dir.name, "option-bender.json"))
+        scene = self.scene(**globe, machine_profile="scene.json-bender.json")
+        r = run_blender(BATCH, scene, "--out", os.path.join(self.dir.name, "out2"), "--profile",
+                        os.path.join(self.dir.name, "option-bender.json"))
+        self.assertEqual(r.returncode, 1, r.stdout + r.stderr)
+        self.assertIn("option-bender.json does not exist", r.stderr)
 
     def test_missing_arguments(self):
         r = run_blender(BATCH)

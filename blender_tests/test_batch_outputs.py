@@ -3,10 +3,14 @@ next to design.json, from a separate headless Blender as a user runs it."""
 import json
 import os
 import re
+import subprocess
 import tempfile
 import unittest
 
-from helpers import BATCH, ROOT, run_blender, wiresculpt_lines
+import numpy as np
+
+from helpers import BATCH, ROOT, run_blender, run_under_xvfb, wiresculpt_lines
+from wiresculpt.core import blendfile
 
 GLOBE = os.path.join(ROOT, "scripts", "examples", "globe", "scene.json")
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -85,3 +89,55 @@ class BatchOutputs(unittest.TestCase):
             self.assertAlmostEqual(bevel, 0.0015, places=7)
         self.assertEqual(found["optimize"], ["FINISHED"])
         self.assertEqual(found["after"], 3)
+
+    def test_blend_opens_framed_on_the_wire_tab_with_the_first_wire_selected(self):
+        """Opened in a Blender with a window (the add-on enabled) and drawn: the 3D view looks at
+        the sculpture's centre from within 3 model sizes, its sidebar is open, the first wire is
+        selected and active, and the sidebar shows the Wire tab (Blender 3.4 has no Python for the
+        tab: drawing replaces a tab that is not there by the first one there is, and the copy
+        Blender saves after drawing holds the region's tab stack)."""
+        with open(os.path.join(self.out, "design.json")) as f:
+            design = json.load(f)
+        points = np.concatenate([np.asarray(w["target"]) for w in design["wires"]])
+        lo, hi = points.min(axis=0), points.max(axis=0)
+        size, centre = float((hi - lo).max()), (lo + hi) / 2  # from the design, not from Blender
+        self.assertGreater(size, 0.05)
+        path = os.path.join(self.out, "sculpture.blend")
+        # every 3D view of every screen in the file remembers the Wire tab
+        saved = blendfile.read(path)
+        sidebars = saved.view3d_sidebars()
+        self.assertGreater(len(sidebars), 1)
+        for screen, region in sidebars:
+            self.assertEqual(saved.sidebar_tabs(region)[:1], ["Wire"], screen)
+        copy = os.path.join(self.dir.name, "drawn.blend")
+        r, seen = run_under_xvfb(os.path.join(ROOT, "blender_tests", "ui_open_blend.py"), "MODAL ",
+                                 args=(path, copy))
+        self.assertIsNotNone(seen, r.stdout + r.stderr)
+        self.assertNotIn("error", seen)
+        self.assertEqual(len(seen["views"]), 1, seen)
+        view = seen["views"][0]
+        self.assertTrue(view["sidebar"])
+        self.assertLessEqual(view["distance"], 3 * size)
+        self.assertGreaterEqual(view["distance"], 0.5 * size)  # not inside the sculpture either
+        self.assertLess(float(np.linalg.norm(np.asarray(view["centre"]) - centre)), 0.1 * size)
+        first = "Wire " + design["wires"][0]["name"]
+        self.assertEqual(seen["active"], first)
+        self.assertEqual(seen["selected"], [first])
+        drawn = blendfile.read(copy)
+        tabs = [drawn.sidebar_tabs(region) for screen, region in drawn.view3d_sidebars() if screen == seen["screen"]]
+        self.assertEqual(tabs, [["Wire"]])
+
+    def test_demo_closing_lines_list_every_output(self):
+        """The demo's closing lines (scripts/lib.sh summarize_outputs) on this run's folder: one
+        line per file and folder the run wrote, each folder with its slash and what it holds."""
+        r = subprocess.run(["bash", "-c", 'source "$1/scripts/lib.sh"; summarize_outputs "$2" 0', "bash", ROOT,
+                            self.out], capture_output=True, text=True)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        lines = r.stderr.splitlines()
+        entries = sorted(os.listdir(self.out))
+        for folder in ("svg", "dxf", "templates", "gcode", "bends", "bendlist", "assembly"):
+            self.assertIn(folder, entries)
+        for name in entries:
+            label = name + "/" if os.path.isdir(os.path.join(self.out, name)) else name
+            [line] = [l for l in lines if l.split()[1:2] == [label]]
+            self.assertGreater(len(line.split()), 3, f"{label} is listed without saying what it holds")

@@ -252,8 +252,10 @@ class OperatorTest(unittest.TestCase):
             f.write("commanded_deg,measured_deg\n10,8.8\n50,45.6\n90,82.4\n")
         self.assertEqual(bpy.ops.wiresculpt.calibration_load(filepath=springback, kind='SPRINGBACK'), {'FINISHED'})
         out = os.path.join(self.tmp.name, "bender.json")
+        scene.wiresculpt.machine_profile = ""
         self.assertEqual(bpy.ops.wiresculpt.calibration_save_profile(filepath=out), {'FINISHED'})
         self.assertAlmostEqual(cal.load_profile(out)["springback_a"], self.store.results(scene)["springback"]["springback_a"])
+        self.assertEqual(scene.wiresculpt.machine_profile, out)  # selected for Export and Send
 
     def test_malformed_capture_is_cancelled_naming_the_line(self):
         bad = os.path.join(self.tmp.name, "bad.csv")

@@ -100,7 +100,7 @@ class FabricationOperators(unittest.TestCase):
             stem = export.file_stem(wire)
             for rel in (f"svg/{stem}.svg", f"gcode/{stem}.gcode", f"bends/{stem}.csv"):
                 self.assertTrue(os.path.isfile(os.path.join(out, rel)), rel)
-        for rel in ("svg/sheet.svg", "dxf/sculpture.dxf"):
+        for rel in ("templates/sheet.svg", "dxf/sculpture.dxf"):
             self.assertTrue(os.path.isfile(os.path.join(out, rel)), rel)
         self.assertEqual(glob.glob(os.path.join(out, "*", "*.tmp*")), [])
         bends = 0

@@ -16,6 +16,7 @@ from wiresculpt import native, pipeline, props
 from wiresculpt.blend import guide as assembly_guide
 from wiresculpt.blend import results as scene_results
 from wiresculpt.core import materials, settings as settings_table
+from wiresculpt.core.design import crossing_direction
 from wiresculpt.blend.mesh import import_mesh
 from wiresculpt.operators import optimize
 from wiresculpt.ui import overlay
@@ -136,7 +137,7 @@ class OptimizeGlobe(Case):
         for c in design["crossings"]:
             if not c["hook"]:
                 continue
-            dirn = scene_results.hook_direction(design, c)
+            dirn = crossing_direction(design, c)
             ends = []
             for k in (0, 1):
                 wire = design["wires"][c["wires"][k]]
@@ -401,6 +402,44 @@ class Panels(Case):
         ops = [a[0] for n, a, _k in draw(results_ui.VIEW3D_PT_wiresculpt_optimize) if n == "operator"]
         self.assertEqual(ops, ["wiresculpt.optimize"])
         self.assertFalse(results_ui.VIEW3D_PT_wiresculpt_report.poll(bpy.context))
+
+    def test_advanced_box_holds_the_search_knobs(self):
+        ws = bpy.context.scene.wiresculpt
+        props_drawn = lambda: [a[1] for n, a, _k in draw(results_ui.VIEW3D_PT_wiresculpt_settings) if n == "prop"]
+        self.assertIn("show_advanced", props_drawn())
+        self.assertNotIn("max_nodes", props_drawn())  # closed by default
+        ws.show_advanced = True
+        try:
+            self.assertLessEqual({"in_plane_tiebreak", "max_nodes", "relayer_rounds"}, set(props_drawn()))
+        finally:
+            ws.property_unset("show_advanced")
+        # The panel's values reach the solver's settings, typed as the scene file's.
+        ws.max_nodes, ws.relayer_rounds, ws.in_plane_tiebreak = 1234, 0, True
+        try:
+            s = props.solver_settings(ws)
+            self.assertEqual((s["max_nodes"], s["relayer_rounds"], s["in_plane_tiebreak"]), (1234, 0, True))
+            self.assertIs(type(s["max_nodes"]), int)
+        finally:
+            for key in ("max_nodes", "relayer_rounds", "in_plane_tiebreak"):
+                ws.property_unset(key)
+
+    @unittest.skipUnless(native.available(), "the native module is not built")
+    def test_max_nodes_reached_reads_search_incomplete(self):
+        # The panel's node budget reaches the layering; one node cannot finish three rings.
+        globe()
+        ws = bpy.context.scene.wiresculpt
+        ws.max_nodes = 1
+        try:
+            bpy.ops.wiresculpt.optimize()
+        finally:
+            ws.property_unset("max_nodes")
+        design = scene_results.stored_design()
+        self.assertFalse(design["stable"])
+        self.assertTrue(design.get("search_incomplete"))
+        self.assertTrue(design["reason"].startswith("search incomplete"), design["reason"])
+        shown = labels(draw(results_ui.VIEW3D_PT_wiresculpt_report))
+        self.assertIn("Search incomplete", shown)
+        self.assertNotIn("Not stable", shown)
 
     @unittest.skipUnless(native.available(), "the native module is not built")
     def test_result_panel_shows_forces_toggle_only_with_forces(self):

@@ -1,11 +1,78 @@
-"""The packaged zip installs into a clean user scripts folder and loads its compiled module."""
+"""The packaged zips: the add-on zip installs into a clean user scripts folder and loads its
+compiled module (the Blender executable); both zips carry their own solver libraries, and a failed
+load says what is wrong; the extension zip passes Blender's own manifest check, installs into a
+temporary extension repository through Blender's extension API, enables and Optimizes the bundled
+globe (Blender 4.2+, e.g. the PyPI bpy)."""
 import os
+import re
+import shutil
 import subprocess
+import sys
 import tempfile
 import textwrap
 import unittest
 
-from helpers import ROOT, run_blender
+from helpers import GLOBE_OBJ, GLOBE_RADIUS, ROOT, run_blender
+
+
+def package(out_dir):
+    """(add-on zip, extension zip) written by scripts/package.py into out_dir."""
+    made = subprocess.run(["/usr/bin/python3.11", os.path.join(ROOT, "scripts", "package.py"), out_dir],
+                          capture_output=True, text=True)
+    if made.returncode != 0:
+        raise AssertionError("scripts/package.py failed: " + made.stderr)
+    addon_zip, extension_zip = made.stdout.split()
+    return addon_zip, extension_zip
+
+
+def extensions_api():
+    """A sentence when this Blender has no extension API to install through, else ""."""
+    import bpy
+
+    if not hasattr(bpy.context.preferences, "extensions") or \
+            "package_install_files" not in dir(bpy.ops.extensions):
+        return f"Blender {bpy.app.version_string} has no extensions (4.2+)"
+    return ""
+
+
+REPO = "wiresculpt_test"
+INSTALL = textwrap.dedent("""
+    import importlib, math, os, sys
+    import bpy
+    zip_path, repo_dir, globe_obj, radius = sys.argv[sys.argv.index("--") + 1:]
+    repo = bpy.context.preferences.extensions.repos.new(
+        name="wiresculpt test", module="%(repo)s", custom_directory=repo_dir, source='USER')
+    result = bpy.ops.extensions.package_install_files(filepath=zip_path, repo=repo.module,
+                                                      enable_on_install=True)
+    assert result == {'FINISHED'}, f"the install returned {result}"
+    name = "bl_ext.%(repo)s.wiresculpt"
+    assert name in bpy.context.preferences.addons, f"{name} is not enabled after the install"
+    native = importlib.import_module(name + ".native")
+    assert native.module is not None, native.LOAD_ERROR
+    assert native.__file__.startswith(os.path.realpath(repo_dir)) or native.__file__.startswith(repo_dir), native.__file__
+    assert "wiresculpt" not in sys.modules, "the source tree's package was imported"
+    mesh = importlib.import_module(name + ".blend.mesh")
+    results = importlib.import_module(name + ".blend.results")
+    _V, _F, objects = mesh.import_mesh(globe_obj)
+    target = objects[0]
+    target.scale = (float(radius),) * 3
+    bpy.context.view_layer.update()
+    bpy.context.scene.wiresculpt.target = target
+    for rotation in ((0, 0, 0), (0, math.pi / 2, 0), (math.pi / 2, 0, 0)):
+        assert bpy.ops.wiresculpt.add_plane() == {'FINISHED'}
+        bpy.context.view_layer.objects.active.rotation_euler = rotation
+    assert bpy.ops.wiresculpt.slice() == {'FINISHED'}
+    assert bpy.ops.wiresculpt.optimize() == {'FINISHED'}
+    design = results.stored_design()
+    assert design is not None and design["stable"], design and design["reason"]
+    with open("/proc/self/maps") as f:  # the solver's libraries come from the extension's libs/
+        mapped = {line.split()[-1] for line in f if "/" in line.split()[-1]}
+    solver = [p for p in mapped if os.path.basename(p).startswith(("libglpk", "libnlopt", "libserialport"))]
+    outside = [p for p in solver if not os.path.realpath(p).startswith(os.path.realpath(repo_dir))]
+    assert solver and not outside, f"solver libraries loaded from outside the extension: {outside or 'none loaded'}"
+    print("EXTENSION-OK", len(design["wires"]), "wires", flush=True)
+    os._exit(0)  # the bpy module crashes in Python's teardown with a dynamic enum registered (run.py)
+""") % {"repo": REPO}
 
 CHECK = textwrap.dedent("""
     import sys, addon_utils, bpy
@@ -20,6 +87,44 @@ CHECK = textwrap.dedent("""
     assert hasattr(bpy.types.Scene, "wiresculpt"), "the settings are not registered"
     print("PACKAGE-OK", native.module.__version__)
 """)
+
+
+# The globe example through the installed add-on, with a check of where every solver library
+# was loaded from (/proc/self/maps: the mapped files of this process).
+OPTIMIZE = textwrap.dedent("""
+    import math, os, sys, addon_utils, bpy
+    zip_path, user, globe_obj = sys.argv[sys.argv.index("--") + 1:]
+    bpy.ops.preferences.addon_install(filepath=zip_path)
+    assert addon_utils.enable("wiresculpt", default_set=True) is not None, "the add-on did not enable"
+    import wiresculpt, wiresculpt.native as native
+    assert wiresculpt.__file__.startswith(user), wiresculpt.__file__
+    assert native.available(), native.LOAD_ERROR
+    from wiresculpt.blend.mesh import import_mesh
+    _V, _F, objects = import_mesh(globe_obj)
+    objects[0].scale = (0.125,) * 3
+    bpy.context.view_layer.update()
+    bpy.context.scene.wiresculpt.target = objects[0]
+    for rotation in ((0, 0, 0), (0, math.pi / 2, 0), (math.pi / 2, 0, 0)):
+        bpy.ops.wiresculpt.add_plane()
+        bpy.context.view_layer.objects.active.rotation_euler = rotation
+    assert bpy.ops.wiresculpt.slice() == {'FINISHED'}
+    assert bpy.ops.wiresculpt.optimize() == {'FINISHED'}
+    wires = [o for o in bpy.context.scene.objects if o.type == 'CURVE']
+    with open("/proc/self/maps") as f:
+        mapped = sorted({line.split()[-1] for line in f if "/" in line.split()[-1]})
+    solver = [p for p in mapped if os.path.basename(p).startswith(("libglpk", "libnlopt", "libserialport", "_wiresculpt"))]
+    print("LOADED", *solver)
+    print("WIRES", len(wires))
+""")
+
+GLIBC = {"ld-linux-x86-64.so.2", "libc.so.6", "libm.so.6", "libpthread.so.0", "libdl.so.2", "librt.so.1"}
+
+
+def readelf(path):
+    """(NEEDED entries, RUNPATH/RPATH) of an ELF file, parsed from readelf -d."""
+    out = subprocess.run(["readelf", "-d", path], capture_output=True, text=True, check=True).stdout
+    return (re.findall(r"\(NEEDED\)\s+Shared library: \[([^\]]+)\]", out),
+            re.findall(r"\((?:RUNPATH|RPATH)\)\s+Library (?:runpath|rpath): \[([^\]]+)\]", out))
 
 
 class PackageTest(unittest.TestCase):
@@ -41,10 +146,7 @@ class PackageTest(unittest.TestCase):
 
     def test_zip_installs_and_loads(self):
         with tempfile.TemporaryDirectory() as tmp:
-            made = subprocess.run(["/usr/bin/python3.11", os.path.join(ROOT, "scripts", "package.py"), tmp],
-                                  capture_output=True, text=True)
-            self.assertEqual(made.returncode, 0, made.stderr)
-            zip_path = made.stdout.strip()
+            zip_path, _extension = package(tmp)
             self.assertRegex(os.path.basename(zip_path), r"^wiresculpt-\d+\.\d+\.\d+-linux-x86_64\.zip$")
             user = os.path.join(tmp, "user")
             script = os.path.join(tmp, "check.py")
@@ -53,6 +155,140 @@ class PackageTest(unittest.TestCase):
             r = run_blender(script, zip_path, user, env={"BLENDER_USER_SCRIPTS": user})
             self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
             self.assertIn("PACKAGE-OK", r.stdout)
+
+    def assert_carries_solver(self, zip_path, package_dir):
+        """Every NEEDED entry of every ELF file in the zip is in the zip or glibc, GLPK, NLopt and
+        libserialport are in `package_dir`/libs, and every ELF file has an $ORIGIN run path (the
+        module's is $ORIGIN/libs). Returns (the unpacked folder, the unpacked package folder)."""
+        unpacked = os.path.join(os.path.dirname(zip_path), "unpacked-" + os.path.basename(zip_path))
+        shutil.unpack_archive(zip_path, unpacked)
+        package_folder = os.path.join(unpacked, package_dir)
+        bundled = set(os.listdir(os.path.join(package_folder, "libs")))
+        for name in ("libglpk", "libnlopt", "libserialport"):
+            self.assertTrue(any(b.startswith(name + ".so") or b.startswith(name + "_cxx.so") for b in bundled),
+                            f"{name} is not bundled: {sorted(bundled)}")
+        elves = [os.path.join(d, n) for d, _s, files in os.walk(unpacked) for n in files if ".so" in n]
+        self.assertGreater(len(elves), 3)
+        for path in elves:
+            entries, runpaths = readelf(path)
+            outside = [n for n in entries if n not in bundled and n not in GLIBC]
+            self.assertEqual(outside, [], f"{os.path.relpath(path, unpacked)} needs libraries outside the zip")
+            self.assertTrue(runpaths and runpaths[0].startswith("$ORIGIN"), f"{path}: run path {runpaths}")
+        module = next(n for n in os.listdir(package_folder) if n.startswith("_wiresculpt"))
+        self.assertEqual(readelf(os.path.join(package_folder, module))[1], ["$ORIGIN/libs"])
+        return unpacked, package_folder
+
+    def test_zip_carries_its_solver(self):
+        """The add-on zip carries its solver (assert_carries_solver); installed into a fresh user
+        folder and run with LD_LIBRARY_PATH cleared, the add-on loads GLPK, NLopt and libserialport
+        from its own folder (not the system's) and optimizes the globe."""
+        with tempfile.TemporaryDirectory() as tmp:
+            zip_path, _extension = package(tmp)
+            self.assert_carries_solver(zip_path, "wiresculpt")
+            user = os.path.join(tmp, "user")
+            script = os.path.join(tmp, "optimize.py")
+            with open(script, "w") as f:
+                f.write(OPTIMIZE)
+            r = run_blender(script, zip_path, user, GLOBE_OBJ, timeout=600,
+                            env={"LD_LIBRARY_PATH": None, "BLENDER_USER_SCRIPTS": user})
+            self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+            loaded = next(line for line in r.stdout.splitlines() if line.startswith("LOADED")).split()[1:]
+            for name in ("libglpk", "libnlopt", "libserialport", "_wiresculpt"):
+                paths = [p for p in loaded if os.path.basename(p).startswith(name)]
+                self.assertTrue(paths, f"{name} was not loaded: {loaded}")
+                for p in paths:
+                    self.assertTrue(p.startswith(user), f"{name} came from {p}, not from the installed add-on")
+            wires = int(next(line for line in r.stdout.splitlines() if line.startswith("WIRES")).split()[1])
+            self.assertGreaterEqual(wires, 3)
+
+    def test_extension_zip_carries_its_solver(self):
+        """The extension zip, whose files sit at its top level, carries the same libraries in libs/
+        with the same run paths."""
+        with tempfile.TemporaryDirectory() as tmp:
+            _addon, extension_zip = package(tmp)
+            self.assert_carries_solver(extension_zip, "")
+
+
+class LoadErrorTest(unittest.TestCase):
+    """A real failed import, made in a copy of the zip, turned into the sentence the panel shows."""
+
+    def load_error(self, folder):
+        code = "import wiresculpt.native as n; print(n.LOAD_ERROR)"
+        r = subprocess.run(["/usr/bin/python3.11", "-c", code], capture_output=True, text=True,
+                           env={**os.environ, "PYTHONPATH": folder}, cwd=folder)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        return r.stdout.strip()
+
+    def test_other_python_and_missing_library(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            zip_path, _extension = package(tmp)
+            folder = os.path.join(tmp, "unpacked")
+            shutil.unpack_archive(zip_path, folder)
+            addon = os.path.join(folder, "wiresculpt")
+            module = next(n for n in os.listdir(addon) if n.startswith("_wiresculpt"))
+            self.assertEqual(self.load_error(folder), "")
+            # the module's NEEDED entry for GLPK renamed to a library that exists nowhere
+            glpk = next(n for n in readelf(os.path.join(addon, module))[0] if n.startswith("libglpk"))
+            subprocess.run(["patchelf", "--replace-needed", glpk, "libglpk_gone.so.40", os.path.join(addon, module)],
+                           check=True)
+            message = self.load_error(folder)
+            self.assertIn("libglpk_gone.so.40 is missing", message)
+            self.assertIn("install the zip again", message)
+            # the same module named for Python 3.10: Python 3.11 does not import it
+            os.rename(os.path.join(addon, module), os.path.join(addon, "_wiresculpt.cpython-310-x86_64-linux-gnu.so"))
+            message = self.load_error(folder)
+            self.assertIn("this build is for Python 3.10; this Python uses 3.11", message)
+            self.assertIn("build from source with scripts/package", message)
+
+
+class ExtensionTest(unittest.TestCase):
+    """The extension zip through Blender's own tools: the manifest validator of the extension
+    CLI (strict, as the extensions platform checks it) and the Install from Disk operator into a
+    temporary repository, in a fresh Python with this bpy and its own user folder."""
+
+    @classmethod
+    def setUpClass(cls):
+        import bpy
+
+        reason = extensions_api()
+        if reason:
+            raise unittest.SkipTest(reason)
+        if bpy.app.binary_path:
+            raise unittest.SkipTest("runs with the bpy module (a fresh `python` with bpy per "
+                                    "check); the Blender executable has its own CLI for this")
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.addon_zip, cls.zip = package(cls.tmp.name)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def run_python(self, *args, cwd=None):
+        user = os.path.join(self.tmp.name, "user")
+        env = {**os.environ, "BLENDER_USER_RESOURCES": user, "PYTHONPATH": ""}
+        return subprocess.run([sys.executable, *args], capture_output=True, text=True, cwd=cwd or self.tmp.name,
+                              env=env, timeout=600)
+
+    def test_blender_validates_the_manifest(self):
+        import bpy
+
+        cli = os.path.join(bpy.utils.system_resource('SCRIPTS'), "addons_core", "bl_pkg", "cli",
+                           "blender_ext.py")
+        self.assertTrue(os.path.isfile(cli), f"Blender's extension CLI is not at {cli}")
+        r = self.run_python(cli, "validate", self.zip)
+        self.assertEqual(r.returncode, 0, f"Blender rejects the manifest: {r.stdout}{r.stderr}")
+
+    def test_installs_enables_and_optimizes_the_globe(self):
+        script = os.path.join(self.tmp.name, "install.py")
+        with open(script, "w") as f:
+            f.write(INSTALL)
+        repo = os.path.join(self.tmp.name, "repo")
+        r = self.run_python(script, "--", self.zip, repo, GLOBE_OBJ, str(GLOBE_RADIUS))
+        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+        self.assertIn("EXTENSION-OK 3 wires", r.stdout)
+        warned = [line for line in (r.stdout + r.stderr).splitlines()
+                  if "deprecat" in line.lower()]
+        self.assertEqual(warned, [], "deprecation warnings while the add-on installs and runs")
 
 
 if __name__ == "__main__":

@@ -42,7 +42,7 @@ class Hold:
         self.cancelled_in = None
         module.run = self.run
 
-    def run(self, design, material, settings, native_progress=None):
+    def run(self, design, material, settings, native_progress=None, **options):
         def progress(stage, fraction):
             if stage == self.native_stage and not self.inside.is_set():
                 self.inside.set()
@@ -54,7 +54,7 @@ class Hold:
             if not go_on and self.cancelled_in is None:
                 self.cancelled_in = stage
             return go_on
-        return self.original(design, material, settings, progress)
+        return self.original(design, material, settings, progress, **options)
 
     def restore(self):
         self.module.run = self.original

@@ -17,7 +17,17 @@ PACKAGES=(
   blender python3.11 python3-dev python3-numpy
   libeigen3-dev pybind11-dev catch2
   libglpk-dev libnlopt-cxx-dev libserialport-dev
+  patchelf binutils  # scripts/package bundles the solver's libraries with an $ORIGIN run path
 )
+
+# Blender as a Python module (PyPI `bpy`, built for Python 3.11 like our module), one venv per
+# pinned version under BPY_CACHE, reused when present: 4.2 LTS (the first with extensions) and the
+# newest bpy release for Python 3.11. scripts/test runs the Blender suites against each.
+BPY_VERSIONS=(4.2.23 5.0.1)
+# The numpy they run with: what bpy 5.0 requires (<2) and what Blender bundles; bpy 4.2 would take
+# numpy 2, which our module (Debian's pybind11 2.10) predates.
+BPY_NUMPY=1.26.4
+BPY_CACHE=${WIRESCULPT_BPY_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/wiresculpt}
 
 # The sanitizer and fuzz builds (scripts/test, scripts/fuzz).
 FUZZ_PACKAGES=(clang libclang-rt-14-dev)
@@ -73,6 +83,52 @@ build_fuzz() {
   fi
   "$CMAKE" --build "$ROOT/build/fuzz" -j"$(nproc)" >"$ROOT/build/fuzz/build.log" 2>&1 ||
     { cat "$ROOT/build/fuzz/build.log" >&2; say "fuzz build failed"; return 1; }
+}
+
+# The demo's closing lines: every file and folder a batch run wrote into $1 (exit status $2), one
+# line each with what it holds.
+summarize_outputs() {
+  local out=$1 code=${2:-0} entry name what
+  say "done: the results are in $out/"
+  for entry in "$out"/*; do
+    [ -e "$entry" ] || continue
+    name=$(basename "$entry")
+    case "$name" in
+      design.json) what="the design: wires, crossings, stability, assembly order" ;;
+      sculpture.blend) what="open in Blender: framed on the sculpture, sidebar on the Wire tab, first wire selected" ;;
+      sculpture.blend1) what="the previous sculpture.blend (Blender's backup)" ;;
+      render.png) what="a still of the wire sculpture" ;;
+      assembly) what="the printable assembly guide (index.html), one picture per step" ;;
+      svg) what="machine files: each wire's rest shape as one path, in mm, from its start" ;;
+      dxf) what="machine files: DXF R2000 in mm per wire, and sculpture.dxf with every wire side by side" ;;
+      templates) what="print templates at 1:1 (bends, crossings, labels); sheet.svg holds them all" ;;
+      gcode) what="bend programs for a GRBL wire bender (or send them from the Fabrication panel)" ;;
+      bends) what="bend tables (CSV): feed, bend angle and commanded angle per step" ;;
+      bendlist) what="bend lists (UNIT/FEED/BEND) for a DIWire-class machine through FabMo's Bend List app" ;;
+      *) what="" ;;
+    esac
+    [ -d "$entry" ] && name="$name/"
+    say "$(printf '  %-20s %s' "$name" "$what")"
+  done
+  [ "$code" -eq 2 ] && say "  not stable: see \"reason\" in design.json or the Stability panel" || true
+}
+
+# Prints the python of a venv of $PYTHON holding bpy==$1, making it once (a ~350 MB download; the
+# wheel is kept in $BPY_CACHE/wheels); a venv is used only after its install finished.
+bpy_python() {
+  local version=$1 venv="$BPY_CACHE/bpy-$1"
+  if [ ! -f "$venv/.complete" ]; then
+    ensure_packages python3.11-venv
+    rm -rf "$venv"
+    mkdir -p "$BPY_CACHE/wheels"
+    say "installing bpy $version into $venv"
+    "$PYTHON" -m venv "$venv" >&2
+    "$venv/bin/python" -m pip download -q --no-deps -d "$BPY_CACHE/wheels" "bpy==$version" >&2
+    "$venv/bin/python" -m pip install -q --find-links "$BPY_CACHE/wheels" "bpy==$version" \
+      "numpy==$BPY_NUMPY" >&2
+    touch "$venv/.complete"
+  fi
+  echo "$venv/bin/python"
 }
 
 # Runs a Python file inside headless Blender; extra arguments follow "--".

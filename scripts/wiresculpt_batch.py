@@ -1,13 +1,15 @@
 """The headless wiresculpt run (FORMATS.md):
 
-    blender --background --factory-startup --python scripts/wiresculpt_batch.py -- SCENE.json --out DIR
+    blender --background --factory-startup --python scripts/wiresculpt_batch.py -- SCENE.json --out DIR [--profile P.json]
 
 Reads and validates the scene file, imports the mesh, runs the pipeline and writes DIR/design.json
-with the fabrication files beside it (svg/, dxf/, gcode/, bends/), then the results as a Blender
-user sees them: DIR/sculpture.blend (wires, crossing markers and the design in a scene),
+with the fabrication files beside it (svg/, dxf/, templates/, gcode/, bends/, bendlist/), then the results as
+a Blender user sees them: DIR/sculpture.blend (wires, crossing markers and the design in a scene;
+it opens with the 3D view framed on the sculpture, the sidebar on the Wire tab, the first wire
+selected),
 DIR/render.png (a Workbench still) and the assembly guide DIR/assembly/index.html with a picture
 per step. The outputs replace an earlier run's as one set, only once all are written (the folders
-svg/ dxf/ gcode/ bends/ assembly/ belong to the run; other files in DIR are left alone). One
+svg/ dxf/ templates/ gcode/ bends/ bendlist/ assembly/ belong to the run; other files in DIR are left alone). One
 progress line per stage on stdout. Exit status: 0 a stable design was written;
 2 the input was valid but no stable design exists (design.json still written, with the reason);
 1 bad input or failure, with one clear message on stderr.
@@ -24,19 +26,20 @@ if os.path.isdir(os.path.join(ADDON, "wiresculpt")) and ADDON not in sys.path:
 
 EXIT_STABLE, EXIT_FAILURE, EXIT_UNSTABLE = 0, 1, 2
 # What a run writes into DIR, replaced as one set (files, or folders that belong to the run).
-OUTPUTS = ("design.json", "sculpture.blend", "sculpture.blend1", "render.png", "assembly", "svg", "dxf",
-           "gcode", "bends")
+OUTPUTS = ("design.json", "sculpture.blend", "sculpture.blend1", "render.png", "assembly", "svg", "dxf", "templates",
+           "gcode", "bends", "bendlist")
 
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message):
-        raise ValueError(f"usage: wiresculpt_batch.py -- SCENE.json --out DIR ({message})")
+        raise ValueError(f"usage: wiresculpt_batch.py -- SCENE.json --out DIR [--profile PROFILE.json] ({message})")
 
 
 def parse_args(argv):
     parser = _Parser(prog="wiresculpt_batch.py", add_help=False)
     parser.add_argument("scene")
     parser.add_argument("--out", required=True)
+    parser.add_argument("--profile", default=None)
     return parser.parse_args(argv)
 
 
@@ -72,8 +75,11 @@ def write_scene_outputs(design, objects, planes, factor, out, say):
     from mathutils import Matrix
 
     import wiresculpt
+    from wiresculpt.blend import compat
     from wiresculpt.blend import guide as assembly_guide
     from wiresculpt.blend import results as scene_results
+    from wiresculpt.blend import view as scene_view
+    from wiresculpt.core import blendfile
 
     if not wiresculpt._modules:
         wiresculpt.register()
@@ -99,26 +105,53 @@ def write_scene_outputs(design, objects, planes, factor, out, say):
         path = assembly_guide.write_guide(scene, design, os.path.join(out, "assembly"))
         say("guide", f"{os.path.relpath(path, out)}, {len(design['assembly_steps'])} steps "
                      f"({time.perf_counter() - start:.3f} s)")
+    # the file opens ready: the 3D views framed on the sculpture, the sidebar on the Wire tab,
+    # the first wire selected
+    ready = scene_view.open_ready(scene)
     path = os.path.abspath(os.path.join(out, "sculpture.blend"))
-    # Blender writes the .blend to a temporary name and renames it: atomic like the rest
-    bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False, compress=True)
-    say("blend", "sculpture.blend")
+    # Blender writes the .blend to a temporary name and renames it: atomic like the rest. Blender
+    # 3.4 cannot set the sidebar's tab from Python: it is written into the saved (uncompressed)
+    # file instead, atomically too.
+    bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False, compress=ready["tab_set"])
+    tab = f"{compat.SIDEBAR_TAB} tab"
+    if not ready["tab_set"]:
+        try:
+            blendfile.set_sidebar_tab(path, compat.SIDEBAR_TAB)
+        except (ValueError, KeyError) as exc:  # a file layout this reader does not know: the file stays as saved
+            tab = f"last used tab (the {compat.SIDEBAR_TAB} tab could not be set: {exc})"
+    say("blend", f"sculpture.blend (opens on the {tab}, {ready['selected'] or 'no wire'} "
+                 f"selected, the view {ready['size'] * scene_view.DISTANCE_IN_SIZES:.3g} m from the centre)")
 
 
-def write_fabrication(design, out, say):
-    """svg/, dxf/, gcode/ and bends/ in `out` for every wire with a rest shape; the programs'
+def machine_profile(scene, args, say):
+    """The machine profile of the run: --profile, else the scene's "machine_profile", else None
+    (the default profile); ValueError naming the file when it cannot be used."""
+    from wiresculpt.core.calibration import load_profile
+
+    path = args.profile or scene.machine_profile
+    if path is None:
+        return None
+    if not os.path.isfile(path):
+        raise ValueError(f"machine profile {path} does not exist (--profile or the scene's \"machine_profile\")")
+    profile = load_profile(path)
+    say("profile", f"{profile.get('name') or os.path.basename(path)} ({path})")
+    return profile
+
+
+def write_fabrication(design, out, say, profile=None):
+    """svg/, dxf/, templates/, gcode/, bends/ and bendlist/ in `out` for every wire with a rest shape; the programs'
     summary goes into the design as `fabrication`."""
     from wiresculpt.fab import export
 
     if not any("rest" in w for w in design["wires"]):
         return  # no folders: the earlier run's are removed with the rest of its set
     start = time.perf_counter()
-    result = export.export(design, out)
+    result = export.export(design, out, profile)
     design["fabrication"] = {"wires": result["wires"], "errors": result["errors"]}
     minutes = sum(w["machine_seconds"] for w in result["wires"]) / 60
     say("fabrication", f"{len(result['wires'])} bend programs ({sum(w['bend_count'] for w in result['wires'])} "
-                       f"bends, about {minutes:.0f} min on the machine), {len(result['files'])} files in svg/, dxf/, "
-                       f"gcode/, bends/ ({time.perf_counter() - start:.3f} s)")
+                       f"bends, about {minutes:.0f} min on the machine), {len(result['files'])} files in svg/, dxf/, templates/, "
+                       f"gcode/, bends/, bendlist/ ({time.perf_counter() - start:.3f} s)")
     for error in result["errors"]:
         say("fabrication", error)
 
@@ -152,11 +185,12 @@ def run(argv):
     say("mesh", f"{len(V)} vertices, {len(F)} triangles, scale x{factor:g} "
                 f"({time.perf_counter() - start:.3f} s)")
     planes = scaled_planes(scene.planes, factor)
+    profile = machine_profile(scene, args, say)  # refused before the long work when it is wrong
     design = pipeline.run(V, F, planes, scene.material, scene.settings, say)
     # Everything is written into a hidden folder first and replaces the earlier run's outputs
     # only when all of it is there: a failure half-way leaves the earlier set as it was.
     with staged(args.out, OUTPUTS) as folder:
-        write_fabrication(design, folder, say)
+        write_fabrication(design, folder, say, profile)
         write_design(os.path.join(folder, "design.json"), design)
         write_scene_outputs(design, objects, planes, factor, folder, say)
     say("written", os.path.join(args.out, "design.json"))

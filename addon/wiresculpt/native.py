@@ -10,17 +10,62 @@ instead of failing to register, and every wrapper raises RuntimeError with it.
 The results are the module's dicts, in the design document's own key names (docs/formats.md):
 the stages copy them without renaming.
 """
+import os
+import re
+import sys
+
 import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def built_for():
+    """The Pythons the compiled modules beside this file were built for, e.g. ["3.11"], from their
+    file names (_wiresculpt.cpython-311-x86_64-linux-gnu.so)."""
+    try:
+        names = os.listdir(HERE)
+    except OSError:
+        return []
+    tags = (re.match(r"_wiresculpt\.cpython-(\d)(\d+)", n) for n in names)
+    return sorted({f"{t.group(1)}.{t.group(2)}" for t in tags if t}, key=lambda v: tuple(map(int, v.split("."))))
+
+
+def host_name():
+    """ "Blender 4.0.2" inside Blender (bpy already imported), else "this Python"."""
+    bpy = sys.modules.get("bpy")
+    version = getattr(getattr(bpy, "app", None), "version_string", None)
+    return f"Blender {version}" if version else "this Python"
+
+
+def explain_load_error(exc, builds, python=None, host=None):
+    """One sentence saying why the solver did not load and what to do: the Python the zip was
+    built for against the one running, or the shared library the loader could not find."""
+    python = python or f"{sys.version_info[0]}.{sys.version_info[1]}"
+    host = host or host_name()
+    text = str(exc)
+    if builds and python not in builds:
+        advice = ("use Blender 4.1+" if tuple(map(int, python.split("."))) < (3, 11) else
+                  "use a Blender whose Python is " + " or ".join(builds))
+        return (f"The wiresculpt solver did not load: this build is for Python {' and '.join(builds)}; "
+                f"{host} uses {python}: {advice} or build from source with scripts/package.")
+    missing = re.search(r"([\w.+-]+\.so[\w.]*): cannot open shared object file", text)
+    if missing:
+        return (f"The wiresculpt solver did not load: the library {missing.group(1)} is missing. The "
+                f"packaged zip carries it in libs/ beside the module: install the zip again (Preferences > "
+                "Add-ons > Install, or Get Extensions > Install from Disk for the extension), or install it on "
+                "the system, or build from source with scripts/package.")
+    if not builds:
+        return ("The wiresculpt solver (_wiresculpt) is not built: build it with scripts/setup, or "
+                "install the packaged zip (scripts/package).")
+    return f"The wiresculpt solver (_wiresculpt) did not load in {host}: {text}"
+
 
 try:
     from . import _wiresculpt as module
     LOAD_ERROR = ""
-except ImportError as exc:  # not built, or built for another Python
+except ImportError as exc:  # not built, built for another Python, or a library missing
     module = None
-    LOAD_ERROR = (
-        "The wiresculpt solver (_wiresculpt) is not installed for this Blender's Python "
-        f"({exc}). Build it with scripts/test or install the packaged zip."
-    )
+    LOAD_ERROR = explain_load_error(exc, built_for())
 
 
 class _NeverRaised(Exception):
@@ -157,15 +202,29 @@ def make_bend_program(points, profile=None):
     return require().make_bend_program(as_points(points, "points", 2), {} if profile is None else profile)
 
 
+def bend_program_problems(points, profile=None):
+    """Everything that keeps a 2D wire from being bent (make_bend_program's refusals, all listed)."""
+    return require().bend_program_problems(as_points(points, "points", 2), {} if profile is None else profile)
+
+
 def write_svg(path, wires, sheet=None, options=None):
     """1:1 SVG template; wires [{"name", "points" (n, 2) m, ...}]. Returns the text."""
     return require().write_svg(path, _with_points(wires, "wires", "points", 2), sheet,
                                {} if options is None else options)
 
 
-def write_dxf(path, wires, labels=True):
-    """DXF R12, one layer per wire (mm). Returns the text."""
-    return require().write_dxf(path, _with_points(wires, "wires", "points", 2), labels)
+def write_dxf(path, wires, labels=False, layout="as_given", gap_mm=20.0):
+    """DXF R2000 in mm, one layer and one LWPOLYLINE per wire; layout "as_given",
+    "start_at_origin" or "side_by_side" (gap_mm apart). Returns the text."""
+    return require().write_dxf(path, _with_points(wires, "wires", "points", 2), labels, layout, gap_mm)
+
+
+def write_machine_svg(path, wire, stroke_mm=0.5):
+    """The machine SVG of one wire {"name", "points" (n, 2) m}: one path in mm from its first
+    point. Returns the text."""
+    if isinstance(wire, dict) and "points" in wire:
+        wire = dict(wire, points=as_points(wire["points"], "wire['points']", 2))
+    return require().write_machine_svg(path, wire, stroke_mm)
 
 
 def write_gcode(path, points, profile=None, wire_name="", material="", sync_each_step=True):

@@ -29,9 +29,14 @@ REFERENCE = materials.PRESETS["steel"]  # the custom material starts from steel'
 
 
 def _setting(key, name, **kw):
-    """A FloatProperty for core/settings.py's `key`: default, bounds and text from the table.
-    Degrees are stored as radians (subtype ANGLE) so Blender shows the user's unit."""
+    """A property for core/settings.py's `key`: default, bounds and text from the table; a
+    BoolProperty or IntProperty for the "bool" and "int" keys, else a FloatProperty. Degrees are
+    stored as radians (subtype ANGLE) so Blender shows the user's unit."""
     default, low, high, unit, text = settings_table.SETTINGS[key]
+    if unit == "bool":
+        return BoolProperty(name=name, description=text, default=default, **kw)
+    if unit == "int":
+        return IntProperty(name=name, description=text, default=default, min=low, max=high, **kw)
     if unit == "deg":
         kw.update(subtype='ANGLE', default=math.radians(default), min=math.radians(low),
                   max=math.radians(high))
@@ -94,7 +99,10 @@ def solver_settings(settings):
         if key not in SETTING_PROPS:
             continue
         value = getattr(settings, key)
-        out[key] = _f(math.degrees(value) if unit == "deg" else value)
+        if unit in ("bool", "int"):
+            out[key] = bool(value) if unit == "bool" else int(value)
+        else:
+            out[key] = _f(math.degrees(value) if unit == "deg" else value)
     if settings.use_load_factor:  # the solver picks the least torque fraction that holds it
         out["torque_fraction"] = None
     if out["min_bend_deg"] >= out["max_bend_deg"]:
@@ -104,7 +112,8 @@ def solver_settings(settings):
 
 # core/settings.py keys shown in the panel (weld_tolerance stays automatic)
 SETTING_PROPS = ("min_segment", "max_bend_deg", "min_bend_deg", "contact_angle_deg", "torque_fraction",
-                 "load_factor")
+                 "load_factor", "in_plane_tiebreak", "max_nodes", "relayer_rounds")
+ADVANCED_PROPS = ("in_plane_tiebreak", "max_nodes", "relayer_rounds")  # the panel's Advanced box
 
 
 def _assembly_step_changed(settings, context):
@@ -116,7 +125,7 @@ def _port_suggestions(_settings, _context, _text):
     a pseudo-terminal, a udev symlink)."""
     if not native.available():
         return []
-    return [p["name"] for p in native.require().list_ports()]
+    return [p["name"] for p in native.list_ports()]
 
 
 NO_WIRE = "__none__"  # the wire enum's only item when the design has no wire with a rest shape
@@ -195,6 +204,12 @@ class WiresculptSettings(bpy.types.PropertyGroup):
         description="Use the least torque fraction (pre-stress) whose sculpture holds the load "
                     "factor times its weight in each of the six directions; off: the torque "
                     "fraction as set")
+    in_plane_tiebreak: _setting("in_plane_tiebreak", "In-Plane Tie-Break")
+    max_nodes: _setting("max_nodes", "Max Search Nodes")
+    relayer_rounds: _setting("relayer_rounds", "Re-Layering Rounds")
+    show_advanced: BoolProperty(
+        name="Advanced", default=False,
+        description="Show the layering's search settings (tie-break, node budget, re-layering rounds)")
 
     # results display
     show_forces: BoolProperty(

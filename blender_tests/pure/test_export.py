@@ -42,12 +42,36 @@ class ExportTest(unittest.TestCase):
         self.assertEqual(self.result["errors"], [])
         for w in self.design["wires"]:
             stem = export.file_stem(w)
-            for folder, ext in (("svg", "svg"), ("gcode", "gcode"), ("bends", "csv")):
+            for folder, ext in (("svg", "svg"), ("dxf", "dxf"), ("templates", "svg"), ("gcode", "gcode"), ("bends", "csv"),
+                                ("bendlist", "txt")):
                 self.assertTrue(os.path.isfile(os.path.join(self.tmp.name, folder, f"{stem}.{ext}")))
-        for extra in ("svg/sheet.svg", "dxf/sculpture.dxf"):
+        for extra in ("templates/sheet.svg", "dxf/sculpture.dxf"):
             self.assertTrue(os.path.isfile(os.path.join(self.tmp.name, extra)))
         leftovers = [n for _d, _s, files in os.walk(self.tmp.name) for n in files if n.endswith(".tmp")]
         self.assertEqual(leftovers, [])
+
+    def test_templates_are_tiled_onto_pages(self):
+        from wiresculpt.fab import tiles
+
+        pages = os.path.join(self.tmp.name, "templates", "pages")
+        for w in self.design["wires"]:
+            stem = export.file_stem(w)
+            root = ET.parse(os.path.join(self.tmp.name, "templates", stem + ".svg")).getroot()
+            expected = tiles.layout(float(root.get("width")[:-2]), float(root.get("height")[:-2]))["tiles"]
+            found = sorted(n for n in os.listdir(pages) if n.startswith(stem + "-"))
+            self.assertEqual(found, sorted(f"{stem}-{t['name']}.svg" for t in expected))
+            for name in found:
+                self.assertIn(os.path.join(pages, name), self.result["files"])
+                page = ET.parse(os.path.join(pages, name)).getroot()
+                self.assertEqual((page.get("width"), page.get("height")), ("210.000mm", "297.000mm"))
+        level, text = export.summary(self.result, self.tmp.name)
+        self.assertIn(f"{len(os.listdir(pages))} {os.path.join('templates', 'pages')}", text)
+        with tempfile.TemporaryDirectory() as tmp:  # Letter on request; an unknown paper is refused
+            export.export(self.design, tmp, paper="Letter")
+            page = ET.parse(os.path.join(tmp, "templates", "pages", os.listdir(os.path.join(tmp, "templates", "pages"))[0])).getroot()
+            self.assertEqual(page.get("width"), "215.900mm")
+            with self.assertRaises(ValueError):
+                export.export(self.design, tmp, paper="A3")
 
     def test_file_names_stay_unique_and_old_files_go(self):
         self.assertEqual(export.file_stem({"id": 3, "name": "Equator/0"}), "03-Equator-0")
@@ -66,20 +90,69 @@ class ExportTest(unittest.TestCase):
 
     def test_svg_is_one_to_one(self):
         for w in self.design["wires"]:
-            root = ET.parse(os.path.join(self.tmp.name, "svg", export.file_stem(w) + ".svg")).getroot()
+            root = ET.parse(os.path.join(self.tmp.name, "templates", export.file_stem(w) + ".svg")).getroot()
             self.assertTrue(root.get("width").endswith("mm"))
             line = next(e for e in root.iter() if e.tag.endswith("polyline") and "wire-path" in (e.get("class") or ""))
             pts = [tuple(map(float, p.split(","))) for p in line.get("points").split()]
             np.testing.assert_allclose(edge_lengths(pts), edge_lengths(self.rest_mm(w["name"])), atol=0.01)
 
-    def test_dxf_is_one_to_one(self):
+    def test_machine_svg_is_one_path_from_the_origin(self):
+        for w in self.design["wires"]:
+            root = ET.parse(os.path.join(self.tmp.name, "svg", export.file_stem(w) + ".svg")).getroot()
+            self.assertTrue(root.get("width").endswith("mm") and root.get("height").endswith("mm"))
+            drawn = [e for e in root.iter() if e.tag.split("}")[-1] in
+                     ("path", "polyline", "line", "circle", "text", "rect", "polygon", "ellipse")]
+            self.assertEqual([e.tag.split("}")[-1] for e in drawn], ["path"], w["name"])
+            words = drawn[0].get("d").split()
+            self.assertEqual(words[0], "M")
+            pts = np.array([[float(words[i + 1]), float(words[i + 2])] for i in range(0, len(words), 3)])
+            self.assertTrue(all(words[i] in ("M", "L") for i in range(0, len(words), 3)))
+            np.testing.assert_allclose(pts[0], [0.0, 0.0], atol=1e-9)
+            rest = self.rest_mm(w["name"])
+            np.testing.assert_allclose(edge_lengths(pts), edge_lengths(rest), atol=0.01)
+            # the same shape, not its mirror image: y is flipped for the page (SVG y points down)
+            np.testing.assert_allclose(pts, (rest - rest[0]) * [1.0, -1.0], atol=0.01)
+            vb = [float(x) for x in root.get("viewBox").split()]
+            self.assertLessEqual(vb[0], pts[:, 0].min())
+            self.assertGreaterEqual(vb[0] + vb[2], pts[:, 0].max())
+            self.assertAlmostEqual(float(root.get("width")[:-2]), vb[2], places=3)  # 1 user unit = 1 mm
+
+    def read_dxf(self, path):
         import ezdxf
 
-        doc = ezdxf.readfile(os.path.join(self.tmp.name, "dxf", "sculpture.dxf"))
-        self.assertFalse(doc.audit().has_errors)
-        polylines = list(doc.modelspace().query("POLYLINE"))
+        doc = ezdxf.readfile(path)
+        auditor = doc.audit()
+        self.assertFalse(auditor.has_errors, [str(e) for e in auditor.errors])
+        self.assertGreaterEqual(doc.dxfversion, "AC1015")  # R2000 or later
+        self.assertEqual(doc.header.get("$INSUNITS"), 4)  # millimetres
+        return doc
+
+    def test_each_wire_dxf_is_one_lwpolyline_in_mm(self):
+        for w in self.design["wires"]:
+            doc = self.read_dxf(os.path.join(self.tmp.name, "dxf", export.file_stem(w) + ".dxf"))
+            entities = list(doc.modelspace())
+            self.assertEqual([e.dxftype() for e in entities], ["LWPOLYLINE"], w["name"])
+            pts = np.array([(x, y) for x, y, *_ in entities[0].get_points()])
+            np.testing.assert_allclose(pts[0], [0.0, 0.0], atol=1e-6)  # origin at the start
+            rest = self.rest_mm(w["name"])
+            np.testing.assert_allclose(pts, rest - rest[0], atol=1e-3)
+            self.assertIn(entities[0].dxf.layer, [layer.dxf.name for layer in doc.layers])
+
+    def test_combined_dxf_lays_the_wires_side_by_side(self):
+        doc = self.read_dxf(os.path.join(self.tmp.name, "dxf", "sculpture.dxf"))
+        polylines = list(doc.modelspace().query("LWPOLYLINE"))
         self.assertEqual(len(polylines), len(self.design["wires"]))
-        lengths = sorted(float(np.sum(edge_lengths([(v.dxf.location.x, v.dxf.location.y) for v in p.vertices]))) for p in polylines)
+        self.assertEqual(len({p.dxf.layer for p in polylines}), len(polylines))  # one layer per wire
+        boxes = []
+        for p in polylines:
+            pts = np.array([(x, y) for x, y, *_ in p.get_points()])
+            boxes.append((pts[:, 0].min(), pts[:, 0].max(), pts[:, 1].min(), pts[:, 1].max()))
+        for i in range(len(boxes)):
+            for j in range(i + 1, len(boxes)):
+                a, b = boxes[i], boxes[j]
+                overlap = a[0] < b[1] and b[0] < a[1] and a[2] < b[3] and b[2] < a[3]
+                self.assertFalse(overlap, f"the boxes of wires {i} and {j} overlap: {a} {b}")
+        lengths = sorted(float(np.sum(edge_lengths([(x, y) for x, y, *_ in p.get_points()]))) for p in polylines)
         expected = sorted(float(np.sum(edge_lengths(self.rest_mm(w["name"])))) for w in self.design["wires"])
         np.testing.assert_allclose(lengths, expected, atol=0.01)
 

@@ -7,7 +7,6 @@ The polylines must be found at 1:1 in millimetres within 0.01 mm.
 import csv
 import math
 import os
-import random
 import shutil
 import struct
 import subprocess
@@ -18,7 +17,7 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
-from helpers import GrblEmulator
+from helpers import GrblEmulator, random_walk
 from wiresculpt import native
 
 SVG = "{http://www.w3.org/2000/svg}"
@@ -32,17 +31,6 @@ def square(a=0.06):
 def polygon(n=9, r=0.08, centre=(0.3, 0.1)):
     return np.array([[centre[0] + r * math.cos(2 * math.pi * i / n), centre[1] + r * math.sin(2 * math.pi * i / n)]
                      for i in range(n + 1)])
-
-
-def random_walk(seed=7, n=14):
-    rng = random.Random(seed)
-    p, h, pts = np.array([-0.2, 0.05]), rng.uniform(0, 2 * math.pi), []
-    pts.append(p.copy())
-    for i in range(n):
-        p = p + rng.uniform(0.016, 0.05) * np.array([math.cos(h), math.sin(h)])
-        pts.append(p.copy())
-        h += math.radians(rng.choice([-1, 1]) * rng.uniform(3, 100))
-    return np.array(pts)
 
 
 def png_size(path):
@@ -68,7 +56,8 @@ class FabFiles(unittest.TestCase):
         self.dir = tempfile.mkdtemp(prefix="wiresculpt_fab_")
         self.addCleanup(shutil.rmtree, self.dir, True)
         self.wires = []
-        for k, (name, pts) in enumerate([("A/0", square()), ("B/1", polygon()), ("C/2", random_walk())]):
+        walk = random_walk(7, start=(-0.2, 0.05), steps=(0.016, 0.05), turns_deg=(3, 100))
+        for k, (name, pts) in enumerate([("A/0", square()), ("B/1", polygon()), ("C/2", walk)]):
             prog = self.w.make_bend_program(pts, {})
             self.wires.append({"name": name, "points": pts, "bend_points": prog["bend_vertices"],
                                "crossing_points": [0, len(pts) // 2]})
@@ -138,18 +127,19 @@ class FabFiles(unittest.TestCase):
         path = os.path.join(self.dir, "wires.dxf")
         self.w.write_dxf(path, self.wires)
         doc = self.ezdxf.readfile(path)
-        self.assertEqual(doc.dxfversion, "AC1009")
+        self.assertEqual(doc.dxfversion, "AC1015")
+        self.assertEqual(doc.header.get("$INSUNITS"), 4)
         auditor = doc.audit()
         self.assertEqual(len(auditor.errors), 0, [str(e) for e in auditor.errors])
         self.assertFalse(auditor.has_errors)
         msp = doc.modelspace()
-        polylines = list(msp.query("POLYLINE"))
+        polylines = list(msp.query("LWPOLYLINE"))
         self.assertEqual(len(polylines), len(self.wires))
         layers = {p.dxf.layer for p in polylines}
         self.assertEqual(len(layers), len(self.wires))  # one layer per wire
         for poly, wire in zip(polylines, self.wires):
             self.assertIn(poly.dxf.layer, [layer.dxf.name for layer in doc.layers])
-            found = np.array([[v[0], v[1]] for v in poly.points()])
+            found = np.array([[v[0], v[1]] for v in poly.get_points()])
             offset = self.assert_same_shape_mm(found, wire["points"], flip_y=False)
             self.assertLess(np.abs(offset).max(), TOL_MM)  # DXF keeps the wire's own coordinates
 
@@ -184,6 +174,37 @@ class FabFiles(unittest.TestCase):
                     c = float(row["commanded_deg"])
                     self.assertAlmostEqual(0.92 * abs(c) - 1.5, abs(b), delta=1e-3)
         self.assertFalse([n for n in os.listdir(self.dir) if ".tmp-" in n])
+
+    def test_default_profile_moves_its_pin_at_each_change_of_bend_side(self):
+        """The default profile ducks its pin (Z) before every bend to the other side than the one
+        before (the pin starts on the left, positive side); the change count is read off the
+        polyline's turn signs, not off the program. A profile with "pin_axis": "" never moves Z
+        and is otherwise the same program."""
+        tested = 0
+        for wire in self.wires:
+            pts = np.asarray(wire["points"])
+            if np.allclose(pts[0], pts[-1]):
+                continue  # closed: the program's first bend depends on where it starts
+            edges = np.diff(pts, axis=0)
+            cross = edges[:-1, 0] * edges[1:, 1] - edges[:-1, 1] * edges[1:, 0]
+            sides = [1 if c > 0 else -1 for c in cross if abs(c) > 1e-12]
+            changes, side = 0, 1
+            for s_ in sides:
+                changes += s_ != side
+                side = s_
+            self.assertGreaterEqual(changes, 2, wire["name"])
+            lines = self.w.stream_lines(self.w.write_gcode(None, pts, {}, wire["name"], "steel"))
+            self.assertEqual(lines.count("G0 Z-5.0000"), changes)
+            self.assertEqual(lines.count("G0 Z5.0000"), changes)
+            for i, line in enumerate(lines):  # each duck is followed by the bend to the new side
+                if line == "G0 Z-5.0000":
+                    self.assertEqual(lines[i + 1], "G0 Z5.0000")
+                    self.assertTrue(lines[i + 2].startswith("G1 Y"), lines[i + 2])
+            pinless = self.w.stream_lines(self.w.write_gcode(None, pts, {"pin_axis": ""}, wire["name"], "steel"))
+            self.assertFalse([l for l in pinless if "Z" in l])
+            self.assertEqual(pinless, [l for l in lines if not l.startswith("G0 Z")])
+            tested += 1
+        self.assertGreaterEqual(tested, 1)
 
     def test_errors_name_the_path_and_leave_nothing(self):
         missing = os.path.join(self.dir, "no", "such", "folder", "w.svg")

@@ -63,6 +63,39 @@ class LayeringBinding(unittest.TestCase):
             native.module.check_assembly([wire("X", [1, 0, 0]), wire("Y", [0, 1, 0])], [1, -1], [[0, "1"]])
         self.assertEqual(str(ctx.exception), "steps[0][1]: expected an integer, got str")
 
+    def test_forbidden_hooks(self):
+        wires = [wire("X", [1, 0, 0]), wire("Y", [0, 1, 0]), wire("Z", [0, 0, 1])]
+        free = native.layering(wires)
+        # Forbid every hook the free search chose: each such crossing gets the other hook or null.
+        chosen = [[c, h] for c, h in enumerate(free["hook"]) if h != 0]
+        r = native.layering(wires, {"forbidden_hooks": chosen})
+        for (c, h) in chosen:
+            self.assertNotEqual(r["hook"][c], h, f"crossing {c}")
+        # Both hooks of every crossing forbidden: nothing can hold anything, and the reason says why.
+        r = native.layering(wires, {"forbidden_hooks": [[c, h] for c in range(6) for h in (-1, 1)]})
+        self.assertFalse(r["stable"])
+        self.assertEqual(r["hook"], [0] * 6)
+        self.assertIn("12 hooks forbidden", r["reason"])
+        bad = [([[6, 1]], "settings['forbidden_hooks'][0]: crossing 6 does not exist (the network has 6 crossings)"),
+               ([[0, 0]], "settings['forbidden_hooks'][0]: the hook must be -1 or 1 (null is always allowed), got 0"),
+               ([[0, 1, 2]], "settings['forbidden_hooks'][0]: expected [crossing id, hook]")]
+        for pairs, message in bad:
+            with self.assertRaises(ValueError) as ctx:
+                native.layering(wires, {"forbidden_hooks": pairs})
+            self.assertEqual(str(ctx.exception), message)
+        with self.assertRaises(ValueError) as ctx:
+            native.check_assembly(wires, free["hook"], free["steps"], {"forbidden_hooks": chosen})
+        self.assertIn("only layering() takes forbidden hooks", str(ctx.exception))
+
+    def test_max_nodes_reached_is_search_incomplete(self):
+        wires = [wire("X", [1, 0, 0]), wire("Y", [0, 1, 0]), wire("Z", [0, 0, 1])]
+        r = native.layering(wires, {"max_nodes": 1})
+        self.assertFalse(r["complete_search"])
+        self.assertFalse(r["stable"])
+        self.assertTrue(r["reason"].startswith("search incomplete"), r["reason"])
+        self.assertNotIn("no stable", r["reason"])
+        self.assertTrue(native.layering(wires, {"max_nodes": 0})["stable"])  # 0: no limit
+
     def test_check_assembly_cancel(self):
         wires = [wire("X", [1, 0, 0]), wire("Y", [0, 1, 0]), wire("Z", [0, 0, 1])]
         r = native.module.layering(wires)

@@ -59,17 +59,24 @@ class Coupling(unittest.TestCase):
 
     def test_rest_bends_respect_the_machine_after_coupling(self):
         once = self.solve(1)
-        self.assertTrue(once["stable"])
         self.assertGreater(largest_rest_turn_deg(once), 50.0)  # the case needs the coupling
+        # Without it the layering's verdict stood, but a bend over the limit cannot be made.
+        self.assertFalse(once["stable"])
+        self.assertIn("more than the machine's maximum reliable bend of 50.0 deg", once["reason"])
+        self.assertTrue(all(p["kind"] == "over_bend" for p in once["buildability"]["problems"]))
         coupled = self.solve(4)
-        self.assertTrue(coupled["stable"])
-        self.assertLessEqual(largest_rest_turn_deg(coupled), 50.0 + 1e-6)
+        self.assertTrue(coupled["stable"], coupled["reason"])
+        # Strictly inside: the bend program makes every wire, and the rest bends stay below 50 deg.
+        self.assertLess(largest_rest_turn_deg(coupled), 50.0)
+        self.assertEqual(coupled["buildability"]["problems"], [])
         stage = coupled["stages"]["target_shape"]
         self.assertGreater(stage["coupling_rounds"], 1)
+        self.assertEqual(stage["rest_excess_deg"], 0.0)
         # The stage's counts add every coupling round, as its time does.
         self.assertEqual(stage["wire_solves"], self.calls)
         self.assertGreater(stage["wire_solves"], len(coupled["wires"]))
-        self.assertLess(stage["max_bend_deg"], 50.0)
+        self.assertGreater(stage["vertex_limits"], 0)  # the over-bent vertices got their own limits
+        self.assertLessEqual(stage["max_bend_deg"], 50.0)
         self.assertEqual(coupled["pending_stages"], [])
 
 
@@ -108,3 +115,42 @@ class Cancelling(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+def eq12(target, torque, l_bar, k_b):
+    """The paper's Eq. 12 (signs for counter-clockwise angles, rest_shape.hpp), written apart from
+    pipeline.rest_angle: the rest angle of a target angle under a torque."""
+    t = math.tan(target / 2)
+    return 2 * math.atan(t + torque / ((4 * k_b / l_bar) * (1 + t * t)))
+
+
+class CouplingStep(unittest.TestCase):
+    """pipeline._tighten on the vertex measured on the corpus (bear, zzxxy5, 0.75 m; wire X1/0,
+    target vertex 40): target bend 120.000 deg at the limit, rest 120.089 deg from its torque."""
+
+    def design(self, target_deg, rest_deg):
+        angles = [0.0, math.radians(target_deg), 0.0]
+        rests = [0.0, math.radians(rest_deg), 0.0]
+        return {"wires": [{"name": "X1/0", "closed": True, "cut": 39, "target": [[0, 0, 0]] * 60,
+                           "target_angles": angles, "rest_angles": rests}]}
+
+    def test_the_vertex_gets_the_limit_that_puts_its_rest_bend_inside(self):
+        memo = pipeline.target_shape.Memo()
+        changed, stuck = pipeline._tighten(self.design(120.0, 120.089), memo, 120.0, 20.01)
+        self.assertEqual((changed, stuck), (1, 0.0))
+        limit = memo.vertex_limits["X1/0"][40]  # position 1 from the cut at 39
+        # The torque read back from the two angles (any l_bar, k_b: only t l_bar / k_b matters).
+        k_b, l_bar = 0.73, 0.03
+        t = math.tan(math.radians(60.0))
+        torque = (math.tan(math.radians(120.089) / 2) - t) * (1 + t * t) * 4 * k_b / l_bar
+        self.assertAlmostEqual(math.degrees(eq12(math.radians(120.0), torque, l_bar, k_b)), 120.089, places=9)
+        self.assertAlmostEqual(math.degrees(eq12(limit, torque, l_bar, k_b)), 120.0 - pipeline.COUPLING_MARGIN_DEG,
+                               places=6)
+        self.assertLess(math.degrees(limit), 120.0)
+
+    def test_a_kink_at_its_least_bend_is_left_to_the_global_limit(self):
+        memo = pipeline.target_shape.Memo()
+        changed, stuck = pipeline._tighten(self.design(40.0, 51.046), memo, 50.0, 40.01)
+        self.assertEqual(changed, 0)
+        self.assertAlmostEqual(stuck, 1.046, places=9)
+        self.assertEqual(memo.vertex_limits.get("X1/0", {}), {})

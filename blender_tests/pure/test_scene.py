@@ -71,6 +71,21 @@ class SceneTest(unittest.TestCase):
         self.assertRefused('settings.load_factor', settings={"load_factor": "3"})
         self.assertRefused('settings.torque_fraction', settings={"torque_fraction": 1.5})
 
+    def test_search_knobs(self):
+        # FORMATS.md additions: in_plane_tiebreak (bool), max_nodes and relayer_rounds (integers).
+        s = self.parse()
+        self.assertEqual((s.settings["in_plane_tiebreak"], s.settings["max_nodes"], s.settings["relayer_rounds"]),
+                         (False, 200000, 8))
+        s = self.parse(settings={"in_plane_tiebreak": True, "max_nodes": 0, "relayer_rounds": 3})
+        self.assertEqual((s.settings["in_plane_tiebreak"], s.settings["max_nodes"], s.settings["relayer_rounds"]),
+                         (True, 0, 3))
+        self.assertIs(type(s.settings["max_nodes"]), int)
+        self.assertRefused('"settings.in_plane_tiebreak" must be true or false', settings={"in_plane_tiebreak": 1})
+        self.assertRefused('"settings.max_nodes" must be a whole number', settings={"max_nodes": 1.5})
+        self.assertRefused('"settings.max_nodes" must be a whole number', settings={"max_nodes": True})
+        self.assertRefused('"settings.max_nodes" must be at least 0', settings={"max_nodes": -1})
+        self.assertRefused('"settings.relayer_rounds" must be at most 100', settings={"relayer_rounds": 101})
+
     def test_material(self):
         self.assertEqual(self.parse(material="brass").material["max_torque"], 1.30)
         self.assertRefused('preset "gold"', material="gold")

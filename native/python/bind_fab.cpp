@@ -95,7 +95,8 @@ std::vector<TemplateWire> to_templates(py::handle wires) {
                  {"points", [&](py::handle v, const std::string& at) { w.points = to_points<2>(v, at); }},
                  {"bend_points", [&](py::handle v, const std::string& at) { w.bend_points = to_integers<std::size_t>(v, at); }},
                  {"crossing_points",
-                  [&](py::handle v, const std::string& at) { w.crossing_points = to_integers<std::size_t>(v, at); }}});
+                  [&](py::handle v, const std::string& at) { w.crossing_points = to_integers<std::size_t>(v, at); }},
+                 {"self_crossings", [&](py::handle v, const std::string& at) { w.self_crossings = to_points<2>(v, at); }}});
     out.push_back(std::move(w));
   });
   return out;
@@ -146,6 +147,26 @@ py::dict make_bend_program_py(const py::object& points, const py::object& profil
   return program_dict(p);
 }
 
+py::list bend_program_problems_py(const py::object& points, const py::object& profile) {
+  const MachineProfile m = to_profile(profile);
+  const Polyline2 poly = to_points<2>(points, "points");
+  std::vector<BendProblem> problems;
+  {
+    py::gil_scoped_release release;
+    problems = bend_program_problems(poly, m);
+  }
+  static const char* kinds[] = {"over_bend", "short_feed", "command"};
+  py::list out;
+  for (const BendProblem& b : problems) {
+    const bool feed = b.kind == BendProblem::Kind::short_feed;
+    out.append(py::dict(py::arg("kind") = kinds[static_cast<int>(b.kind)], py::arg("number") = b.number,
+                        py::arg("from") = b.from, py::arg("to") = b.to, py::arg("at") = b.at,
+                        py::arg("value") = feed ? b.value : to_deg(b.value),
+                        py::arg("limit") = feed ? b.limit : to_deg(b.limit), py::arg("message") = b.message));
+  }
+  return out;
+}
+
 std::string write_svg(const std::optional<std::string>& path, const py::object& wires, std::optional<bool> sheet,
                       const py::object& options) {
   const std::vector<TemplateWire> w = to_templates(wires);
@@ -162,14 +183,33 @@ std::string write_svg(const std::optional<std::string>& path, const py::object& 
   return text;
 }
 
-std::string write_dxf(const std::optional<std::string>& path, const py::object& wires, bool labels) {
+std::string write_dxf(const std::optional<std::string>& path, const py::object& wires, bool labels,
+                      const std::string& layout, double gap_mm) {
   const std::vector<TemplateWire> w = to_templates(wires);
+  DxfOptions o;
+  o.labels = labels;
+  o.gap_mm = gap_mm;
+  if (layout == "as_given") o.layout = DxfLayout::as_given;
+  else if (layout == "start_at_origin") o.layout = DxfLayout::start_at_origin;
+  else if (layout == "side_by_side") o.layout = DxfLayout::side_by_side;
+  else throw InputError("DXF layout must be \"as_given\", \"start_at_origin\" or \"side_by_side\", got \"" + layout + "\"");
   std::string text;
   {
     py::gil_scoped_release release;
-    DxfOptions o;
-    o.labels = labels;
     text = dxf_document(w, o);
+    maybe_write(path, text);
+  }
+  return text;
+}
+
+std::string write_machine_svg(const std::optional<std::string>& path, const py::object& wire, double stroke_mm) {
+  py::list one;
+  one.append(wire);
+  const std::vector<TemplateWire> w = to_templates(one);
+  std::string text;
+  {
+    py::gil_scoped_release release;
+    text = svg_machine(w[0], stroke_mm);
     maybe_write(path, text);
   }
   return text;
@@ -257,12 +297,26 @@ Returns {"steps": [{"feed_mm", "bend_deg", "commanded_deg", "vertex"}], "feeds_m
 "commanded_deg", "wire_length" (m), "bend_count", "machine_seconds", "shape_error" (m),
 "merged_points", "small_turns", "rounded_bends", "dropped_turn_deg", "start", "start_heading_deg",
 "bend_vertices", "rebuilt" (k, 2) m}. Raises ValueError naming the bend, step or point.)");
+  m.def("bend_program_problems", &bend_program_problems_py, py::arg("points"), py::arg("profile") = py::dict(),
+        R"(What keeps a 2D wire from being bent (the problems make_bend_program refuses, all of them).
+
+points, profile: as make_bend_program. Returns [{"kind": "over_bend" | "short_feed" | "command",
+"number" (the bend, or the step of a short feed, from 1), "from", "to" (input points: the bend, or
+the feed's first and last), "at" (m from the cut to "from"), "value", "limit" (degrees for bends,
+metres for feeds), "message"}], empty when the wire can be made. Raises ValueError for bad input.)");
   m.def("write_svg", &write_svg, py::arg("path"), py::arg("wires"), py::arg("sheet") = py::none(),
         py::arg("options") = py::dict(),
-        R"(1:1 SVG template (mm). wires: [{"name", "points" (n, 2) m, "bend_points", "crossing_points"}].
+        R"(1:1 SVG template (mm). wires: [{"name", "points" (n, 2) m, "bend_points", "crossing_points",
+"self_crossings" (k, 2) m, optional}].
 sheet: None = a sheet when more than one wire. Writes atomically when path is not None; returns the text.)");
-  m.def("write_dxf", &write_dxf, py::arg("path"), py::arg("wires"), py::arg("labels") = true,
-        "DXF R12, one layer per wire, mm. Writes atomically when path is not None; returns the text.");
+  m.def("write_dxf", &write_dxf, py::arg("path"), py::arg("wires"), py::arg("labels") = false,
+        py::arg("layout") = "as_given", py::arg("gap_mm") = 20.0,
+        R"(DXF R2000, $INSUNITS mm, one layer and one LWPOLYLINE per wire. layout: "as_given", "start_at_origin"
+(each wire's first point at 0,0) or "side_by_side" (bounding boxes gap_mm apart on the x axis).
+Writes atomically when path is not None; returns the text.)");
+  m.def("write_machine_svg", &write_machine_svg, py::arg("path"), py::arg("wire"), py::arg("stroke_mm") = 0.5,
+        R"(The machine SVG of one wire {"name", "points" (n, 2) m}: exactly one path, mm, origin at the first
+point. Writes atomically when path is not None; returns the text.)");
   m.def("write_gcode", &write_gcode, py::arg("path"), py::arg("points"), py::arg("profile") = py::dict(),
         py::arg("wire_name") = "", py::arg("material") = "", py::arg("sync_each_step") = true,
         "GRBL G-code for the wire. Writes atomically when path is not None; returns the text.");

@@ -3,6 +3,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -40,7 +41,32 @@ std::vector<WireSpec> to_wires(py::handle list) {
   return wires;
 }
 
-void read_settings(py::handle d, NetworkOptions& net, LayeringOptions& lay) {
+/// settings['forbidden_hooks']: [[crossing id, hook (-1 or 1)], ...], read before the network
+/// (and so the number of crossings) is known.
+struct Forbidden {
+  std::vector<std::vector<int>> pairs;
+
+  /// LayeringOptions::allowed_hooks for a network of `crossings` crossings; InputError names the
+  /// entry at fault.
+  std::vector<std::array<bool, 2>> mask(std::size_t crossings) const {
+    if (pairs.empty()) return {};
+    std::vector<std::array<bool, 2>> allowed(crossings, {true, true});
+    for (std::size_t k = 0; k < pairs.size(); ++k) {
+      const std::string at = "settings['forbidden_hooks'][" + std::to_string(k) + "]";
+      const auto& p = pairs[k];
+      if (p.size() != 2) throw InputError(at + ": expected [crossing id, hook]");
+      if (p[0] < 0 || static_cast<std::size_t>(p[0]) >= crossings)
+        throw InputError(at + ": crossing " + std::to_string(p[0]) + " does not exist (the network has " +
+                         std::to_string(crossings) + " crossings)");
+      if (p[1] != -1 && p[1] != 1)
+        throw InputError(at + ": the hook must be -1 or 1 (null is always allowed), got " + std::to_string(p[1]));
+      allowed[p[0]][p[1] > 0 ? 1 : 0] = false;
+    }
+    return allowed;
+  }
+};
+
+void read_settings(py::handle d, NetworkOptions& net, LayeringOptions& lay, Forbidden* forbidden = nullptr) {
   read_fields(d, "settings",
               {field::number("tolerance", net.tolerance), field::number("min_segment", net.min_segment),
                field::number("friction", lay.contact.friction), field::number("contact_angle", lay.contact.contact_angle),
@@ -49,7 +75,11 @@ void read_settings(py::handle d, NetworkOptions& net, LayeringOptions& lay) {
                field::boolean("two_wire_steps", lay.two_wire_steps), field::integer("max_nodes", lay.max_nodes),
                field::integer("max_step_crossings", lay.max_step_crossings),
                field::boolean("in_plane_tiebreak", lay.in_plane_tiebreak),
-               field::integer("in_plane_nodes", lay.in_plane_nodes)});
+               field::integer("in_plane_nodes", lay.in_plane_nodes),
+               {"forbidden_hooks", [&](py::handle v, const std::string& at) {
+                  if (forbidden == nullptr) throw InputError(at + ": only layering() takes forbidden hooks");
+                  forbidden->pairs = to_integer_lists(v, at);
+                }}});
 }
 
 /// The network in the design document's own keys (docs/formats.md): a wire's points are its
@@ -92,13 +122,15 @@ py::dict layering_py(const py::object& wire_list, const py::object& settings, co
   const std::vector<WireSpec> wires = to_wires(wire_list);
   NetworkOptions net_options;
   LayeringOptions options;
-  read_settings(settings, net_options, options);
+  Forbidden forbidden;
+  read_settings(settings, net_options, options, &forbidden);
 
   PythonProgress reporter(progress);
   const ProgressFn fn = reporter.fn();
   Network net;
   const LayeringResult r = reporter.run([&] {
     net = build_network(wires, net_options, fn);
+    options.allowed_hooks = forbidden.mask(net.crossings.size());
     return layering(net, options, fn);
   });
 
@@ -161,7 +193,8 @@ wires: list of {"name": str, "origin": 3 floats, "normal": 3 floats, "points": f
 metres on the plane, "closed": bool (default True)}.
 settings (all optional): tolerance (m, 1e-5), min_segment (m, 0.015), friction (0.32),
 contact_angle (rad, 2pi/3), bisector_span (m, 0.005), straight_angle (rad, 1 degree),
-two_wire_steps (True), max_nodes (200000), max_step_crossings (20), in_plane_tiebreak (False), in_plane_nodes (300);
+two_wire_steps (True), max_nodes (200000), max_step_crossings (20), in_plane_tiebreak (False), in_plane_nodes (300),
+forbidden_hooks ([[crossing id, hook -1 or 1], ...]: hooks the search may not choose; default none);
 unknown keys raise ValueError.
 progress(stage, fraction) -> False cancels (raises _wiresculpt.Cancelled).
 Returns {"network": {"wires": [{id, name, origin, normal, closed, contour [[x, y, z]] (the points

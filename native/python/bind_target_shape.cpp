@@ -41,6 +41,10 @@ TargetShapeOptions to_options(py::handle d) {
                field::number("sweep_tol", o.sweep_tol), field::integer("max_sweeps", o.max_sweeps),
                field::number("model_size", o.model_size), field::number("angle_tolerance", o.angle_tolerance),
                field::number("length_tolerance", o.length_tolerance), field::text("wire_name", o.wire_name),
+               {"vertex_max_bend",
+                [&](py::handle v, const std::string& at) {
+                  each_item(v, at, [&](py::handle x, const std::string& i) { o.vertex_max_bend.push_back(to_number(x, i)); });
+                }},
                field::choice("algorithm", o.algorithm,
                              {{"slsqp", TargetShapeAlgorithm::slsqp},
                               {"auglag_lbfgs", TargetShapeAlgorithm::auglag_lbfgs},
@@ -85,7 +89,7 @@ void bind_target_shape(py::module_& m) {
 
 points: float64 (n, 2), metres; closed: bool; crossings: list of {"vertex": int (index into
 points), "bisector": (x, y) desired h*, "contact_angle": radians (default 2π/3), "active": bool
-(default True)}; options: dict of TargetShapeOptions fields (min_segment, max_bend, spacing,
+(default True)}; options: dict of TargetShapeOptions fields (min_segment, max_bend, vertex_max_bend (radians per point of the result), spacing,
 regularization, friction, algorithm ("slsqp" | "auglag_lbfgs" | "ccsaq" | "mma"), ftol_rel,
 xtol_rel, constraint_tol, max_iterations, window, sweep_tol, max_sweeps, model_size,
 angle_tolerance, length_tolerance, wire_name); progress: optional callable(stage, fraction) ->

@@ -4,13 +4,16 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
 
 #include "wiresculpt/error.hpp"
 #include "wiresculpt/in_plane.hpp"
+#include "wiresculpt/mechanism.hpp"
 #include "wiresculpt/stability.hpp"
+#include "wire_names.hpp"
 
 namespace wiresculpt {
 namespace {
@@ -36,26 +39,14 @@ bool less(const Key& a, const Key& b) {
   return a.unbal < b.unbal;
 }
 
-std::string quoted(const Network& net, int w) { return "'" + net.wires[w].name + "'"; }
-
-std::string join(const std::vector<std::string>& items) {
-  std::string out;
-  for (std::size_t k = 0; k < items.size(); ++k)
-    out += (k == 0 ? "" : (k + 1 == items.size() ? " and " : ", ")) + items[k];
-  return out;
+bool allowed(const LayeringOptions& options, int c, int side) {
+  return options.allowed_hooks.empty() || options.allowed_hooks[c][side];
 }
 
-std::string wire_list(const Network& net, const std::vector<int>& wires) {
-  std::vector<std::string> names;
-  for (int w : wires) names.push_back(quoted(net, w));
-  return join(names);
-}
-
-std::string crossing_list(const std::vector<int>& crossings) {
-  std::vector<std::string> ids;
-  for (int c : crossings) ids.push_back(std::to_string(c));
-  return join(ids);
-}
+using detail::crossing_list;
+using detail::join;
+using detail::quoted;
+using detail::wire_list;
 
 class Search {
  public:
@@ -66,9 +57,16 @@ class Search {
     full_ = P_ == 64 ? ~std::uint64_t{0} : ((std::uint64_t{1} << P_) - 1);
     cost_.resize(C_);
     minhook_.resize(C_);
+    relaxed_.resize(C_);
+    constexpr double forbidden = std::numeric_limits<double>::infinity();
     for (int c = 0; c < C_; ++c) {
-      cost_[c] = {hook_metric(net, c, -1, options.contact), hook_metric(net, c, 1, options.contact)};
+      // A forbidden hook (LayeringOptions::allowed_hooks) costs +inf: never enumerated, and the
+      // prunings compare with the cheaper allowed hook.
+      const bool minus = allowed(options, c, 0), plus = allowed(options, c, 1);
+      cost_[c] = {minus ? hook_metric(net, c, -1, options.contact) : forbidden,
+                  plus ? hook_metric(net, c, 1, options.contact) : forbidden};
       minhook_[c] = std::min(cost_[c][0], cost_[c][1]);
+      relaxed_[c] = minus && plus ? 2 : (plus ? 1 : (minus ? -1 : 0));
     }
     hooks_.assign(C_, 0);
     neighbours_.assign(P_, 0);
@@ -106,6 +104,9 @@ class Search {
   std::uint64_t full_ = 0;
   std::vector<std::array<double, 2>> cost_;  // [c][0]: hook -1, [c][1]: hook +1
   std::vector<double> minhook_;
+  // Per crossing: the pyramids of every allowed hook at once (2: both, +-1: the one allowed, 0:
+  // none), for prunings (d) and (e).
+  std::vector<int> relaxed_;
   std::vector<std::uint64_t> neighbours_;  // per wire: the wires it crosses
   // balances_in_plane per wire and hooks of its crossings (key: wire id, then hooks).
   mutable std::unordered_map<std::string, bool> balance_memo_;
@@ -357,10 +358,11 @@ class Search {
         const std::size_t before = children.size();
         enumerate(groups[gi], gi, children, round == 0);
         if (round == 0 || children.size() - before < 16) continue;  // cheaper to try a few one by one
-        // Pruning (d): both pyramids at every new crossing; if that fails, every choice fails.
+        // Pruning (d): every allowed hook's pyramid at every new crossing; if that fails, every
+        // choice fails.
         std::vector<int> wires = order_;
         for (int w : groups[gi].wires) wires.push_back(w);
-        for (int c : groups[gi].fresh) hooks_[c] = 2;
+        for (int c : groups[gi].fresh) hooks_[c] = relaxed_[c];
         const bool ok = checker_.check(wires, hooks_, wires.size() == 2).stable;
         for (int c : groups[gi].fresh) hooks_[c] = 0;
         if (!ok) children.resize(before);
@@ -470,6 +472,15 @@ std::string explain(const Network& net, const Search& s, bool tried_pairs) {
          (worst_c.size() > 1 ? "s " : " ") + crossing_list(worst_c) + " with them" + also;
 }
 
+// Appended to a reason when hooks were forbidden: the verdict is over the allowed ones only.
+std::string forbidden_note(const LayeringOptions& options) {
+  int count = 0;
+  for (const auto& a : options.allowed_hooks) count += !a[0] + !a[1];
+  if (count == 0) return "";
+  return " (with " + std::to_string(count) + " hook" + (count == 1 ? "" : "s") +
+         " forbidden because the target shape cannot realise them)";
+}
+
 }  // namespace
 
 LayeringResult layering(const Network& net, const LayeringOptions& options, const ProgressFn& progress) {
@@ -483,6 +494,9 @@ LayeringResult layering(const Network& net, const LayeringOptions& options, cons
   if (options.in_plane_nodes < 0) throw InputError("in_plane_nodes must be >= 0 (0 means no limit)");
   if (options.max_step_crossings < 1 || options.max_step_crossings > 30)
     throw InputError("max_step_crossings must be between 1 and 30");
+  if (!options.allowed_hooks.empty() && static_cast<int>(options.allowed_hooks.size()) != C)
+    throw InputError("allowed_hooks has " + std::to_string(options.allowed_hooks.size()) + " entries for " +
+                     std::to_string(C) + " crossings (one per crossing, or none)");
   for (const auto& x : net.crossings)
     if (x.wires[0] < 0 || x.wires[0] >= P || x.wires[1] < 0 || x.wires[1] >= P || x.wires[0] == x.wires[1])
       throw InputError("the network has a crossing with invalid wire ids; build it with build_network");
@@ -534,24 +548,34 @@ LayeringResult layering(const Network& net, const LayeringOptions& options, cons
   {
     std::vector<int> all(P);
     for (int w = 0; w < P; ++w) all[w] = w;
-    const StabilityResult relaxed = s.checker_.check(all, std::vector<int>(C, 2), P == 2);
+    const StabilityResult relaxed = s.checker_.check(all, s.relaxed_, P == 2);
     if (!relaxed.stable) {
-      int w = relaxed.failed_wire;
-      if (w < 0) {  // the combined load failed: name the wire with the fewest crossings
-        std::vector<int> count(P, 0);
-        for (const auto& x : net.crossings) ++count[x.wires[0]], ++count[x.wires[1]];
-        w = static_cast<int>(std::min_element(count.begin(), count.end()) - count.begin());
-      }
-      std::vector<int> cs;
-      for (int c = 0; c < C; ++c)
-        if (net.crossings[c].wires[0] == w || net.crossings[c].wires[1] == w) cs.push_back(c);
-      static const char* what[6] = {"a force along x", "a force along y", "a force along z",
-                                    "a torque about x", "a torque about y", "a torque about z"};
+      // Name what moves, from the null space of the crossings as ball joints (mechanism.hpp),
+      // rather than the LP's failing load, whose wire need not be the one that moves.
+      const Mechanism mechanism = find_mechanism(net);
       r.reason = "no hook configuration can make the finished sculpture stable: even with both hook directions "
-                 "allowed at every crossing, the wires cannot balance " +
-                 (relaxed.failed_component >= 0 ? std::string(what[relaxed.failed_component]) : std::string("every load")) +
-                 " on wire " + quoted(net, w) + " (its crossing" + (cs.size() == 1 ? " " : "s ") + crossing_list(cs) +
-                 "): the wires are held at too few crossings or can move as a mechanism";
+                 "allowed at every crossing, ";
+      if (!mechanism.moving.empty()) {
+        r.reason += mechanism_message(net, mechanism);
+      } else {  // rigid as ball joints, yet the allowed pyramids do not span (forbidden hooks, degenerate contact angle)
+        int w = relaxed.failed_wire;
+        if (w < 0) {  // the combined load failed: name the wire with the fewest crossings
+          std::vector<int> count(P, 0);
+          for (const auto& x : net.crossings) ++count[x.wires[0]], ++count[x.wires[1]];
+          w = static_cast<int>(std::min_element(count.begin(), count.end()) - count.begin());
+        }
+        std::vector<int> cs;
+        for (int c = 0; c < C; ++c)
+          if (net.crossings[c].wires[0] == w || net.crossings[c].wires[1] == w) cs.push_back(c);
+        static const char* what[6] = {"a force along x", "a force along y", "a force along z",
+                                      "a torque about x", "a torque about y", "a torque about z"};
+        r.reason += "the wires cannot balance " +
+                    (relaxed.failed_component >= 0 ? std::string(what[relaxed.failed_component])
+                                                   : std::string("every load")) +
+                    " on wire " + quoted(net, w) + " (its crossing" + (cs.size() == 1 ? " " : "s ") +
+                    crossing_list(cs) + "): the wires are held at too few crossings";
+      }
+      r.reason += forbidden_note(options);
       r.stats.lp_solves = s.checker_.lp_solves();
       return finish();
     }
@@ -623,8 +647,13 @@ LayeringResult layering(const Network& net, const LayeringOptions& options, cons
         r.sum_metric += r.metric[c];
       }
     }
-    r.reason = s.stopped() ? "the search stopped (max_nodes) before finding a stable assembly; " + explain(net, s, tried_pairs)
+    // A stopped search proves nothing: it says so, never that no stable assembly exists.
+    r.reason = s.stopped() ? "search incomplete: the layering stopped after " + std::to_string(s.nodes_) +
+                                 " nodes (max_nodes = " + std::to_string(options.max_nodes) +
+                                 ") before finding a stable assembly; a stable one may exist: raise max_nodes (0: no "
+                                 "limit) to search further"
                            : explain(net, s, tried_pairs);
+    r.reason += forbidden_note(options);
   }
   report_progress(progress, "layering", 1.0);
   return finish();

@@ -38,6 +38,17 @@ double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x
 double angle_between(const Vec2& a, const Vec2& b) { return std::atan2(std::abs(cross2(a, b)), a.dot(b)); }
 
 
+}  // namespace
+
+double bend_limit(const TargetShapeOptions& options, int i) {
+  const std::size_t k = static_cast<std::size_t>(i);
+  return i >= 0 && k < options.vertex_max_bend.size() && options.vertex_max_bend[k] > 0.0
+             ? std::min(options.vertex_max_bend[k], options.max_bend)
+             : options.max_bend;
+}
+
+namespace {
+
 void validate(const Polyline2& contour, bool closed, const std::vector<TargetCrossing>& crossings,
               const TargetShapeOptions& o) {
   const std::string& w = o.wire_name;
@@ -45,6 +56,9 @@ void validate(const Polyline2& contour, bool closed, const std::vector<TargetCro
   auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
   if (!positive(o.min_segment)) bad("min_segment must be a positive number of metres");
   if (!(positive(o.max_bend) && o.max_bend <= pi)) bad("max_bend must be in (0, π] radians");
+  for (std::size_t i = 0; i < o.vertex_max_bend.size(); ++i)
+    if (!(std::isfinite(o.vertex_max_bend[i]) && o.vertex_max_bend[i] <= pi))
+      bad("vertex_max_bend[" + std::to_string(i) + "] must be a number of radians <= π (0: max_bend)");
   if (!(std::isfinite(o.spacing) && o.spacing >= 0.0)) bad("spacing must be >= 0 metres");
   if (!(std::isfinite(o.regularization) && o.regularization >= 0.0)) bad("regularization must be >= 0");
   if (!(std::isfinite(o.friction) && o.friction >= 0.0)) bad("friction must be >= 0");
@@ -518,7 +532,7 @@ double TargetShapeProblem::constraint(std::size_t k, const Polyline2& p, Polylin
         (*grad)[i] += dv;
         (*grad)[b] -= dv;
       }
-      return std::cos(options_.max_bend) - uh.dot(vh);
+      return std::cos(bend_limit(options_, i)) - uh.dot(vh);
     }
     case Kind::contact: {
       const Vec2& h = crossings_[c.crossing].bisector;
@@ -890,8 +904,9 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     const Vec2 u = p[i] - p[(i + m - 1) % m], v = p[(i + 1) % m] - p[i];
     const double bend = angle_between(u, v);
     result.max_bend = std::max(result.max_bend, bend);
-    if (bend - o.max_bend > 0.0) result.max_angle_violation = std::max(result.max_angle_violation, bend - o.max_bend);
-    if (bend - o.max_bend > o.angle_tolerance) sharp_bends.push_back(i);
+    const double limit = bend_limit(o, i);
+    if (bend - limit > 0.0) result.max_angle_violation = std::max(result.max_angle_violation, bend - limit);
+    if (bend - limit > o.angle_tolerance) sharp_bends.push_back(i);
   }
   for (std::size_t c = 0; c < crossings.size(); ++c) {
     TargetCrossingStatus& s = result.crossings[c];
@@ -923,6 +938,39 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
                   deg(s.contact_violation) + " outside the contact cone)";
     }
   }
+  // A kink whose neighbours break a machine limit is not made either: the solver met the contact
+  // constraints at the expense of a bend or segment next to the crossing (the kink, l_min and the
+  // bend limit conflict there). Blaming the crossing lets the caller null it (or choose the other
+  // hook) instead of passing on a wire the bender cannot make.
+  std::vector<char> is_fixed(static_cast<std::size_t>(m), 0);
+  for (const auto& st : result.crossings) is_fixed[static_cast<std::size_t>(st.vertex)] = 1;
+  auto over_at = [&](int i) {  // the bend at point i beyond its limit (radians), 0 when within or an end
+    if (m < 3 || (!closed && (i <= 0 || i >= m - 1))) return 0.0;
+    const int k = (i + m) % m;
+    const double bend = angle_between(p[k] - p[(k + m - 1) % m], p[(k + 1) % m] - p[k]);
+    return bend - bend_limit(o, k) > o.angle_tolerance ? bend : 0.0;
+  };
+  for (std::size_t c = 0; c < crossings.size(); ++c) {
+    TargetCrossingStatus& s = result.crossings[c];
+    if (!crossings[c].active || !s.realised) continue;
+    const int v = s.vertex;
+    for (int nb : {v - 1, v + 1}) {
+      if (!closed && (nb < 0 || nb >= m)) continue;
+      const int k = (nb + m) % m;
+      if (is_fixed[static_cast<std::size_t>(k)]) continue;  // between fixed points: too_close's case
+      const double bend = over_at(nb);
+      const double len = (p[k] - p[v]).norm();
+      if (bend <= 0.0 && o.min_segment - len <= o.length_tolerance) continue;
+      result.feasible = false;
+      s.status = "infeasible";
+      s.realised = false;
+      s.message = "crossing " + std::to_string(c) + " on wire " + w +
+                  ": its kink cannot be made within the machine's limits: next to it, at point " + std::to_string(k) +
+                  ", the wire " + (bend > 0.0 ? "bends " + deg(bend) + ", more than " + deg(bend_limit(o, k))
+                                                : "has a segment of " + mm(len) + ", less than " + mm(o.min_segment));
+      break;
+    }
+  }
   auto list = [](const std::vector<int>& v) {
     std::string s;
     for (std::size_t k = 0; k < v.size() && k < 8; ++k) s += (k ? ", " : "") + std::to_string(v[k]);
@@ -933,7 +981,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     result.warnings.push_back("wire " + w + ": segments starting at points " + list(short_edges) + " are shorter than " +
                               mm(o.min_segment) + " (by up to " + mm(result.max_length_violation) + ")");
   if (!sharp_bends.empty())
-    result.warnings.push_back("wire " + w + ": bends at points " + list(sharp_bends) + " exceed " + deg(o.max_bend));
+    result.warnings.push_back("wire " + w + ": bends at points " + list(sharp_bends) + " exceed " + deg(o.max_bend) + (o.vertex_max_bend.empty() ? "" : " or their own limits (vertex_max_bend)"));
   result.feasible = result.feasible && short_edges.empty() && sharp_bends.empty();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   report_progress(progress, "target_shape", 1.0);

@@ -12,6 +12,7 @@
 using namespace wiresculpt;
 using namespace wiresculpt::fab;
 using Catch::Matchers::Contains;
+using Catch::Matchers::Equals;
 
 namespace {
 constexpr double pi = std::numbers::pi;
@@ -146,7 +147,8 @@ TEST_CASE("bend program: limits are refused with messages naming the bend or ste
   const MachineProfile m;
   SECTION("a bend over the maximum reliable angle") {
     const Polyline2 p = walk({0, 0}, 0, {0.02, 0.02, 0.02}, {40 * deg, 130 * deg});
-    CHECK_THROWS_WITH(make_bend_program(p, m), Contains("bend 2") && Contains("point 2") && Contains("130.00 deg") &&
+    CHECK_THROWS_WITH(make_bend_program(p, m), Contains("bend 2") && Contains("40.0 mm from the cut") &&
+                                                   Contains("130.00 deg") &&
                                                    Contains("120.0 deg"));
   }
   SECTION("a commanded angle beyond the head's range") {
@@ -166,7 +168,36 @@ TEST_CASE("bend program: limits are refused with messages naming the bend or ste
   SECTION("a feed shorter than l_min") {
     const Polyline2 p = walk({0, 0}, 0, {0.02, 0.010, 0.02}, {30 * deg, 30 * deg});
     CHECK_THROWS_WITH(make_bend_program(p, m), Contains("step 2") && Contains("10.000 mm") && Contains("15.000 mm") &&
-                                                   Contains("points 1 to 2"));
+                                                   Contains("between bends 1 and 2, 20.0 mm from the cut"));
+  }
+  SECTION("a bend 0.1 deg over the limit, and one 0.1 deg under it") {
+    CHECK_THROWS_WITH(make_bend_program(walk({0, 0}, 0, {0.02, 0.02}, {120.1 * deg}), m),
+                      Contains("bend 1") && Contains("120.10 deg"));
+    CHECK(bend_program_problems(walk({0, 0}, 0, {0.02, 0.02}, {-120.1 * deg}), m).size() == 1);
+    CHECK(bend_program_problems(walk({0, 0}, 0, {0.02, 0.02}, {119.9 * deg}), m).empty());
+    CHECK_NOTHROW(make_bend_program(walk({0, 0}, 0, {0.02, 0.02}, {119.9 * deg}), m));
+  }
+  SECTION("every problem is listed, with the numbers of make_bend_program's message") {
+    // bends 1..4 at 20, 40, 45, 65 mm: bend 2 over, the feed between bends 2 and 3 5 mm, bend 4 over
+    const Polyline2 p = walk({0, 0}, 0, {0.02, 0.02, 0.005, 0.02, 0.02},
+                             {30 * deg, 125 * deg, 30 * deg, -121 * deg});
+    const auto problems = bend_program_problems(p, m);
+    REQUIRE(problems.size() == 3);
+    CHECK(problems[0].kind == BendProblem::Kind::over_bend);
+    CHECK(problems[0].number == 2);
+    CHECK(problems[0].from == 2);
+    CHECK(problems[0].at == Approx(0.04));
+    CHECK(to_deg(problems[0].value) == Approx(125.0));
+    CHECK(problems[1].kind == BendProblem::Kind::over_bend);
+    CHECK(problems[1].number == 4);
+    CHECK(problems[1].at == Approx(0.065));
+    CHECK(problems[2].kind == BendProblem::Kind::short_feed);
+    CHECK(problems[2].number == 3);
+    CHECK(problems[2].from == 2);
+    CHECK(problems[2].to == 3);
+    CHECK(problems[2].value == Approx(0.005));
+    CHECK_THAT(problems[2].message, Contains("between bends 2 and 3"));
+    CHECK_THROWS_WITH(make_bend_program(p, m), Equals(problems[0].message));
   }
   SECTION("bad polylines") {
     CHECK_THROWS_AS(make_bend_program(Polyline2{{0, 0}}, m), InputError);

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <numbers>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <algorithm>
 #include <csignal>
@@ -106,6 +107,45 @@ bool has_temp_files(const fs::path& dir) {
 }
 }  // namespace
 
+TEST_CASE("svg: the template marks the start, the feed direction and the cut", "[fab][svg]") {
+  auto number = [](const std::string& text, const std::string& re) {
+    std::smatch m;
+    REQUIRE(std::regex_search(text, m, std::regex(re)));
+    return std::stod(m[1]);
+  };
+  TemplateWire open;
+  open.name = "L";
+  open.points = {{0, 0}, {0.03, 0.04}, {0.09, 0.04}};  // first edge 3-4-5 up and right, last edge along +x
+  for (const TemplateWire& w : {open, square_wire()}) {
+    const std::string svg = svg_wire(w);
+    CHECK(balanced_tags(svg));
+    CHECK(count(svg, "class=\"start\"") == 1);
+    CHECK(count(svg, "class=\"feed\"") == 1);
+    CHECK(count(svg, "class=\"cut\"") == 1);
+    const auto q = polyline_points(svg);  // page coordinates, y down
+    const double cx = number(svg, "class=\"start\" cx=\"([-0-9.]+)\""), cy = number(svg, "class=\"start\"[^>]* cy=\"([-0-9.]+)\"");
+    CHECK(cx == Approx(q.front().x()).margin(1e-4));
+    CHECK(cy == Approx(q.front().y()).margin(1e-4));
+    const Vec2 feed(number(svg, "data-dx=\"([-0-9.]+)\""), number(svg, "data-dy=\"([-0-9.]+)\""));
+    CHECK(feed.dot((q[1] - q[0]).normalized()) == Approx(1).margin(1e-4));
+    // the arrow's line runs along the feed direction, beside the first segment
+    const std::regex line_re("class=\"feed\"[^>]*><line x1=\"([-0-9.]+)\" y1=\"([-0-9.]+)\" x2=\"([-0-9.]+)\" y2=\"([-0-9.]+)\"");
+    std::smatch m;
+    REQUIRE(std::regex_search(svg, m, line_re));
+    const Vec2 a(std::stod(m[1]), std::stod(m[2])), b(std::stod(m[3]), std::stod(m[4]));
+    CHECK((b - a).normalized().dot(feed) == Approx(1).margin(1e-3));
+    const std::regex cut_re("class=\"cut\" x1=\"([-0-9.]+)\" y1=\"([-0-9.]+)\" x2=\"([-0-9.]+)\" y2=\"([-0-9.]+)\"");
+    REQUIRE(std::regex_search(svg, m, cut_re));
+    const Vec2 c1(std::stod(m[1]), std::stod(m[2])), c2(std::stod(m[3]), std::stod(m[4]));
+    CHECK(((c1 + c2) / 2 - q.back()).norm() == Approx(0).margin(1e-3));  // across the last point
+    CHECK(std::abs((c2 - c1).normalized().dot((q.back() - q[q.size() - 2]).normalized())) < 1e-3);
+  }
+  // the open wire's numbers by hand: feed along (3, -4)/5 on the page (y down), cut across +x
+  const std::string svg = svg_wire(open);
+  CHECK(number(svg, "data-dx=\"([-0-9.]+)\"") == Approx(0.6).margin(1e-4));
+  CHECK(number(svg, "data-dy=\"([-0-9.]+)\"") == Approx(-0.8).margin(1e-4));
+}
+
 TEST_CASE("svg: one wire at 1:1 with width and height of the bounding box plus margins", "[fab][svg]") {
   SvgOptions o;
   o.margin_mm = 12.0;
@@ -180,7 +220,7 @@ TEST_CASE("svg: the sheet lays wires out without overlap", "[fab][svg]") {
   CHECK_THROWS_WITH(svg_sheet({square_wire(), bad}), Contains("wire 1") && Contains("crossing point index 9"));
 }
 
-TEST_CASE("dxf: R12 structure, one layer per wire, polylines in mm", "[fab][dxf]") {
+TEST_CASE("dxf: R2000 structure, mm units, one layer and one LWPOLYLINE per wire", "[fab][dxf]") {
   std::vector<TemplateWire> wires{square_wire(), square_wire()};
   wires[1].name = "B/1";
   for (auto& p : wires[1].points) p += Vec2(0.2, 0.0);
@@ -193,16 +233,80 @@ TEST_CASE("dxf: R12 structure, one layer per wire, polylines in mm", "[fab][dxf]
   }
   CHECK(lines[lines.size() - 2] == "  0");
   CHECK(lines.back() == "EOF");
-  CHECK_THAT(dxf, Contains("$ACADVER\n  1\nAC1009\n"));
-  CHECK(count(dxf, "\nPOLYLINE\n") == 2);
-  CHECK(count(dxf, "\nSEQEND\n") == 2);
-  CHECK(count(dxf, "\nVERTEX\n") == 10);
+  CHECK_THAT(dxf, Contains("$ACADVER\n  1\nAC1015\n"));
+  CHECK_THAT(dxf, Contains("$INSUNITS\n 70\n4\n"));
+  CHECK(count(dxf, "\nLWPOLYLINE\n") == 2);
+  CHECK(count(dxf, "\nPOLYLINE\n") == 0);
+  CHECK(count(dxf, "\nTEXT\n") == 0);  // labels are off by default: machine files hold the wire only
   CHECK(dxf_layer_name(0, "A/0 <square>") == "WIRE_0_A_0__SQUARE_");
   CHECK(dxf_layer_name(1, "B/1") == "WIRE_1_B_1");
   CHECK(dxf_layer_name(3, std::string(60, 'x')).size() == 31);
-  CHECK(count(dxf, "\n  2\nWIRE_1_B_1\n") == 1);                 // the layer table entry
-  CHECK(count(dxf, "\n  8\nWIRE_1_B_1\n") == 1 + 5 + 1 + 1);    // polyline, vertices, seqend, text
+  CHECK(count(dxf, "\n  2\nWIRE_1_B_1\n") == 1);  // the layer table entry
+  CHECK(count(dxf, "\n  8\nWIRE_1_B_1\n") == 1);  // the polyline
   CHECK_THAT(dxf, Contains(" 10\n280.000000\n 20\n50.000000\n"));  // (0.28, 0.05) m of wire B
+  // handles are unique
+  std::set<std::string> handles;
+  std::size_t handle_count = 0;
+  for (std::size_t i = 0; i + 1 < lines.size(); i += 2)
+    if (lines[i] == "  5" || lines[i] == "105") { handles.insert(lines[i + 1]); ++handle_count; }
+  CHECK(handles.size() == handle_count);
+
+  DxfOptions labelled;
+  labelled.labels = true;
+  CHECK(count(dxf_document(wires, labelled), "\nTEXT\n") == 2);
+}
+
+TEST_CASE("dxf: layouts move each wire, side by side never overlaps", "[fab][dxf]") {
+  std::vector<TemplateWire> wires{square_wire(), square_wire(), square_wire()};
+  for (auto& p : wires[1].points) p = Vec2(2 * p.x() - 0.05, p.y());  // wider, overlapping wire 0
+  DxfOptions o;
+  o.layout = DxfLayout::start_at_origin;
+  for (const Polyline2& w : dxf_placed_mm(wires, o)) CHECK(w.front().norm() == Approx(0).margin(1e-12));
+  o.layout = DxfLayout::side_by_side;
+  o.gap_mm = 15;
+  const auto placed = dxf_placed_mm(wires, o);
+  double previous_right = -1e9;
+  for (std::size_t k = 0; k < placed.size(); ++k) {
+    double left = 1e9, right = -1e9, bottom = 1e9;
+    for (const Vec2& p : placed[k]) { left = std::min(left, p.x()); right = std::max(right, p.x()); bottom = std::min(bottom, p.y()); }
+    if (k > 0) CHECK(left - previous_right == Approx(15).margin(1e-9));
+    CHECK(bottom == Approx(0).margin(1e-9));
+    previous_right = right;
+    for (std::size_t i = 1; i < placed[k].size(); ++i)  // moved, not reshaped
+      CHECK((placed[k][i] - placed[k][i - 1]).norm() ==
+            Approx(1000 * (wires[k].points[i] - wires[k].points[i - 1]).norm()).margin(1e-9));
+  }
+  o.gap_mm = -1;
+  CHECK_THROWS_WITH(dxf_placed_mm(wires, o), Contains("gap_mm"));
+}
+
+TEST_CASE("svg: the machine file is one path from the origin", "[fab][svg]") {
+  TemplateWire w = square_wire();
+  for (auto& p : w.points) p += Vec2(0.3, -0.1);
+  const std::string svg = svg_machine(w);
+  CHECK(count(svg, "<path") == 1);
+  CHECK(count(svg, "<polyline") + count(svg, "<line") + count(svg, "<circle") + count(svg, "<text") == 0);
+  CHECK_THAT(svg, Contains("d=\"M 0.0000 0.0000 L "));
+  CHECK_THROWS_WITH(svg_machine(w, 0.0), Contains("stroke_mm"));
+}
+
+TEST_CASE("gcode: the default profile ducks its pin at every change of bend side", "[fab][gcode]") {
+  // a zigzag whose turn signs are known by construction: + - - + - (left, right, right, left, right)
+  const Polyline2 zigzag{{0, 0}, {0.03, 0}, {0.06, 0.03}, {0.09, 0.03}, {0.12, 0}, {0.15, 0.0}, {0.18, -0.03}};
+  std::vector<int> sides;
+  for (std::size_t i = 1; i + 1 < zigzag.size(); ++i) {
+    const Vec2 a = zigzag[i] - zigzag[i - 1], b = zigzag[i + 1] - zigzag[i];
+    const double cross = a.x() * b.y() - a.y() * b.x();
+    if (std::abs(cross) > 1e-12) sides.push_back(cross > 0 ? 1 : -1);
+  }
+  int changes = 0, side = 1;  // the pin starts on the positive (left) side
+  for (int s : sides) { changes += s != side; side = s; }
+  REQUIRE(changes >= 2);
+  const MachineProfile m;
+  CHECK(m.axes.pin_axis == 'Z');
+  const auto lines = stream_lines(gcode_program(make_bend_program(zigzag, m), m, GcodeInfo{"Z", "", true}));
+  CHECK(std::count(lines.begin(), lines.end(), "G0 Z-5.0000") == changes);
+  CHECK(std::count(lines.begin(), lines.end(), "G0 Z5.0000") == changes);
 }
 
 TEST_CASE("gcode: header, axis mapping, units and the bend table", "[fab][gcode]") {
@@ -223,9 +327,19 @@ TEST_CASE("gcode: header, axis mapping, units and the bend table", "[fab][gcode]
   std::snprintf(minus, sizeof minus, "G1 Y-%.4f F5400.0", c);
   const std::vector<std::string> expected{"G21", "G91", "G94",
                                           "G1 X50.0000 F1200.0", plus, minus, "G4 P0",
-                                          "G1 X50.0000 F1200.0", minus, plus, "G4 P0",
-                                          "G1 X50.0000 F1200.0", "G4 P0", "M2"};
-  CHECK(lines == expected);
+                                          "G1 X50.0000 F1200.0", "G0 Z-5.0000", "G0 Z5.0000", minus, plus,
+                                          "G4 P0", "G1 X50.0000 F1200.0", "G4 P0", "M2"};
+  CHECK(lines == expected);  // the default profile moves its pin (Z) before the bend to the other side
+
+  // A profile without a pin axis (a head that bends both ways) writes what every profile wrote
+  // before the pin became the default: the same program without the two pin moves.
+  MachineProfile no_pin = m;
+  no_pin.axes.pin_axis = '\0';
+  const std::vector<std::string> expected_no_pin{"G21", "G91", "G94",
+                                                 "G1 X50.0000 F1200.0", plus, minus, "G4 P0",
+                                                 "G1 X50.0000 F1200.0", minus, plus, "G4 P0",
+                                                 "G1 X50.0000 F1200.0", "G4 P0", "M2"};
+  CHECK(stream_lines(gcode_program(prog, no_pin, info)) == expected_no_pin);
 
   // Another mapping: feed on A in 0.5 units/mm, bend on B in 2 units/deg, left = negative, a pin on Z.
   m.axes.feed_axis = 'A';

@@ -1,6 +1,7 @@
 // The layering search against hand-known verdicts and against brute-force enumeration of every
 // hook configuration and every assembly order.
 #include <algorithm>
+#include <array>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <map>
@@ -74,8 +75,10 @@ bool better(const Objective& a, const Objective& b) {
   return a.unbal < b.unbal;
 }
 
-// Every configuration (3^C) and every order (P!), single-wire steps.
-Objective brute_force(const Network& net, const ContactOptions& co, bool in_plane = true) {
+// Every configuration (3^C) and every order (P!), single-wire steps; with `allowed` (per
+// crossing: hook -1, hook +1 allowed), only the configurations it allows.
+Objective brute_force(const Network& net, const ContactOptions& co, bool in_plane = true,
+                      const std::vector<std::array<bool, 2>>& allowed = {}) {
   const int P = static_cast<int>(net.wires.size());
   const int C = static_cast<int>(net.crossings.size());
   StabilityChecker checker(net, co);
@@ -99,10 +102,13 @@ Objective brute_force(const Network& net, const ContactOptions& co, bool in_plan
   std::vector<int> hooks(C);
   for (int code = 0; code < configs; ++code) {
     int rest = code;
+    bool permitted = true;
     for (int c = 0; c < C; ++c) {
       hooks[c] = rest % 3 - 1;
       rest /= 3;
+      if (hooks[c] != 0 && !allowed.empty() && !allowed[c][hooks[c] > 0 ? 1 : 0]) permitted = false;
     }
+    if (!permitted) continue;
     const Objective here = objective_of(net, hooks, co, in_plane);
     if (best.found && !better(here, best)) continue;  // cannot improve the best value
     std::vector<int> all(P);
@@ -178,6 +184,30 @@ std::vector<WireSpec> random_polygons(std::mt19937& rng, int P) {
     wires.push_back(w);
   }
   return wires;
+}
+
+// A random network of 3 wires (even attempts) or 4 (odd), great-circle-like cuts of a sphere or
+// (every third attempt) random polygons, with 2 to 8 crossings (small enough for brute_force);
+// false when this attempt gives none.
+bool random_small_network(std::mt19937& rng, int attempt, Network& net) {
+  const int P = 3 + attempt % 2;
+  const std::vector<Cut> cuts = fixtures::random_cuts(rng, P, 0.7 * R);
+  try {
+    net = build_network(attempt % 3 == 2 ? random_polygons(rng, P) : fixtures::sphere_wires(cuts, R, 48));
+  } catch (const InputError&) {
+    return false;
+  }
+  const int C = static_cast<int>(net.crossings.size());
+  return C >= 2 && C <= 8;
+}
+
+// The default contact, and a grippy one (more friction, sharper kinks) under which many
+// configurations are stable, so the first structure found is often not the best.
+std::vector<ContactOptions> default_and_grippy() {
+  ContactOptions grippy;
+  grippy.friction = 0.8;
+  grippy.contact_angle = 80.0 * std::numbers::pi / 180.0;
+  return {ContactOptions{}, grippy};
 }
 
 Network great_circles(int count) {
@@ -293,31 +323,15 @@ TEST_CASE("layering: a four-wire cage needs a step with two hands") {
 }
 
 TEST_CASE("layering: branch and bound finds the brute-force optimum on random small networks") {
-  // Two contact settings: the default, and a grippy one (more friction, sharper kinks) under
-  // which many configurations are stable, so the first structure found is often not the best.
-  ContactOptions grippy;
-  grippy.friction = 0.8;
-  grippy.contact_angle = 80.0 * std::numbers::pi / 180.0;
-  for (const ContactOptions& co : {ContactOptions{}, grippy}) {
+  // Two contact settings (default_and_grippy).
+  for (const ContactOptions& co : default_and_grippy()) {
     std::mt19937 rng(20160724);
-    std::uniform_real_distribution<double> unit(-1.0, 1.0);
     int tested = 0, stable = 0;
     for (int attempt = 0; attempt < 1500 && tested < 30; ++attempt) {
       const int P = 3 + attempt % 2;
-      std::vector<Cut> cuts;
-      for (int k = 0; k < P; ++k) {
-        Vec3 n(unit(rng), unit(rng), unit(rng));
-        if (n.norm() < 0.2) n = Vec3::UnitZ();
-        cuts.push_back({std::string(1, static_cast<char>('A' + k)), n.normalized(), 0.7 * R * unit(rng)});
-      }
       Network net;
-      try {
-        net = build_network(attempt % 3 == 2 ? random_polygons(rng, P) : fixtures::sphere_wires(cuts, R, 48));
-      } catch (const InputError&) {
-        continue;
-      }
+      if (!random_small_network(rng, attempt, net)) continue;
       const int C = static_cast<int>(net.crossings.size());
-      if (C < 2 || C > 8) continue;
       ++tested;
       INFO("friction " << co.friction << ", attempt " << attempt << ", " << P << " wires, " << C << " crossings");
       const Objective expect = brute_force(net, co);
@@ -344,6 +358,88 @@ TEST_CASE("layering: branch and bound finds the brute-force optimum on random sm
     CHECK(tested >= 20);
     CHECK(stable >= 4);
   }
+}
+
+TEST_CASE("layering: forbidden hooks never appear and the optimum over the allowed ones is the brute force's") {
+  // Random small networks and random masks (each hook forbidden with probability 1/3, both at
+  // some crossings): the search must stay exact under every pruning with the mask (layering.hpp
+  // (b) dominance with the cheaper allowed hook, (d)/(e) with the allowed pyramids only).
+  for (const ContactOptions& co : default_and_grippy()) {
+    std::mt19937 rng(20200520);
+    int tested = 0, stable = 0, changed = 0, forbidden_used_before = 0;
+    for (int attempt = 0; attempt < 1500 && tested < 30; ++attempt) {
+      const int P = 3 + attempt % 2;
+      Network net;
+      if (!random_small_network(rng, attempt, net)) continue;
+      const int C = static_cast<int>(net.crossings.size());
+      LayeringOptions lo;
+      lo.contact = co;
+      lo.two_wire_steps = false;  // the brute force adds one wire at a time
+      const LayeringResult unmasked = layering(net, lo);
+      // Forbid at random, and always the unmasked optimum's first hook, so the mask bites.
+      lo.allowed_hooks.assign(C, {true, true});
+      for (int c = 0; c < C; ++c)
+        for (int side = 0; side < 2; ++side) lo.allowed_hooks[c][side] = rng() % 3 != 0;
+      for (int c = 0; c < C; ++c)
+        if (unmasked.stable && unmasked.hooks[c] != 0) {
+          lo.allowed_hooks[c][unmasked.hooks[c] > 0 ? 1 : 0] = false;
+          break;
+        }
+      ++tested;
+      INFO("friction " << co.friction << ", attempt " << attempt << ", " << P << " wires, " << C << " crossings");
+      const Objective expect = brute_force(net, co, false, lo.allowed_hooks);
+      const LayeringResult r = layering(net, lo);
+      for (int c = 0; c < C; ++c) {
+        INFO("crossing " << c << " hook " << r.hooks[c]);
+        CHECK((r.hooks[c] == 0 || lo.allowed_hooks[c][r.hooks[c] > 0 ? 1 : 0]));
+        if (unmasked.stable && unmasked.hooks[c] != 0 && !lo.allowed_hooks[c][unmasked.hooks[c] > 0 ? 1 : 0])
+          ++forbidden_used_before;
+      }
+      REQUIRE(r.stable == expect.found);
+      if (!expect.found) {
+        // Stable without the mask, not with it: the reason says hooks were forbidden (networks that
+        // are not connected fail before any hook matters, and say so).
+        if (unmasked.stable) CHECK_THAT(r.reason, Contains("forbidden"));
+        continue;
+      }
+      ++stable;
+      if (!unmasked.stable || unmasked.hooks != r.hooks) ++changed;
+      CHECK(r.max_metric == Approx(expect.max).margin(1e-9));
+      CHECK(r.null_crossings == expect.nulls);
+      CHECK(r.sum_metric == Approx(expect.sum).margin(1e-9));
+      const Objective mine = objective_of(net, r.hooks, co, false);
+      CHECK(mine.max == Approx(r.max_metric).margin(1e-12));
+      CHECK(mine.nulls == r.null_crossings);
+      check_prefixes(net, r, true, co);
+    }
+    CHECK(tested >= 20);
+    CHECK(stable >= 4);
+    CHECK(changed >= 4);                // the mask changed the answer on several networks
+    CHECK(forbidden_used_before >= 4);  // the unmasked optimum used a hook the mask forbids
+  }
+}
+
+TEST_CASE("layering: a crossing with both hooks forbidden is null, and the verdict says hooks were forbidden") {
+  // Two great circles cross twice; a pair needs both crossings hooked (one cannot hold a pair,
+  // Sec. 4.2), so forbidding both hooks at one leaves no stable configuration.
+  const Network net = great_circles(2);
+  REQUIRE(net.crossings.size() == 2);
+  LayeringOptions lo;
+  REQUIRE(layering(net, lo).stable);
+  lo.allowed_hooks = {{false, false}, {true, true}};
+  const LayeringResult r = layering(net, lo);
+  CHECK_FALSE(r.stable);
+  CHECK(r.hooks[0] == 0);
+  CHECK_THAT(r.reason, Contains("2 hooks forbidden"));
+  // Forbidding only the hook the free search picks at crossing 0 makes it pick the other one.
+  const int free_hook = layering(net, {}).hooks[0];
+  REQUIRE(free_hook != 0);
+  lo.allowed_hooks = {{true, true}, {true, true}};
+  lo.allowed_hooks[0][free_hook > 0 ? 1 : 0] = false;
+  const LayeringResult flipped = layering(net, lo);
+  REQUIRE(flipped.stable);
+  CHECK(flipped.hooks[0] == -free_hook);
+  check_prefixes(net, flipped);
 }
 
 TEST_CASE("layering: branch and bound finds the brute-force optimum of key 5 on random great circles") {
@@ -543,6 +639,27 @@ TEST_CASE("layering: progress is reported and cancellation stops the search") {
   CHECK(calls >= 2);
   CHECK(last == 1.0);
   CHECK_THROWS_AS(layering(net, {}, [](std::string_view, double) { return false; }), Cancelled);
+}
+
+TEST_CASE("layering: a search stopped by max_nodes says search incomplete, never that none exists") {
+  const Network net = great_circles(3);
+  LayeringOptions lo;
+  lo.max_nodes = 1;  // stops after the first pair, before any complete structure
+  const LayeringResult r = layering(net, lo);
+  CHECK_FALSE(r.stable);
+  CHECK_FALSE(r.complete_search);
+  CHECK_THAT(r.reason, Catch::Matchers::StartsWith("search incomplete"));
+  CHECK_THAT(r.reason, !Contains("no stable"));
+  lo.max_nodes = 0;  // no limit: the same network is stable (test "three great circles")
+  CHECK(layering(net, lo).stable);
+}
+
+TEST_CASE("layering: allowed_hooks must have one entry per crossing") {
+  const Network net = great_circles(3);
+  LayeringOptions lo;
+  lo.allowed_hooks = {{true, true}};
+  CHECK_THROWS_AS(layering(net, lo), InputError);
+  CHECK_THROWS_WITH(layering(net, lo), Contains("allowed_hooks has 1 entries"));
 }
 
 TEST_CASE("layering: options and inputs are validated") {

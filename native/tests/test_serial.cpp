@@ -184,6 +184,12 @@ TEST_CASE("serial: ALARM stops the stream", "[fab][serial]") {
   CHECK(state.next_line == 2);
   CHECK(grbl.received().size() == 3);
   CHECK_THAT(r.message, Contains("ALARM:1") && Contains("line 3"));
+  CHECK_THAT(r.message, Contains("$X") && Contains("$H"));  // what unlocks the machine
+  // resuming while GRBL is still locked: every line gets error:9, and the message says how to unlock
+  const auto again = stream_program(grbl.path(), lines, MachineProfile{}, state, quick());
+  CHECK(again.status == StreamStatus::error);
+  CHECK_THAT(again.message, Contains("error:9") && Contains("$X") && Contains("$H"));
+  CHECK(state.next_line == 2);  // nothing more was acknowledged
 }
 
 TEST_CASE("serial: slow answers are waited for, missing answers time out", "[fab][serial]") {

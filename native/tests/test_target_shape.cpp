@@ -453,3 +453,78 @@ TEST_CASE("target shape: contact constraints that cannot hold together are repor
   CHECK(failed >= 1);
   CHECK_FALSE(r.feasible);
 }
+
+TEST_CASE("target shape: a per-point bend limit holds at that point, the others keep max_bend", "[target]") {
+  // A square of side 0.1 m: its corners are the sharpest bends of the target.
+  Polyline2 contour;
+  const Vec2 corner[4] = {{0, 0}, {0.1, 0}, {0.1, 0.1}, {0, 0.1}};
+  for (int s = 0; s < 4; ++s)
+    for (int k = 0; k < 50; ++k) contour.push_back(corner[s] + (corner[(s + 1) % 4] - corner[s]) * (k / 50.0));
+  TargetShapeOptions o;
+  const TargetShapeResult free = optimize_target_shape(contour, true, {}, o);
+  const int m = static_cast<int>(free.points.size());
+  auto bend = [&](const Polyline2& p, int i) {
+    return angle_between(p[i] - p[(i + m - 1) % m], p[(i + 1) % m] - p[i]);
+  };
+  int sharpest = 0;
+  for (int i = 0; i < m; ++i)
+    if (bend(free.points, i) > bend(free.points, sharpest)) sharpest = i;
+  const double before = bend(free.points, sharpest);
+  REQUIRE(before > 20.0 * pi / 180.0);
+
+  o.vertex_max_bend.assign(static_cast<std::size_t>(m), 0.0);
+  o.vertex_max_bend[static_cast<std::size_t>(sharpest)] = before - 10.0 * pi / 180.0;
+  const TargetShapeResult limited = optimize_target_shape(contour, true, {}, o);
+  REQUIRE(static_cast<int>(limited.points.size()) == m);  // the same points, so the index still means it
+  CHECK(limited.feasible);
+  CHECK(bend(limited.points, sharpest) <= before - 10.0 * pi / 180.0 + 1e-6);
+  for (int i = 0; i < m; ++i) CHECK(bend(limited.points, i) <= o.max_bend + 1e-6);
+  CHECK(bend_limit(o, sharpest) == Approx(before - 10.0 * pi / 180.0));
+  CHECK(bend_limit(o, m + 5) == o.max_bend);
+
+  o.vertex_max_bend = {std::nan("")};
+  CHECK_THROWS_WITH(optimize_target_shape(contour, true, {}, o), Contains("vertex_max_bend[0]"));
+}
+
+TEST_CASE("target shape: a kink whose neighbour breaks the bend limit is not realised", "[target]") {
+  // A hairpin right after an active crossing A at the origin (kink opening towards +y): the wire
+  // runs along +x for 18 mm, turns back by 140° and meets a fixed (null) crossing B 21 mm later.
+  // Between them there is one free point, and with the kink's cone, 15 mm segments and B fixed,
+  // the solver meets the cone at the cost of a bend over 120° at that point: the kink cannot be
+  // made, so A is reported, not passed on as realised beside an unbendable wire.
+  Polyline2 contour;
+  auto run = [&](Vec2 a, Vec2 b) {
+    const int n = static_cast<int>(std::lround((b - a).norm() / 0.001));
+    for (int k = 1; k <= n; ++k) contour.push_back(a + (b - a) * (static_cast<double>(k) / n));
+  };
+  const Vec2 d2(std::cos(140.0 * pi / 180.0), std::sin(140.0 * pi / 180.0));
+  const Vec2 corner(0.018, 0.0), b = corner + 0.021 * d2;
+  contour.push_back({-0.06, 0.0});
+  run({-0.06, 0.0}, {0.0, 0.0});
+  run({0.0, 0.0}, corner);
+  run(corner, b);
+  run(b, b + 0.06 * d2);
+  REQUIRE((contour[60] - Vec2(0, 0)).norm() < 1e-12);
+  REQUIRE((contour[99] - b).norm() < 1e-12);
+  TargetShapeOptions o;
+  o.friction = 0.0;
+  o.angle_tolerance = 0.1 * pi / 180.0;
+  o.length_tolerance = 1e-5;
+  const std::vector<TargetCrossing> xs{{60, Vec2(0, 1), 2 * pi / 3, true}, {99, Vec2(0, 1), 2 * pi / 3, false}};
+  const TargetShapeResult r = optimize_target_shape(contour, false, xs, o);
+  // Independently of the solver's bookkeeping: some free point next to A bends over 120°.
+  const auto& p = r.points;
+  const int v = r.crossing_vertices[0];
+  double worst = 0.0;
+  int at = -1;
+  for (int nb : {v - 1, v + 1}) {
+    const double bend = angle_between(p[nb] - p[nb - 1], p[nb + 1] - p[nb]);
+    if (bend > worst) worst = bend, at = nb;
+  }
+  REQUIRE(worst > o.max_bend + o.angle_tolerance);
+  CHECK(r.crossings[0].status == "infeasible");
+  CHECK_FALSE(r.crossings[0].realised);
+  CHECK_THAT(r.crossings[0].message, Contains("its kink cannot be made") && Contains("point " + std::to_string(at)));
+  CHECK_FALSE(r.feasible);
+  CHECK(r.crossings[1].status == "inactive");
+}

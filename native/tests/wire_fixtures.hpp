@@ -127,17 +127,25 @@ struct HookedNetwork {
   std::vector<int> hooks;
   std::vector<std::vector<int>> steps;
 };
+/// `count` random cuts named A, B, ...: normals uniform in a cube (near-zero ones replaced by z),
+/// offsets uniform in [-max_offset, max_offset].
 template <class Rng>
-bool random_hooked_sphere(Rng& rng, int attempt, int n, HookedNetwork& out) {
+std::vector<Cut> random_cuts(Rng& rng, int count, double max_offset) {
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  const double R = 0.125;
-  const int P = 3 + attempt % 3;
   std::vector<Cut> cuts;
-  for (int k = 0; k < P; ++k) {
+  for (int k = 0; k < count; ++k) {
     Vec3 nrm(unit(rng), unit(rng), unit(rng));
     if (nrm.norm() < 0.2) nrm = Vec3::UnitZ();
-    cuts.push_back({std::string(1, static_cast<char>('A' + k)), nrm.normalized(), 0.5 * R * unit(rng)});
+    cuts.push_back({std::string(1, static_cast<char>('A' + k)), nrm.normalized(), max_offset * unit(rng)});
   }
+  return cuts;
+}
+
+template <class Rng>
+bool random_hooked_sphere(Rng& rng, int attempt, int n, HookedNetwork& out) {
+  const double R = 0.125;
+  const int P = 3 + attempt % 3;
+  const std::vector<Cut> cuts = random_cuts(rng, P, 0.5 * R);
   try {
     out.net = wiresculpt::build_network(sphere_wires(cuts, R, n));
   } catch (const wiresculpt::InputError&) {

@@ -14,6 +14,7 @@ import numpy as np
 from mathutils import Vector
 
 from ..core import closure
+from ..core.design import crossing_direction
 from ..core.files import write_atomic
 from . import results
 from .objects import tagged
@@ -50,7 +51,7 @@ def crossing_sentence(design, crossing, centre=None):
     hook = crossing.get("hook", 0)
     if not hook:
         return f"{head}, {a} and {b} only touch: no hook, either wire may lie on top"
-    d = results.hook_direction(design, crossing)
+    d = crossing_direction(design, crossing)
     side = results.side_of(crossing, 0)  # where wires[0] lies, in units of d
     push = d if side > 0 else -d  # the way wires[0] is pushed
     plus, minus = direction_words(push)

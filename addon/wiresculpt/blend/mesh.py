@@ -6,6 +6,8 @@ import os
 import bpy
 import numpy as np
 
+from . import compat
+
 
 def object_triangles(obj, depsgraph):
     """(V, F) of `obj` as evaluated in `depsgraph`: V (#V, 3) float64 world coordinates, F (#F, 3)
@@ -41,29 +43,6 @@ def join_triangles(parts):
 FORMATS = (".obj", ".stl", ".ply")
 
 
-def _has_operator(group, name):
-    # bpy.ops resolves names lazily (hasattr is always true); dir() lists the real ones.
-    return name in dir(getattr(bpy.ops, group))
-
-
-def _import(path, ext):
-    same = {"forward_axis": "Y", "up_axis": "Z"}
-    if ext == ".obj":
-        if _has_operator("wm", "obj_import"):
-            return bpy.ops.wm.obj_import(filepath=path, **same)
-        return bpy.ops.import_scene.obj(filepath=path, axis_forward="Y", axis_up="Z", split_mode="OFF")
-    if ext == ".stl":
-        if _has_operator("wm", "stl_import"):  # Blender 4.2+
-            return bpy.ops.wm.stl_import(filepath=path, global_scale=1.0, use_scene_unit=False, **same)
-        return bpy.ops.import_mesh.stl(filepath=path, axis_forward="Y", axis_up="Z", global_scale=1.0,
-                                       use_scene_unit=False)
-    if ext == ".ply":
-        if _has_operator("wm", "ply_import"):  # Blender 4.0+
-            return bpy.ops.wm.ply_import(filepath=path, global_scale=1.0, use_scene_unit=False, **same)
-        return bpy.ops.import_mesh.ply(filepath=path)
-    raise ValueError(f"mesh file {path}: unsupported format {ext or '(none)'}; use OBJ, STL or PLY")
-
-
 def import_mesh(path):
     """(V, F, objects): the file's meshes joined, world coordinates equal to the file's numbers.
     ValueError for a missing, unreadable or empty file."""
@@ -74,7 +53,7 @@ def import_mesh(path):
         raise ValueError(f"mesh file {path}: unsupported format {ext or '(none)'}; use OBJ, STL or PLY")
     before = set(bpy.data.objects)
     try:
-        result = _import(path, ext)
+        result = compat.IMPORTERS[ext](path)
     except RuntimeError as exc:
         raise ValueError(f"mesh file {path}: Blender could not read it ({str(exc).strip()})") from None
     if "FINISHED" not in result:

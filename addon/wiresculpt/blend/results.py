@@ -10,7 +10,7 @@ import bmesh
 import bpy
 import numpy as np
 
-from ..core.design import dumps
+from ..core.design import crossing_direction, dumps
 from . import cut_handles
 from .objects import remove_object, scene_collection, tagged, write_polyline
 
@@ -87,13 +87,6 @@ def crossing_vertex(wire, crossing, k):
     return crossing["contour_vertices"][k]
 
 
-def hook_direction(design, crossing):
-    """d = normalize(n0 x n1) (FORMATS.md `hook`)."""
-    n0, n1 = (np.asarray(design["wires"][w]["plane"]["normal"], dtype=np.float64) for w in crossing["wires"])
-    d = np.cross(n0, n1)
-    return d / np.linalg.norm(d)
-
-
 def side_of(crossing, k):
     """Which way wire k (0 or 1) of the crossing is pushed, in units of d: with hook = +1 the kink of
     wires[0] opens towards +d, so wires[0] lies on the -d side and wires[1] on the +d side."""
@@ -132,7 +125,7 @@ def wire_shapes(design):
     for c in design.get("crossings", []):
         if not c.get("hook"):
             continue
-        d = hook_direction(design, c)
+        d = crossing_direction(design, c)
         for k in (0, 1):
             wire = design["wires"][c["wires"][k]]
             bumps[wire["id"]][crossing_vertex(wire, c, k)] = side_of(c, k) * 0.5 * diameter * d

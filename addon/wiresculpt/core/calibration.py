@@ -22,6 +22,7 @@ import zlib
 
 import numpy as np
 
+from .. import native
 from . import materials
 from .files import write_atomic
 
@@ -133,12 +134,48 @@ def read_springback(source):
             "measured_deg": _numbers(t, "measured_deg", "degrees"), "lines": t["line"]}
 
 
+# --- plausibility: numbers that parse but are probably not what was meant -------------------------
+
+def cantilever_warnings(capture, overhang=0.30):
+    """Sentences on a cantilever capture that fits but says little or was typed in other units:
+    one loaded load only (k_b then rests on one frame, with nothing to check its linearity), and
+    deflections larger than the wire could bend (millimetres typed as metres)."""
+    out = []
+    loads = sorted({g for g, loaded in zip(capture["load_g"], capture["loaded"]) if loaded and g > 0})
+    if len(loads) < 2:
+        out.append(f"only one load ({loads[0]:g} g) was captured: k_b rests on one frame; capture two or more "
+                   "loads to see that the deflection grows in proportion" if loads else
+                   "no loaded frame with a load above 0 g: k_b cannot be measured")
+    for s, d, line in zip(capture["s"], capture["deflection"], capture["lines"]):
+        if abs(d) > max(abs(s), 1e-9) or abs(d) > overhang:
+            out.append(f"line {line}: a deflection of {d:g} m at {s:g} m along the wire is more than the wire can "
+                       "bend there: were millimetres typed in the metres column deflection_m?")
+            break
+    return out
+
+
+def tilt_warnings(angles_deg):
+    """Tilt angles that look like radians (all below 1.6, the largest under 1.57 = 90° in radians)."""
+    if angles_deg and max(angles_deg) < 1.6:
+        a = max(angles_deg)
+        return [f"the tilt angles are all below 1.6 (largest {a:g}): if they are radians, {a:g} rad is "
+                f"{math.degrees(a):.1f}°; the column angle_deg takes degrees"]
+    return []
+
+
+def springback_warnings(commanded_deg):
+    """Commanded angles no bender turns (beyond 180°) or all tiny (radians typed as degrees)."""
+    out = []
+    big = [c for c in commanded_deg if abs(c) > 180]
+    if big:
+        out.append(f"a commanded angle of {big[0]:g}° is beyond 180°, which a bend head cannot turn: "
+                   "check the commanded_deg column")
+    if commanded_deg and max(abs(c) for c in commanded_deg) < 3.2:
+        out.append("every commanded angle is below 3.2: if they are radians, convert them to degrees")
+    return out
+
+
 # --- fits -------------------------------------------------------------------------------------------
-
-def _native():
-    from .. import native  # imported lazily: core stays importable without the compiled module
-    return native.require()
-
 
 def linear_density(material):
     """kg/m of a round wire of the material (0 when it has no density)."""
@@ -158,21 +195,26 @@ def fit_cantilever(source, overhang=0.30, linear_density=0.0, plastic_tolerance=
             state = "loaded" if loaded else "unloaded"
             raise CaptureError(f"the {load:g} g {state} frame has {len(lines)} mark{'s' if len(lines) > 1 else ''}; "
                                "at least 3 points along the wire are needed", lines[0])
-    fit = _native().fit_cantilever(c["load_g"], c["loaded"], c["s"], c["deflection"], c["lines"],
-                                   overhang=overhang, linear_density=linear_density,
-                                   plastic_tolerance=plastic_tolerance)
-    fit.update(overhang=overhang, linear_density=linear_density, plastic_tolerance=plastic_tolerance)
+    fit = native.fit_cantilever(c["load_g"], c["loaded"], c["s"], c["deflection"], c["lines"],
+                                overhang=overhang, linear_density=linear_density,
+                                plastic_tolerance=plastic_tolerance)
+    fit.update(overhang=overhang, linear_density=linear_density, plastic_tolerance=plastic_tolerance,
+               warnings=cantilever_warnings(c, overhang))
     return fit
 
 
 def fit_friction(source):
     t = read_tilt(source)
-    return _native().fit_friction(t["angle_deg"], t["lines"])
+    fit = native.fit_friction(t["angle_deg"], t["lines"])
+    fit["warnings"] = tilt_warnings(t["angle_deg"])
+    return fit
 
 
 def fit_springback(source):
     t = read_springback(source)
-    return _native().fit_springback(t["commanded_deg"], t["measured_deg"], t["lines"])
+    fit = native.fit_springback(t["commanded_deg"], t["measured_deg"], t["lines"])
+    fit["warnings"] = springback_warnings(t["commanded_deg"])
+    return fit
 
 
 # --- materials as JSON ------------------------------------------------------------------------------
@@ -282,7 +324,7 @@ PROFILE_KEYS = ("name", "min_segment", "max_bend_deg", "min_bend_deg", "max_comm
 
 def default_profile():
     """The DIWire-class default (l_min 1.5 cm, 1 deg minimum bend) from the native module."""
-    return dict(_native().default_machine_profile())
+    return dict(native.default_machine_profile())
 
 
 def machine_dict(profile):
@@ -300,7 +342,11 @@ def with_springback(profile, fit, source=""):
 
 
 FILE_MARKERS = ("format", "version")  # written by save_profile, dropped by load_profile
-PROFILE_FILE_KEYS = FILE_MARKERS + ("springback_fit",)  # in the file, not machine settings
+# Checked here, not by the native module: the wire stock's length (m, default core.sizes.STOCK_LENGTH)
+# and the paper the print templates are tiled onto ("A4", the default, or "Letter"; fab/tiles.py).
+PYTHON_KEYS = ("stock_length", "paper")
+PAPERS = ("A4", "Letter")
+PROFILE_FILE_KEYS = FILE_MARKERS + ("springback_fit",) + PYTHON_KEYS  # not native machine settings
 
 
 def validate_profile(profile, where="machine profile"):
@@ -308,8 +354,14 @@ def validate_profile(profile, where="machine profile"):
     key, a wrong type, a value out of range), prefixed with `where`."""
     if not isinstance(profile, dict):
         raise ValueError(f"{where}: expected a JSON object")
+    stock = profile.get("stock_length", 1.0)
+    if isinstance(stock, bool) or not isinstance(stock, (int, float)) or not 0 < stock < 100:
+        raise ValueError(f"{where}: stock_length must be a length in metres between 0 and 100, got {stock!r}")
+    paper = profile.get("paper", "A4")
+    if not isinstance(paper, str) or paper.upper() not in (p.upper() for p in PAPERS):
+        raise ValueError(f"{where}: paper must be one of {', '.join(PAPERS)}, got {paper!r}")
     try:
-        _native().validate_machine_profile({k: v for k, v in profile.items() if k not in PROFILE_FILE_KEYS})
+        native.validate_machine_profile({k: v for k, v in profile.items() if k not in PROFILE_FILE_KEYS})
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None
     return profile

@@ -27,7 +27,8 @@ VERSION = 1
 # "fabrication" (the batch's exports) or "every stage" (appended to by each).
 # `stable`/`reason` are the layering's verdict (new_design's default until it runs; the pipeline
 # answers when there are fewer than two wires; layering.recheck_verdict after a later stage nulls
-# crossings). A crossing's `hook` and `metric` are the layering's; the target shape sets both to
+# crossings; fab/buildability.apply, through the pipeline, when a wire's bend program cannot be
+# made: "stable" means buildable). A crossing's `hook` and `metric` are the layering's; the target shape sets both to
 # 0 for a crossing it cannot realise. `torque_fraction` is the settings' (null when the load
 # factor chooses it) until the forces stage writes the fraction it used.
 KEYS = {
@@ -38,7 +39,8 @@ KEYS = {
         "pending_stages": "pipeline", "warnings": "every stage",
         "crossings": "layering", "assembly_order": "layering", "assembly_steps": "layering",
         "two_hand_steps": "layering", "close_crossings": "layering", "required_size": "layering",
-        "out_of_plane": "forces", "load_capacity": "forces", "load_factor": "forces",
+        "search_incomplete": "layering",
+        "out_of_plane": "forces", "load_capacity": "forces", "load_factor": "forces", "buildability": "pipeline",
         "fabrication": "fabrication",
     },
     "wire": {
@@ -59,14 +61,15 @@ KEYS = {
     },
     "stages": {
         "slicing": "slicing", "layering": "layering", "target_shape": "target_shape",
-        "forces": "forces", "rest_shape": "forces", "hook_search": "pipeline",
+        "forces": "forces", "rest_shape": "forces", "hook_search": "pipeline", "relayering": "pipeline",
     },
 }
 
 # Keys written only in some cases (a stage that ran may leave them out): close crossings, a
 # material without density, a user's cut, the batch's exports.
 OPTIONAL = {
-    "top": {"close_crossings", "required_size", "load_capacity", "load_factor", "fabrication", "warnings"},
+    "top": {"close_crossings", "required_size", "load_capacity", "load_factor", "fabrication", "warnings",
+            "buildability", "search_incomplete"},
     "wire": {"cut_override", "cut_point", "out_of_plane_deflection", "out_of_plane_deflection_vertex"},
     "crossing": set(),
     "stages": set(),

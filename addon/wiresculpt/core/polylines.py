@@ -10,3 +10,37 @@ def polyline_length(points, closed):
     if closed:
         p = np.concatenate([p, p[:1]])
     return float(np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1)))
+
+
+def self_crossings(rest, closed):
+    """Where a 2D polyline crosses itself: [(edge i, edge j, point (2,), s_i, s_j)] with i < j - 1,
+    s the arc length from the first point. For a closed wire's rest shape its first and last edges
+    (the two sides of the cut) do not count as crossing each other."""
+    p = np.asarray(rest, dtype=np.float64)
+    a, b = p[:-1], p[1:]
+    d = b - a
+    length = np.linalg.norm(d, axis=1)
+    s = np.concatenate([[0.0], np.cumsum(length)])
+    n = len(d)
+    if n < 3:
+        return []
+    i, j = np.triu_indices(n, k=2)
+    if closed:
+        keep = ~((i == 0) & (j == n - 1))
+        i, j = i[keep], j[keep]
+    r, q = d[i], d[j]
+    denom = r[:, 0] * q[:, 1] - r[:, 1] * q[:, 0]
+    w = a[j] - a[i]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (w[:, 0] * q[:, 1] - w[:, 1] * q[:, 0]) / denom
+        u = (w[:, 0] * r[:, 1] - w[:, 1] * r[:, 0]) / denom
+    hit = (np.abs(denom) > 1e-18) & (t >= 0) & (t <= 1) & (u >= 0) & (u <= 1)
+    # A crossing through a shared point of two edges is found twice: keep one per point.
+    out = []
+    for k in np.flatnonzero(hit):
+        point = a[i[k]] + t[k] * r[k]
+        if any(np.linalg.norm(point - o[2]) < 1e-9 for o in out):
+            continue
+        out.append((int(i[k]), int(j[k]), point, float(s[i[k]] + t[k] * length[i[k]]),
+                    float(s[j[k]] + u[k] * length[j[k]])))
+    return out

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 from . import materials, settings as settings_table
 
-TOP_KEYS = {"mesh", "size", "material", "planes", "settings"}
+TOP_KEYS = {"mesh", "size", "material", "planes", "settings", "machine_profile"}
 PLANE_KEYS = {"name", "origin", "normal", "contours"}
 MAX_COORDINATE = 1e6  # metres (or mesh units): beyond this a number is a typo, not a sculpture
 MAX_SIZE = 100.0  # metres
@@ -32,6 +32,7 @@ class Scene:
     material: dict
     planes: list
     settings: dict = field(default_factory=settings_table.defaults)
+    machine_profile: object = None  # absolute path of a machine profile JSON, or None: the default
 
 
 def _number(value, key, low=None, high=None, low_open=False):
@@ -130,8 +131,17 @@ def _settings(value):
         if key == "cuts":
             out["cuts"] = _cuts(raw)
             continue
-        _default, low, high, _unit, _text = settings_table.SETTINGS[key]
-        out[key] = None if raw is None and _default is None else _number(raw, f"settings.{key}", low, high)
+        _default, low, high, unit, _text = settings_table.SETTINGS[key]
+        if unit == "bool":
+            if not isinstance(raw, bool):
+                raise ValueError(f'scene key "settings.{key}" must be true or false, got {json.dumps(raw)}')
+            out[key] = raw
+        elif unit == "int":
+            if isinstance(raw, bool) or not isinstance(raw, int):
+                raise ValueError(f'scene key "settings.{key}" must be a whole number, got {json.dumps(raw)}')
+            out[key] = int(_number(raw, f"settings.{key}", low, high))
+        else:
+            out[key] = None if raw is None and _default is None else _number(raw, f"settings.{key}", low, high)
     if out["min_bend_deg"] >= out["max_bend_deg"]:
         raise ValueError('scene key "settings.min_bend_deg" must be smaller than "settings.max_bend_deg"')
     return out
@@ -157,8 +167,15 @@ def parse_scene(data, path="scene.json"):
         raise ValueError('scene key "planes" must be a non-empty list of planes')
     names = set()
     parsed = [_plane(p, i, names) for i, p in enumerate(planes)]
+    profile = data.get("machine_profile")
+    if profile is not None:
+        if not isinstance(profile, str) or not profile:
+            raise ValueError('scene key "machine_profile" must be the path of a machine profile JSON file')
+        profile = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(path)), profile))
+        if not os.path.isfile(profile):
+            raise ValueError(f'scene key "machine_profile": file not found: {profile}')
     return Scene(os.path.abspath(path), mesh, size, _material(data.get("material")), parsed,
-                 _settings(data.get("settings")))
+                 _settings(data.get("settings")), profile)
 
 
 def load_scene(path):

@@ -17,7 +17,22 @@ SETTINGS = {
                     "the least pre-stress (torque fraction) that does so is used"),
     "weld_tolerance": (None, 0.0, 0.01, "m",
                        "Mesh vertices closer than this are merged (default: 1e-7 of the mesh size)"),
+    # the layering's search knobs (docs/method-layering.md); unit "bool" / "int": not a number of
+    # a physical unit, parsed as such by the scene loader
+    "in_plane_tiebreak": (False, None, None, "bool",
+                          "Among equally good hook patterns, prefer those in which every wire balances "
+                          "in its own plane (slower on boxy models)"),
+    "max_nodes": (200000, 0, 100000000, "int",
+                  "Layering search budget in candidate assemblies; when reached the result is "
+                  "reported as \"search incomplete\" (0: no limit)"),
+    "relayer_rounds": (8, 0, 100, "int",
+                       "How many times to layer again after the target shape could not realise a hook, "
+                       "with that hook forbidden (0: layer once)"),
 }
+
+# the keys whose values are not floats
+BOOLEAN = tuple(k for k, spec in SETTINGS.items() if spec[3] == "bool")
+INTEGER = tuple(k for k, spec in SETTINGS.items() if spec[3] == "int")
 
 
 def defaults():

@@ -1,5 +1,16 @@
-"""Fabrication files for a finished design (Sec. 5.1): per wire a bend program, a 1:1 SVG
-template, G-code and a CSV bend table, plus one SVG sheet and one DXF with a layer per wire.
+"""Fabrication files for a finished design (Sec. 5.1), for machines and for people, separately:
+
+    svg/NN-name.svg        machine file: the rest shape as one path, mm, origin at the start
+    dxf/NN-name.dxf        machine file: DXF R2000, $INSUNITS mm, one layer, one LWPOLYLINE, origin at the start
+    dxf/sculpture.dxf      every wire on its own layer, side by side without overlap
+    templates/NN-name.svg  the annotated 1:1 print template (bends, crossings, label)
+    templates/sheet.svg    every template on one sheet
+    templates/pages/NN-name-A1.svg ...  each template tiled onto A4 (or Letter) pages, 1:1, with a
+                           100 mm scale bar and overlap marks (fab/tiles.py)
+    gcode/NN-name.gcode    the bend program for a GRBL bender
+    bends/NN-name.csv      the bend table
+    bendlist/NN-name.txt   the bend list for a DIWire-class machine (FabMo Bend List app; fab/bendlist.py)
+
 Free of bpy: the batch run and the add-on's Export operator both call it. Every file is written
 atomically by the native writers.
 """
@@ -9,9 +20,16 @@ import re
 import numpy as np
 
 from .. import native
+from . import bendlist, tiles
 from ..core.calibration import machine_dict
+from ..core.sizes import STOCK_LENGTH, size_warnings
+from ..core.polylines import self_crossings
 
-FOLDERS = ("svg", "dxf", "gcode", "bends")
+# Each folder with the file types an export writes there (and removes from an earlier export).
+FOLDER_TYPES = {"svg": (".svg",), "dxf": (".dxf",), "templates": (".svg",),
+                os.path.join("templates", "pages"): (".svg",), "gcode": (".gcode",), "bends": (".csv",),
+                "bendlist": (".txt",)}
+FOLDERS = tuple(FOLDER_TYPES)
 
 
 # The machine limits a design records, each with the function that picks the stricter of two values.
@@ -32,7 +50,7 @@ def machine_profile(design, profile=None):
     machine changes nothing, while a machine stricter than the design must never be commanded
     beyond what it can do. Each limit where the profile is stricter gives a note (the wires
     that break it are then refused by the bend program, naming the bend or step)."""
-    out = native.require().default_machine_profile()
+    out = native.default_machine_profile()
     notes = []
     if profile is not None:
         out.update(machine_dict(profile))
@@ -50,9 +68,6 @@ def machine_profile(design, profile=None):
     return out, notes
 
 
-EXTENSIONS = (".svg", ".dxf", ".gcode", ".csv")
-
-
 def file_stem(wire):
     """A wire's file name: its id, then its name made safe ("Equator/0", id 3 -> "03-Equator-0").
     The id keeps names unique where the safe names of two wires would be the same."""
@@ -61,13 +76,14 @@ def file_stem(wire):
 
 
 def clear(out_dir):
-    """Removes the fabrication files of an earlier export from out_dir's four folders, so what is
-    there always belongs to the design written beside it. Other files are left alone."""
-    for folder in FOLDERS:
+    """Removes the fabrication files of an earlier export from out_dir's folders (the types an
+    export writes in each), so what is there always belongs to the design written beside it.
+    Other files are left alone."""
+    for folder, types in FOLDER_TYPES.items():
         path = os.path.join(out_dir, folder)
         if os.path.isdir(path):
             for name in os.listdir(path):
-                if name.endswith(EXTENSIONS):
+                if name.endswith(types):
                     os.remove(os.path.join(path, name))
 
 
@@ -83,59 +99,86 @@ def crossing_indices(design, wire):
     return sorted(out)
 
 
-def export(design, out_dir, profile=None):
+def no_rest_reason(design):
+    """Why no wire has a rest shape, matching the design's state: an unstable result points at the
+    Stability report, an unfinished one at Optimize."""
+    if design.get("stable") is False and design.get("reason"):
+        return f"the design is not stable: see Stability ({design['reason']})"
+    return "no wire has a rest shape yet: optimize until the rest shape stage has run"
+
+
+def export(design, out_dir, profile=None, paper=None):
     """Writes the fabrication files of every wire that has a rest shape into out_dir/{svg, dxf,
-    gcode, bends}, with the machine `profile` (None: the default; see machine_profile). Returns
+    templates, templates/pages, gcode, bends, bendlist} (see the module's text), with the machine `profile`
+    (None: the default; see machine_profile), the template pages on `paper` ("A4" or "Letter";
+    None: the profile's key "paper", else A4). Returns
     {"files": [paths], "wires": [per-wire program summary], "errors": [one sentence per wire that
     cannot be bent], "notes": [limits where the profile is stricter than the design]}."""
-    w = native.require()
+    paper = paper or (profile or {}).get("paper") or "A4"
+    tiles.layout(1.0, 1.0, paper)  # an unknown paper is refused before anything is written
+    stock = float((profile or {}).get("stock_length", STOCK_LENGTH))
+    stock_notes = [n for n in size_warnings(design, stock, (profile or {}).get("name") or "the machine profile")
+                   if n.startswith("wire ")]
+    profile, notes = machine_profile(design, profile)  # and a missing module (RuntimeError)
+    notes += stock_notes
     clear(out_dir)
-    profile, notes = machine_profile(design, profile)
     material = design["material"].get("name", "")
     files, summaries, errors, templates = [], [], [], []
     wires = [x for x in design["wires"] if "rest" in x]
     for wire in wires:
         rest = np.asarray(wire["rest"], dtype=np.float64)
         try:
-            program = w.make_bend_program(rest, profile)
+            program = native.make_bend_program(rest, profile)
         except ValueError as exc:
             errors.append(f"wire {wire['name']}: {exc}")
             continue
         stem = file_stem(wire)
         template = {"name": wire["name"], "points": rest, "bend_points": list(program["bend_vertices"]),
                     "crossing_points": crossing_indices(design, wire)}
+        crosses = self_crossings(rest, wire["closed"])
+        if crosses:  # marked on the template: the wire must pass over itself there
+            template["self_crossings"] = np.array([c[2] for c in crosses], dtype=np.float64)
         templates.append(template)
         for folder, name, write in (
-            ("svg", f"{stem}.svg", lambda p: w.write_svg(p, [template], False)),
-            ("gcode", f"{stem}.gcode", lambda p: w.write_gcode(p, rest, profile, wire["name"], material)),
-            ("bends", f"{stem}.csv", lambda p: w.write_bend_table(p, rest, profile)),
+            ("svg", f"{stem}.svg", lambda p: native.write_machine_svg(p, template)),
+            ("dxf", f"{stem}.dxf", lambda p: native.write_dxf(p, [template], layout="start_at_origin")),
+            ("templates", f"{stem}.svg", lambda p: native.write_svg(p, [template], False)),
+            ("gcode", f"{stem}.gcode", lambda p: native.write_gcode(p, rest, profile, wire["name"], material)),
+            ("bends", f"{stem}.csv", lambda p: native.write_bend_table(p, rest, profile)),
+            ("bendlist", f"{stem}.txt",
+             lambda p: bendlist.write_bend_list(p, program, bool(profile.get("left_is_positive", True)))),
         ):
             path = os.path.join(out_dir, folder, name)
             os.makedirs(os.path.dirname(path), exist_ok=True)
-            write(path)
+            text = write(path)
             files.append(path)
+            if folder == "templates":
+                files += tiles.write_pages(text, os.path.join(out_dir, "templates", "pages"), stem, wire["name"], paper)
         summaries.append({"id": wire["id"], "name": wire["name"], "bend_count": program["bend_count"],
                           "wire_length": program["wire_length"], "machine_seconds": program["machine_seconds"],
                           "shape_error": program["shape_error"]})
     if templates:
-        for folder, name, write in (("svg", "sheet.svg", lambda p: w.write_svg(p, templates, True)),
-                                    ("dxf", "sculpture.dxf", lambda p: w.write_dxf(p, templates))):
+        for folder, name, write in (("templates", "sheet.svg", lambda p: native.write_svg(p, templates, True)),
+                                    ("dxf", "sculpture.dxf",
+                                     lambda p: native.write_dxf(p, templates, layout="side_by_side"))):
             path = os.path.join(out_dir, folder, name)
             os.makedirs(os.path.dirname(path), exist_ok=True)
             write(path)
             files.append(path)
-    return {"files": files, "wires": summaries, "errors": errors, "notes": notes}
+    return {"files": files, "wires": summaries, "errors": errors, "notes": notes,
+            "empty_reason": "" if wires else no_rest_reason(design)}
 
 
 def summary(result, out_dir):
     """(level, one message) of an export: counts per folder, then each wire's bends, length and
     machine time or the reason it cannot be bent, then the profile notes. level is "INFO",
     "WARNING" (some wire refused or a note) or "ERROR" (no wire written)."""
-    counts = {folder: sum(1 for p in result["files"] if os.path.basename(os.path.dirname(p)) == folder)
+    counts = {folder: sum(1 for p in result["files"] if os.path.relpath(os.path.dirname(p), out_dir) == folder)
               for folder in FOLDERS}
     done, refused = result["wires"], result["errors"]
     if not done and not refused:
-        return "ERROR", "No wire has a rest shape: optimize until the rest shape stage has run"
+        reason = result.get("empty_reason") or "no wire has a rest shape yet: optimize until the rest shape stage has run"
+        return "ERROR", "Nothing to export: " + reason
     parts = [f"{w['name']}: {w['bend_count']} bends, {w['wire_length'] * 1000:.0f} mm, "
              f"about {w['machine_seconds']:.0f} s" for w in done]
     head = (f"Exported {len(done)} of {len(done) + len(refused)} wires to {out_dir} ("

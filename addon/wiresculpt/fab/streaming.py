@@ -31,15 +31,14 @@ def wire_program(design, wire_name, profile=None):
     if wire is None:
         raise ValueError(f"the design has no wire '{wire_name}'")
     if "rest" not in wire:
-        raise ValueError(f"wire {wire_name} has no rest shape: optimize until the rest shape stage has run")
-    w = native.require()
+        raise ValueError(f"wire {wire_name} has no rest shape: {export.no_rest_reason(design)}")
     machine, notes = export.machine_profile(design, profile)
     material = design["material"].get("name", "")
     try:
-        text = w.write_gcode(None, np.asarray(wire["rest"], dtype=np.float64), machine, wire_name, material)
+        text = native.write_gcode(None, np.asarray(wire["rest"], dtype=np.float64), machine, wire_name, material)
     except ValueError as exc:
         raise ValueError(f"wire {wire_name}: {exc}") from None
-    return w.stream_lines(text), machine, notes
+    return native.stream_lines(text), machine, notes
 
 
 class Stopped:
@@ -74,7 +73,7 @@ class StreamJob(WorkerJob):
         self.dry_run, self.settle, self.response_timeout, self.resumed = dry_run, settle, response_timeout, resumed
         self.first = int(state.get("next_line", 0))
         self.fraction = self.first / len(lines) if lines else 1.0
-        self.control = native.require().StreamControl()  # abort is one-shot: a fresh one per run
+        self.control = native.stream_control()  # abort is one-shot: a fresh one per run
         self.result = None
 
     def _progress(self, _stage, fraction):
@@ -82,7 +81,7 @@ class StreamJob(WorkerJob):
         return True
 
     def work(self):
-        self.result = native.require().stream_program(
+        self.result = native.stream_program(
             self.port, self.lines, self.profile, self.state, progress=self._progress, control=self.control,
             dry_run=self.dry_run, response_timeout=self.response_timeout, settle=self.settle)
 

@@ -69,7 +69,8 @@ class WIRESCULPT_OT_calibration_load(bpy.types.Operator, ImportHelper):
         except (OSError, RuntimeError) as exc:
             self.report({'WARNING'}, f"Cannot show the plot: {exc}")
         settings.plot = self.kind
-        self.report({'INFO'}, f"{name}: {text}")
+        warnings = fit.get("warnings") or []
+        self.report({'WARNING'} if warnings else {'INFO'}, "; ".join([f"{name}: {text}"] + warnings))
         return {'FINISHED'}
 
 
@@ -142,8 +143,10 @@ class WIRESCULPT_OT_calibration_save_profile(bpy.types.Operator, ExportHelper):
         except (ValueError, OSError) as exc:
             self.report({'ERROR'}, f"Cannot save the machine profile: {exc}")
             return {'CANCELLED'}
+        # the profile just saved is the one Export and Send to Machine use from now on
+        scene.wiresculpt.machine_profile = self.filepath
         note = "with the spring-back fit" if fit else "without a spring-back fit (load one first)"
-        self.report({'INFO'}, f"Machine profile saved {note}: {self.filepath}")
+        self.report({'INFO'}, f"Machine profile saved {note} and selected for fabrication: {self.filepath}")
         return {'FINISHED'}
 
 

@@ -86,7 +86,7 @@ class WIRESCULPT_OT_export_fabrication(bpy.types.Operator):
 
 
 def _port_items(_self, _context):
-    ports = native.require().list_ports() if native.available() else []
+    ports = native.list_ports() if native.available() else []
     items = [(p["name"], p["name"], p["description"] or p["name"]) for p in ports]
     _port_items.cache = items or [("", "(no serial port found)", "Type the port's path instead")]
     return _port_items.cache

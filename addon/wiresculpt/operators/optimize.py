@@ -81,7 +81,7 @@ def run_optimize(context, progress=None, cancel=None):
     """Builds, solves and writes the design into the scene (the synchronous path). Raises
     pipeline.Cancelled (the scene untouched), ValueError or RuntimeError (untouched too)."""
     design, material, settings = build_design(context)
-    pipeline.solve(design, material, settings, progress, cancel)
+    design = pipeline.solve(design, material, settings, progress, cancel)  # a new dict after re-layering
     scene_results.write_results(context.scene, design)
     return design
 
@@ -112,8 +112,8 @@ class Job(WorkerJob):
 
     def work(self):
         try:
-            pipeline.solve(self.design, self.material, self.settings, self._progress,
-                           self.cancel_event.is_set)
+            self.design = pipeline.solve(self.design, self.material, self.settings, self._progress,
+                                         self.cancel_event.is_set)
         except pipeline.Cancelled:
             self.cancelled = True
 
@@ -194,7 +194,7 @@ class WIRESCULPT_OT_optimize(WorkerModal, bpy.types.Operator):
     def execute(self, context):
         try:
             design, material, settings = build_design(context)
-            pipeline.solve(design, material, settings)
+            design = pipeline.solve(design, material, settings)
         except pipeline.Cancelled:
             self.report({'WARNING'}, "Optimize cancelled; the scene is unchanged")
             return {'CANCELLED'}

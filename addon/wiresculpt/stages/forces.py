@@ -105,13 +105,10 @@ def run(design, material, settings, native_progress=None):
     # The solver answers in the design's own keys (docs/formats.md): copied, never renamed.
     for c, out in zip(design["crossings"], r["crossings"]):
         c.update(out)
+    # A rest bend over the machine's limit is named by the buildability verdict (fab/buildability.py),
+    # in the bend program's numbering, after the pipeline's coupling rounds (Sec. 4.3).
     for w, out in zip(design["wires"], r["wires"]):
         w.update(out)
-        for o in out["rest_over_bend"]:
-            design.setdefault("warnings", []).append(
-                f"wire {w['name']}: the rest shape bends {abs(o['angle_deg']):.1f} deg at vertex "
-                f"{o['vertex']}, more than the machine's {settings['max_bend_deg']:g} deg; lower the torque "
-                "fraction or the maximum bend of the target shape and solve again")
     design["torque_fraction"] = r["torque_fraction"]
     if r["load_factor"] is not None:
         design["load_factor"] = r["load_factor"]

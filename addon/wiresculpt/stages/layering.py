@@ -4,6 +4,12 @@ import math
 import numpy as np
 
 from .. import native
+from ..core import settings as settings_table
+
+
+def knob(settings, key):
+    """A setting of core/settings.py, its default when `settings` (e.g. a test's) lacks it."""
+    return settings.get(key, settings_table.SETTINGS[key][0])
 
 
 def settings_for(material, settings):
@@ -12,6 +18,8 @@ def settings_for(material, settings):
         "min_segment": settings["min_segment"],
         "friction": material["friction"],
         "contact_angle": math.radians(settings["contact_angle_deg"]),
+        "in_plane_tiebreak": bool(knob(settings, "in_plane_tiebreak")),
+        "max_nodes": int(knob(settings, "max_nodes")),
     }
 
 
@@ -22,10 +30,15 @@ def wire_specs(design, key="contour"):
             for w in design["wires"]]
 
 
-def run(design, material, settings, native_progress=None):
+def run(design, material, settings, native_progress=None, forbidden=()):
     """Fills crossings, assembly order, stable/reason and stages.layering. Returns a progress line.
-    `native_progress(stage, fraction) -> bool` (False cancels) is handed to the solver."""
-    result = native.layering(wire_specs(design), settings_for(material, settings), native_progress)
+    `native_progress(stage, fraction) -> bool` (False cancels) is handed to the solver.
+    `forbidden`: (crossing id, hook) pairs the search may not choose (the re-layering loop,
+    pipeline.solve); crossing ids are those of the network the design's contours give."""
+    options = settings_for(material, settings)
+    if forbidden:
+        options["forbidden_hooks"] = [[int(c), int(h)] for c, h in sorted(forbidden)]
+    result = native.layering(wire_specs(design), options, native_progress)
     net = result["network"]
     for wire, solved in zip(design["wires"], net["wires"]):
         wire["contour"] = solved["contour"]  # the sliced contour with its crossing points inserted
@@ -35,6 +48,8 @@ def run(design, material, settings, native_progress=None):
     design["two_hand_steps"] = list(result["two_hand_steps"])
     design["stable"] = bool(result["stable"])
     design["reason"] = result["reason"]
+    if not result["complete_search"] and not design["stable"]:
+        design["search_incomplete"] = True  # max_nodes stopped it: a stable design may still exist
     design.setdefault("warnings", []).extend(result["warnings"])
     if net["close_crossings"]:
         design["close_crossings"] = [g["message"] for g in net["close_crossings"]]

@@ -56,6 +56,9 @@ def solve_wire(design, wire, material, settings, size, native_progress=None, mem
     options = {"min_segment": settings["min_segment"], "max_bend": math.radians(settings["max_bend_deg"]),
                "friction": 0.0, "model_size": size, "wire_name": wire["name"],
                "angle_tolerance": REALISED_ANGLE, "length_tolerance": REALISED_LENGTH}
+    limits = memo.vertex_limits.get(wire["name"]) if memo is not None else None
+    if limits:  # the coupling's own limits at some points (pipeline._tighten), radians by target index
+        options["vertex_max_bend"] = tuple(limits.get(i, 0.0) for i in range(max(limits) + 1))
     contour = to_2d(wire["contour"], origin, u, v)
     key = Memo.key(contour, wire["closed"], specs, options) if memo is not None else None
     result = memo.reusable(key, options["max_bend"]) if memo is not None else None
@@ -73,6 +76,8 @@ class Memo:
     - `nulled`: the crossings it could not realise. A lower bend limit only shrinks each wire's
       feasible set, so they are nulled from the start of the next round instead of being solved
       (and failing) again.
+    - `vertex_limits`: {wire name: {target index: radians}}, the bend limits the coupling set at
+      single points (pipeline._tighten); they only ever go down, so the same argument holds.
     - every wire's solve. A result that was a converged, feasible optimum with every active crossing
       realised under the old limit and whose bends all lie within the new one is still a local
       optimum of the tighter problem (the same point, feasible, in a smaller feasible set): it is
@@ -83,6 +88,7 @@ class Memo:
 
     def __init__(self):
         self.nulled = []
+        self.vertex_limits = {}
         self.solves = {}  # key -> (max_bend, result)
         self.reused = 0
 
@@ -109,6 +115,36 @@ class Memo:
 
     def remember(self, key, max_bend, result):
         self.solves[key] = (max_bend, result)
+
+
+def unrealisable(design):
+    """The (crossing id, hook) pairs this stage could not realise (stages.target_shape's nulled
+    crossings), for the re-layering loop (pipeline.relayer) to forbid: the hook that failed, or
+    both hooks of a crossing "too_close" to a neighbour along its wire whose straight piece is
+    shorter than min_segment (the solver marks both ends of such a piece whatever their hooks). A
+    "too_close" crossing with a longer piece failed because that piece, fixed between the two
+    crossings, lies outside the kink this hook needs: the other hook may hold it. Empty when the
+    stage did not run."""
+    pairs = set()
+    for n in design["stages"].get("target_shape", {}).get("nulled_crossings", []):
+        short = n["status"] == "too_close" and _shortest_piece(design, n) < design["machine"]["min_segment"]
+        pairs.update((n["crossing"], h) for h in ((-1, 1) if short else (n["hook"],)))
+    return pairs
+
+
+def _shortest_piece(design, failure):
+    """The shorter straight piece (m) from a nulled crossing to its neighbouring crossings along the
+    wire it failed on (`failure["wire"]`, a name)."""
+    wire = next(w for w in design["wires"] if w["name"] == failure["wire"])
+    along = sorted((c["contour_vertices"][c["wires"].index(wire["id"])], c["id"]) for c in design["crossings"]
+                   if wire["id"] in c["wires"])
+    ids = [cid for _v, cid in along]
+    k = ids.index(failure["crossing"])
+    neighbours = [ids[k - 1] if k > 0 or wire["closed"] else None, ids[(k + 1) % len(ids)]
+                  if k + 1 < len(ids) or wire["closed"] else None]
+    point = np.asarray(design["crossings"][failure["crossing"]]["point"])
+    return min((float(np.linalg.norm(np.asarray(design["crossings"][o]["point"]) - point))
+                for o in neighbours if o is not None and o != failure["crossing"]), default=math.inf)
 
 
 def _ids(numbers):
@@ -161,7 +197,8 @@ def run(design, material, settings, native_progress=None, memo=None):
         for wire, (r, refs, _frame) in zip(design["wires"], solved):
             for (c, _k), status in zip(refs, r["crossings"]):
                 if c["hook"] != 0 and status["status"] in FAILED:
-                    failing.setdefault(c["id"], {"crossing": c["id"], "wire": wire["name"], "status": status["status"],
+                    failing.setdefault(c["id"], {"crossing": c["id"], "hook": c["hook"], "wire": wire["name"],
+                                                 "status": status["status"],
                                                  "scale": status["scale"], "message": status["message"]})
         if not failing:
             break

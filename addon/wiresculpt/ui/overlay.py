@@ -13,7 +13,7 @@ import gpu
 import numpy as np
 from gpu_extras.batch import batch_for_shader
 
-from ..blend import results
+from ..blend import compat, results
 
 ARROW_SHARE = 0.2
 HEAD_SHARE = 0.25  # arrow head length as a share of the arrow
@@ -28,13 +28,10 @@ _arrows = {"design": None, "step": None, "lines": None, "whiskers": None}  # the
 
 
 def uniform_colour_shader():
-    """The built-in flat-colour shader: 'UNIFORM_COLOR' (Blender 4+) or '3D_UNIFORM_COLOR' (3.x)."""
+    """The built-in flat-colour shader (its name depends on the Blender: blend.compat)."""
     global _shader
     if _shader is None:
-        try:
-            _shader = gpu.shader.from_builtin('UNIFORM_COLOR')
-        except (ValueError, TypeError):
-            _shader = gpu.shader.from_builtin('3D_UNIFORM_COLOR')
+        _shader = compat.uniform_colour_shader()
     return _shader
 
 

@@ -7,17 +7,19 @@ from .. import native
 from ..blend.registration import classes_factory
 from ..operators.slicing import WIRESCULPT_OT_add_plane, WIRESCULPT_OT_slice
 
-CHARS_PER_PIXEL = 1 / 7  # rough width of a label character, for wrapping long messages
+CHARS_PER_PIXEL = 1 / 7.5  # rough width of a label character, for wrapping long messages
 BOX_MARGIN = 30  # pixels of a box not available to its text
+ICON_WIDTH = 22  # pixels an icon takes from a label's text
+WIDE_LIST = 280  # pixels of sidebar from which a contour row has room for its length too
 
 
-def length_text(scene, value):
+def length_text(scene, value, precision=4):
     """`value` (scene units) as the scene displays lengths, e.g. "1.235 m"."""
     units = scene.unit_settings
     if units.system == 'NONE':
-        return f"{value:.4g}"
+        return f"{value:.{precision}g}"
     return bpy.utils.units.to_string(units.system, 'LENGTH', value * units.scale_length,
-                                     precision=4)
+                                     precision=precision)
 
 
 def draw_load_error(layout, context):
@@ -34,14 +36,48 @@ class WIRESCULPT_UL_contours(bpy.types.UIList):
 
     def draw_item(self, context, layout, data, item, icon, active_data, active_propname,
                   index=0, flt_flag=0):
-        split = layout.split(factor=0.55)
+        # The name comes first: in a sidebar too narrow for name and length (Blender's default
+        # width) the row shows the name alone; the details box below the list shows the active
+        # row in full, length included, however narrow the sidebar is.
+        icon = 'MESH_CIRCLE' if item.closed else 'IPO_LINEAR'
+        width = context.region.width if context.region else WIDE_LIST
+        if width < WIDE_LIST:
+            row = layout.row(align=True)
+            row.prop(item, "use", text="")
+            row.label(text=contour_name(item), icon=icon)
+            return
+        split = layout.split(factor=0.62)
         row = split.row(align=True)
         row.prop(item, "use", text="")
-        row.label(text=f"{item.plane} #{item.index}",
-                  icon='MESH_CIRCLE' if item.closed else 'IPO_LINEAR')
+        row.label(text=contour_name(item), icon=icon)
         right = split.row()
         right.alignment = 'RIGHT'
-        right.label(text=length_text(context.scene, item.length))
+        right.label(text=length_text(context.scene, item.length, precision=3))
+
+
+def contour_name(item):
+    return f"{item.plane} #{item.index}"
+
+
+def contour_details(scene, item):
+    """The active contour in full, one sentence (wrapped by the panel)."""
+    shape = "closed loop" if item.closed else "open curve (the mesh has a hole there)"
+    role = "ticked: it becomes a wire" if item.use else "not ticked: not a wire"
+    return (f"Plane \"{item.plane}\", contour {item.index} (longest first): a {shape}, "
+            f"{length_text(scene, item.length)}; {role}")
+
+
+def line_chars(context, icon='NONE'):
+    """How many characters of label text fit the region's width in a box (an icon takes some)."""
+    width = context.region.width if context.region else 280
+    return max(20, int((width - BOX_MARGIN - (ICON_WIDTH if icon != 'NONE' else 0)) * CHARS_PER_PIXEL))
+
+
+def wrap_labels(layout, context, text, icon='NONE'):
+    """`text` as labels that fit the region's width (the sidebar cuts a long label short)."""
+    lines = textwrap.wrap(text, line_chars(context, icon)) or [""]
+    for i, line in enumerate(lines):
+        layout.label(text=line, icon=icon if i == 0 else 'BLANK1' if icon != 'NONE' else 'NONE')
 
 
 class VIEW3D_PT_wiresculpt(bpy.types.Panel):
@@ -62,6 +98,9 @@ class VIEW3D_PT_wiresculpt(bpy.types.Panel):
         layout.label(text="Contours (ticked: wires)")
         layout.template_list(WIRESCULPT_UL_contours.__name__, "", settings, "contours",
                              settings, "active_contour", rows=4)
+        if 0 <= settings.active_contour < len(settings.contours):
+            wrap_labels(layout.box(), context,
+                        contour_details(context.scene, settings.contours[settings.active_contour]), icon='INFO')
 
 
 register, unregister = classes_factory(

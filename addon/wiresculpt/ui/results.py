@@ -2,17 +2,16 @@
 stability report of the stored design, and the display of the result (forces, assembly steps,
 assembly guide)."""
 import math
-import textwrap
 
 import bpy
 
-from .. import native
+from .. import native, props
 from ..blend import results as scene_results
 from ..blend.registration import classes_factory
 from ..core import closure
 from ..operators import optimize
 from ..operators.results import WIRESCULPT_OT_assembly_guide, WIRESCULPT_OT_clear_results
-from .panel import BOX_MARGIN, CHARS_PER_PIXEL, VIEW3D_PT_wiresculpt, length_text
+from .panel import VIEW3D_PT_wiresculpt, length_text, wrap_labels
 
 GRAVITY = 9.81  # m/s^2: weights in newtons to grams
 
@@ -100,11 +99,7 @@ def assembly_rows(design):
     return rows
 
 
-def _wrap(layout, context, text, icon='NONE'):
-    width = context.region.width if context.region else 280
-    lines = textwrap.wrap(text, max(20, int((width - BOX_MARGIN) * CHARS_PER_PIXEL))) or [""]
-    for i, line in enumerate(lines):
-        layout.label(text=line, icon=icon if i == 0 else 'BLANK1' if icon != 'NONE' else 'NONE')
+_wrap = wrap_labels
 
 
 # --- panels -------------------------------------------------------------------------------------
@@ -144,6 +139,11 @@ class VIEW3D_PT_wiresculpt_settings(_Child, bpy.types.Panel):
         sub = col.column(align=True)
         sub.active = not ws.use_load_factor
         sub.prop(ws, "torque_fraction")
+        box = layout.box()  # the layering's search knobs (docs/user-guide.md, Advanced)
+        box.prop(ws, "show_advanced", icon='TRIA_DOWN' if ws.show_advanced else 'TRIA_RIGHT', emboss=False)
+        if ws.show_advanced:
+            for key in props.ADVANCED_PROPS:
+                box.prop(ws, key)
 
 
 class VIEW3D_PT_wiresculpt_optimize(_Child, bpy.types.Panel):
@@ -181,14 +181,15 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
             box.label(text="Stable", icon='CHECKMARK')
         else:
             box.alert = True
-            box.label(text="Not stable", icon='ERROR')
+            # max_nodes stopped the layering: a stable design may exist (the reason says how to go on)
+            box.label(text="Search incomplete" if design.get("search_incomplete") else "Not stable", icon='ERROR')
             _wrap(box, context, design.get("reason") or "no reason given")
         rows = assembly_rows(design)
         if rows:
             col = layout.column(align=True)
             col.label(text="Assembly order:")
             for row in rows:
-                col.label(text=row.strip(), icon='BLANK1' if row.startswith(" ") else 'FORWARD')
+                _wrap(col, context, row.strip(), icon='BLANK1' if row.startswith(" ") else 'FORWARD')
         distances = [w["target_max_distance"] for w in design["wires"] if "target_max_distance" in w]
         if distances:
             row = layout.row()
@@ -219,7 +220,12 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
         pending = design.get("pending_stages") or []
         if pending:
             layout.label(text="Pending: " + ", ".join(p.replace("_", " ") for p in pending), icon='INFO')
-        warnings = design.get("warnings") or []
+        crossing = [c["message"] for c in (design.get("buildability") or {}).get("self_crossings", [])]
+        if crossing:  # a rest shape that crosses itself: shown first, the maker must see it before bending
+            col = layout.column(align=True)
+            for message in crossing:
+                _wrap(col, context, message, icon='ERROR')
+        warnings = [w for w in design.get("warnings") or [] if w not in crossing]
         if warnings:
             col = layout.column(align=True)
             for warning in warnings[:3]:

@@ -17,7 +17,7 @@
 // first one found is returned (deterministic).
 //
 // Exactness: the search returns a configuration and order whose objective is the minimum over
-// every hook configuration (3^C) and every order of single-wire steps whose prefixes are all
+// every hook configuration (3^C, or those LayeringOptions::allowed_hooks allows) and every order of single-wire steps whose prefixes are all
 // stable. Prunings used, all exact: (a) lower bound against the best complete structure;
 // (b) dominance: a null crossing whose cheaper hook costs no more than the current maximum is
 // never optimal (hooking it keeps every prefix stable, as pyramids only add columns, and lowers
@@ -40,6 +40,7 @@
 // three wires have at most three, 12 columns, fewer than the 13 needed to span the 12
 // self-equilibrated loads of three wires; and, for 0 < contact_angle/2 - atan μ < π/2, any pair
 // with two crossings is stable under forces only with opposite hooks.)
+#include <array>
 #include <string>
 #include <vector>
 
@@ -73,6 +74,13 @@ struct LayeringOptions {
   /// kept (never worse than the first search's) with a warning and in_plane_complete = false.
   /// Default 300 (about 1.5 s on the bench chair; docs/method-layering.md).
   long in_plane_nodes = 300;
+  /// Per crossing, which hooks the search may choose: [c][0] hook -1, [c][1] hook +1 (null is
+  /// always allowed). A forbidden hook costs +inf, so it is never enumerated and every pruning
+  /// above stays exact over the allowed configurations ((b) compares with the cheaper allowed
+  /// hook; (d) and (e) put only the allowed hooks' pyramids). Used by the re-layering loop
+  /// (pipeline.solve) to forbid what the target shape cannot realise. Empty (default): every hook
+  /// allowed; otherwise one entry per crossing.
+  std::vector<std::array<bool, 2>> allowed_hooks;
 };
 
 struct LayeringStats {

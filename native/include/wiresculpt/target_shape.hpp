@@ -30,6 +30,10 @@
 
 namespace wiresculpt {
 
+struct TargetShapeOptions;
+/// The bend limit at point i: vertex_max_bend[i] when given (> 0), else max_bend.
+double bend_limit(const TargetShapeOptions& options, int i);
+
 /// One crossing on the wire, as the layering stage hands it over (FORMATS.md, `hook`).
 struct TargetCrossing {
   /// Index into the input contour of the vertex that IS the crossing point (exactly on it).
@@ -57,6 +61,12 @@ struct TargetShapeOptions {
   /// Radians, in (0, π]. The largest bend (turning angle, π minus the kink's opening) the machine
   /// makes at one point (Sec. 4.3, c_f,angle). Default 2π/3 (120°).
   double max_bend = 2.0 * std::numbers::pi / 3.0;
+  /// Radians, per point of the result (an index into TargetShapeResult::points, which is the
+  /// same for every solve of one contour with the same crossings and spacing): a tighter bend
+  /// limit at that point than max_bend. The coupling with the rest shape (Sec. 4.3) sets it where
+  /// the forces bend the rest shape beyond the machine. Entries <= 0 or past the end: max_bend.
+  /// Default empty.
+  std::vector<double> vertex_max_bend;
   /// Metres. Arc-length spacing of the initial resampling between consecutive crossings; 0 means
   /// 1.5 × min_segment. Should not be below min_segment. Default 0.
   double spacing = 0.0;
@@ -112,7 +122,9 @@ struct TargetCrossingStatus {
   /// "ok" (realised), "inactive" (null hook, point kept), "too_close" (no free point towards a
   /// neighbouring crossing and the fixed edge cannot satisfy the constraints), "infeasible" (the
   /// constraints cannot hold: contact angle vs friction or max bend, or the solver could not meet
-  /// them), "open_end" (an active crossing at an end of an open wire has no kink).
+  /// them, at the kink or at a free point next to it: a bend over its limit or a segment under
+  /// min_segment there, named in the message), "open_end" (an active crossing at an end of an
+  /// open wire has no kink).
   std::string status = "ok";
   bool realised = true;   ///< false: the caller should make it null and re-check stability
   int vertex = -1;        ///< index of the crossing in TargetShapeResult::points

@@ -58,7 +58,12 @@ double compensate(double target, const MachineProfile& profile, int bend_number)
   return std::copysign(magnitude, target);
 }
 
-BendProgram make_bend_program(const Polyline2& points, const MachineProfile& profile) {
+namespace {
+
+std::string from_cut(double metres) { return fmt(to_mm(metres), 1) + " mm from the cut"; }
+
+// The program and everything that keeps it from being made (bend_program.hpp); input errors throw.
+BendProgram build(const Polyline2& points, const MachineProfile& profile, std::vector<BendProblem>& problems) {
   validate(profile);
   const std::size_t n = points.size();
   if (n < 2)
@@ -67,6 +72,7 @@ BendProgram make_bend_program(const Polyline2& points, const MachineProfile& pro
     if (!points[i].allFinite())
       throw InputError("point " + std::to_string(i) + " of the wire has a non-finite coordinate");
   std::vector<double> L(n - 1);
+  std::vector<double> s_at(n, 0.0);  // arc length from the cut at each input point
   for (std::size_t i = 0; i + 1 < n; ++i) {
     L[i] = (points[i + 1] - points[i]).norm();
     if (!(L[i] > 1e-12))
@@ -76,6 +82,7 @@ BendProgram make_bend_program(const Polyline2& points, const MachineProfile& pro
       throw InputError("segment " + std::to_string(i) + " (points " + std::to_string(i) + " and " +
                        std::to_string(i + 1) + ") is longer than " + fmt(kMaxSegment, 0) +
                        " m: the points are not in metres");
+    s_at[i + 1] = s_at[i] + L[i];
   }
 
   BendProgram prog;
@@ -102,12 +109,17 @@ BendProgram make_bend_program(const Polyline2& points, const MachineProfile& pro
         carry = t - made;
         ++prog.rounded_bends;
       } else if (at > profile.max_bend + kAngleSlack) {
-        if (std::abs(theta) > profile.max_bend + kAngleSlack)
-          throw InputError("bend " + std::to_string(prog.steps.size() + 1) + " (at point " +
-                           std::to_string(j) + ") turns " + fmt(to_deg(theta), 2) +
-                           " deg, more than the machine's maximum reliable bend of " +
-                           fmt(to_deg(profile.max_bend), 1) + " deg");
-        made = theta;  // keep the carry for the next point rather than overbend here
+        if (std::abs(theta) > profile.max_bend + kAngleSlack) {
+          const int bend = static_cast<int>(prog.steps.size()) + 1;
+          problems.push_back({BendProblem::Kind::over_bend, bend, static_cast<int>(j), static_cast<int>(j),
+                              s_at[j], std::abs(theta), profile.max_bend,
+                              "bend " + std::to_string(bend) + " (" + from_cut(s_at[j]) + ") turns " +
+                                  fmt(to_deg(theta), 2) + " deg, more than the machine's maximum reliable bend of " +
+                                  fmt(to_deg(profile.max_bend), 1) + " deg"});
+          carry = 0.0;  // made as asked, to go on listing what else keeps the wire from being made
+        } else {
+          made = theta;  // keep the carry for the next point rather than overbend here
+        }
       } else {
         carry = 0.0;
       }
@@ -133,15 +145,24 @@ BendProgram make_bend_program(const Polyline2& points, const MachineProfile& pro
   prog.dropped_turn = carry;
   prog.bend_count = static_cast<int>(prog.steps.size()) - 1;
 
-  // Feeds: every one must reach l_min.
+  // Feeds: every one must reach l_min. Step k feeds the wire before bend k (the G-code's and the
+  // bend table's numbering), so a feed is named by the bends around it.
+  const int bends = static_cast<int>(prog.steps.size()) - 1;
   for (std::size_t k = 0; k < prog.steps.size(); ++k) {
     const BendStep& s = prog.steps[k];
     if (s.feed + kFeedSlack < profile.min_feed) {
+      const int step = static_cast<int>(k) + 1;
       const std::size_t to = s.vertex >= 0 ? static_cast<std::size_t>(s.vertex) : n - 1;
-      throw InputError("step " + std::to_string(k + 1) + " feeds " + fmt(to_mm(s.feed), 3) +
-                       " mm (points " + std::to_string(feed_start[k]) + " to " + std::to_string(to) +
-                       "), shorter than the machine's minimum feed between bends of " +
-                       fmt(to_mm(profile.min_feed), 3) + " mm");
+      const std::string where = step == 1 ? (bends > 0 ? "from the cut to bend 1" : "the whole wire")
+                                : s.vertex < 0 ? "after bend " + std::to_string(bends) + ", to the end"
+                                               : "between bends " + std::to_string(step - 1) + " and " +
+                                                     std::to_string(step);
+      problems.push_back({BendProblem::Kind::short_feed, step, static_cast<int>(feed_start[k]), static_cast<int>(to),
+                          s_at[feed_start[k]], s.feed, profile.min_feed,
+                          "step " + std::to_string(step) + " feeds " + fmt(to_mm(s.feed), 3) + " mm (" + where +
+                              ", " + from_cut(s_at[feed_start[k]]) +
+                              "), shorter than the machine's minimum feed between bends of " +
+                              fmt(to_mm(profile.min_feed), 3) + " mm"});
     }
   }
 
@@ -153,13 +174,36 @@ BendProgram make_bend_program(const Polyline2& points, const MachineProfile& pro
       prog.machine_seconds += s.feed / profile.feed_speed;
       continue;
     }
-    s.commanded = compensate(s.bend, profile, static_cast<int>(k + 1));
+    if (std::abs(s.bend) > profile.max_bend + kAngleSlack) continue;  // already a problem: over the limit
+    try {
+      s.commanded = compensate(s.bend, profile, static_cast<int>(k + 1));
+    } catch (const InputError& e) {
+      problems.push_back({BendProblem::Kind::command, static_cast<int>(k) + 1, s.vertex, s.vertex,
+                          s_at[static_cast<std::size_t>(s.vertex)], std::abs(s.bend), profile.max_commanded,
+                          e.what()});
+      continue;
+    }
     prog.machine_seconds += std::max(profile.seconds_per_bend,
                                      s.feed / profile.feed_speed + 2.0 * std::abs(s.commanded) / profile.bend_speed);
   }
 
   prog.shape_error = arclength_distance(points, rebuild_polyline(prog));
   return prog;
+}
+
+}  // namespace
+
+BendProgram make_bend_program(const Polyline2& points, const MachineProfile& profile) {
+  std::vector<BendProblem> problems;
+  BendProgram prog = build(points, profile, problems);
+  if (!problems.empty()) throw InputError(problems.front().message);
+  return prog;
+}
+
+std::vector<BendProblem> bend_program_problems(const Polyline2& points, const MachineProfile& profile) {
+  std::vector<BendProblem> problems;
+  build(points, profile, problems);
+  return problems;
 }
 
 Polyline2 rebuild_polyline(const BendProgram& program, bool from_origin) {

@@ -266,6 +266,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// What unlocks a GRBL in alarm (ALARM:n) or lock (error:9) state, named in every such message.
+const std::string kUnlock =
+    "unlock it with $X (kill alarm lock), or home it with $H when the machine has homing switches";
+
 int to_ms(double seconds) { return static_cast<int>(std::clamp(seconds, 0.0, 1e6) * 1000.0); }
 
 std::string quoted(const std::vector<std::string>& lines, std::size_t i) {
@@ -400,7 +404,7 @@ StreamResult stream_program(SerialPort& port, const std::vector<std::string>& li
       else if (starts_with(answer, "error:") || starts_with(answer, "ALARM"))
         return stop(starts_with(answer, "error:") ? StreamStatus::error : StreamStatus::alarm, lj,
                     "GRBL answered " + answer + " to " + quoted(lines, j) +
-                    " while its modes were restored before resuming (clear any alarm with $X)" + resume);
+                    " while its modes were restored before resuming (" + kUnlock + ")" + resume);
     }
   }
 
@@ -449,6 +453,11 @@ StreamResult stream_program(SerialPort& port, const std::vector<std::string>& li
         acknowledged = true;
       } else if (starts_with(answer, "error:")) {
         r.code = code_after_colon(answer);
+        if (r.code == 9)  // "G-code locked out during alarm or jog state"
+          return stop(StreamStatus::error, li,
+                      "GRBL is locked (an alarm, or a jog in progress) and refused " + quoted(lines, i) + " with " +
+                          answer + " (the line was not executed): " + kUnlock + ", then resume from line " +
+                          std::to_string(i + 1));
         return stop(StreamStatus::error, li,
                     "GRBL rejected " + quoted(lines, i) + " with " + answer +
                         " (the line was not executed); fix it and resume from line " + std::to_string(i + 1));
@@ -456,7 +465,7 @@ StreamResult stream_program(SerialPort& port, const std::vector<std::string>& li
         r.code = code_after_colon(answer);
         return stop(StreamStatus::alarm, li,
                     "GRBL raised " + answer + " while " + quoted(lines, i) +
-                        " was in flight; the machine is locked: clear the alarm ($X or reset), check the wire, and "
+                        " was in flight; the machine is locked: " + kUnlock + ", check the wire, and "
                         "resume from line " + std::to_string(i + 1));
       } else if (starts_with(answer, "Grbl ")) {
         return stop(StreamStatus::disconnected, li,

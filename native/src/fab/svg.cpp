@@ -99,11 +99,58 @@ std::string wire_group(const TemplateWire& w, std::size_t index, double ox, doub
     s += "    <circle class=\"crossing\" data-point=\"" + std::to_string(i) + "\" cx=\"" + num(q[i].x()) +
          "\" cy=\"" + num(q[i].y()) + "\" r=\"" + num(o.crossing_radius_mm) +
          "\" fill=\"none\" stroke=\"#0050d0\" stroke-width=\"" + num(o.stroke_mm * 0.6) + "\"/>\n";
+  for (std::size_t k = 0; k < w.self_crossings.size(); ++k) {
+    const Vec2& p = w.self_crossings[k];
+    const Vec2 c(ox + m + to_mm(p.x()) - b.min_x, oy + m + b.max_y - to_mm(p.y()));
+    const double r = 1.5 * o.crossing_radius_mm;
+    s += "    <g class=\"self-crossing\" data-index=\"" + std::to_string(k) + "\">\n";
+    s += "      <circle cx=\"" + num(c.x()) + "\" cy=\"" + num(c.y()) + "\" r=\"" + num(r) +
+         "\" fill=\"none\" stroke=\"#ff8000\" stroke-width=\"" + num(o.stroke_mm) + "\"/>\n";
+    s += "      <text x=\"" + num(c.x() + r) + "\" y=\"" + num(c.y() - r) +
+         "\" font-family=\"sans-serif\" font-size=\"" + num(0.6 * o.label_mm) +
+         "\" fill=\"#ff8000\">crosses itself</text>\n";
+    s += "    </g>\n";
+  }
   char len[64];
   std::snprintf(len, sizeof len, "%.1f mm", wire_length_mm(w));
   s += "    <text class=\"label\" x=\"" + num(ox + m) + "\" y=\"" + num(oy + 0.75 * m) +
        "\" font-family=\"sans-serif\" font-size=\"" + num(o.label_mm) + "\">" + xml_escape(w.name) + "  (" + len +
        ")</text>\n";
+  // Where the bender starts (a dot on the first point), which way the wire comes out of it (an
+  // arrow beside the first segment, pointing along it) and where it is cut (a bar across the
+  // last point). All in green, away from the black centreline, ticks and rings.
+  const std::string mark = "#008060";
+  const double sw = o.stroke_mm * 0.6;
+  s += "    <circle class=\"start\" cx=\"" + num(q.front().x()) + "\" cy=\"" + num(q.front().y()) + "\" r=\"" +
+       num(1.5 * o.stroke_mm + 0.5) + "\" fill=\"" + mark + "\"/>\n";
+  if (q.size() >= 2) {
+    std::size_t j = 1;  // the first point apart from the start: the feed direction
+    while (j + 1 < q.size() && (q[j] - q[0]).norm() < 1e-9) ++j;
+    Vec2 d = q[j] - q[0];
+    const double seg = d.norm();
+    d = seg > 1e-12 ? Vec2(d / seg) : Vec2(1, 0);
+    const Vec2 n(-d.y(), d.x());
+    const double along = std::min(10.0, std::max(seg, 4.0));  // arrow length, mm
+    const Vec2 a = q[0] + o.tick_mm * n, tip = a + along * d;
+    const Vec2 h1 = tip - 1.5 * d + 0.8 * n, h2 = tip - 1.5 * d - 0.8 * n;
+    s += "    <g class=\"feed\" data-dx=\"" + num(d.x()) + "\" data-dy=\"" + num(d.y()) + "\">";
+    s += "<line x1=\"" + num(a.x()) + "\" y1=\"" + num(a.y()) + "\" x2=\"" + num(tip.x()) + "\" y2=\"" + num(tip.y()) +
+         "\" stroke=\"" + mark + "\" stroke-width=\"" + num(sw) + "\"/>";
+    s += "<polygon points=\"" + num(tip.x()) + "," + num(tip.y()) + " " + num(h1.x()) + "," + num(h1.y()) + " " +
+         num(h2.x()) + "," + num(h2.y()) + "\" fill=\"" + mark + "\"/></g>\n";
+    // the cut: a bar across the wire at its last point
+    std::size_t k = q.size() - 2;
+    while (k > 0 && (q.back() - q[k]).norm() < 1e-9) --k;
+    Vec2 e = q.back() - q[k];
+    e = e.norm() > 1e-12 ? Vec2(e.normalized()) : Vec2(1, 0);
+    const Vec2 en(-e.y(), e.x());
+    const Vec2 c1 = q.back() + o.tick_mm * en, c2 = q.back() - o.tick_mm * en;
+    s += "    <line class=\"cut\" x1=\"" + num(c1.x()) + "\" y1=\"" + num(c1.y()) + "\" x2=\"" + num(c2.x()) +
+         "\" y2=\"" + num(c2.y()) + "\" stroke=\"" + mark + "\" stroke-width=\"" + num(2 * sw) + "\"/>\n";
+    const Vec2 t = q.back() + (o.tick_mm + 1.0) * en;
+    s += "    <text class=\"cut-label\" x=\"" + num(t.x()) + "\" y=\"" + num(t.y()) +
+         "\" font-family=\"sans-serif\" font-size=\"" + num(0.6 * o.label_mm) + "\" fill=\"" + mark + "\">cut</text>\n";
+  }
   s += "  </g>\n";
   return s;
 }
@@ -123,6 +170,30 @@ std::string svg_wire(const TemplateWire& wire, const SvgOptions& options) {
   const Box b = bbox_mm(wire);
   const double w = b.width() + 2 * options.margin_mm, h = b.height() + 2 * options.margin_mm;
   return svg_open(w, h) + wire_group(wire, 0, 0.0, 0.0, options) + "</svg>\n";
+}
+
+std::string svg_machine(const TemplateWire& wire, double stroke_mm) {
+  validate(wire, 0);
+  if (!(std::isfinite(stroke_mm) && stroke_mm > 0))
+    throw InputError("machine SVG of wire " + wire.name + ": stroke_mm must be a positive number of millimetres");
+  // page coordinates: mm from the first point, y down (the drawing seen from the same side as the template)
+  const Vec2 start = wire.points.front();
+  std::string d;
+  double min_x = 0, min_y = 0, max_x = 0, max_y = 0;
+  for (std::size_t i = 0; i < wire.points.size(); ++i) {
+    // y = start - point rather than -(point - start): the first point is (0, 0), never "-0.0000"
+    const double x = to_mm(wire.points[i].x() - start.x()), y = to_mm(start.y() - wire.points[i].y());
+    min_x = std::min(min_x, x); max_x = std::max(max_x, x);
+    min_y = std::min(min_y, y); max_y = std::max(max_y, y);
+    d += (i == 0 ? "M " : " L ") + num(x) + " " + num(y);
+  }
+  const double pad = stroke_mm;
+  const double w = max_x - min_x + 2 * pad, h = max_y - min_y + 2 * pad;
+  return "<?xml version=\"1.0\" encoding=\"UTF-8\" standalone=\"no\"?>\n"
+         "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"" + num(w) + "mm\" height=\"" + num(h) +
+         "mm\" viewBox=\"" + num(min_x - pad) + " " + num(min_y - pad) + " " + num(w) + " " + num(h) + "\">\n"
+         "  <path id=\"" + xml_escape(wire.name) + "\" fill=\"none\" stroke=\"black\" stroke-width=\"" + num(stroke_mm) +
+         "\" d=\"" + d + "\"/>\n</svg>\n";
 }
 
 std::vector<SheetCell> sheet_layout(const std::vector<TemplateWire>& wires, const SvgOptions& options) {

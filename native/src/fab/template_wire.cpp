@@ -20,6 +20,9 @@ void validate(const TemplateWire& wire, std::size_t index) {
     if (i >= n)
       throw InputError(who + ": crossing point index " + std::to_string(i) + " is outside 0.." +
                        std::to_string(n - 1));
+  for (std::size_t i = 0; i < wire.self_crossings.size(); ++i)
+    if (!wire.self_crossings[i].allFinite())
+      throw InputError(who + ": self-crossing " + std::to_string(i) + " has a non-finite coordinate");
 }
 
 }  // namespace wiresculpt::fab

@@ -37,11 +37,17 @@
 //   and direction; both are piecewise linear in s with kinks at input points, so the maximum is
 //   attained at an input point and computed exactly there).
 //
+// Numbering (one for every message about a wire's bends): bend k is the k-th bend from the cut,
+// made at step k of the program, which first feeds the wire before it (the G-code's "; step k"
+// and the bend table's row k); a place is also given as its arc length from the cut in mm.
+//
 // Refused (InputError, nothing returned): fewer than 2 points, non-finite coordinates, a
-// zero-length segment (naming the points), a bend over max_bend (naming the bend number, its
-// point and angle), a commanded angle beyond max_commanded or non-positive after compensation
-// (naming the bend and its angle), a feed shorter than min_feed (naming the step and its points).
+// zero-length segment (naming the points); and the problems bend_program_problems lists, the
+// first of them: a bend over max_bend (naming the bend, where it is and its angle), a feed
+// shorter than min_feed (naming the step, the bends around it and where it starts), a commanded
+// angle beyond max_commanded or non-positive after compensation (naming the bend and its angle).
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "wiresculpt/fab/machine.hpp"
@@ -73,6 +79,28 @@ struct BendProgram {
                                  ///< max(seconds_per_bend, feed/feed_speed + 2|commanded|/bend_speed)
                                  ///< plus the final feed / feed_speed
 };
+
+/// Something that keeps a wire from being made on the machine.
+struct BendProblem {
+  enum class Kind {
+    over_bend,   ///< |bend| > max_bend
+    short_feed,  ///< a feed < min_feed
+    command,     ///< the compensated command is not positive or beyond max_commanded
+  };
+  Kind kind = Kind::over_bend;
+  int number = 0;     ///< the bend (over_bend, command) or the step (short_feed), from 1
+  int from = -1;      ///< input point of the bend, or where the short feed starts
+  int to = -1;        ///< input point of the bend, or where the short feed ends (the next bend or the end)
+  double at = 0.0;    ///< m, arc length from the cut (points[0]) to `from`
+  double value = 0.0; ///< rad |bend| or m feed
+  double limit = 0.0; ///< rad max_bend / max_commanded, or m min_feed
+  std::string message;  ///< the sentence make_bend_program throws for it
+};
+
+/// Every problem of the program for `points` on `profile`, in the order make_bend_program meets
+/// them (bends walking from the cut, then feeds, then compensation); empty when it can be made.
+/// Throws InputError for the input errors above.
+std::vector<BendProblem> bend_program_problems(const Polyline2& points, const MachineProfile& profile);
 
 /// The program that bends `points` (#P by 2, metres, open, starting at the cut) on `profile`.
 /// Throws InputError as listed above; validates the profile first.

@@ -36,7 +36,8 @@ struct SerialSettings {
 struct AxisMapping {
   char feed_axis = 'X';        ///< axis that feeds the wire; default 'X'
   char bend_axis = 'Y';        ///< axis that rotates the bending head; default 'Y'
-  char pin_axis = '\0';        ///< optional axis retracting the bend pin to change sides; '\0' = none
+  char pin_axis = 'Z';         ///< axis that ducks the bend pin under the wire to change bend side; default 'Z'
+                               ///< ('\0' = none: only for a machine that bends to one side, or has no pin axis)
   double feed_units_per_mm = 1.0;  ///< feed-axis units per millimetre of wire; default 1 (GRBL $100 in steps/mm)
   double bend_units_per_deg = 1.0; ///< bend-axis units per degree of head rotation; default 1
   double pin_travel = 5.0;     ///< pin-axis units to retract (and then re-extend) the pin; default 5

@@ -7,7 +7,12 @@
 //   <polyline class="wire-path">   the centreline, absolute coordinates in mm
 //   <line class="bend">            a tick across the wire at each bend point (bisector normal)
 //   <circle class="crossing">      a ring at each crossing point
+//   <g class="self-crossing">      an orange ring and "crosses itself" where the wire crosses itself
 //   <text class="label">           "name  (length mm)" in the wire's top margin
+//   <circle class="start">         a dot on the first point: where the bender starts
+//   <g class="feed">               an arrow beside the first segment pointing along it (the way the
+//                                  wire leaves the bender); data-dx/data-dy its direction on the page
+//   <line class="cut">, <text class="cut-label">   a bar across the last point: where it is cut
 // A wire occupies a cell of (bounding box + 2 * margin) in each direction; the label, ticks and
 // rings stay inside the margin when tick_mm, crossing_radius_mm and label_mm are below margin_mm.
 #include <string>
@@ -33,6 +38,12 @@ struct SheetCell {
 
 /// One wire alone: width = bbox width + 2 margin, height = bbox height + 2 margin (mm).
 std::string svg_wire(const TemplateWire& wire, const SvgOptions& options = {});
+
+/// The machine file of one wire: its rest-shape centreline as exactly one <path> (M, then L per
+/// point), millimetres, the origin at the wire's first point (where the bender starts), y down as
+/// on the template; width/height in mm and a viewBox fitting the path plus stroke_mm. Nothing
+/// else is drawn: vector-to-bend importers read every path as a wire.
+std::string svg_machine(const TemplateWire& wire, double stroke_mm = 0.5);
 
 /// Cells of the sheet layout: rows left to right, a new row when the next cell would pass
 /// sheet_width_mm (a wider cell gets a row of its own). Cells never overlap.

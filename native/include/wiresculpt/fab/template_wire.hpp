@@ -13,6 +13,9 @@ struct TemplateWire {
   Polyline2 points;                           ///< #P by 2, metres, in the wire's own 2D frame
   std::vector<std::size_t> bend_points;       ///< indices into points: tick marks (see bend_vertices())
   std::vector<std::size_t> crossing_points;   ///< indices into points: crossing marks
+  /// Metres, in the wire's frame: where the wire crosses itself (the rest shape must pass over
+  /// itself on the bender), marked so the maker sees it before bending.
+  Polyline2 self_crossings;
 };
 
 /// Throws InputError naming the wire (`index`, name) when it has no point, a non-finite point

@@ -1,0 +1,31 @@
+"""Export's message matches the design's state: an unstable result points at Stability, an
+unfinished one at Optimize (issue 21, part 6)."""
+import unittest
+
+from wiresculpt.fab import export
+
+
+def empty_result(design):
+    return {"files": [], "wires": [], "errors": [], "notes": [], "empty_reason": export.no_rest_reason(design)}
+
+
+class ExportMessageTest(unittest.TestCase):
+    def test_unstable_design_points_at_stability(self):
+        design = {"stable": False, "reason": "crossing 3 pulls wires A/0 and B/0 apart",
+                  "pending_stages": ["rest_shape"], "wires": [{"name": "A/0"}]}
+        level, text = export.summary(empty_result(design), "/tmp/out")
+        self.assertEqual(level, "ERROR")
+        self.assertIn("the design is not stable: see Stability", text)
+        self.assertIn("crossing 3", text)
+        self.assertNotIn("optimize until", text)
+
+    def test_unfinished_design_points_at_optimize(self):
+        design = {"stable": True, "reason": "", "pending_stages": ["rest_shape"], "wires": [{"name": "A/0"}]}
+        level, text = export.summary(empty_result(design), "/tmp/out")
+        self.assertEqual(level, "ERROR")
+        self.assertIn("optimize until the rest shape stage has run", text)
+        self.assertNotIn("not stable", text)
+
+
+if __name__ == "__main__":
+    unittest.main()
