@@ -150,13 +150,18 @@ class GrblEmulator:
     realtime bytes (! ~ Ctrl-X) are recorded apart, as GRBL acts on them outside the line stream;
     a soft reset (Ctrl-X) while a line waits for its answer discards that line unanswered.
 
+    `answers` maps a line's number (1-based) to the raw bytes sent instead of `ok` (b"ok\\r\\nok\\r\\n"
+    for a device that doubles its answer, b"error:\\xff9\\r\\n" for invalid UTF-8); `double_ok`
+    doubles every `ok`.
+
     received: every line as it arrived; acknowledged: the lines answered `ok`, in order."""
 
-    def __init__(self, error_on=None, drop_on=None, delay=0.0):
+    def __init__(self, error_on=None, drop_on=None, delay=0.0, answers=None, double_ok=False):
         self.master, self.slave = os.openpty()
         tty.setraw(self.slave)
         self.port = os.ttyname(self.slave)
         self.error_on, self.drop_on, self.delay = error_on, drop_on, delay
+        self.answers, self.double_ok = dict(answers or {}), double_ok
         self.received, self.acknowledged, self.realtime = [], [], []
         self.dropped = False
         self._stop = threading.Event()
@@ -171,11 +176,13 @@ class GrblEmulator:
             return False
         if self.delay and self._reset_within(self.delay):
             return True  # a soft reset discards the line before it is answered, as GRBL does
-        if self.error_on is not None and len(self.received) == self.error_on:
+        if len(self.received) in self.answers:
+            os.write(self.master, self.answers[len(self.received)])
+        elif self.error_on is not None and len(self.received) == self.error_on:
             os.write(self.master, b"error:20\r\n")
         else:
             self.acknowledged.append(line)
-            os.write(self.master, b"ok\r\n")
+            os.write(self.master, b"ok\r\nok\r\n" if self.double_ok else b"ok\r\n")
         return True
 
     def _read(self, timeout):
@@ -208,7 +215,7 @@ class GrblEmulator:
                 self._read(0.01)
                 while b"\n" in self._buffer:
                     line, self._buffer = self._buffer.split(b"\n", 1)
-                    if not self._answer(line.decode().strip()):
+                    if not self._answer(line.decode(errors="replace").strip()):
                         return
             except OSError:
                 return

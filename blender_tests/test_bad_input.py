@@ -70,7 +70,7 @@ class BadInput(unittest.TestCase):
                     with open(os.path.join(tmp, name), "w") as f:
                         f.write(mesh_text(spec))
                 scene = os.path.join(tmp, "scene.json")
-                with open(scene, "w") as f:
+                with open(scene, "w", encoding=case.get("encoding", "utf-8")) as f:
                     f.write(case["text"] if "text" in case else json.dumps(case["scene"]))
                 out = os.path.join(tmp, "out")
                 r = run_blender(BATCH, scene, "--out", out, timeout=120)

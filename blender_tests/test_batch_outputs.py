@@ -52,6 +52,18 @@ class BatchOutputs(unittest.TestCase):
         for stage in ("slicing", "layering", "target_shape", "written", "scene", "render", "guide", "blend"):
             self.assertIn(stage, stages)
 
+    def test_outputs_are_0644_and_the_blend_is_complete(self):
+        """Issue 18: design.json and the guide were 0600; the .blend is verified by its end block."""
+        import stat
+        for root, dirs, files in os.walk(self.out):
+            for name in files:
+                path = os.path.join(root, name)
+                self.assertEqual(stat.S_IMODE(os.stat(path).st_mode), 0o644, path)
+        with open(os.path.join(self.out, "sculpture.blend"), "rb") as f:
+            data = f.read()
+        self.assertTrue(data.startswith(b"BLENDER"))
+        self.assertIn(b"ENDB", data[-32:])
+
     def test_render_and_guide(self):
         with open(os.path.join(self.out, "render.png"), "rb") as f:
             self.assertEqual(f.read(8), PNG)

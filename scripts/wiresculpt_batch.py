@@ -109,10 +109,13 @@ def write_scene_outputs(design, objects, planes, factor, out, say):
     # the first wire selected
     ready = scene_view.open_ready(scene)
     path = os.path.abspath(os.path.join(out, "sculpture.blend"))
-    # Blender writes the .blend to a temporary name and renames it: atomic like the rest. Blender
-    # 3.4 cannot set the sidebar's tab from Python: it is written into the saved (uncompressed)
-    # file instead, atomically too.
-    bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False, compress=ready["tab_set"])
+    # Blender writes the .blend to a temporary name and renames it: atomic like the rest. Saved
+    # uncompressed, so that the set's verification (core/staging.py) can see its end block, and so
+    # that on Blender 3.4, which cannot set the sidebar's tab from Python, the tab can be written
+    # into the saved file.
+    if bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False, compress=False) != {'FINISHED'}:
+        raise OSError(f"Blender could not save {os.path.basename(path)} (is the disk full?); "
+                      "the earlier outputs are kept")
     tab = f"{compat.SIDEBAR_TAB} tab"
     if not ready["tab_set"]:
         try:
@@ -162,6 +165,7 @@ def run(argv):
 
     from wiresculpt import native, pipeline
     from wiresculpt.core.design import write_design
+    from wiresculpt.core.meshcheck import check_output_folder, check_vertices
     from wiresculpt.core.staging import staged
     from wiresculpt.core.scene import load_scene
     from wiresculpt.blend.mesh import import_mesh
@@ -170,11 +174,13 @@ def run(argv):
         print(f"wiresculpt: {stage}: {message}", flush=True)
 
     args = parse_args(argv)
+    check_output_folder(args.out)  # before any work: a full solve must not end in "cannot write"
     scene = load_scene(args.scene)
     native.require()
     bpy.ops.wm.read_factory_settings(use_empty=True)
     start = time.perf_counter()
     V, F, objects = import_mesh(scene.mesh)
+    check_vertices(V, scene.mesh, scene.size)  # NaN/inf, magnitudes, millimetres, before scaling
     factor = 1.0
     if scene.size is not None:
         extent = float(np.max(V.max(axis=0) - V.min(axis=0)))

@@ -114,7 +114,7 @@ class SelfCrossing(unittest.TestCase):
         with tempfile.TemporaryDirectory() as out:
             result = export.export(design, out)
             self.assertEqual(result["errors"], [])
-            svg = open(os.path.join(out, "svg", "00-T-0.svg"), encoding="utf-8").read()
+            svg = open(os.path.join(out, "templates", "00-T-0.svg"), encoding="utf-8").read()  # the annotated template (svg/ holds the machine file)
         self.assertEqual(svg.count('class="self-crossing"'), 1)
         self.assertIn("crosses itself", svg)
 

@@ -259,6 +259,49 @@ class StreamThroughBinding(unittest.TestCase):
         finally:
             grbl.close()
 
+    def test_strict_accounting_lenient_decoding_and_one_stream_per_port(self):
+        """Issue 18: 'ok ok' to one line stops before the next line is counted (the resume sends
+        it); invalid UTF-8 in error: is a status, not UnicodeDecodeError; a second stream on a
+        port in use is refused naming the holder."""
+        w = native.require()
+        lines = w.stream_lines(w.write_gcode(None, square(), {}, "A/0", "steel"))
+        fast = dict(settle=0.05, response_timeout=1.0)
+        with GrblEmulator(answers={3: b"ok\r\nok\r\n"}) as grbl:
+            state = {}
+            r = w.stream_program(grbl.port, lines, {}, state, **fast)
+            self.assertEqual((r["status"], r["failed_line"], state["next_line"]), ("protocol_error", 3, 3))
+            self.assertEqual(grbl.received, lines[:3])  # line 4 was never sent
+            r = w.stream_program(grbl.port, lines, {}, state, **fast)
+            self.assertEqual(r["status"], "completed")
+            self.assertEqual(grbl.received[-(len(lines) - 3):], lines[3:])
+        with GrblEmulator(double_ok=True) as grbl:
+            r = w.stream_program(grbl.port, lines, {}, {}, **fast)
+            self.assertEqual((r["status"], r["next_line"]), ("protocol_error", 1))
+        with GrblEmulator(answers={2: b"error:\xff\xfe9\r\n"}) as grbl:
+            r = w.stream_program(grbl.port, lines, {}, {}, **fast)
+            self.assertEqual((r["status"], r["failed_line"]), ("error", 1))
+            self.assertIn("error:\\xff\\xfe9", r["message"])
+        with GrblEmulator(delay=0.3) as grbl:
+            import threading
+            first = {}
+            worker = threading.Thread(target=lambda: first.update(w.stream_program(grbl.port, lines[:3], {}, {}, **fast)))
+            worker.start()
+            try:
+                for _ in range(200):  # until the first stream holds the port (it has sent a line)
+                    if grbl.received:
+                        break
+                    time.sleep(0.01)
+                with self.assertRaises(ValueError) as ctx:
+                    w.stream_program(grbl.port, lines, {}, {}, **fast)
+                self.assertIn(f"is in use by process {os.getpid()}", str(ctx.exception))
+            finally:
+                worker.join(10)
+            self.assertEqual(first["status"], "completed")
+            self.assertEqual(grbl.received, lines[:3])  # nothing of the second stream arrived
+        with self.assertRaises(ValueError) as ctx:
+            w.stream_program("/dev/null-port", lines, {}, {}, settle=float("inf"))
+        self.assertEqual(str(ctx.exception), "settle must be from 0 to 60 seconds, got inf")
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -346,7 +346,7 @@ point. Writes atomically when path is not None; returns the text.)");
 state: dict whose "next_line" (0-based, first unacknowledged line) is read and updated in place,
 so calling again after an error or a disconnect resumes without repeating or skipping a line.
 progress(stage, fraction) -> False aborts. control: a StreamControl to pause/resume/abort from
-another thread. Returns {"status": completed|dry_run|error|alarm|disconnected|timeout|aborted,
+another thread. Returns {"status": completed|dry_run|error|alarm|disconnected|timeout|aborted|protocol_error,
 "sent", "acknowledged", "last_acknowledged", "failed_line", "code", "message", "next_line"}.)");
 }
 

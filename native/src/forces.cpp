@@ -245,7 +245,7 @@ ForceProblem::ForceProblem(const Network& net, const std::vector<int>& hooks,
   }
   T_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), K);
   T3_ = Eigen::MatrixXd::Zero(3 * static_cast<Eigen::Index>(rows.size()), K);
-  for (std::size_t r = 0; r < rows.size(); ++r) {
+  for (std::size_t r = 0; K > 0 && r < rows.size(); ++r) {  // K = 0: nothing to copy (no data to index)
     T_.row(static_cast<Eigen::Index>(r)) = rows[r];
     T3_.middleRows(3 * static_cast<Eigen::Index>(r), 3) = frame_rows[r];
   }
@@ -419,9 +419,11 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
       }
     }
     if (sol.status != detail::LpSolution::optimal)
-      throw SolverError("the force LP could not be solved (GLPK " +
-                        std::string(sol.status == detail::LpSolution::infeasible ? "found it infeasible" : "failed") +
-                        "); please report this input");
+      throw SolverError("the force LP could not be solved (" +
+                        (sol.status == detail::LpSolution::infeasible ? std::string("GLPK found it infeasible")
+                         : sol.reason.empty()                         ? std::string("GLPK failed")
+                                                                      : sol.reason) +
+                        "); check the material's numbers and the model's size, or report this input");
     for (int j = 0; j < K; ++j) a(j) = std::max(0.0, sol.x[j]);
     if (least) {
       // Near the optimum: minimise Σ s over s_{h,w} >= |f_h · n_w| (2 per hooked crossing h),

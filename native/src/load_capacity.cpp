@@ -19,7 +19,9 @@ LoadCapacityResult load_capacity(const Network& net, const std::vector<int>& cut
   const auto start = std::chrono::steady_clock::now();
   auto positive = [](double v) { return std::isfinite(v) && v > 0; };
   if (!positive(options.wire_diameter)) throw InputError("wire_diameter must be a finite number of metres > 0");
-  if (!positive(options.density)) throw InputError("density must be a finite number of kg/m^3 > 0");
+  // A weight far from any real wire's makes the LP's numbers leave the range GLPK handles.
+  if (!(options.density >= 1.0 && options.density <= 1e5))
+    throw InputError("density must be a number of kg/m^3 from 1 to 100000 (steel 7850)");
   if (!positive(options.gravity)) throw InputError("gravity must be a finite number of m/s^2 > 0");
   if (!std::isfinite(options.tie_tolerance) || options.tie_tolerance < 0)
     throw InputError("tie_tolerance must be a finite number of metres >= 0");

@@ -5,22 +5,124 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
+#include <string>
 
 #include "glpk_guard.hpp"
 
 namespace wiresculpt::detail {
 
+namespace {
+
+// GLPK's numbers: outside these magnitudes its scaling (glp_set_rii / glp_set_sjj) and its
+// factorisation fail, so a problem holding one is refused before GLPK sees it
+// (docs/robustness.md).
+constexpr double kLargest = 1e100, kSmallest = 1e-100;
+
+int bound_type(double lo, double hi) {
+  const bool l = std::isfinite(lo), h = std::isfinite(hi);
+  if (l && h) return lo == hi ? GLP_FX : GLP_DB;
+  if (l) return GLP_LO;
+  if (h) return GLP_UP;
+  return GLP_FR;
+}
+
+// Everything GLPK needs, as plain arrays, and what it answers: the body below runs inside
+// run_guarded (only trivially destructible locals, nothing that throws).
+struct OneShot {
+  int rows, cols, entries;
+  int dir;
+  const int* row_type;
+  const double *row_lo, *row_hi;
+  const int* col_type;
+  const double *col_lo, *col_hi, *obj;
+  const int *ia, *ja;
+  const double* ar;
+  double* x;  // cols entries
+  int ret, status, iterations;
+  double objective;
+};
+
+void one_shot_body(void* c) {
+  OneShot& q = *static_cast<OneShot*>(c);
+  glp_prob* lp = glp_create_prob();
+  glp_set_obj_dir(lp, q.dir);
+  if (q.rows > 0) glp_add_rows(lp, q.rows);
+  if (q.cols > 0) glp_add_cols(lp, q.cols);
+  for (int r = 0; r < q.rows; ++r) glp_set_row_bnds(lp, r + 1, q.row_type[r], q.row_lo[r], q.row_hi[r]);
+  for (int j = 0; j < q.cols; ++j) {
+    glp_set_col_bnds(lp, j + 1, q.col_type[j], q.col_lo[j], q.col_hi[j]);
+    glp_set_obj_coef(lp, j + 1, q.obj[j]);
+  }
+  glp_load_matrix(lp, q.entries, q.ia, q.ja, q.ar);
+  glp_scale_prob(lp, GLP_SF_AUTO);
+  glp_smcp parm;
+  glp_init_smcp(&parm);
+  parm.msg_lev = GLP_MSG_OFF;
+  parm.presolve = GLP_ON;
+  int ret = glp_simplex(lp, &parm);
+  if (ret != 0 && ret != GLP_ENOPFS && ret != GLP_ENODFS) {  // retry without presolve
+    parm.presolve = GLP_OFF;
+    glp_adv_basis(lp, 0);
+    ret = glp_simplex(lp, &parm);
+  }
+  q.ret = ret;
+  q.status = glp_get_status(lp);
+  if (ret == 0 && q.status == GLP_OPT) {
+    for (int j = 0; j < q.cols; ++j) q.x[j] = glp_get_col_prim(lp, j + 1);
+    q.objective = glp_get_obj_val(lp);
+  }
+  q.iterations = glp_get_it_cnt(lp);
+  glp_delete_prob(lp);
+}
+
+// The first number of the problem GLPK cannot take, as a sentence; empty when all are fine.
+std::string out_of_range(const LinearProgram& in) {
+  auto bad = [](double v, bool nonzero_entry) {
+    if (!std::isfinite(v)) return true;
+    const double a = std::abs(v);
+    return a > kLargest || (nonzero_entry && a < kSmallest);
+  };
+  auto say = [](const std::string& what, double v) {
+    std::ostringstream s;
+    s << what << " is " << v << ", outside the range the LP solver handles (magnitudes 1e-100 to 1e100)";
+    return s.str();
+  };
+  for (std::size_t t = 0; t < in.tri_val.size(); ++t)
+    if (in.tri_val[t] != 0.0 && bad(in.tri_val[t], true))
+      return say("a coefficient (row " + std::to_string(in.tri_row[t]) + ", column " + std::to_string(in.tri_col[t]) + ")",
+                 in.tri_val[t]);
+  for (std::size_t j = 0; j < in.obj.size(); ++j)
+    if (bad(in.obj[j], false)) return say("objective coefficient " + std::to_string(j), in.obj[j]);
+  auto bound_bad = [&](double v) { return std::isnan(v) || (std::isfinite(v) && bad(v, false)); };
+  for (std::size_t r = 0; r < in.row_lo.size(); ++r)
+    if (bound_bad(in.row_lo[r]) || bound_bad(in.row_hi[r]))
+      return say("a bound of row " + std::to_string(r), bound_bad(in.row_lo[r]) ? in.row_lo[r] : in.row_hi[r]);
+  for (std::size_t j = 0; j < in.col_lo.size(); ++j)
+    if (bound_bad(in.col_lo[j]) || bound_bad(in.col_hi[j]))
+      return say("a bound of column " + std::to_string(j), bound_bad(in.col_lo[j]) ? in.col_lo[j] : in.col_hi[j]);
+  return {};
+}
+
+}  // namespace
+
 LpSolution solve_lp(const LinearProgram& in) {
   LpSolution out;
   const int K = static_cast<int>(in.obj.size());
   const int R = static_cast<int>(in.row_lo.size());
-  auto bound_type = [](double lo, double hi) {
-    const bool l = std::isfinite(lo), h = std::isfinite(hi);
-    if (l && h) return lo == hi ? GLP_FX : GLP_DB;
-    if (l) return GLP_LO;
-    if (h) return GLP_UP;
-    return GLP_FR;
-  };
+  if (in.col_lo.size() != in.obj.size() || in.col_hi.size() != in.obj.size() || in.row_hi.size() != in.row_lo.size() ||
+      in.tri_row.size() != in.tri_val.size() || in.tri_col.size() != in.tri_val.size()) {
+    out.reason = "the LP's arrays differ in size";
+    return out;
+  }
+  for (std::size_t t = 0; t < in.tri_val.size(); ++t)
+    if (in.tri_row[t] < 0 || in.tri_row[t] >= R || in.tri_col[t] < 0 || in.tri_col[t] >= K) {
+      out.reason = "a coefficient names row " + std::to_string(in.tri_row[t]) + ", column " +
+                   std::to_string(in.tri_col[t]) + ", outside the LP";
+      return out;
+    }
+  out.reason = out_of_range(in);
+  if (!out.reason.empty()) return out;
   // Entries below 1e-13 of their column's largest are rounding noise of cross products (a
   // structural zero computed as 1e-19 would otherwise pin a variable); rows left empty become
   // free when their bounds admit 0 up to rounding, else the LP is infeasible.
@@ -43,52 +145,38 @@ LpSolution solve_lp(const LinearProgram& in) {
       out.status = LpSolution::infeasible;
       return out;
     }
-  glp_prob* lp = glp_create_prob();
-  glp_set_obj_dir(lp, in.maximise ? GLP_MAX : GLP_MIN);
-  if (R > 0) glp_add_rows(lp, R);
-  if (K > 0) glp_add_cols(lp, K);
-  for (int r = 0; r < R; ++r)
-    glp_set_row_bnds(lp, r + 1, row_used[r] ? bound_type(in.row_lo[r], in.row_hi[r]) : GLP_FR, std::isfinite(in.row_lo[r]) ? in.row_lo[r] : 0.0,
-                     std::isfinite(in.row_hi[r]) ? in.row_hi[r] : 0.0);
-  for (int j = 0; j < K; ++j) {
-    glp_set_col_bnds(lp, j + 1, bound_type(in.col_lo[j], in.col_hi[j]), std::isfinite(in.col_lo[j]) ? in.col_lo[j] : 0.0,
-                     std::isfinite(in.col_hi[j]) ? in.col_hi[j] : 0.0);
-    glp_set_obj_coef(lp, j + 1, in.obj[j]);
+  auto finite_or_zero = [](double v) { return std::isfinite(v) ? v : 0.0; };
+  std::vector<int> row_type(R), col_type(K);
+  std::vector<double> row_lo(R), row_hi(R), col_lo(K), col_hi(K), x(K, 0.0);
+  for (int r = 0; r < R; ++r) {
+    row_type[r] = row_used[r] ? bound_type(in.row_lo[r], in.row_hi[r]) : GLP_FR;
+    row_lo[r] = finite_or_zero(in.row_lo[r]);
+    row_hi[r] = finite_or_zero(in.row_hi[r]);
   }
-  glp_load_matrix(lp, static_cast<int>(ar.size()) - 1, ia.data(), ja.data(), ar.data());
-  glp_scale_prob(lp, GLP_SF_AUTO);
-  glp_smcp parm;
-  glp_init_smcp(&parm);
-  parm.msg_lev = GLP_MSG_OFF;
-  parm.presolve = GLP_ON;
-  int ret = guarded_simplex(lp, &parm);
-  if (ret == -1) {  // GLPK's environment (and with it `lp`) is gone
-    out.status = LpSolution::failed;
+  for (int j = 0; j < K; ++j) {
+    col_type[j] = bound_type(in.col_lo[j], in.col_hi[j]);
+    col_lo[j] = finite_or_zero(in.col_lo[j]);
+    col_hi[j] = finite_or_zero(in.col_hi[j]);
+  }
+  OneShot q{R, K, static_cast<int>(ar.size()) - 1, in.maximise ? GLP_MAX : GLP_MIN, row_type.data(), row_lo.data(),
+            row_hi.data(), col_type.data(), col_lo.data(), col_hi.data(), in.obj.data(), ia.data(), ja.data(),
+            ar.data(), x.data(), 0, 0, 0, 0.0};
+  if (!run_guarded(one_shot_body, &q)) {  // GLPK's environment (and the problem) is gone
+    out.reason = "GLPK stopped with an internal error";
     return out;
   }
-  if (ret != 0 && ret != GLP_ENOPFS && ret != GLP_ENODFS) {  // retry without presolve
-    parm.presolve = GLP_OFF;
-    glp_adv_basis(lp, 0);
-    ret = guarded_simplex(lp, &parm);
-    if (ret == -1) {
-      out.status = LpSolution::failed;
-      return out;
-    }
-  }
-  if (ret == 0 || ret == GLP_ENOPFS || ret == GLP_ENODFS) {
-    const int status = glp_get_status(lp);
-    if (ret == GLP_ENOPFS || status == GLP_NOFEAS) out.status = LpSolution::infeasible;
-    else if (ret == GLP_ENODFS || status == GLP_UNBND) out.status = LpSolution::unbounded;
-    else if (status == GLP_OPT) out.status = LpSolution::optimal;
-    else out.status = LpSolution::failed;
+  out.iterations = q.iterations;
+  if (q.ret == 0 || q.ret == GLP_ENOPFS || q.ret == GLP_ENODFS) {
+    if (q.ret == GLP_ENOPFS || q.status == GLP_NOFEAS) out.status = LpSolution::infeasible;
+    else if (q.ret == GLP_ENODFS || q.status == GLP_UNBND) out.status = LpSolution::unbounded;
+    else if (q.status == GLP_OPT) out.status = LpSolution::optimal;
   }
   if (out.status == LpSolution::optimal) {
-    out.x.resize(K);
-    for (int j = 0; j < K; ++j) out.x[j] = glp_get_col_prim(lp, j + 1);
-    out.objective = glp_get_obj_val(lp);
+    out.x = std::move(x);
+    out.objective = q.objective;
+  } else if (out.status == LpSolution::failed) {
+    out.reason = "GLPK's simplex stopped (code " + std::to_string(q.ret) + ") without a solution";
   }
-  out.iterations = glp_get_it_cnt(lp);
-  glp_delete_prob(lp);
   return out;
 }
 
@@ -143,36 +231,100 @@ struct EqualityLp::State {
   bool alive() const { return generation == glpk_generation(); }
 };
 
+namespace {
+
+struct EqualityBuild {
+  int rows, cols, entries;
+  const int *ia, *ja;
+  const double *ar, *cost;
+  glp_prob* p;
+};
+
+void equality_build_body(void* c) {
+  EqualityBuild& q = *static_cast<EqualityBuild*>(c);
+  glp_prob* p = glp_create_prob();
+  q.p = p;
+  glp_set_obj_dir(p, GLP_MIN);
+  if (q.rows > 0) glp_add_rows(p, q.rows);
+  if (q.cols > 0) glp_add_cols(p, q.cols);
+  for (int r = 1; r <= q.rows; ++r) glp_set_row_bnds(p, r, GLP_FX, 0.0, 0.0);
+  for (int j = 1; j <= q.cols; ++j) {
+    glp_set_col_bnds(p, j, GLP_LO, 0.0, 0.0);
+    glp_set_obj_coef(p, j, q.cost[j - 1]);
+  }
+  glp_load_matrix(p, q.entries, q.ia, q.ja, q.ar);
+}
+
+struct EqualitySolve {
+  glp_prob* p;
+  glp_smcp* parm;
+  int rows;
+  const int* changed;  // row indices (0-based) whose right-hand side changed
+  int changes;
+  const double* b;
+  int attempts, outcome;  // outcome: 0 feasible, 1 infeasible, 2 failed
+};
+
+void equality_solve_body(void* c) {
+  EqualitySolve& q = *static_cast<EqualitySolve*>(c);
+  for (int k = 0; k < q.changes; ++k) {
+    const int r = q.changed[k];
+    glp_set_row_bnds(q.p, r + 1, GLP_FX, q.b[r], q.b[r]);
+  }
+  q.parm->meth = GLP_DUALP;
+  q.outcome = 2;
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    ++q.attempts;
+    const int ret = glp_simplex(q.p, q.parm);
+    if (ret == 0) {
+      const int status = glp_get_status(q.p);
+      if (status == GLP_OPT || status == GLP_FEAS) {
+        q.outcome = 0;
+        return;
+      }
+      if (status == GLP_NOFEAS || glp_get_prim_stat(q.p) == GLP_NOFEAS) {
+        q.outcome = 1;
+        return;
+      }
+    }
+    // A singular or ill-conditioned basis: restart from the slack basis with the primal simplex.
+    glp_std_basis(q.p);
+    q.parm->meth = GLP_PRIMAL;
+  }
+}
+
+}  // namespace
+
 EqualityLp::EqualityLp(int rows, int cols, const std::vector<int>& tri_row, const std::vector<int>& tri_col,
                        const std::vector<double>& tri_val, const std::vector<double>& cost)
     : s_(std::make_unique<State>()) {
-  configure_glpk();
-  s_->p = glp_create_prob();
-  s_->generation = glpk_generation();
-  s_->rhs.assign(rows, 0.0);
-  glp_prob* p = s_->p;
-  glp_set_obj_dir(p, GLP_MIN);
-  glp_add_rows(p, rows);
-  glp_add_cols(p, cols);
-  for (int r = 1; r <= rows; ++r) glp_set_row_bnds(p, r, GLP_FX, 0.0, 0.0);
-  for (int j = 1; j <= cols; ++j) {
-    glp_set_col_bnds(p, j, GLP_LO, 0.0, 0.0);
-    glp_set_obj_coef(p, j, cost[j - 1]);
-  }
+  s_->rhs.assign(static_cast<std::size_t>(std::max(rows, 0)), 0.0);
   std::vector<int> ia{0}, ja{0};
   std::vector<double> ar{0.0};
-  for (std::size_t t = 0; t < tri_val.size(); ++t) {
+  bool valid = rows >= 0 && cols >= 0 && cost.size() == static_cast<std::size_t>(cols) &&
+               tri_row.size() == tri_val.size() && tri_col.size() == tri_val.size();
+  for (std::size_t t = 0; valid && t < tri_val.size(); ++t) {
+    const double a = std::abs(tri_val[t]);
+    valid = tri_row[t] >= 0 && tri_row[t] < rows && tri_col[t] >= 0 && tri_col[t] < cols && std::isfinite(a) &&
+            a <= kLargest && (a == 0.0 || a >= kSmallest);
     ia.push_back(tri_row[t] + 1);
     ja.push_back(tri_col[t] + 1);
     ar.push_back(tri_val[t]);
   }
-  glp_load_matrix(p, static_cast<int>(ar.size()) - 1, ia.data(), ja.data(), ar.data());
+  for (std::size_t j = 0; valid && j < cost.size(); ++j) valid = std::isfinite(cost[j]) && std::abs(cost[j]) <= kLargest;
+  if (!valid) return;  // p stays null: every solve is an internal_error
   glp_init_smcp(&s_->parm);
   s_->parm.msg_lev = GLP_MSG_OFF;
   s_->parm.presolve = GLP_OFF;
   s_->parm.pricing = GLP_PT_STD;  // textbook pricing: these LPs are small, steepest edge does not pay
   s_->parm.meth = GLP_DUALP;  // costs >= 0: the slack basis and every optimal basis stay dual feasible
                               // when the right-hand side changes
+  EqualityBuild q{rows, cols, static_cast<int>(ar.size()) - 1, ia.data(), ja.data(), ar.data(), cost.data(), nullptr};
+  const unsigned generation = glpk_generation();
+  if (run_guarded(equality_build_body, &q)) {
+    s_->p = q.p;
+    s_->generation = generation;
+  }
 }
 
 EqualityLp::~EqualityLp() {
@@ -181,27 +333,19 @@ EqualityLp::~EqualityLp() {
 
 EqualityLp::Outcome EqualityLp::solve(const std::vector<double>& b, int* attempts) {
   State& s = *s_;
-  if (!s.alive()) return Outcome::internal_error;
-  s.parm.meth = GLP_DUALP;
-  for (std::size_t r = 0; r < s.rhs.size(); ++r)
-    if (b[r] != s.rhs[r]) {
-      glp_set_row_bnds(s.p, static_cast<int>(r) + 1, GLP_FX, b[r], b[r]);
-      s.rhs[r] = b[r];
-    }
-  for (int attempt = 0; attempt < 2; ++attempt) {
-    if (attempts) ++*attempts;
-    const int ret = guarded_simplex(s.p, &s.parm);
-    if (ret == -1 || !s.alive()) return Outcome::internal_error;
-    if (ret == 0) {
-      const int status = glp_get_status(s.p);
-      if (status == GLP_OPT || status == GLP_FEAS) return Outcome::feasible;
-      if (status == GLP_NOFEAS || glp_get_prim_stat(s.p) == GLP_NOFEAS) return Outcome::infeasible;
-    }
-    // A singular or ill-conditioned basis: restart from the slack basis with the primal simplex.
-    glp_std_basis(s.p);
-    s.parm.meth = GLP_PRIMAL;
+  if (!s.p || !s.alive() || b.size() != s.rhs.size()) return Outcome::internal_error;
+  std::vector<int> changed;
+  for (std::size_t r = 0; r < s.rhs.size(); ++r) {
+    if (!std::isfinite(b[r]) || std::abs(b[r]) > kLargest) return Outcome::internal_error;
+    if (b[r] != s.rhs[r]) changed.push_back(static_cast<int>(r));
   }
-  return Outcome::failed;
+  EqualitySolve q{s.p, &s.parm, static_cast<int>(s.rhs.size()), changed.data(), static_cast<int>(changed.size()),
+                  b.data(), 0, 2};
+  const bool ran = run_guarded(equality_solve_body, &q);
+  if (attempts) *attempts += q.attempts;
+  if (!ran || !s.alive()) return Outcome::internal_error;
+  for (int r : changed) s.rhs[static_cast<std::size_t>(r)] = b[static_cast<std::size_t>(r)];
+  return q.outcome == 0 ? Outcome::feasible : q.outcome == 1 ? Outcome::infeasible : Outcome::failed;
 }
 
 }  // namespace wiresculpt::detail

@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 #include <memory>
 #include <set>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -36,10 +37,17 @@ struct LpSolution {
   std::vector<double> x;
   double objective = 0.0;
   int iterations = 0;
+  /// When `failed`: why, as a clause ("a coefficient (row 3, column 1) is 1e-300, outside the
+  /// range the LP solver handles (magnitudes 1e-100 to 1e100)", "GLPK stopped with an internal
+  /// error"); empty otherwise.
+  std::string reason;
 };
 
-/// GLPK simplex (presolve on, terminal output off, errors never abort: they return `failed`).
-/// Matrix entries below 1e-13 of their column's largest are dropped as rounding noise.
+/// GLPK simplex (presolve on, terminal output off, errors never abort: they return `failed` with
+/// a reason). A number GLPK cannot take (not finite, a magnitude above 1e100, a non-zero matrix
+/// entry below 1e-100) or an index outside the LP is refused before GLPK sees it; every GLPK call
+/// runs inside glpk_guard's run_guarded. Matrix entries below 1e-13 of their column's largest are
+/// dropped as rounding noise.
 LpSolution solve_lp(const LinearProgram& lp);
 
 /// Torques linear in an LP's columns x: block v (rows 3v..3v+2) is t_v = A_v x + c_v, its
@@ -68,7 +76,8 @@ class EqualityLp {
     feasible,        ///< an optimal (or feasible) x exists
     infeasible,      ///< no x >= 0 with A x = b
     failed,          ///< GLPK failed twice (a singular basis, then again from the slack basis)
-    internal_error,  ///< GLPK hit an internal error; its environment (and this problem) is gone
+    internal_error,  ///< GLPK hit an internal error (its environment, and this problem, is gone), or
+                     ///< the problem holds a number GLPK cannot take (see solve_lp)
   };
   EqualityLp(int rows, int cols, const std::vector<int>& tri_row, const std::vector<int>& tri_col,
              const std::vector<double>& tri_val, const std::vector<double>& cost);

@@ -38,6 +38,9 @@ double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x
 double angle_between(const Vec2& a, const Vec2& b) { return std::atan2(std::abs(cross2(a, b)), a.dot(b)); }
 
 
+constexpr int kMaxIterations = 10'000'000, kMaxWindow = 10'000, kMaxSweeps = 100'000;
+constexpr double kMaxSeconds = 86'400.0;
+constexpr double kMaxTargetPoints = 1e6;  // per wire, after subdividing at spacing/4
 }  // namespace
 
 double bend_limit(const TargetShapeOptions& options, int i) {
@@ -65,10 +68,18 @@ void validate(const Polyline2& contour, bool closed, const std::vector<TargetCro
   if (!positive(o.ftol_rel) || !positive(o.xtol_rel) || !positive(o.constraint_tol))
     bad("the solver tolerances must be positive");
   if (!positive(o.angle_tolerance) || !positive(o.length_tolerance)) bad("the check tolerances must be positive");
-  if (o.max_iterations <= 0) bad("max_iterations must be positive");
-  if (o.window < 0) bad("window must be >= 0 points");
-  if (o.window > 0 && o.window < 4) bad("window must be 0 (one block) or at least 4 points");
-  if (o.max_sweeps <= 0) bad("max_sweeps must be positive");
+  // The ranges of docs/robustness.md: beyond them a run cannot end in reasonable time or memory.
+  if (!(o.min_segment <= 10.0)) bad("min_segment must be at most 10 metres");
+  if (!(o.spacing == 0.0 || (o.spacing >= 0.1 * o.min_segment && o.spacing <= 10.0)))
+    bad("spacing must be 0 (1.5 x min_segment) or from min_segment/10 (" + mm(0.1 * o.min_segment) + ") to 10 metres");
+  if (o.max_iterations <= 0 || o.max_iterations > kMaxIterations)
+    bad("max_iterations must be from 1 to " + std::to_string(kMaxIterations));
+  if (o.window < 0 || o.window > kMaxWindow || (o.window > 0 && o.window < 4))
+    bad("window must be 0 (one block) or from 4 to " + std::to_string(kMaxWindow) + " points");
+  if (o.max_sweeps <= 0 || o.max_sweeps > kMaxSweeps) bad("max_sweeps must be from 1 to " + std::to_string(kMaxSweeps));
+  if (!(o.max_seconds > 0.0 && o.max_seconds <= kMaxSeconds))
+    bad("max_seconds must be more than 0 and at most " + std::to_string(static_cast<int>(kMaxSeconds)) + " seconds");
+  if (!(o.model_size <= 1e6)) bad("model_size must be at most 1e6 metres");
   if (!positive(o.sweep_tol)) bad("sweep_tol must be a positive number of metres");
   if (!(std::isfinite(o.model_size) && o.model_size >= 0.0)) bad("model_size must be >= 0 metres");
   const std::size_t n = contour.size();
@@ -125,6 +136,10 @@ TargetShapeProblem::TargetShapeProblem(const Polyline2& contour, bool closed,
   for (int i = 0; i < n_edges; ++i) cum[i + 1] = cum[i] + (contour[(i + 1) % n] - contour[i]).norm();
   const double total = cum[n_edges];
   if (!(total > 0.0)) throw InputError("target shape of wire " + w + ": the contour has zero length");
+  if (total / (spacing / 4.0) > kMaxTargetPoints)
+    throw InputError("target shape of wire " + w + ": the wire is " + fmt(total, 4) + " m long, which at a spacing of " +
+                     mm(spacing) + " is more than " + fmt(kMaxTargetPoints, 1) +
+                     " points; is the model in millimetres? scale it to its real size (size) or raise min_segment");
   auto point_at = [&](double s) -> Vec2 {
     if (closed) s = std::fmod(std::fmod(s, total) + total, total);
     s = std::clamp(s, 0.0, total);
@@ -717,7 +732,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
   // docs/method-target-shape.md).
   std::vector<Block> blocks;
   const int window = o.window;
-  if (window <= 0 || m <= 4 * window) {  // small wires: one block is as cheap
+  if (window <= 0 || static_cast<long long>(m) <= 4LL * window) {  // small wires: one block is as cheap
     std::vector<int> all(m);
     for (int i = 0; i < m; ++i) all[i] = i;
     blocks.push_back(make_block(problem, all));
@@ -760,6 +775,9 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
   data.max_evaluations = o.max_iterations;
   result.nlopt_result = "none";
   std::string worst_result;
+  auto out_of_time = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() >= o.max_seconds;
+  };
   auto solve_block = [&](const Block& b) {
     const unsigned nvar = static_cast<unsigned>(2 * b.points.size());
     data.block = &b;
@@ -770,6 +788,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
       local.set_ftol_rel(o.ftol_rel);
       local.set_xtol_rel(o.xtol_rel);
       local.set_maxeval(o.max_iterations);
+      local.set_maxtime(o.max_seconds);
       opt.set_local_optimizer(local);
     }
     opt.set_min_objective(objective, &data);
@@ -778,6 +797,8 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     opt.set_ftol_rel(o.ftol_rel);
     opt.set_xtol_rel(o.xtol_rel);
     opt.set_maxeval(std::max(1, o.max_iterations - data.evaluations));
+    // The wall-clock budget of the whole call (max_seconds), shared by every block.
+    opt.set_maxtime(std::max(1e-3, o.max_seconds - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
     std::vector<double> x(nvar);
     for (std::size_t k = 0; k < b.points.size(); ++k) {
       x[2 * k] = data.p[b.points[k]].x() / data.scale_x;
@@ -850,9 +871,9 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
           auto& wv = watchers[(j + m) % m];
           if (wv.empty() || wv.back() != static_cast<int>(k)) wv.push_back(static_cast<int>(k));
         }
-    for (int sweep = 0; sweep < o.max_sweeps; ++sweep) {
+    for (int sweep = 0; sweep < o.max_sweeps && !out_of_time(); ++sweep) {
       bool any = false;
-      for (std::size_t k = 0; k < blocks.size(); ++k) {
+      for (std::size_t k = 0; k < blocks.size() && !out_of_time(); ++k) {
         if (!dirty[k]) continue;
         any = true;
         dirty[k] = 0;
@@ -871,6 +892,11 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
         break;
       }
     }
+  }
+  if (out_of_time()) {
+    result.nlopt_result = "NLOPT_MAXTIME_REACHED";
+    result.warnings.push_back("wire " + w + ": the target shape stopped at its time budget of " + fmt(o.max_seconds, 4) +
+                              " s (max_seconds) before it converged");
   }
   result.iterations = data.evaluations;
   p = data.p;

@@ -96,6 +96,26 @@ TEST_CASE("load: bad options and sizes are input errors", "[load]") {
   CHECK_THROWS_AS(load_capacity(net, cuts, problem, Eigen::VectorXd::Zero(3)), InputError);
 }
 
+TEST_CASE("load: densities far outside any wire's are refused before GLPK (it aborted on 1e-300 and 1e200)",
+          "[load][robustness]") {
+  const Network net = gallows();
+  const auto cuts = choose_cuts(net);
+  const ForceProblem problem(net, {1}, {{0, 1}}, cuts);
+  const ForceResult pre = optimize_forces(net, {1}, {{0, 1}}, cuts);
+  for (double density : {1e-300, 1e200, 0.5, 1.1e5}) {
+    LoadCapacityOptions lo;
+    lo.density = density;
+    CHECK_THROWS_WITH(load_capacity(net, cuts, problem, pre.coefficients, lo),
+                      "density must be a number of kg/m^3 from 1 to 100000 (steel 7850)");
+  }
+  for (double density : {1.0, 1e5}) {  // the ends of the range still solve
+    LoadCapacityOptions lo;
+    lo.density = density;
+    const LoadCapacityResult r = load_capacity(net, cuts, problem, pre.coefficients, lo);
+    for (const LoadDirection& d : r.directions) CHECK(d.status != "failed");
+  }
+}
+
 TEST_CASE("load: on random networks every 3D torque at the limit load stays within t_max", "[load][torque]") {
   // At each direction's limit load (the LP's contact coefficients and λ times the weight), every
   // vertex of every wire not held has |t_v| <= t_max, summed directly with each edge's weight at

@@ -9,6 +9,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -25,7 +26,8 @@ namespace {
 
 class GrblEmulator {
  public:
-  enum class Mode { normal, error_at, alarm_at, slow, disconnect_after, garbage_at };
+  enum class Mode { normal, error_at, alarm_at, slow, disconnect_after, garbage_at, double_ok_at, double_ok_always,
+                    binary_error_at };
 
   explicit GrblEmulator(Mode mode, std::size_t k = 0, int delay_ms = 0) : mode_(mode), k_(k), delay_ms_(delay_ms) {
     termios raw{};
@@ -67,12 +69,17 @@ class GrblEmulator {
     }
     if (mode_ == Mode::garbage_at && index == k_)  // line noise: near-misses of "ok", binary junk
       return send("okay\r\nerror\r\n\x01\xff\xfeok?\r\nOK \r\nerror:\r\n");
+    if (mode_ == Mode::binary_error_at && index == k_)  // invalid UTF-8 in the answer
+      return send("error:\xff\xfe" "9\r\n");
     if (mode_ == Mode::slow) std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms_));
     {
       std::lock_guard<std::mutex> g(mu_);
       acknowledged_.push_back(line);
     }
-    send("[MSG:busy]\r\nok\r\n");  // an informational line first: the streamer must skip it
+    // An informational line first: the streamer must skip it. A doubled "ok" comes in one write,
+    // as a device that echoes its answer twice sends it.
+    const bool twice = (mode_ == Mode::double_ok_at && index == k_) || mode_ == Mode::double_ok_always;
+    send(twice ? "[MSG:busy]\r\nok\r\nok\r\n" : "[MSG:busy]\r\nok\r\n");
     if (mode_ == Mode::disconnect_after && index + 1 == k_) {
       std::this_thread::sleep_for(std::chrono::milliseconds(100));  // the ok reaches the streamer
       ::close(master_);  // the cable is pulled: the slave end hangs up
@@ -332,4 +339,107 @@ TEST_CASE("serial: dry run, bad programs and bad ports", "[fab][serial]") {
   state.next_line = lines.size() + 1;
   CHECK_THROWS_WITH(stream_program("/dev/does-not-exist", lines, MachineProfile{}, state, o), Contains("past"));
   CHECK_NOTHROW(list_ports());
+}
+
+TEST_CASE("serial: 'ok ok' to one line is a protocol error before the next line; the resume sends that line",
+          "[fab][serial][robustness]") {
+  // Before strict accounting, the second "ok" acknowledged line k+1 the moment it was sent: a
+  // resume after any later stop would have skipped it (a bend never made).
+  const auto lines = program_lines();
+  const std::size_t k = 3;
+  StreamState state;
+  {
+    GrblEmulator grbl(GrblEmulator::Mode::double_ok_at, k);
+    const auto r = stream_program(grbl.path(), lines, MachineProfile{}, state, quick());
+    CHECK(r.status == StreamStatus::protocol_error);
+    CHECK(std::string(to_string(r.status)) == "protocol_error");
+    CHECK(r.failed_line == static_cast<long>(k) + 1);
+    CHECK(r.last_acknowledged == static_cast<long>(k));
+    CHECK(state.next_line == k + 1);
+    CHECK(grbl.received().size() == k + 1);  // line k+1 was never sent
+    CHECK_THAT(r.message, Contains("unexpected 'ok'") && Contains("resume from line " + std::to_string(k + 2)));
+  }
+  GrblEmulator again(GrblEmulator::Mode::normal);
+  const auto r = stream_program(again.path(), lines, MachineProfile{}, state, quick());
+  CHECK(r.status == StreamStatus::completed);
+  const auto got = again.received();
+  REQUIRE(got.size() >= lines.size() - (k + 1));
+  // After the restored mode lines, exactly the lines from k+1 on, each once.
+  CHECK(std::vector<std::string>(got.end() - static_cast<long>(lines.size() - (k + 1)), got.end()) ==
+        std::vector<std::string>(lines.begin() + static_cast<long>(k + 1), lines.end()));
+}
+
+TEST_CASE("serial: a device that always doubles its 'ok' never gets 'all lines acknowledged'",
+          "[fab][serial][robustness]") {
+  const auto lines = program_lines();
+  GrblEmulator grbl(GrblEmulator::Mode::double_ok_always);
+  StreamState state;
+  const auto r = stream_program(grbl.path(), lines, MachineProfile{}, state, quick());
+  CHECK(r.status == StreamStatus::protocol_error);
+  CHECK(r.failed_line == 1);
+  CHECK(state.next_line == 1);
+  CHECK(grbl.received().size() == 1);
+}
+
+TEST_CASE("serial: an error: line with invalid UTF-8 is a status with a printable message", "[fab][serial][robustness]") {
+  const auto lines = program_lines();
+  GrblEmulator grbl(GrblEmulator::Mode::binary_error_at, 2);
+  StreamState state;
+  const auto r = stream_program(grbl.path(), lines, MachineProfile{}, state, quick());
+  CHECK(r.status == StreamStatus::error);
+  CHECK(r.failed_line == 2);
+  CHECK_THAT(r.message, Contains("error:\\xff\\xfe9"));
+  for (char c : r.message) CHECK(static_cast<unsigned char>(c) < 0x80);
+}
+
+TEST_CASE("serial: a port held by a stream refuses a second one, naming the holder", "[fab][serial][robustness]") {
+  const auto lines = program_lines();
+  GrblEmulator grbl(GrblEmulator::Mode::normal);
+  StreamState state;
+  {
+    SerialPort holder(grbl.path(), MachineProfile{}.serial);
+    CHECK_THROWS_WITH(stream_program(grbl.path(), lines, MachineProfile{}, state, quick()),
+                      Contains("is in use by process " + std::to_string(::getpid())) &&
+                          Contains("stop that stream first"));
+    CHECK(grbl.received().empty());  // nothing of the second stream reached the device
+    CHECK(state.next_line == 0);
+  }
+  const auto r = stream_program(grbl.path(), lines, MachineProfile{}, state, quick());  // released
+  CHECK(r.status == StreamStatus::completed);
+  CHECK(grbl.received() == lines);
+}
+
+TEST_CASE("serial: timeouts and settle outside their ranges are refused on entry", "[fab][serial][robustness]") {
+  const auto lines = program_lines();
+  StreamState state;
+  const double inf = std::numeric_limits<double>::infinity();
+  StreamOptions o = quick();
+  o.settle = inf;  // used to wait 11 days
+  CHECK_THROWS_WITH(stream_program("/dev/null-port", lines, MachineProfile{}, state, o),
+                    "settle must be from 0 to 60 seconds, got inf");
+  o = quick();
+  o.response_timeout = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_WITH(stream_program("/dev/null-port", lines, MachineProfile{}, state, o),
+                    "response_timeout must be more than 0 and at most 3600 seconds, got nan");
+  o = quick();
+  o.write_timeout = 0.0;
+  CHECK_THROWS_WITH(stream_program("/dev/null-port", lines, MachineProfile{}, state, o),
+                    "write_timeout must be more than 0 and at most 600 seconds, got 0");
+}
+
+TEST_CASE("serial: parse_answer classifies GRBL's lines; device bytes become printable text", "[fab][serial]") {
+  using K = GrblAnswer::Kind;
+  CHECK(parse_answer("ok").kind == K::ok);
+  CHECK(parse_answer("ok\r").kind == K::ok);
+  for (const char* not_ok : {"OK", "okay", "ok ", " ok", "ok?", ""}) CHECK(parse_answer(not_ok).kind == K::info);
+  const GrblAnswer e = parse_answer("error:20\r");
+  CHECK((e.kind == K::error && e.code == 20 && e.text == "error:20"));
+  const GrblAnswer bad = parse_answer("error:\xff\xfe" "9");
+  CHECK((bad.kind == K::error && bad.code == 0 && bad.text == "error:\\xff\\xfe9"));
+  CHECK(parse_answer("error:99999999999999").code == 0);
+  const GrblAnswer alarm = parse_answer("ALARM:1");
+  CHECK((alarm.kind == K::alarm && alarm.code == 1));
+  CHECK(parse_answer("Grbl 1.1h ['$' for help]").kind == K::banner);
+  CHECK(parse_answer("[MSG:busy]").kind == K::info);
+  CHECK(parse_answer(std::string("a\0b\x7f", 4)).text == "a\\x00b\\x7f");
 }

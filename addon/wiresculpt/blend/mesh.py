@@ -1,12 +1,16 @@
 """Blender meshes as numpy arrays for the solver (world-space, triangulated, modifiers applied), and
 mesh files read into such arrays through Blender's own importers, coordinates exactly as written in
 the file (FORMATS.md: no axis conversion, every object of the file joined into one mesh)."""
+import contextlib
+import io
 import os
+import sys
 
 import bpy
 import numpy as np
 
 from . import compat
+from ..core import meshcheck
 
 
 def object_triangles(obj, depsgraph):
@@ -51,11 +55,19 @@ def import_mesh(path):
     ext = os.path.splitext(path)[1].lower()
     if ext not in FORMATS:
         raise ValueError(f"mesh file {path}: unsupported format {ext or '(none)'}; use OBJ, STL or PLY")
+    meshcheck.check_file(path)  # what the importer would drop silently or choke on
     before = set(bpy.data.objects)
+    # An importer written in Python prints its traceback through sys.stderr before bpy.ops raises:
+    # keep it (WIRESCULPT_DEBUG=1 shows it) and give the user the exception's last line only.
+    caught = io.StringIO()
     try:
-        result = compat.IMPORTERS[ext](path)
+        with contextlib.redirect_stderr(caught):
+            result = compat.IMPORTERS[ext](path)
     except RuntimeError as exc:
-        raise ValueError(f"mesh file {path}: Blender could not read it ({str(exc).strip()})") from None
+        if os.environ.get("WIRESCULPT_DEBUG"):
+            sys.__stderr__.write(caught.getvalue())
+        lines = [l.strip() for l in str(exc).strip().splitlines() if l.strip()]
+        raise ValueError(f"mesh file {path}: Blender could not read it ({lines[-1] if lines else 'no reason given'})") from None
     if "FINISHED" not in result:
         raise ValueError(f"mesh file {path}: Blender could not read it")
     objects = [o for o in bpy.data.objects if o not in before and o.type == "MESH"]

@@ -17,7 +17,7 @@ FIELDS = {
     "bending_stiffness": ("N m^2", 0.0, 1e4),
     "max_torque": ("N m", 0.0, 1e4),
     "friction": ("", 0.0, 10.0),
-    "density": ("kg/m^3", 0.0, 1e5),
+    "density": ("kg/m^3", 1.0, 1e5),  # the core's range: beyond it the load LP's numbers break GLPK
     "shear_modulus": ("Pa", 0.0, 1e12),
 }
 REQUIRED = ("wire_diameter", "bending_stiffness", "max_torque", "friction")

@@ -14,6 +14,7 @@ TOP_KEYS = {"mesh", "size", "material", "planes", "settings", "machine_profile"}
 PLANE_KEYS = {"name", "origin", "normal", "contours"}
 MAX_COORDINATE = 1e6  # metres (or mesh units): beyond this a number is a typo, not a sculpture
 MAX_SIZE = 100.0  # metres
+MAX_PLANES = 64  # a sculpture of more wires than this is beyond the layering's search (docs/robustness.md)
 
 
 @dataclass
@@ -165,6 +166,8 @@ def parse_scene(data, path="scene.json"):
     planes = data.get("planes")
     if not isinstance(planes, list) or not planes:
         raise ValueError('scene key "planes" must be a non-empty list of planes')
+    if len(planes) > MAX_PLANES:
+        raise ValueError(f'scene key "planes" has {len(planes)} planes; at most {MAX_PLANES} are allowed')
     names = set()
     parsed = [_plane(p, i, names) for i, p in enumerate(planes)]
     profile = data.get("machine_profile")
@@ -185,6 +188,9 @@ def load_scene(path):
             text = f.read()
     except OSError as exc:
         raise ValueError(f"cannot read scene file {path}: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"scene file {path} is not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at offset "
+                         f"{exc.start}); save it as UTF-8") from None
     try:
         data = json.loads(text)
     except json.JSONDecodeError as exc:

@@ -34,7 +34,7 @@ namespace wiresculpt {
 
 struct LoadCapacityOptions {
   double wire_diameter = 0.003;  ///< metres (Table 1: 3 mm). Default 0.003.
-  double density = 7850.0;       ///< kg/m³ (steel 7850, brass 8500). Default 7850.
+  double density = 7850.0;       ///< kg/m³ in [1, 1e5] (steel 7850, brass 8500). Default 7850.
   double gravity = 9.81;         ///< m/s². Default 9.81.
   /// Metres: wires whose lowest point is this close to the lowest one are held too. Default 1e-6.
   double tie_tolerance = 1e-6;

@@ -56,7 +56,8 @@ enum class TargetShapeAlgorithm {
 };
 
 struct TargetShapeOptions {
-  /// Metres. The machine's minimum distance between bending points (Sec. 5.1). Default 0.015.
+  /// Metres, in (0, 10]. The machine's minimum distance between bending points (Sec. 5.1).
+  /// Default 0.015.
   double min_segment = 0.015;
   /// Radians, in (0, π]. The largest bend (turning angle, π minus the kink's opening) the machine
   /// makes at one point (Sec. 4.3, c_f,angle). Default 2π/3 (120°).
@@ -68,7 +69,8 @@ struct TargetShapeOptions {
   /// Default empty.
   std::vector<double> vertex_max_bend;
   /// Metres. Arc-length spacing of the initial resampling between consecutive crossings; 0 means
-  /// 1.5 × min_segment. Should not be below min_segment. Default 0.
+  /// 1.5 × min_segment. 0, or from min_segment/10 to 10 m (should not be below min_segment). A
+  /// wire longer than 250000 × spacing (10^6 target points) is refused. Default 0.
   double spacing = 0.0;
   /// w_r of Eq. 3, in metres (E_d is in m³, E_r in m²). Default 1e-3 m: a one-point bump of
   /// height a costs about 2·spacing·a² in E_d and 1.5·w_r·a² in E_r, so at the default spacing the
@@ -87,10 +89,10 @@ struct TargetShapeOptions {
   /// Tolerance on each constraint in its solver form (dimensionless: 1 - |e|²/l_min² for lengths,
   /// cosines for angles). Default 1e-10.
   double constraint_tol = 1e-10;
-  /// Maximum number of energy evaluations over all blocks (SLSQP uses about one per iteration).
-  /// Default 20000.
+  /// Maximum number of energy evaluations over all blocks (SLSQP uses about one per iteration),
+  /// 1 to 10^7. Default 20000.
   int max_iterations = 20000;
-  /// Points per block. 0, or a wire of at most 4 × window points, is solved as one NLopt
+  /// Points per block: 0 or 4 to 10000. 0, or a wire of at most 4 × window points, is solved as one NLopt
   /// problem; otherwise windows of `window` points centred on each active crossing, then
   /// overlapping windows of `window` consecutive points (every window/2 points), are solved in
   /// turn, each with the rest of the wire held, until no window moves a point by more than
@@ -103,8 +105,12 @@ struct TargetShapeOptions {
   /// flat along the wire) for 10-20 times as many evaluations without changing the energy's
   /// first 7 digits; see docs/method-target-shape.md.
   double sweep_tol = 1e-7;
-  /// Maximum number of sweeps over the windows. Default 200.
+  /// Maximum number of sweeps over the windows, 1 to 100000. Default 200.
   int max_sweeps = 200;
+  /// Seconds: the wall-clock budget of the whole call, in (0, 86400]. When it runs out the
+  /// solver stops where it is: nlopt_result "NLOPT_MAXTIME_REACHED" and a warning naming the
+  /// wire (the constraints are then checked as usual). Default 120.
+  double max_seconds = 120.0;
   /// Metres: the model's current size (largest bounding-box side), used to say how large it must
   /// be scaled when two crossings are too close. 0: only the scale factor is reported.
   double model_size = 0.0;

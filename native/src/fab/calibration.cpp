@@ -205,7 +205,7 @@ Polyline2 simulate_cantilever(double kb, double length, double tip_force, double
   if (!(length > 0) || !std::isfinite(length)) throw InputError("cantilever: length must be > 0");
   if (!std::isfinite(tip_force) || !std::isfinite(weight_per_length))
     throw InputError("cantilever: loads must be finite");
-  if (segments < 2) throw InputError("cantilever: at least 2 segments");
+  if (segments < 2 || segments > 100000) throw InputError("cantilever: segments must be from 2 to 100000");
   const int m = segments;
   const double h = length / m;
   std::vector<double> l_bar(m, voronoi_length(h, h));
@@ -301,9 +301,12 @@ CantileverFit fit_cantilever(const std::vector<CantileverRecord>& records, const
   if (!(o.linear_density >= 0) || !std::isfinite(o.linear_density))
     throw InputError("cantilever: the linear density must be >= 0 kg/m");
   if (!(o.gravity > 0) || !std::isfinite(o.gravity)) throw InputError("cantilever: gravity must be > 0");
-  if (!(o.plastic_tolerance > 0)) throw InputError("cantilever: the plastic tolerance must be > 0 m");
+  if (!(o.plastic_tolerance > 0) || !std::isfinite(o.plastic_tolerance))
+    throw InputError("cantilever: the plastic tolerance must be a finite number of metres > 0");
   if (o.smoothing_degree < 2 || o.nodes < 3 || o.simulation_segments < 2)
     throw InputError("cantilever: smoothing_degree >= 2, nodes >= 3 and simulation_segments >= 2 are needed");
+  if (o.smoothing_degree > 50 || o.nodes > 1000 || o.simulation_segments > 100000)
+    throw InputError("cantilever: smoothing_degree <= 50, nodes <= 1000 and simulation_segments <= 100000 are the limits");
   if (records.empty()) throw InputError("cantilever: the capture has no rows");
 
   // Group rows into frames (load, loaded), loads ascending, loaded before unloaded.

@@ -3,8 +3,14 @@
 #include <fcntl.h>
 #include <libserialport.h>
 #include <poll.h>
+#include <sys/file.h>
+#include <sys/ioctl.h>
+#include <sys/stat.h>
 #include <termios.h>
 #include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
 
 #include <algorithm>
 #include <cctype>
@@ -45,13 +51,23 @@ struct SerialPort::Impl {
   std::string name;
   sp_port* sp = nullptr;
   int fd = -1;
+  int lock_fd = -1;        // the lock file, flock()ed while the port is open
+  std::string lock_path;
 
   ~Impl() {
+    // Exclusive mode outlives our descriptor while anyone else keeps the tty open: clear it.
+    int handle = fd;
+    if (sp && sp_get_port_handle(sp, &handle) != SP_OK) handle = -1;
+    if (handle >= 0) ::ioctl(handle, TIOCNXCL);
     if (sp) {
       sp_close(sp);
       sp_free_port(sp);
     }
     if (fd >= 0) ::close(fd);
+    if (lock_fd >= 0) {
+      ::unlink(lock_path.c_str());  // while still locked: nobody else holds this file
+      ::close(lock_fd);
+    }
   }
 };
 
@@ -59,6 +75,68 @@ namespace {
 
 [[noreturn]] void open_failed(const std::string& name, const std::string& why) {
   throw InputError("could not open serial port '" + name + "': " + why);
+}
+
+// The lock file of a port: LCK..<device> (UUCP's name; "/" after /dev/ becomes "_") in
+// $WIRESCULPT_LOCK_DIR, else /var/lock when writable, else /tmp. Held with flock(), which the
+// system releases when the process ends, so a crash leaves no stale lock.
+std::string lock_path_for(const std::string& port) {
+  std::string device = port;
+  char resolved[4096];
+  if (::realpath(port.c_str(), resolved)) device = resolved;
+  if (device.rfind("/dev/", 0) == 0) device.erase(0, 5);
+  std::replace(device.begin(), device.end(), '/', '_');
+  std::string dir;
+  if (const char* env = std::getenv("WIRESCULPT_LOCK_DIR"); env && *env) dir = env;
+  else if (::access("/var/lock", W_OK) == 0) dir = "/var/lock";
+  else dir = "/tmp";
+  return dir + "/LCK.." + device;
+}
+
+// Who holds the lock file: "process 1234 (blender)", from the pid written in it.
+std::string holder_of(const std::string& path) {
+  std::ifstream in(path);
+  long pid = 0;
+  if (!(in >> pid) || pid <= 0) return "another program";
+  std::string who = "process " + std::to_string(pid);
+  std::ifstream comm("/proc/" + std::to_string(pid) + "/comm");
+  std::string name;
+  if (std::getline(comm, name) && !name.empty()) who += " (" + name + ")";
+  if (pid == static_cast<long>(::getpid())) who += ", this program";
+  return who;
+}
+
+void take_lock(SerialPort::Impl& impl) {
+  impl.lock_path = lock_path_for(impl.name);
+  for (int attempt = 0; attempt < 5; ++attempt) {
+    const int fd = ::open(impl.lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd < 0)
+      open_failed(impl.name, "cannot create its lock file " + impl.lock_path + ": " + std::strerror(errno));
+    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+      ::close(fd);
+      throw InputError("serial port '" + impl.name + "' is in use by " + holder_of(impl.lock_path) +
+                       " (lock file " + impl.lock_path + "); stop that stream first");
+    }
+    // The holder before us may have removed the file between our open and our lock: lock the
+    // file that is at the path now.
+    struct stat here {}, there {};
+    if (::fstat(fd, &here) != 0 || ::stat(impl.lock_path.c_str(), &there) != 0 || here.st_ino != there.st_ino ||
+        here.st_dev != there.st_dev) {
+      ::close(fd);
+      continue;
+    }
+    const std::string pid = std::to_string(::getpid()) + "\n";
+    if (::ftruncate(fd, 0) != 0 || ::write(fd, pid.data(), pid.size()) < 0) { /* the lock itself holds */ }
+    impl.lock_fd = fd;
+    return;
+  }
+  open_failed(impl.name, "its lock file " + impl.lock_path + " keeps changing");
+}
+
+// TIOCEXCL: further open() calls on the tty fail with EBUSY (for other users than root) while we
+// hold it; the lock file covers everyone who asks (and names the holder).
+void make_exclusive(int fd) {
+  if (fd >= 0) ::ioctl(fd, TIOCEXCL);
 }
 
 speed_t posix_speed(int baud) {
@@ -133,11 +211,15 @@ void open_libserialport(SerialPort::Impl& impl, const SerialSettings& s) {
 SerialPort::SerialPort(const std::string& name, const SerialSettings& settings) : impl_(std::make_unique<Impl>()) {
   impl_->name = name;
   if (name.empty()) open_failed(name, "no port name given");
+  take_lock(*impl_);
   if (sp_get_port_by_name(name.c_str(), &impl_->sp) == SP_OK) {
     open_libserialport(*impl_, settings);
+    int handle = -1;
+    if (sp_get_port_handle(impl_->sp, &handle) == SP_OK) make_exclusive(handle);
   } else {
     impl_->sp = nullptr;
     open_posix(*impl_, settings);
+    make_exclusive(impl_->fd);
   }
 }
 
@@ -214,6 +296,7 @@ const char* to_string(StreamStatus status) {
     case StreamStatus::disconnected: return "disconnected";
     case StreamStatus::timeout: return "timeout";
     case StreamStatus::aborted: return "aborted";
+    case StreamStatus::protocol_error: return "protocol_error";
   }
   return "unknown";
 }
@@ -264,47 +347,24 @@ void validate_program(const std::vector<std::string>& lines, const MachineProfil
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-// What unlocks a GRBL in alarm (ALARM:n) or lock (error:9) state, named in every such message.
-const std::string kUnlock =
-    "unlock it with $X (kill alarm lock), or home it with $H when the machine has homing switches";
-
-int to_ms(double seconds) { return static_cast<int>(std::clamp(seconds, 0.0, 1e6) * 1000.0); }
-
-std::string quoted(const std::vector<std::string>& lines, std::size_t i) {
-  return "line " + std::to_string(i + 1) + " ('" + lines[i] + "')";
-}
-
-// Splits the port's bytes into lines ("\n"-terminated, "\r" dropped).
-class LineReader {
- public:
-  explicit LineReader(SerialPort& port) : port_(port) {}
-  enum class Got { line, nothing, lost };
-  // Waits at most timeout_ms for one complete line.
-  Got next(std::string& line, int timeout_ms) {
-    const auto deadline = Clock::now() + std::chrono::milliseconds(timeout_ms);
-    for (;;) {
-      const std::size_t nl = buffer_.find('\n');
-      if (nl != std::string::npos) {
-        line = buffer_.substr(0, nl);
-        buffer_.erase(0, nl + 1);
-        line.erase(std::remove(line.begin(), line.end(), '\r'), line.end());
-        return Got::line;
-      }
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
-      if (left <= 0) return Got::nothing;
-      char buf[256];
-      const int n = port_.read(buf, sizeof buf, static_cast<int>(left));
-      if (n < 0) return Got::lost;
-      buffer_.append(buf, static_cast<std::size_t>(n));
+// The device's bytes as message text: "\r" dropped, any other byte outside printable ASCII
+// (invalid UTF-8 included) shown as \xNN, so an answer always reaches the user as a string.
+std::string printable(const std::string& raw) {
+  static const char* hex = "0123456789abcdef";
+  std::string out;
+  for (char c : raw) {
+    const unsigned char u = static_cast<unsigned char>(c);
+    if (u == '\r') continue;
+    if (u >= 0x20 && u < 0x7f) {
+      out += c;
+    } else {
+      out += "\\x";
+      out += hex[u >> 4];
+      out += hex[u & 15];
     }
   }
-
- private:
-  SerialPort& port_;
-  std::string buffer_;
-};
+  return out;
+}
 
 bool starts_with(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
 
@@ -317,6 +377,71 @@ int code_after_colon(const std::string& s) {
     return 0;
   }
 }
+
+}  // namespace
+
+GrblAnswer parse_answer(const std::string& raw) {
+  GrblAnswer a;
+  a.text = printable(raw);
+  if (a.text == "ok") {
+    a.kind = GrblAnswer::Kind::ok;
+  } else if (starts_with(a.text, "error:")) {
+    a.kind = GrblAnswer::Kind::error;
+    a.code = code_after_colon(a.text);
+  } else if (starts_with(a.text, "ALARM")) {
+    a.kind = GrblAnswer::Kind::alarm;
+    a.code = code_after_colon(a.text);
+  } else if (starts_with(a.text, "Grbl ")) {
+    a.kind = GrblAnswer::Kind::banner;
+  }
+  return a;
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// What unlocks a GRBL in alarm (ALARM:n) or lock (error:9) state, named in every such message.
+const std::string kUnlock =
+    "unlock it with $X (kill alarm lock), or home it with $H when the machine has homing switches";
+using Kind = GrblAnswer::Kind;
+
+int to_ms(double seconds) { return static_cast<int>(std::clamp(seconds, 0.0, 1e6) * 1000.0); }
+
+std::string quoted(const std::vector<std::string>& lines, std::size_t i) {
+  return "line " + std::to_string(i + 1) + " ('" + lines[i] + "')";
+}
+
+// Splits the port's bytes into lines ("\n"-terminated), each read by parse_answer.
+class LineReader {
+ public:
+  explicit LineReader(SerialPort& port) : port_(port) {}
+  enum class Got { line, nothing, lost };
+  // Waits at most timeout_ms for one complete line.
+  Got next(GrblAnswer& line, int timeout_ms) {
+    const auto deadline = Clock::now() + std::chrono::milliseconds(timeout_ms);
+    for (bool looked = false;; looked = true) {
+      const std::size_t nl = buffer_.find('\n');
+      if (nl != std::string::npos) {
+        line = parse_answer(buffer_.substr(0, nl));
+        buffer_.erase(0, nl + 1);
+        return Got::line;
+      }
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+      if (left <= 0 && looked) return Got::nothing;  // the port is read at least once
+      char buf[256];
+      const int n = port_.read(buf, sizeof buf, static_cast<int>(std::max<long long>(left, 0)));
+      if (n < 0) return Got::lost;
+      buffer_.append(buf, static_cast<std::size_t>(n));
+    }
+  }
+  // A complete line already received or readable now, without waiting.
+  Got pending(GrblAnswer& line) { return next(line, 0); }
+
+ private:
+  SerialPort& port_;
+  std::string buffer_;
+};
 
 // A line that only sets modes (units, distance mode, feed-rate mode, plane): G17-G19, G20/G21,
 // G90/G91, G93/G94, nothing else but comments.
@@ -340,8 +465,23 @@ bool is_modal_setup(const std::string& line) {
 
 }  // namespace
 
+void validate(const StreamOptions& o) {
+  auto fmt = [](double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+  };
+  if (!(o.response_timeout > 0.0 && o.response_timeout <= 3600.0))
+    throw InputError("response_timeout must be more than 0 and at most 3600 seconds, got " + fmt(o.response_timeout));
+  if (!(o.write_timeout > 0.0 && o.write_timeout <= 600.0))
+    throw InputError("write_timeout must be more than 0 and at most 600 seconds, got " + fmt(o.write_timeout));
+  if (!(o.settle >= 0.0 && o.settle <= 60.0))
+    throw InputError("settle must be from 0 to 60 seconds, got " + fmt(o.settle));
+}
+
 StreamResult stream_program(SerialPort& port, const std::vector<std::string>& lines, const MachineProfile& profile,
                             StreamState& state, const StreamOptions& options, const ProgressFn& progress) {
+  validate(options);
   validate(profile);
   validate_program(lines, profile);
   if (state.next_line > lines.size())
@@ -394,16 +534,16 @@ StreamResult stream_program(SerialPort& port, const std::vector<std::string>& li
       if (left <= 0)
         return stop(StreamStatus::timeout, lj, "no answer to " + quoted(lines, j) +
                     " while restoring the machine's modes before resuming" + resume);
-      std::string answer;
+      GrblAnswer answer;
       const auto got = reader.next(answer, static_cast<int>(std::min<long long>(left, kSliceMs)));
       if (got == LineReader::Got::lost)
         return stop(StreamStatus::disconnected, lj, "the link to " + port.name() +
                     " dropped while restoring the machine's modes before resuming" + resume);
       if (got == LineReader::Got::nothing) continue;
-      if (answer == "ok") ok = true;
-      else if (starts_with(answer, "error:") || starts_with(answer, "ALARM"))
-        return stop(starts_with(answer, "error:") ? StreamStatus::error : StreamStatus::alarm, lj,
-                    "GRBL answered " + answer + " to " + quoted(lines, j) +
+      if (answer.kind == Kind::ok) ok = true;
+      else if (answer.kind == Kind::error || answer.kind == Kind::alarm)
+        return stop(answer.kind == Kind::error ? StreamStatus::error : StreamStatus::alarm, lj,
+                    "GRBL answered " + answer.text + " to " + quoted(lines, j) +
                     " while its modes were restored before resuming (" + kUnlock + ")" + resume);
     }
   }
@@ -417,7 +557,7 @@ StreamResult stream_program(SerialPort& port, const std::vector<std::string>& li
         return stop(StreamStatus::disconnected, li, "the link to " + port.name() + " dropped while pausing; resume starts at line " + std::to_string(i + 1));
       while (control->pause.load()) {
         if (wants_abort() || !report()) return abort_machine(li);
-        std::string ignored;
+        GrblAnswer ignored;
         if (reader.next(ignored, kSliceMs * 5) == LineReader::Got::lost)
           return stop(StreamStatus::disconnected, li, "the link to " + port.name() + " dropped while paused; resume starts at line " + std::to_string(i + 1));
       }
@@ -425,6 +565,24 @@ StreamResult stream_program(SerialPort& port, const std::vector<std::string>& li
         return stop(StreamStatus::disconnected, li, "the link to " + port.name() + " dropped on resuming; resume starts at line " + std::to_string(i + 1));
     }
 
+    // Strict accounting: with nothing outstanding, any answer already here is not for a line of
+    // ours. An "ok" would otherwise be taken as the next line's acknowledgement (a device that
+    // doubles its "ok" would skip a bend on resume), so it stops the stream; next_line stays.
+    for (GrblAnswer early; reader.pending(early) == LineReader::Got::line;) {
+      if (early.kind == Kind::ok)
+        return stop(StreamStatus::protocol_error, li,
+                    "protocol error: the controller sent an unexpected 'ok' (more answers than lines sent) before " +
+                        quoted(lines, i) + " was sent; " + std::to_string(i) +
+                        " lines are acknowledged; check the device and the port settings, then resume from line " +
+                        std::to_string(i + 1));
+      if (early.kind == Kind::alarm) {
+        r.code = early.code;
+        return stop(StreamStatus::alarm, li,
+                    "GRBL raised " + early.text + " before " + quoted(lines, i) +
+                        " was sent; the machine is locked: clear the alarm ($X or reset), check the wire, and resume "
+                        "from line " + std::to_string(i + 1));
+      }
+    }
     if (!port.write(lines[i] + "\n", write_ms))
       return stop(StreamStatus::disconnected, li,
                   "the link to " + port.name() + " dropped (or stopped accepting data) before " + quoted(lines, i) +
@@ -441,7 +599,7 @@ StreamResult stream_program(SerialPort& port, const std::vector<std::string>& li
         return stop(StreamStatus::timeout, li,
                     "no answer to " + quoted(lines, i) + " within " + std::to_string(answer_ms) +
                         " ms; it is not acknowledged, so a resume sends it again after you check the machine");
-      std::string answer;
+      GrblAnswer answer;
       const auto got = reader.next(answer, static_cast<int>(std::min<long long>(left, kSliceMs)));
       if (got == LineReader::Got::nothing) continue;
       if (got == LineReader::Got::lost)
@@ -449,25 +607,25 @@ StreamResult stream_program(SerialPort& port, const std::vector<std::string>& li
                     "the link to " + port.name() + " dropped while " + quoted(lines, i) +
                         " was waiting for its answer; the last acknowledged line is line " + std::to_string(i) +
                         "; reconnect and resume from line " + std::to_string(i + 1));
-      if (answer == "ok") {
+      if (answer.kind == Kind::ok) {
         acknowledged = true;
-      } else if (starts_with(answer, "error:")) {
-        r.code = code_after_colon(answer);
+      } else if (answer.kind == Kind::error) {
+        r.code = answer.code;
         if (r.code == 9)  // "G-code locked out during alarm or jog state"
           return stop(StreamStatus::error, li,
                       "GRBL is locked (an alarm, or a jog in progress) and refused " + quoted(lines, i) + " with " +
-                          answer + " (the line was not executed): " + kUnlock + ", then resume from line " +
+                          answer.text + " (the line was not executed): " + kUnlock + ", then resume from line " +
                           std::to_string(i + 1));
         return stop(StreamStatus::error, li,
-                    "GRBL rejected " + quoted(lines, i) + " with " + answer +
+                    "GRBL rejected " + quoted(lines, i) + " with " + answer.text +
                         " (the line was not executed); fix it and resume from line " + std::to_string(i + 1));
-      } else if (starts_with(answer, "ALARM")) {
-        r.code = code_after_colon(answer);
+      } else if (answer.kind == Kind::alarm) {
+        r.code = answer.code;
         return stop(StreamStatus::alarm, li,
-                    "GRBL raised " + answer + " while " + quoted(lines, i) +
+                    "GRBL raised " + answer.text + " while " + quoted(lines, i) +
                         " was in flight; the machine is locked: " + kUnlock + ", check the wire, and "
                         "resume from line " + std::to_string(i + 1));
-      } else if (starts_with(answer, "Grbl ")) {
+      } else if (answer.kind == Kind::banner) {
         return stop(StreamStatus::disconnected, li,
                     "the controller restarted while " + quoted(lines, i) +
                         " was in flight (its banner arrived); resume from line " + std::to_string(i + 1));
@@ -479,6 +637,17 @@ StreamResult stream_program(SerialPort& port, const std::vector<std::string>& li
     r.last_acknowledged = li;
     if (!report()) return abort_machine(state.next_line < total ? static_cast<long>(state.next_line) : -1);
   }
+  // An "ok" beyond the last line's means some acknowledgement was not for the line it was taken
+  // for: the count is not to be trusted (the answer to the last line is already here when a
+  // device doubles it).
+  for (GrblAnswer late; reader.pending(late) == LineReader::Got::line;)
+    if (late.kind == Kind::ok) {
+      r.status = StreamStatus::protocol_error;
+      r.failed_line = static_cast<long>(total) - 1;
+      r.message = "protocol error: the controller sent an unexpected 'ok' after the last line (more answers than "
+                  "lines sent), so its acknowledgements cannot be trusted; check the device and the port settings";
+      return r;
+    }
   r.status = StreamStatus::completed;
   r.message = "all " + std::to_string(total) + " lines acknowledged";
   return r;
@@ -487,6 +656,7 @@ StreamResult stream_program(SerialPort& port, const std::vector<std::string>& li
 StreamResult stream_program(const std::string& port_name, const std::vector<std::string>& lines,
                             const MachineProfile& profile, StreamState& state, const StreamOptions& options,
                             const ProgressFn& progress) {
+  validate(options);
   validate(profile);
   validate_program(lines, profile);
   if (state.next_line > lines.size())

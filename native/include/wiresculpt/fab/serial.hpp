@@ -68,11 +68,11 @@ struct StreamControl {
 };
 
 struct StreamOptions {
-  double response_timeout = 30.0;  ///< s to wait for a line's answer; default 30 s (a full planner
-                                   ///< buffer answers only when a move ends)
-  double write_timeout = 2.0;      ///< s to hand a line to the port; default 2 s
+  double response_timeout = 30.0;  ///< s to wait for a line's answer, (0, 3600]; default 30 s (a
+                                   ///< full planner buffer answers only when a move ends)
+  double write_timeout = 2.0;      ///< s to hand a line to the port, (0, 600]; default 2 s
   double settle = 2.0;             ///< s to wait after opening (GRBL restarts when the port opens)
-                                   ///< before discarding its banner; default 2 s
+                                   ///< before discarding its banner, [0, 60]; default 2 s
   bool dry_run = false;            ///< only validate the program; no port is opened
   StreamControl* control = nullptr;  ///< optional pause/abort switches (not owned)
 };
@@ -84,10 +84,32 @@ enum class StreamStatus {
   alarm,         ///< GRBL raised ALARM:N while failed_line was in flight
   disconnected,  ///< the link dropped (or GRBL restarted) with failed_line in flight (or next)
   timeout,       ///< no answer to failed_line within response_timeout
-  aborted        ///< StreamControl::abort or the progress callback returned false
+  aborted,       ///< StreamControl::abort or the progress callback returned false
+  protocol_error ///< an answer no line was waiting for ("ok" with nothing outstanding): stopped
+                 ///< before failed_line was sent; next_line is not advanced by it
 };
 
 const char* to_string(StreamStatus status);
+
+/// Throws InputError naming the option outside its range (above; NaN and inf refused).
+void validate(const StreamOptions& options);
+
+/// One line the controller sent, as the streamer reads it.
+struct GrblAnswer {
+  enum class Kind {
+    ok,      ///< exactly "ok": acknowledges the one outstanding line
+    error,   ///< "error:N": the outstanding line was rejected
+    alarm,   ///< "ALARM:N" (or "ALARM"): the machine is locked
+    banner,  ///< "Grbl ...": the controller restarted
+    info,    ///< anything else ([MSG:...], <status>, blank, noise): ignored
+  } kind = Kind::info;
+  int code = 0;      ///< N of error:N / ALARM:N (0 when absent or unreadable)
+  std::string text;  ///< the line as printable ASCII: "\r" dropped, other bytes outside 0x20-0x7e
+                     ///< (invalid UTF-8 included) as \xNN, so a message can always quote it
+};
+
+/// Classifies one raw line from the device (without its "\n"); never throws.
+GrblAnswer parse_answer(const std::string& raw);
 
 struct StreamResult {
   StreamStatus status = StreamStatus::completed;
