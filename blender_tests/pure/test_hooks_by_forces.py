@@ -43,6 +43,16 @@ class Patterns(unittest.TestCase):
         limited, total = pipeline.equal_cost_patterns(design, limit=3)
         self.assertEqual((len(limited), total), (3, 8))
 
+    def test_a_forbidden_hook_is_never_flipped_onto(self):
+        # the re-layering loop forbade hook -1 at crossing 0 and hook +1 at crossing 2 (relayer)
+        design = {"crossings": [crossing(0, 1, (2, 2)), crossing(1, -1, (1.5, 2.5)), crossing(2, -1, (2, 2)),
+                                crossing(3, 1, (2.0, 2.0))]}
+        patterns, total = pipeline.equal_cost_patterns(design, limit=100, forbidden={(0, -1), (2, 1)})
+        self.assertEqual(total, 2)
+        self.assertEqual(patterns, [[1, -1, -1, 1], [1, -1, -1, -1]])
+        # forbidding a hook the layering did not choose at a crossing nobody flips changes nothing
+        self.assertEqual(pipeline.equal_cost_patterns(design, limit=100, forbidden={(1, 1)})[1], 8)
+
     def test_better(self):
         self.assertTrue(pipeline.better((3.0, 0.2), None))
         self.assertFalse(pipeline.better(None, (3.0, 0.2)))
