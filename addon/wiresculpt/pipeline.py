@@ -295,6 +295,25 @@ def equal_cost_patterns(design, limit, forbidden=()):
     return out, 2 ** len(free)
 
 
+def _with_hooks(design, hooks):
+    """A copy of `design` (sharing contours) whose crossings take `hooks` (with their metrics)."""
+    trial = _copy_sharing_contours(design)
+    for c, h in zip(trial["crossings"], hooks):
+        if c["hook"] != h:
+            c["hook"] = h
+            c["metric"] = c["hook_metrics"][(h + 1) // 2]
+    return trial
+
+
+def _without_user_cuts(design):
+    """A copy of `design` whose wires take automatic cuts (no cut_override or cut_point)."""
+    plain = _copy_sharing_contours(design)
+    for w in plain["wires"]:
+        w.pop("cut_override", None)
+        w.pop("cut_point", None)
+    return plain
+
+
 def force_score(design):
     """(load capacity, out-of-plane measure) of a solved design for hooks_by_forces: the weakest
     direction's multiple of the weight at the plastic limit (the load factor's `at_plastic_limit`;
@@ -346,6 +365,12 @@ def hooks_by_forces(design, material, settings, say, native_progress, checkpoint
     candidates, total = equal_cost_patterns(design, patterns if design["stable"] else 1, forbidden)
     shared = {}  # the target shape's per-wire solves, shared by the patterns
     base = _copy_sharing_contours(design)
+    # The user's cuts (cut handles, settings.cuts) change the forces a little, so patterns within
+    # CAPACITY_TIE could trade places when a handle moves and move every other wire's automatic
+    # cut with them. The patterns are compared with automatic cuts; the chosen one is then solved
+    # with the user's.
+    user_cuts = len(candidates) > 1 and any("cut_override" in w or "cut_point" in w for w in base["wires"])
+    scored = _without_user_cuts(base) if user_cuts else base
     best, best_score, chosen = None, None, 0
     checked = stable = solved = 0
     cut = design["stable"] and len(candidates) < total
@@ -354,11 +379,7 @@ def hooks_by_forces(design, material, settings, say, native_progress, checkpoint
             cut = True
             break
         checkpoint()
-        trial = _copy_sharing_contours(base)
-        for c, h in zip(trial["crossings"], hooks):
-            if c["hook"] != h:
-                c["hook"] = h
-                c["metric"] = c["hook_metrics"][(h + 1) // 2]
+        trial = _with_hooks(scored, hooks)
         checked += 1
         if index and not layering.recheck(trial, material, settings, native_progress)["stable"]:
             continue
@@ -369,6 +390,11 @@ def hooks_by_forces(design, material, settings, say, native_progress, checkpoint
         score = force_score(trial)
         if best is None or better(score, best_score):
             best, best_score, chosen = trial, score, index
+    if user_cuts and best is not None:  # the chosen pattern again, with the user's cuts
+        checkpoint()
+        best = shape_and_rest(_with_hooks(base, candidates[chosen]), material, settings, _quiet, native_progress,
+                              checkpoint, shared)
+        best_score = force_score(best) or best_score
     search = {"patterns": len(candidates), "equal_cost": total, "checked": checked, "stable": stable,
               "solved": solved, "chosen": chosen, "seconds": time.monotonic() - start, "complete": not cut}
     if best_score is not None:
