@@ -16,6 +16,14 @@ from .stages import forces, layering, slicing, target_shape
 ALL_STAGES = ["layering", "target_shape", "forces", "rest_shape"]
 COUPLING_ROUNDS = 4  # target shape <-> rest shape iterations (Sec. 4.3)
 COUPLING_MARGIN_DEG = 0.5
+# Hooks by their forces (hooks_by_forces, docs/method-forces.md §12): a crossing's two hooks cost
+# the same in Eq. 2 when within HOOK_TIE; load capacities (at the plastic limit) within CAPACITY_TIE
+# of the best are equal, and the paper's out-of-plane measure decides among them; the search
+# solves at most HOOK_PATTERNS patterns and starts no new one after HOOK_SECONDS.
+HOOK_TIE = 1e-6
+CAPACITY_TIE = 0.02
+HOOK_PATTERNS = 64
+HOOK_SECONDS = 60.0
 
 
 class Cancelled(Exception):
@@ -97,7 +105,11 @@ def relayer(design, material, settings, say, native_progress, checkpoint):
         for message in attempt.get("close_crossings", []):
             say("layering", message)
         if attempt["stable"]:
-            attempt = shape_and_rest(attempt, material, settings, say, native_progress, checkpoint)
+            # shape_and_rest on the layering's hooks and on the other stable patterns of equal Eq. 2
+            # cost that use no forbidden hook; the best forces win among the stable (buildable) ones,
+            # and when none is, the layering's own pattern is kept, so the round learns from it.
+            attempt = hooks_by_forces(attempt, material, settings, say, native_progress, checkpoint,
+                                      forbidden=forbidden)
             shaped = attempt
         learnt = target_shape.unrealisable(attempt) - forbidden
         rounds.append({"forbidden": _pairs(forbidden), "stable": attempt["stable"],
@@ -190,7 +202,7 @@ def _tighten(design, memo, machine_limit_deg, floor_deg):
     return changed, stuck
 
 
-def shape_and_rest(design, material, settings, say, native_progress, checkpoint):
+def shape_and_rest(design, material, settings, say, native_progress, checkpoint, solves=None):
     """Target shape, then forces and rest shape, with the coupling of Sec. 4.3: the machine's
     maximum bend limits the rest shape, which is only known after the forces. A rest bend beyond
     it comes from the torque its vertex carries (Eq. 12), so the target shape is solved again with
@@ -200,7 +212,10 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint)
     at most COUPLING_ROUNDS times. Each round starts
     from what the previous one learnt (target_shape.Memo): its nulled crossings, its vertex limits,
     and the wires whose optimum the new limits leave optimal. Then the buildability verdict
-    (fab/buildability.py): a bend still over the limit makes the design not stable, by name."""
+    (fab/buildability.py): a bend still over the limit makes the design not stable, by name.
+    `solves`: a target_shape.Memo's per-wire solves to share with other calls (hooks_by_forces: a
+    wire whose crossings keep their hooks is not solved again; the vertex limits are part of a
+    solve's key)."""
     import copy
 
     def fresh(d):
@@ -213,6 +228,8 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint)
     kink = 180.0 - settings["contact_angle_deg"]  # a hooked crossing bends at least this much
     before = fresh(design)
     memo = target_shape.Memo()
+    if solves is not None:
+        memo.solves = solves
     totals = dict.fromkeys(("seconds", "iterations", "wire_solves", "reused_wires"), 0)
     for round_ in range(COUPLING_ROUNDS):
         if round_:
@@ -250,6 +267,151 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint)
                             f"{target_limit:.2f} deg (Sec. 4.3)")
     # "Stable" means buildable: the bend program of every wire, with the machine profile in use.
     buildability.apply(design)
+    return design
+
+
+def equal_cost_patterns(design, limit, forbidden=()):
+    """Hook patterns of the layering's Eq. 2 cost: the layering's hooks with any set of the
+    crossings whose two hooks cost the same (`hook_metrics` within HOOK_TIE) flipped, fewest flips
+    first, the layering's own first; at most `limit` (the count of all is returned too). Flipping
+    such a crossing keeps every key of the layering's objective (max and sum of e_c, null
+    crossings). A crossing whose other hook is in `forbidden` ((crossing id, hook) pairs, the
+    re-layering loop's) is not flipped."""
+    import itertools
+
+    hooks = [c["hook"] for c in design["crossings"]]
+    free = [c["id"] for c in design["crossings"] if c["hook"] != 0 and "hook_metrics" in c
+            and abs(c["hook_metrics"][0] - c["hook_metrics"][1]) <= HOOK_TIE
+            and (c["id"], -c["hook"]) not in forbidden]
+    out = []
+    for k in range(len(free) + 1):
+        for flipped in itertools.combinations(free, k):
+            if len(out) >= limit:
+                return out, 2 ** len(free)
+            pattern = list(hooks)
+            for c in flipped:
+                pattern[c] = -pattern[c]
+            out.append(pattern)
+    return out, 2 ** len(free)
+
+
+def _with_hooks(design, hooks):
+    """A copy of `design` (sharing contours) whose crossings take `hooks` (with their metrics)."""
+    trial = _copy_sharing_contours(design)
+    for c, h in zip(trial["crossings"], hooks):
+        if c["hook"] != h:
+            c["hook"] = h
+            c["metric"] = c["hook_metrics"][(h + 1) // 2]
+    return trial
+
+
+def _without_user_cuts(design):
+    """A copy of `design` whose wires take automatic cuts (no cut_override or cut_point)."""
+    plain = _copy_sharing_contours(design)
+    for w in plain["wires"]:
+        w.pop("cut_override", None)
+        w.pop("cut_point", None)
+    return plain
+
+
+def force_score(design):
+    """(load capacity, out-of-plane measure) of a solved design for hooks_by_forces: the weakest
+    direction's multiple of the weight at the plastic limit (the load factor's `at_plastic_limit`;
+    with a given torque fraction the weakest `load_capacity` multiple; +inf when unbounded, 0 without
+    a load capacity) and the paper's out-of-plane measure (`out_of_plane.mean_to_max_force`). None
+    when the forces did not run (the pattern is not stable or its target shape failed)."""
+    if "forces" in design.get("pending_stages", ["forces"]) or not design.get("stable"):
+        return None
+    if "load_factor" in design:
+        capacity = design["load_factor"]["at_plastic_limit"]
+    elif "load_capacity" in design:
+        held = [design["load_capacity"][a] for a in forces.AXES]
+        capacity = min((m for m in held if m is not None), default=None)
+    else:
+        capacity = 0.0
+    return (float("inf") if capacity is None else capacity), design["out_of_plane"]["mean_to_max_force"]
+
+
+def better(score, best):
+    """score beats best: a load capacity more than CAPACITY_TIE above, or within CAPACITY_TIE and
+    a smaller out-of-plane measure."""
+    if best is None:
+        return score is not None
+    if score is None:
+        return False
+    capacity, share = score
+    top = best[0]
+    if capacity > top * (1 + CAPACITY_TIE):
+        return True
+    return capacity >= top * (1 - CAPACITY_TIE) and share < best[1] - 1e-12
+
+
+def hooks_by_forces(design, material, settings, say, native_progress, checkpoint, patterns=None, seconds=None,
+                    forbidden=()):
+    """shape_and_rest on the layering's hooks and on the other hook patterns of the same Eq. 2
+    cost (equal_cost_patterns) whose assembly order stays stable (Eq. 1, layering.recheck), and
+    keeps the design whose forces are best (force_score, better): first the weakest-direction load
+    capacity, then the paper's out-of-plane measure. Bounded: at most `patterns` patterns, none
+    started after `seconds`; `stages.hook_search` records patterns (equal cost, in all), checked,
+    stable, solved, the chosen pattern's index (0: the layering's), its score, seconds and
+    `complete` (false, with a warning, when a bound cut the choice). The result is written into
+    `design` itself (and returned), as the stages do. `patterns` and `seconds`
+    default to HOOK_PATTERNS and HOOK_SECONDS (read at the call). `forbidden`: (crossing id, hook)
+    pairs no pattern may use (relayer's). When no pattern ends stable, the layering's own pattern
+    is the result (relayer learns from its unrealisable hooks)."""
+    patterns = HOOK_PATTERNS if patterns is None else patterns
+    seconds = HOOK_SECONDS if seconds is None else seconds
+    start = time.monotonic()
+    candidates, total = equal_cost_patterns(design, patterns if design["stable"] else 1, forbidden)
+    shared = {}  # the target shape's per-wire solves, shared by the patterns
+    base = _copy_sharing_contours(design)
+    # The user's cuts (cut handles, settings.cuts) change the forces a little, so patterns within
+    # CAPACITY_TIE could trade places when a handle moves and move every other wire's automatic
+    # cut with them. The patterns are compared with automatic cuts; the chosen one is then solved
+    # with the user's.
+    user_cuts = len(candidates) > 1 and any("cut_override" in w or "cut_point" in w for w in base["wires"])
+    scored = _without_user_cuts(base) if user_cuts else base
+    best, best_score, chosen = None, None, 0
+    checked = stable = solved = 0
+    cut = design["stable"] and len(candidates) < total
+    for index, hooks in enumerate(candidates):
+        if index and time.monotonic() - start > seconds:
+            cut = True
+            break
+        checkpoint()
+        trial = _with_hooks(scored, hooks)
+        checked += 1
+        if index and not layering.recheck(trial, material, settings, native_progress)["stable"]:
+            continue
+        stable += 1
+        trial = shape_and_rest(trial, material, settings, say if index == 0 else _quiet, native_progress, checkpoint,
+                               shared)
+        solved += 1
+        score = force_score(trial)
+        if best is None or better(score, best_score):
+            best, best_score, chosen = trial, score, index
+    if user_cuts and best is not None:  # the chosen pattern again, with the user's cuts
+        checkpoint()
+        best = shape_and_rest(_with_hooks(base, candidates[chosen]), material, settings, _quiet, native_progress,
+                              checkpoint, shared)
+        best_score = force_score(best) or best_score
+    search = {"patterns": len(candidates), "equal_cost": total, "checked": checked, "stable": stable,
+              "solved": solved, "chosen": chosen, "seconds": time.monotonic() - start, "complete": not cut}
+    if best_score is not None:
+        search["load_capacity"], search["out_of_plane"] = best_score
+        if search["load_capacity"] == float("inf"):
+            search["load_capacity"] = None
+    best["stages"]["hook_search"] = search
+    if cut:
+        best.setdefault("warnings", []).append(
+            f"hooks by forces: {checked} of {total} hook patterns of equal Eq. 2 cost were tried (bounded to "
+            f"{patterns} patterns and {seconds:g} s); a better one may exist")
+    if chosen:
+        say("forces", f"hooks by forces: pattern {chosen} of {checked} tried (weakest load "
+                      f"{best_score[0]:.2f}x the weight at the plastic limit, out of plane "
+                      f"{100 * best_score[1]:.1f}% of the largest force)")
+    design.clear()  # callers keep the dict they passed (operators/optimize.py)
+    design.update(best)
     return design
 
 

@@ -28,10 +28,12 @@ def largest_rest_turn_deg(design):
 class Coupling(unittest.TestCase):
     def solve(self, rounds):
         settings = defaults()
-        settings.update(contact_angle_deg=140.0, max_bend_deg=50.0)
+        # the plastic limit and the force LP as before issue 16: rest bends that need the coupling
+        settings.update(contact_angle_deg=140.0, max_bend_deg=50.0, torque_fraction=1.0, least_out_of_plane=False)
         V, F = sphere()
         saved, module = pipeline.COUPLING_ROUNDS, native.require()
         pipeline.COUPLING_ROUNDS = rounds
+        saved_patterns, pipeline.HOOK_PATTERNS = pipeline.HOOK_PATTERNS, 1  # one hook pattern: count its solves
         self.calls = 0
 
         class Counting:  # counts the native target-shape solves of every round
@@ -52,6 +54,7 @@ class Coupling(unittest.TestCase):
             return pipeline.run(V, F, PLANES, material, settings)
         finally:
             pipeline.COUPLING_ROUNDS = saved
+            pipeline.HOOK_PATTERNS = saved_patterns
             native.require = saved_require
 
     def test_rest_bends_respect_the_machine_after_coupling(self):

@@ -9,8 +9,12 @@ SETTINGS = {
     "min_bend_deg": (1.0, 0.0, 45.0, "deg", "Smallest bend the machine makes reliably"),
     "contact_angle_deg": (120.0, 30.0, 175.0, "deg",
                           "Angle between a wire's two edges at an interlocked crossing (the kink)"),
-    "torque_fraction": (1.0, 0.01, 1.0, "",
-                        "Share of the wire's plastic-limit torque the design may use"),
+    "torque_fraction": (None, 0.01, 1.0, "",
+                        "Share of the wire's plastic-limit torque the design may use (default: the "
+                        "least that holds the load factor)"),
+    "load_factor": (3.0, 0.1, 1000.0, "",
+                    "Times its own weight the sculpture should hold in each of the six directions; "
+                    "the least pre-stress (torque fraction) that does so is used"),
     "weld_tolerance": (None, 0.0, 0.01, "m",
                        "Mesh vertices closer than this are merged (default: 1e-7 of the mesh size)"),
     # the layering's search knobs (docs/method-layering.md); unit "bool" / "int": not a number of
