@@ -23,6 +23,9 @@ void validate(const TemplateWire& wire, std::size_t index) {
   for (std::size_t i = 0; i < wire.self_crossings.size(); ++i)
     if (!wire.self_crossings[i].allFinite())
       throw InputError(who + ": self-crossing " + std::to_string(i) + " has a non-finite coordinate");
+  for (std::size_t i = 0; i < wire.preview.size(); ++i)
+    if (!wire.preview[i].allFinite())
+      throw InputError(who + ": preview point " + std::to_string(i) + " has a non-finite coordinate");
 }
 
 }  // namespace wiresculpt::fab
