@@ -134,5 +134,19 @@ class PreviewTest(unittest.TestCase):
             self.assertEqual(os.listdir(folder), [])
 
 
+class RigidFitTest(unittest.TestCase):
+    def test_a_rotated_moved_and_a_mirrored_copy_are_found(self):
+        from wiresculpt.core.frames import rigid_fit_2d
+
+        src = np.array([[0.0, 0.0], [0.05, 0.0], [0.05, 0.02], [0.01, 0.03]])
+        c, s = math.cos(0.7), math.sin(0.7)
+        R = np.array([[c, -s], [s, c]])
+        for M in (R, R @ np.diag([1.0, -1.0])):
+            dst = src @ M.T + np.array([0.3, -0.1])
+            fit, t = rigid_fit_2d(src, dst)
+            np.testing.assert_allclose(fit, M, atol=1e-12)
+            np.testing.assert_allclose(t, [0.3, -0.1], atol=1e-12)
+
+
 if __name__ == "__main__":
     unittest.main()

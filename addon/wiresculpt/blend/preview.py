@@ -1,0 +1,63 @@
+"""The machine preview in the viewport (issue 21 item 7): after an export, one ghost curve per
+wire showing the wire the machine is predicted to make (fab/export.py's "predicted", the bend
+program run through the spring-back model), laid on the wire's plane by the rigid map that best
+fits the wire's rest shape onto its target there. The ghosts live in the "Machine Preview"
+collection, are tagged by wire name and replaced on every export (never accumulated); a wire that
+is no longer exported (or has no plane to lay it on) loses its ghost."""
+import bpy
+import numpy as np
+
+from ..core.frames import plane_frame, rigid_fit_2d, to_2d, to_3d
+from .objects import remove_object, scene_collection, tagged, write_polyline
+
+PREVIEW_KEY = "wiresculpt_preview"  # custom property on ghost curves: the wire's name
+PREVIEW_COLLECTION = "Machine Preview"
+GHOST_COLOUR = (0.5, 0.0, 0.75, 1.0)  # the template's dashed violet
+
+
+def rest_on_target(wire):
+    """The wire's target points matched to its rest points (rest starts at the cut; a closed
+    wire's rest repeats the cut at its end): (n, 3)."""
+    target = np.asarray(wire["target"], dtype=np.float64)
+    n, m = len(wire["rest"]), len(target)
+    start = max(int(wire.get("cut", -1)), 0)
+    return target[[(start + i) % m for i in range(n)]]
+
+
+def ghost_points(wire, predicted):
+    """The predicted 2D wire (m, rest frame) in 3D on the wire's plane."""
+    _n, u, v = plane_frame(wire["plane"]["normal"])
+    origin = wire["plane"]["origin"]
+    M, t = rigid_fit_2d(wire["rest"], to_2d(rest_on_target(wire), origin, u, v))
+    return to_3d(np.asarray(predicted, dtype=np.float64) @ M.T + t, origin, u, v)
+
+
+def write_ghosts(scene, design, result):
+    """One ghost curve per exported wire of `result` (fab.export.export's); returns how many."""
+    wires = {w["name"]: w for w in design["wires"]}
+    existing = tagged(scene, PREVIEW_KEY)
+    coll = scene_collection(scene, PREVIEW_COLLECTION)
+    written = 0
+    for summary in result["wires"]:
+        wire = wires.get(summary["name"])
+        if wire is None or "predicted" not in summary or "plane" not in wire or not wire.get("target"):
+            continue  # nowhere to lay it (a hand-made design without its plane): no ghost
+        obj = existing.pop(wire["name"], None)
+        if obj is None or obj.type != 'CURVE':
+            name = f"Predicted {wire['name']}"
+            obj = bpy.data.objects.new(name, bpy.data.curves.new(name, 'CURVE'))
+            obj[PREVIEW_KEY] = wire["name"]
+            coll.objects.link(obj)
+        obj.data.dimensions = '3D'
+        obj.data.bevel_depth = 0.0
+        write_polyline(obj.data, ghost_points(wire, summary["predicted"]), False)
+        obj.matrix_world = ((1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1))
+        obj.color = GHOST_COLOUR
+        obj.show_in_front = True
+        obj.hide_render = True
+        obj.hide_select = True
+        obj["wiresculpt_preview_distance_mm"] = round(float(summary["preview_distance"]) * 1000.0, 3)
+        written += 1
+    for obj in existing.values():
+        remove_object(obj)
+    return written
