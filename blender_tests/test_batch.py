@@ -97,6 +97,10 @@ class BatchTest(unittest.TestCase):
             self.assertTrue(names and all(n.endswith(ext) for n in names), (folder, names))
         self.assertEqual(len(d["fabrication"]["wires"]), 3)
         self.assertEqual(d["fabrication"]["errors"], [])
+        for w in d["fabrication"]["wires"]:  # the default profile compensates and predicts: only the
+            # small-bend rule moves the predicted wire off the rest shape
+            self.assertAlmostEqual(w["preview_distance"], w["shape_error"], delta=1e-9)
+            self.assertNotIn("predicted", w)
 
     def check_targets(self, d):
         """The target shapes against FORMATS.md and the machine, computed from the points alone."""

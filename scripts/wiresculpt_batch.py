@@ -68,7 +68,7 @@ def add_handles(scene, planes, design):
         item.use = f"{item.plane}/{item.index}" in picked
 
 
-def write_scene_outputs(design, objects, planes, factor, out, say):
+def write_scene_outputs(design, objects, planes, factor, out, say, overlap=0.0):
     """sculpture.blend, render.png and assembly/ in `out`, from the design (progress lines name
     them relative to `out`, which is the run's staging folder)."""
     import bpy
@@ -102,7 +102,7 @@ def write_scene_outputs(design, objects, planes, factor, out, say):
         say("render", f"render.png ({time.perf_counter() - start:.3f} s)")
     if design.get("assembly_steps"):
         start = time.perf_counter()
-        path = assembly_guide.write_guide(scene, design, os.path.join(out, "assembly"))
+        path = assembly_guide.write_guide(scene, design, os.path.join(out, "assembly"), overlap=overlap)
         say("guide", f"{os.path.relpath(path, out)}, {len(design['assembly_steps'])} steps "
                      f"({time.perf_counter() - start:.3f} s)")
     # the file opens ready: the 3D views framed on the sculpture, the sidebar on the Wire tab,
@@ -150,11 +150,17 @@ def write_fabrication(design, out, say, profile=None):
         return  # no folders: the earlier run's are removed with the rest of its set
     start = time.perf_counter()
     result = export.export(design, out, profile)
-    design["fabrication"] = {"wires": result["wires"], "errors": result["errors"]}
+    # the predicted polylines stay in the templates; the design keeps each wire's preview distance (m)
+    design["fabrication"] = {"wires": [{k: v for k, v in w.items() if k != "predicted"} for w in result["wires"]],
+                             "errors": result["errors"], "preview_model": result["preview_model"]}
     minutes = sum(w["machine_seconds"] for w in result["wires"]) / 60
     say("fabrication", f"{len(result['wires'])} bend programs ({sum(w['bend_count'] for w in result['wires'])} "
                        f"bends, about {minutes:.0f} min on the machine), {len(result['files'])} files in svg/, dxf/, templates/, "
                        f"gcode/, bends/, bendlist/ ({time.perf_counter() - start:.3f} s)")
+    if result["wires"]:
+        worst = max(result["wires"], key=lambda w: w["preview_distance"])
+        say("fabrication", f"predicted wires within {worst['preview_distance'] * 1000:.1f} mm of the rest shapes "
+                           f"(largest: {worst['name']}; spring-back {result['preview_model']})")
     for error in result["errors"]:
         say("fabrication", error)
 
@@ -164,6 +170,7 @@ def run(argv):
     import numpy as np
 
     from wiresculpt import native, pipeline
+    from wiresculpt.core.calibration import closed_overlap
     from wiresculpt.core.design import write_design
     from wiresculpt.core.meshcheck import check_output_folder, check_vertices
     from wiresculpt.core.staging import staged
@@ -198,7 +205,8 @@ def run(argv):
     with staged(args.out, OUTPUTS) as folder:
         write_fabrication(design, folder, say, profile)
         write_design(os.path.join(folder, "design.json"), design)
-        write_scene_outputs(design, objects, planes, factor, folder, say)
+        write_scene_outputs(design, objects, planes, factor, folder, say,
+                            closed_overlap(profile))  # the guide says how the loops close
     say("written", os.path.join(args.out, "design.json"))
     if design["stable"]:
         return EXIT_STABLE

@@ -98,7 +98,7 @@ std::vector<TemplateWire> to_templates(py::handle wires) {
                   [&](py::handle v, const std::string& at) { w.crossing_points = to_integers<std::size_t>(v, at); }},
                  {"self_crossings", [&](py::handle v, const std::string& at) { w.self_crossings = to_points<2>(v, at); }},
                  {"preview", [&](py::handle v, const std::string& at) { w.preview = to_points<2>(v, at); }},
-                 field::number("preview_distance", w.preview_distance)});
+                 field::number("preview_distance", w.preview_distance), field::number("overlap", w.overlap)});
     out.push_back(std::move(w));
   });
   return out;

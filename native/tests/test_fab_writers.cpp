@@ -180,6 +180,32 @@ TEST_CASE("svg: the predicted wire is drawn dashed over the rest shape and named
   CHECK(attribute(svg, "height") == Approx(51.0 + 20.0).margin(1e-3));
 }
 
+TEST_CASE("svg: a closed wire's overlap is drawn over the last stretch of its path", "[fab][svg][overlap]") {
+  TemplateWire w = square_wire();  // 80 x 50 mm, walked (0,0) (80,0) (80,50) (0,50) (0,0)
+  w.points.push_back({0.0, -0.02});  // 20 mm past the cut, straight on
+  w.overlap = 0.03;                  // the band: 20 mm back to the cut, 10 mm more along the last side
+  const std::string svg = svg_wire(w);
+  CHECK(balanced_tags(svg));
+  CHECK(count(svg, "class=\"overlap\"") == 1);
+  CHECK(count(svg, "overlap 30.0 mm") == 1);
+  const auto q = polyline_points(svg);
+  std::smatch m;
+  REQUIRE(std::regex_search(svg, m, std::regex("class=\"overlap\"[^>]*><polyline[^>]*points=\"([^\"]*)\"")));
+  std::istringstream in(m[1].str());
+  std::vector<Vec2> band;
+  for (std::string pair; in >> pair;) {
+    const auto comma = pair.find(',');
+    band.emplace_back(std::stod(pair.substr(0, comma)), std::stod(pair.substr(comma + 1)));
+  }
+  REQUIRE(band.size() == 3);  // the end, the cut, 10 mm before the cut on the last side
+  CHECK((band[0] - q.back()).norm() < 1e-3);
+  CHECK((band[1] - q[q.size() - 2]).norm() < 1e-3);
+  CHECK((band[2] - q[q.size() - 2]).norm() == Approx(10.0).margin(1e-3));
+  CHECK((band[2] - q[q.size() - 3]).norm() == Approx(40.0).margin(1e-3));
+  w.overlap = -1.0;
+  CHECK_THROWS_WITH(svg_wire(w), Contains("overlap"));
+}
+
 TEST_CASE("svg: one wire at 1:1 with width and height of the bounding box plus margins", "[fab][svg]") {
   SvgOptions o;
   o.margin_mm = 12.0;

@@ -21,7 +21,7 @@ import numpy as np
 
 from .. import native
 from . import bendlist, tiles
-from ..core.calibration import machine_dict
+from ..core.calibration import closed_overlap, machine_dict
 from ..core.sizes import STOCK_LENGTH, size_warnings
 from ..core.polylines import self_crossings
 
@@ -107,6 +107,20 @@ def no_rest_reason(design):
     return "no wire has a rest shape yet: optimize until the rest shape stage has run"
 
 
+def with_overlap(rest, closed, overlap):
+    """The polyline the machine bends: a closed wire's rest shape with its last segment fed on
+    straight by `overlap` m past the cut (the profile's closed_overlap), so the loop's ends
+    overlap; an open wire, or no allowance, unchanged. Moving the last point keeps the program's
+    bends and lengthens its final feed by exactly `overlap`."""
+    rest = np.asarray(rest, dtype=np.float64)
+    if not closed or overlap <= 0 or len(rest) < 2:
+        return rest
+    d = rest[-1] - rest[-2]
+    out = rest.copy()
+    out[-1] = rest[-1] + overlap * d / np.linalg.norm(d)
+    return out
+
+
 def preview_model(native_profile):
     """The words for a spring-back line: "measured = a x commanded + b deg (name)"."""
     return (f"measured = {float(native_profile['springback_a']):.4f} × commanded "
@@ -116,7 +130,8 @@ def preview_model(native_profile):
 def export(design, out_dir, profile=None, paper=None, machine=None):
     """Writes the fabrication files of every wire that has a rest shape into out_dir/{svg, dxf,
     templates, templates/pages, gcode, bends, bendlist} (see the module's text), with the machine `profile`
-    (None: the default; see machine_profile), the template pages on `paper` ("A4" or "Letter";
+    (None: the default; see machine_profile; its "closed_overlap" lengthens every closed wire's
+    last feed, with_overlap), the template pages on `paper` ("A4" or "Letter";
     None: the profile's key "paper", else A4). Returns
     {"files": [paths], "wires": [per-wire program summary], "errors": [one sentence per wire that
     cannot be bent], "notes": [limits where the profile is stricter than the design],
@@ -130,6 +145,7 @@ def export(design, out_dir, profile=None, paper=None, machine=None):
     paper = paper or (profile or {}).get("paper") or "A4"
     tiles.layout(1.0, 1.0, paper)  # an unknown paper is refused before anything is written
     stock = float((profile or {}).get("stock_length", STOCK_LENGTH))
+    overlap = closed_overlap(profile)  # refused before anything is written
     stock_notes = [n for n in size_warnings(design, stock, (profile or {}).get("name") or "the machine profile")
                    if n.startswith("wire ")]
     profile, notes = machine_profile(design, profile)  # and a missing module (RuntimeError)
@@ -141,7 +157,7 @@ def export(design, out_dir, profile=None, paper=None, machine=None):
     files, summaries, errors, templates = [], [], [], []
     wires = [x for x in design["wires"] if "rest" in x]
     for wire in wires:
-        rest = np.asarray(wire["rest"], dtype=np.float64)
+        rest = with_overlap(wire["rest"], wire.get("closed"), overlap)
         try:
             program = native.make_bend_program(rest, profile, made_by)
         except ValueError as exc:
@@ -150,7 +166,8 @@ def export(design, out_dir, profile=None, paper=None, machine=None):
         stem = file_stem(wire)
         template = {"name": wire["name"], "points": rest, "bend_points": list(program["bend_vertices"]),
                     "crossing_points": crossing_indices(design, wire),
-                    "preview": program["predicted"], "preview_distance": program["preview_distance"]}
+                    "preview": program["predicted"], "preview_distance": program["preview_distance"],
+                    "overlap": overlap if wire.get("closed") else 0.0}
         crosses = self_crossings(rest, wire["closed"])
         if crosses:  # marked on the template: the wire must pass over itself there
             template["self_crossings"] = np.array([c[2] for c in crosses], dtype=np.float64)
@@ -173,7 +190,8 @@ def export(design, out_dir, profile=None, paper=None, machine=None):
         summaries.append({"id": wire["id"], "name": wire["name"], "bend_count": program["bend_count"],
                           "wire_length": program["wire_length"], "machine_seconds": program["machine_seconds"],
                           "shape_error": program["shape_error"], "predicted": np.asarray(program["predicted"]),
-                          "preview_distance": program["preview_distance"]})
+                          "preview_distance": program["preview_distance"],
+                          "overlap": overlap if wire.get("closed") else 0.0})
     if templates:
         for folder, name, write in (("templates", "sheet.svg", lambda p: native.write_svg(p, templates, True)),
                                     ("dxf", "sculpture.dxf",

@@ -83,6 +83,34 @@ std::string wire_group(const TemplateWire& w, std::size_t index, double ox, doub
     s += num(q[i].y());
   }
   s += "\"/>\n";
+  if (w.overlap > 0.0 && q.size() >= 2) {  // the closing overlap: the last `overlap` of the path, a wide band
+    double left = to_mm(w.overlap);
+    std::vector<Vec2> band{q.back()};
+    for (std::size_t i = q.size() - 1; i > 0 && left > 0.0; --i) {
+      const double len = (q[i] - q[i - 1]).norm();
+      if (len >= left) {
+        band.push_back(q[i] + (left / len) * (q[i - 1] - q[i]));
+        left = 0.0;
+      } else {
+        band.push_back(q[i - 1]);
+        left -= len;
+      }
+    }
+    s += "    <g class=\"overlap\" data-mm=\"" + num(to_mm(w.overlap)) + "\"><polyline fill=\"none\" stroke=\"#00a070\" "
+         "stroke-opacity=\"0.45\" stroke-width=\"" + num(4 * o.stroke_mm) + "\" stroke-linecap=\"butt\" points=\"";
+    for (std::size_t i = 0; i < band.size(); ++i) {
+      if (i) s += ' ';
+      s += num(band[i].x());
+      s += ',';
+      s += num(band[i].y());
+    }
+    char words[96];
+    std::snprintf(words, sizeof words, "overlap %.1f mm past the loop's cut", to_mm(w.overlap));
+    const Vec2 at = band.back();
+    s += "\"/><text x=\"" + num(at.x() + o.tick_mm) + "\" y=\"" + num(at.y() + o.tick_mm + 0.6 * o.label_mm) +
+         "\" font-family=\"sans-serif\" font-size=\"" + num(0.6 * o.label_mm) + "\" fill=\"#00a070\">" + words +
+         "</text></g>\n";
+  }
   const std::string preview_colour = "#8000c0";
   if (w.preview.size() >= 2) {  // the predicted wire: dashed, thinner, violet (named in the legend)
     s += "    <polyline class=\"preview\" fill=\"none\" stroke=\"" + preview_colour + "\" stroke-width=\"" +

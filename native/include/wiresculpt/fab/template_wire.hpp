@@ -22,6 +22,9 @@ struct TemplateWire {
   /// m, the preview's largest distance from the rest shape (arclength_distance), for the legend;
   /// negative: not given.
   double preview_distance = -1.0;
+  /// m, the last stretch of `points` fed past a closed wire's cut so its ends overlap (the
+  /// profile's closed_overlap): drawn as a wide band labelled with its length; 0: none.
+  double overlap = 0.0;
 };
 
 /// Throws InputError naming the wire (`index`, name) when it has no point, a non-finite point
