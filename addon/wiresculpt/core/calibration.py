@@ -184,8 +184,23 @@ def linear_density(material):
     return material["density"] * math.pi * 0.25 * material["wire_diameter"] ** 2
 
 
-def fit_cantilever(source, overhang=0.30, linear_density=0.0, plastic_tolerance=0.001):
-    """k_b (Eq. 13) and the plastic limit of a cantilever capture (a path or CSV text)."""
+def weight_density(material=None, include_weight=True):
+    """kg/m of the wire's own weight the cantilever fit counts: the one rule of the Calibration
+    panel and of fit_cantilever. With include_weight (the panel's *Wire's Own Weight*, ticked by
+    default) the weight of `material` (the Material & Machine panel's; None: the steel preset, the
+    panel's default material), else 0."""
+    if not include_weight:
+        return 0.0
+    return linear_density(materials.PRESETS["steel"] if material is None else material)
+
+
+def fit_cantilever(source, overhang=0.30, linear_density=None, plastic_tolerance=0.001, material=None,
+                   include_weight=True):
+    """k_b (Eq. 13) and the plastic limit of a cantilever capture (a path or CSV text). The wire's
+    own weight is counted as the Calibration panel counts it (weight_density(material,
+    include_weight)) unless `linear_density` (kg/m) is given."""
+    if linear_density is None:
+        linear_density = weight_density(material, include_weight)
     c = read_cantilever(source)
     singles = {}
     for load, loaded, line in zip(c["load_g"], c["loaded"], c["lines"]):
