@@ -13,6 +13,14 @@ from .objects import remove_object, scene_collection, tagged, write_polyline
 PREVIEW_KEY = "wiresculpt_preview"  # custom property on ghost curves: the wire's name
 PREVIEW_COLLECTION = "Machine Preview"
 GHOST_COLOUR = (0.5, 0.0, 0.75, 1.0)  # the template's dashed violet
+GHOST_MATERIAL = "wiresculpt machine preview"
+GHOST_RADIUS = 0.35  # the ghost's tube radius in wire radii: thinner than the wire, seen through it
+
+
+def _ghost_material():
+    mat = bpy.data.materials.get(GHOST_MATERIAL) or bpy.data.materials.new(GHOST_MATERIAL)
+    mat.diffuse_color = GHOST_COLOUR  # the viewport's Material colour
+    return mat
 
 
 def rest_on_target(wire):
@@ -36,6 +44,8 @@ def write_ghosts(scene, design, result):
     """One ghost curve per exported wire of `result` (fab.export.export's); returns how many."""
     wires = {w["name"]: w for w in design["wires"]}
     existing = tagged(scene, PREVIEW_KEY)
+    radius = GHOST_RADIUS * 0.5 * float(design.get("material", {}).get("wire_diameter", 0.002))
+    mat = _ghost_material()
     coll = scene_collection(scene, PREVIEW_COLLECTION)
     written = 0
     for summary in result["wires"]:
@@ -49,7 +59,12 @@ def write_ghosts(scene, design, result):
             obj[PREVIEW_KEY] = wire["name"]
             coll.objects.link(obj)
         obj.data.dimensions = '3D'
-        obj.data.bevel_depth = 0.0
+        obj.data.bevel_depth = radius
+        obj.data.bevel_resolution = 2
+        if obj.data.materials:
+            obj.data.materials[0] = mat
+        else:
+            obj.data.materials.append(mat)
         write_polyline(obj.data, ghost_points(wire, summary["predicted"]), False)
         obj.matrix_world = ((1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1))
         obj.color = GHOST_COLOUR
