@@ -158,6 +158,14 @@ class FabricationOperators(unittest.TestCase):
         self.assertEqual(sorted(ghosts()), names)
         for obj in ghosts().values():
             self.assertGreater(obj["wiresculpt_preview_distance_mm"], 1.0)
+        # a new design (Optimize writes the results) makes them stale: they go until the next export
+        scene_results.write_results(scene, self.design)
+        self.addCleanup(lambda: (scene_results.clear_results(scene), scene_results.store_design(self.design)))
+        self.assertEqual(ghosts(), {})
+        self.export_to("ghosts")
+        self.assertEqual(sorted(ghosts()), names)
+        scene_results.clear_results(scene)
+        self.assertEqual(ghosts(), {})
 
     def test_export_reports_a_missing_profile_naming_the_file(self):
         bpy.context.scene.wiresculpt.machine_profile = os.path.join(self.tmp.name, "nowhere.json")

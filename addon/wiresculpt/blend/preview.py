@@ -40,6 +40,12 @@ def ghost_points(wire, predicted):
     return to_3d(np.asarray(predicted, dtype=np.float64) @ M.T + t, origin, u, v)
 
 
+def clear_ghosts(scene):
+    """Removes every ghost (a new design, or cleared results, makes them stale)."""
+    for obj in tagged(scene, PREVIEW_KEY).values():
+        remove_object(obj)
+
+
 def write_ghosts(scene, design, result):
     """One ghost curve per exported wire of `result` (fab.export.export's); returns how many."""
     wires = {w["name"]: w for w in design["wires"]}
