@@ -168,7 +168,7 @@ def export(design, out_dir, profile=None, paper=None, machine=None):
                     "crossing_points": crossing_indices(design, wire),
                     "preview": program["predicted"], "preview_distance": program["preview_distance"],
                     "overlap": overlap if wire.get("closed") else 0.0}
-        crosses = self_crossings(rest, wire["closed"])
+        crosses = self_crossings(np.asarray(wire["rest"], dtype=np.float64), wire["closed"])  # not the overlap
         if crosses:  # marked on the template: the wire must pass over itself there
             template["self_crossings"] = np.array([c[2] for c in crosses], dtype=np.float64)
         templates.append(template)
