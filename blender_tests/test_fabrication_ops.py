@@ -158,6 +158,10 @@ class FabricationOperators(unittest.TestCase):
         self.assertEqual(sorted(ghosts()), names)
         for obj in ghosts().values():
             self.assertGreater(obj["wiresculpt_preview_distance_mm"], 1.0)
+        rows, model = preview.figures(scene)  # what the Fabrication panel lists
+        self.assertEqual([r[0] for r in rows], names)
+        self.assertEqual([r[1] for r in rows], [ghosts()[n]["wiresculpt_preview_distance_mm"] for n in names])
+        self.assertEqual(model, (0.95, 0.0))
         # a new design (Optimize writes the results) makes them stale: they go until the next export
         scene_results.write_results(scene, self.design)
         self.addCleanup(lambda: (scene_results.clear_results(scene), scene_results.store_design(self.design)))

@@ -7,7 +7,7 @@ Sets up the globe example (three handles through the centre, normals z, x, y), s
 opens the sidebar's Wire tab (Blender 3.4 has no API for the tab: a simulated click), saves
 screenshots after a timer and quits.
 
-With SHOTS=fabrication (and a taller screen, "-screen 0 1600x1900x24", so the Fabrication panel
+With SHOTS=fabrication (and a taller screen, "-screen 0 1600x2050x24", so the Fabrication panel
 fits below the others) it makes docs/images/panel-fabrication.png instead: a spring-back fit 5 % softer than the
 default profile is loaded (as Calibration > Load Capture would store it) and Export runs into a
 temporary folder, so the machine preview's violet ghosts show how far an uncompensated bender

@@ -40,6 +40,19 @@ def ghost_points(wire, predicted):
     return to_3d(np.asarray(predicted, dtype=np.float64) @ M.T + t, origin, u, v)
 
 
+MODEL_KEY = "wiresculpt_preview_springback"  # custom property on ghosts: the spring-back line used (a, b deg)
+DISTANCE_KEY = "wiresculpt_preview_distance_mm"  # custom property on ghosts: largest distance, mm
+
+
+def figures(scene):
+    """([(wire name, largest distance from the rest shape in mm)] by name, (a, b in degrees) of the
+    spring-back line used or None) of the ghosts in the scene, for the Fabrication panel."""
+    ghosts = tagged(scene, PREVIEW_KEY)
+    rows = [(name, float(obj.get(DISTANCE_KEY, 0.0))) for name, obj in sorted(ghosts.items())]
+    model = next((tuple(float(v) for v in obj[MODEL_KEY]) for obj in ghosts.values() if MODEL_KEY in obj), None)
+    return rows, model
+
+
 def clear_ghosts(scene):
     """Removes every ghost (a new design, or cleared results, makes them stale)."""
     for obj in tagged(scene, PREVIEW_KEY).values():
@@ -77,7 +90,9 @@ def write_ghosts(scene, design, result):
         obj.show_in_front = True
         obj.hide_render = True
         obj.hide_select = True
-        obj["wiresculpt_preview_distance_mm"] = round(float(summary["preview_distance"]) * 1000.0, 3)
+        obj[DISTANCE_KEY] = round(float(summary["preview_distance"]) * 1000.0, 3)
+        if "preview_springback" in result:
+            obj[MODEL_KEY] = list(result["preview_springback"])
         written += 1
     for obj in existing.values():
         remove_object(obj)

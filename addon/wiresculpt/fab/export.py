@@ -135,7 +135,8 @@ def export(design, out_dir, profile=None, paper=None, machine=None):
     None: the profile's key "paper", else A4). Returns
     {"files": [paths], "wires": [per-wire program summary], "errors": [one sentence per wire that
     cannot be bent], "notes": [limits where the profile is stricter than the design],
-    "preview_model": the spring-back line of the preview}.
+    "preview_model": the spring-back line of the preview in words, "preview_springback": its (a, b in
+    degrees)}.
 
     The preview (issue 21 item 7): each wire's program run forward through `machine`'s spring-back
     line (a profile as for `profile`, e.g. the fit the Calibration panel loaded; None: the export
@@ -201,7 +202,8 @@ def export(design, out_dir, profile=None, paper=None, machine=None):
             write(path)
             files.append(path)
     return {"files": files, "wires": summaries, "errors": errors, "notes": notes,
-            "empty_reason": "" if wires else no_rest_reason(design), "preview_model": preview_model(made_by)}
+            "empty_reason": "" if wires else no_rest_reason(design), "preview_model": preview_model(made_by),
+            "preview_springback": (float(made_by["springback_a"]), float(made_by["springback_b_deg"]))}
 
 
 def summary(result, out_dir):
