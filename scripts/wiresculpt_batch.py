@@ -32,7 +32,8 @@ OUTPUTS = ("design.json", "sculpture.blend", "sculpture.blend1", "render.png", "
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message):
-        raise ValueError(f"usage: wiresculpt_batch.py -- SCENE.json --out DIR [--profile PROFILE.json] ({message})")
+        raise ValueError(f"usage: wiresculpt_batch.py -- SCENE.json --out DIR [--profile PROFILE.json] "
+                         f"[--machine-model PROFILE.json] ({message})")
 
 
 def parse_args(argv):
@@ -40,6 +41,7 @@ def parse_args(argv):
     parser.add_argument("scene")
     parser.add_argument("--out", required=True)
     parser.add_argument("--profile", default=None)
+    parser.add_argument("--machine-model", default=None)
     return parser.parse_args(argv)
 
 
@@ -141,7 +143,22 @@ def machine_profile(scene, args, say):
     return profile
 
 
-def write_fabrication(design, out, say, profile=None):
+def machine_model(args, say):
+    """The profile whose spring-back line models the machine for the preview (--machine-model),
+    or None (the run's profile itself); ValueError naming the file when it cannot be used."""
+    from wiresculpt.core.calibration import load_profile
+
+    if not args.machine_model:
+        return None
+    if not os.path.isfile(args.machine_model):
+        raise ValueError(f"machine model {args.machine_model} does not exist (--machine-model: a machine profile "
+                         "JSON whose spring-back line the preview uses)")
+    model = load_profile(args.machine_model)
+    say("machine model", f"{model.get('name') or os.path.basename(args.machine_model)} ({args.machine_model})")
+    return model
+
+
+def write_fabrication(design, out, say, profile=None, machine=None):
     """svg/, dxf/, templates/, gcode/, bends/ and bendlist/ in `out` for every wire with a rest shape; the programs'
     summary goes into the design as `fabrication`."""
     from wiresculpt.fab import export
@@ -149,7 +166,7 @@ def write_fabrication(design, out, say, profile=None):
     if not any("rest" in w for w in design["wires"]):
         return  # no folders: the earlier run's are removed with the rest of its set
     start = time.perf_counter()
-    result = export.export(design, out, profile)
+    result = export.export(design, out, profile, machine=machine)
     # the predicted polylines stay in the templates; the design keeps each wire's preview distance (m)
     design["fabrication"] = {"wires": [{k: v for k, v in w.items() if k != "predicted"} for w in result["wires"]],
                              "errors": result["errors"], "preview_model": result["preview_model"]}
@@ -199,11 +216,12 @@ def run(argv):
                 f"({time.perf_counter() - start:.3f} s)")
     planes = scaled_planes(scene.planes, factor)
     profile = machine_profile(scene, args, say)  # refused before the long work when it is wrong
+    model = machine_model(args, say)
     design = pipeline.run(V, F, planes, scene.material, scene.settings, say)
     # Everything is written into a hidden folder first and replaces the earlier run's outputs
     # only when all of it is there: a failure half-way leaves the earlier set as it was.
     with staged(args.out, OUTPUTS) as folder:
-        write_fabrication(design, folder, say, profile)
+        write_fabrication(design, folder, say, profile, model)
         write_design(os.path.join(folder, "design.json"), design)
         write_scene_outputs(design, objects, planes, factor, folder, say,
                             closed_overlap(profile))  # the guide says how the loops close
