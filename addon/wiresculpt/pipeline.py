@@ -78,7 +78,8 @@ def relayer(design, material, settings, say, native_progress, checkpoint):
     """Layering, then target shape, forces and rest shape (shape_and_rest); while the result is not
     stable because the target shape could not realise some crossing's hook, forbid those (crossing,
     hook) pairs (target_shape.unrealisable: the failed hook, or both hooks of a crossing too close to
-    a neighbour) and layer again from the same contours, with a fresh target-shape memo. Stops when
+    a neighbour) and layer again from the same contours, with a fresh target-shape memo (that shares only
+    the solves of identical wire problems: same contour, crossings, hooks and limits). Stops when
     the design is stable, when nothing new can be forbidden, when the layering finds no stable
     assembly under the forbidden hooks or stops at max_nodes (search incomplete), or after
     `relayer_rounds` re-layerings. Records every round in stages.relayering. Returns the design of
@@ -88,6 +89,7 @@ def relayer(design, material, settings, say, native_progress, checkpoint):
     # Layering replaces (never edits) each wire's contour, so the copies share the contours.
     pristine = _copy_sharing_contours(design) if extra_rounds else None
     forbidden, rounds, start, shaped = set(), [], time.perf_counter(), None
+    same_solves = {}  # target-shape solves by exact input, for every round (target_shape.Memo `same`)
     for round_ in range(extra_rounds + 1):
         began = time.perf_counter()
         checkpoint()
@@ -97,7 +99,7 @@ def relayer(design, material, settings, say, native_progress, checkpoint):
         for message in attempt.get("close_crossings", []):
             say("layering", message)
         if attempt["stable"]:
-            attempt = shape_and_rest(attempt, material, settings, say, native_progress, checkpoint)
+            attempt = shape_and_rest(attempt, material, settings, say, native_progress, checkpoint, same_solves)
             shaped = attempt
         learnt = target_shape.unrealisable(attempt) - forbidden
         rounds.append({"forbidden": _pairs(forbidden), "stable": attempt["stable"],
@@ -190,7 +192,7 @@ def _tighten(design, memo, machine_limit_deg, floor_deg):
     return changed, stuck
 
 
-def shape_and_rest(design, material, settings, say, native_progress, checkpoint):
+def shape_and_rest(design, material, settings, say, native_progress, checkpoint, same_solves=None):
     """Target shape, then forces and rest shape, with the coupling of Sec. 4.3: the machine's
     maximum bend limits the rest shape, which is only known after the forces. A rest bend beyond
     it comes from the torque its vertex carries (Eq. 12), so the target shape is solved again with
@@ -199,7 +201,8 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint)
     every other bend is lowered by the excess, which changes the forces; from the same layering,
     at most COUPLING_ROUNDS times. Each round starts
     from what the previous one learnt (target_shape.Memo): its nulled crossings, its vertex limits,
-    and the wires whose optimum the new limits leave optimal. Then the buildability verdict
+    and the wires whose optimum the new limits leave optimal; `same_solves` (a dict, see
+    target_shape.Memo) carries the solves of identical problems across re-layering rounds. Then the buildability verdict
     (fab/buildability.py): a bend still over the limit makes the design not stable, by name."""
     import copy
 
@@ -212,7 +215,7 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint)
     target_limit = machine_limit
     kink = 180.0 - settings["contact_angle_deg"]  # a hooked crossing bends at least this much
     before = fresh(design)
-    memo = target_shape.Memo()
+    memo = target_shape.Memo(same_solves)
     totals = dict.fromkeys(("seconds", "iterations", "wire_solves", "reused_wires"), 0)
     for round_ in range(COUPLING_ROUNDS):
         if round_:

@@ -76,6 +76,25 @@ class AgainstConvergedSweeps(unittest.TestCase):
                 self.assertLessEqual(stage_f["iterations"], stage_s["iterations"])
 
 
+    def test_no_wire_problem_is_solved_twice(self):
+        # The Chair stand-in re-layers (issue 20) and its new layering leaves some wires' crossings
+        # and hooks alone; their problems, identical to the first round's, are taken from the
+        # shared solves (Memo `same`) instead of being solved again.
+        from wiresculpt import pipeline
+
+        scene, _V, _F, _planes, design = bench_scenes.load_and_slice(self.scenes["chair"])
+        real, keys = native.optimize_target_shape, []
+
+        def counted(points, closed, crossings, options=None, progress=None):
+            keys.append(target_shape.Memo.key(points, closed, crossings, options) + (options["max_bend"],))
+            return real(points, closed, crossings, options, progress)
+
+        with mock.patch.object(target_shape.native, "optimize_target_shape", counted):
+            solved = pipeline.solve(design, scene.material, scene.settings)
+        self.assertGreaterEqual(len(solved["stages"]["relayering"]["rounds"]), 2)  # the case it is about
+        self.assertEqual(len(keys), len(set(keys)))
+
+
 class Threads(unittest.TestCase):
     """solve_all keeps the order of its jobs and hands back the memo's results untouched."""
 

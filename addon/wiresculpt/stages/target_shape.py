@@ -129,10 +129,15 @@ class Memo:
 
     CONVERGED = ("NLOPT_SUCCESS", "NLOPT_FTOL_REACHED", "NLOPT_XTOL_REACHED", "none")  # "none": nothing free
 
-    def __init__(self):
+    def __init__(self, same=None):
+        """`same`: a dict {(key, max_bend): result} of earlier solves of exactly the same problem,
+        shared with other memos (pipeline.relayer hands one to every re-layering round: wires whose
+        crossings and hooks the new layering left alone are the same problems). Its results are
+        reused whatever they were: the solve is a deterministic function of its input."""
         self.nulled = []
         self.vertex_limits = {}
         self.solves = {}  # key -> (max_bend, result)
+        self.same = {} if same is None else same
         self.reused = 0
 
     @staticmethod
@@ -144,7 +149,11 @@ class Memo:
 
     def reusable(self, key, max_bend):
         """The remembered result for `key` if it is an optimum that the limit `max_bend` (radians)
-        leaves optimal, else None."""
+        leaves optimal, or the result of exactly this problem (same key and limit), else None."""
+        same = self.same.get((key, max_bend))
+        if same is not None:
+            self.reused += 1
+            return same
         entry = self.solves.get(key)
         if entry is None:
             return None
@@ -158,6 +167,7 @@ class Memo:
 
     def remember(self, key, max_bend, result):
         self.solves[key] = (max_bend, result)
+        self.same[(key, max_bend)] = result
 
 
 def unrealisable(design):
