@@ -609,10 +609,15 @@ std::array<int, 3> constraint_points(const TargetShapeProblem::Constraint& c, in
   return {-1, -1, -1};
 }
 
+// The progress callback is polled at the first evaluation and then every this many: a Python
+// callback takes the GIL, and polled at every evaluation (20-100 µs each) it serialised the wires
+// that the pipeline solves on two threads. 16 evaluations are at most a few milliseconds.
+constexpr int kProgressEvery = 16;
+
 double objective(unsigned, const double* x, double* g, void* data) {
   auto* d = static_cast<SolverData*>(data);
   ++d->evaluations;
-  if (d->progress && *d->progress) {
+  if (d->progress && *d->progress && (d->evaluations - 1) % kProgressEvery == 0) {
     try {
       report_progress(*d->progress, "target_shape",
                       std::min(1.0, static_cast<double>(d->evaluations) / d->max_evaluations));
