@@ -8,6 +8,7 @@ import math
 import time
 
 from . import native
+from .core import settings as settings_table
 from .core.design import new_design
 from .core.sizes import size_warnings
 from .fab import buildability
@@ -30,6 +31,16 @@ class Cancelled(Exception):
     """The user cancelled; the caller keeps its previous state."""
 
 
+class OutOfTime(RuntimeError):
+    """The solve ran past settings.max_solve_seconds; the caller keeps its previous state."""
+
+    def __init__(self, budget, stage):
+        super().__init__(f"the solve stopped at its time budget, settings.max_solve_seconds = {budget:g} s, during "
+                         f"the {stage.replace('_', ' ')}: raise the budget, or give fewer planes or a smaller "
+                         f"max_nodes")
+        self.budget, self.stage = budget, stage
+
+
 def _quiet(stage, message):
     pass
 
@@ -46,16 +57,30 @@ def solve(design, material, settings, progress=None, cancel=None):
     """Runs every stage after slicing on `design` (its wires' contours set), re-layering while the
     target shape cannot realise a hook (relayer). `progress(stage, message)` is called once per
     finished stage; `cancel()` returning True stops at the next safe point with Cancelled.
-    `pending_stages` names the stages that did not run."""
-    say = progress or _quiet
+    `pending_stages` names the stages that did not run. Past settings.max_solve_seconds (wall
+    clock) the solve stops the same way and raises OutOfTime, naming the key and the stage."""
     cancelled = cancel or (lambda: False)
+    budget = float(settings.get("max_solve_seconds") or settings_table.SETTINGS["max_solve_seconds"][0])
+    deadline = time.monotonic() + budget
+    at = {"stage": "layering"}  # the stage under way, for OutOfTime's message
 
-    def native_progress(_stage, _fraction):
-        return not cancelled()
+    def say(stage, message):
+        at["stage"] = stage
+        (progress or _quiet)(stage, message)
+
+    def out_of_time():
+        return time.monotonic() > deadline
+
+    def native_progress(stage, _fraction):
+        if isinstance(stage, str) and stage:  # the solver's parts of the layering are the layering
+            at["stage"] = "layering" if stage in ("network", "check_assembly") else stage
+        return not (cancelled() or out_of_time())
 
     def checkpoint():
         if cancelled():
             raise Cancelled()
+        if out_of_time():
+            raise OutOfTime(budget, at["stage"])
 
     design["pending_stages"] = list(ALL_STAGES)
     if len(design["wires"]) < 2:
@@ -70,6 +95,8 @@ def solve(design, material, settings, progress=None, cancel=None):
     try:
         return relayer(design, material, settings, say, native_progress, checkpoint)
     except native.Cancelled:
+        if not cancelled() and out_of_time():
+            raise OutOfTime(budget, at["stage"]) from None
         raise Cancelled() from None
 
 

@@ -113,6 +113,56 @@ class Cancelling(unittest.TestCase):
                 pipeline.solve(design, PRESETS["steel"], defaults(), cancel=cancel)
 
 
+class Clock:
+    """A stand-in for the time module in pipeline: monotonic() advances `step` seconds per call."""
+
+    def __init__(self, step):
+        import time
+
+        self.now, self.step, self.perf_counter = 0.0, step, time.perf_counter
+
+    def monotonic(self):
+        self.now += self.step
+        return self.now
+
+
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class TimeBudget(unittest.TestCase):
+    """settings.max_solve_seconds: past it the solve stops with OutOfTime naming the key and the
+    stage, whether the budget runs out between stages or inside the native solver's polls."""
+
+    def solve(self, budget, step, cancel=None):
+        V, F = sphere()
+        settings = dict(defaults(), max_solve_seconds=budget)
+        design = pipeline.slice_and_pick(V, F, PLANES, PRESETS["steel"], settings)
+        saved, pipeline.time = pipeline.time, Clock(step)
+        try:
+            return pipeline.solve(design, PRESETS["steel"], settings, cancel=cancel)
+        finally:
+            pipeline.time = saved
+
+    def test_the_budget_stops_the_solve_and_names_the_key(self):
+        stages = ("layering", "target shape", "forces", "rest shape", "load capacity", "relayering", "size")
+        for budget in (1.5, 40.0):  # the first checkpoint, and somewhere inside the work
+            with self.subTest(budget=budget), self.assertRaises(pipeline.OutOfTime) as ctx:
+                self.solve(budget, 1.0)
+            text = str(ctx.exception)
+            self.assertTrue(text.startswith(f"the solve stopped at its time budget, settings.max_solve_seconds = "
+                                            f"{budget:g} s, during the "), text)
+            self.assertTrue(any(f"during the {s}:" in text for s in stages), text)
+            self.assertIsInstance(ctx.exception, RuntimeError)  # the batch's one-line error, exit 1
+
+    def test_the_same_clock_with_room_to_spare_finishes(self):
+        design = self.solve(1e12, 1.0)
+        self.assertTrue(design["stable"], design.get("reason"))
+        self.assertEqual(design["pending_stages"], [])
+
+    def test_a_cancel_is_a_cancel_even_out_of_time(self):
+        with self.assertRaises(pipeline.Cancelled) as ctx:
+            self.solve(1.5, 1.0, cancel=lambda: True)
+        self.assertNotIsInstance(ctx.exception, pipeline.OutOfTime)
+
+
 if __name__ == "__main__":
     unittest.main()
 
