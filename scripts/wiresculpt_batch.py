@@ -168,6 +168,7 @@ def run(argv):
     from wiresculpt.core.meshcheck import check_output_folder, check_vertices
     from wiresculpt.core.staging import staged
     from wiresculpt.core.scene import load_scene
+    from wiresculpt.core.sizes import STOCK_LENGTH
     from wiresculpt.blend.mesh import import_mesh
 
     def say(stage, message):
@@ -192,7 +193,9 @@ def run(argv):
                 f"({time.perf_counter() - start:.3f} s)")
     planes = scaled_planes(scene.planes, factor)
     profile = machine_profile(scene, args, say)  # refused before the long work when it is wrong
-    design = pipeline.run(V, F, planes, scene.material, scene.settings, say)
+    stock = None if profile is None else (float(profile.get("stock_length", STOCK_LENGTH)),
+                                          profile.get("name") or "the machine profile")
+    design = pipeline.run(V, F, planes, scene.material, scene.settings, say, stock=stock)
     # Everything is written into a hidden folder first and replaces the earlier run's outputs
     # only when all of it is there: a failure half-way leaves the earlier set as it was.
     with staged(args.out, OUTPUTS) as folder:

@@ -53,11 +53,13 @@ def slice_and_pick(vertices, faces, planes, material, settings, progress=None):
     return design
 
 
-def solve(design, material, settings, progress=None, cancel=None):
+def solve(design, material, settings, progress=None, cancel=None, stock=None):
     """Runs every stage after slicing on `design` (its wires' contours set), re-layering while the
     target shape cannot realise a hook (relayer). `progress(stage, message)` is called once per
     finished stage; `cancel()` returning True stops at the next safe point with Cancelled.
-    `pending_stages` names the stages that did not run. Past settings.max_solve_seconds (wall
+    `pending_stages` names the stages that did not run. `stock`: (length in m, profile name) of
+    the machine profile in use, for the stock-length warnings said before the long work (None:
+    the default profile's). Past settings.max_solve_seconds (wall
     clock) the solve stops the same way and raises OutOfTime, naming the key and the stage."""
     cancelled = cancel or (lambda: False)
     budget = float(settings.get("max_solve_seconds") or settings_table.SETTINGS["max_solve_seconds"][0])
@@ -89,7 +91,7 @@ def solve(design, material, settings, progress=None, cancel=None):
                             else "a sculpture needs at least two wires: add a plane or pick more contours")
         return design
     apply_cuts(design, settings.get("cuts"))
-    for warning in size_warnings(design):  # before the long work: the figure, at once
+    for warning in size_warnings(design, *(stock or ())):  # before the long work: the figure, at once
         design.setdefault("warnings", []).append(warning)
         say("size", warning)
     try:
@@ -442,7 +444,7 @@ def hooks_by_forces(design, material, settings, say, native_progress, checkpoint
     return design
 
 
-def run(vertices, faces, planes, material, settings, progress=None, cancel=None):
+def run(vertices, faces, planes, material, settings, progress=None, cancel=None, stock=None):
     """slice_and_pick then solve: the whole pipeline from a mesh and planes."""
     design = slice_and_pick(vertices, faces, planes, material, settings, progress)
-    return solve(design, material, settings, progress, cancel)
+    return solve(design, material, settings, progress, cancel, stock)

@@ -163,6 +163,29 @@ class TimeBudget(unittest.TestCase):
         self.assertNotIsInstance(ctx.exception, pipeline.OutOfTime)
 
 
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class StockBeforeSolving(unittest.TestCase):
+    def test_wires_longer_than_the_profiles_stock_are_said_before_the_layering(self):
+        V, F = sphere()
+        design = pipeline.slice_and_pick(V, F, PLANES, PRESETS["steel"], defaults())
+        # the contours' lengths from their points, apart from core/sizes.py
+        lengths = {w["name"]: sum(math.dist(a, b) for a, b in zip(w["contour"], w["contour"][1:] + w["contour"][:1]))
+                   for w in design["wires"]}
+        stock = 0.5 * (min(lengths.values()) + max(lengths.values()))
+        said = []
+        pipeline.solve(design, PRESETS["steel"], defaults(), progress=lambda s, m: said.append((s, m)),
+                       stock=(stock, "shop bender"))
+        longer = sorted(n for n, l in lengths.items() if l > stock)
+        self.assertTrue(0 < len(longer) < len(lengths))
+        warned = [m for s, m in said if s == "size"]
+        self.assertEqual(sorted(m.split()[1] for m in warned), longer)
+        for m in warned:
+            self.assertIn(f"longer than the {stock * 1000:.0f} mm stock of shop bender", m)
+        stages = [s for s, _m in said]
+        self.assertLess(max(i for i, s in enumerate(stages) if s == "size"), stages.index("layering"))
+        self.assertTrue(all(m in design["warnings"] for m in warned))
+
+
 if __name__ == "__main__":
     unittest.main()
 
