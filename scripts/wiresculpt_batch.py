@@ -113,8 +113,13 @@ def write_scene_outputs(design, objects, planes, factor, out, say):
     # uncompressed, so that the set's verification (core/staging.py) can see its end block, and so
     # that on Blender 3.4, which cannot set the sidebar's tab from Python, the tab can be written
     # into the saved file.
-    if bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False, compress=False) != {'FINISHED'}:
-        raise OSError(f"Blender could not save {os.path.basename(path)} (is the disk full?); "
+    try:  # a failed write (a full disk) is a RuntimeError with Blender's errno text, or a CANCELLED
+        saved = bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False, compress=False)
+        why = "" if saved == {'FINISHED'} else f"the save ended {', '.join(sorted(saved))}"
+    except RuntimeError as exc:
+        why = str(exc).strip().removeprefix("Error:").strip() or "no reason given"
+    if why:
+        raise OSError(f"Blender could not save {os.path.basename(path)} ({why}; is the disk full?); "
                       "the earlier outputs are kept")
     tab = f"{compat.SIDEBAR_TAB} tab"
     if not ready["tab_set"]:
