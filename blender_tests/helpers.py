@@ -34,15 +34,16 @@ NO_EXECUTABLE = "starts a blender process; the bpy module has no blender executa
 NO_WINDOW = "needs a Blender window under Xvfb; the bpy module has none"
 
 
-def run_blender(script, *args, env=None, timeout=300):
+def run_blender(script, *args, env=None, timeout=300, preexec_fn=None):
     """Runs `script` in a fresh headless Blender with this process's environment updated by `env`
-    (a None value removes the variable); returns the CompletedProcess (text output)."""
+    (a None value removes the variable), `preexec_fn` run in the child before Blender starts (a
+    resource limit); returns the CompletedProcess (text output)."""
     if BPY_MODULE:
         raise unittest.SkipTest(NO_EXECUTABLE)
     cmd = [BLENDER, "--background", "--factory-startup", "--python-exit-code", "1",
            "--python", script, "--", *args]
     merged = {k: v for k, v in {**os.environ, **(env or {})}.items() if v is not None}
-    return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=merged)
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=merged, preexec_fn=preexec_fn)
 
 
 def run_under_xvfb(script, marker, timeout=180, args=()):

@@ -28,6 +28,9 @@ SETTINGS = {
     "relayer_rounds": (8, 0, 100, "int",
                        "How many times to layer again after the target shape could not realise a hook, "
                        "with that hook forbidden (0: layer once)"),
+    "max_solve_seconds": (600.0, 0.001, 86400.0, "s",
+                          "Wall-clock budget of one solve, every stage and round included; past it the "
+                          "solve stops with a message naming this key"),
 }
 
 # the keys whose values are not floats
