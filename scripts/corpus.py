@@ -452,8 +452,9 @@ def section(results, before=None):
             "realise; seconds: the whole solve of every round). Forbidding a hook the target shape failed is a "
             "heuristic (it failed beside the other hooks of that round), so an unstable end after re-layering "
             "is not a proof that no design exists (docs/method-layering.md, Re-layering). The re-check is "
-            "independent of the solver and also checks the machine's limits, which the solver's verdict does "
-            "not yet include (issue 20, item 3).") if before else ""
+            "independent of the solver and also checks the machine's limits, as the solver's verdict now does "
+            "(stable means buildable, fab/buildability.py); the solver also chooses hooks by their forces and "
+            "the least pre-stress for load factor 3 (issue 16), whose search is part of the solve seconds.") if before else ""
     lines = [BEGIN, "## Real-mesh corpus", "",
              f"`scripts/bench corpus` ({results['date']}, commit {results['commit']}): "
              "the batch on every scene of `scripts/corpus.py` (meshes from Debian packages, "
