@@ -7,8 +7,11 @@
 #include <termios.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdlib>
+#include <fstream>
 #include <limits>
 #include <mutex>
 #include <thread>
@@ -582,4 +585,36 @@ TEST_CASE("serial: a controller restart, an ALARM or a stray 'ok' while paused s
     // (reopening the port resets the controller) restarts the step.
     CHECK(state.next_line == 3);
   }
+}
+
+TEST_CASE("serial: a lock file that is a symbolic link is not followed", "[fab][serial][robustness]") {
+  // Another user's link at the lock path would otherwise make the stream truncate and write the
+  // file it points to.
+  GrblEmulator grbl(GrblEmulator::Mode::normal);
+  char dir_template[] = "/tmp/wiresculpt-lock-XXXXXX";
+  REQUIRE(::mkdtemp(dir_template) != nullptr);
+  const std::string dir = dir_template;
+  const char* before = std::getenv("WIRESCULPT_LOCK_DIR");
+  const std::string saved = before ? before : "";
+  ::setenv("WIRESCULPT_LOCK_DIR", dir.c_str(), 1);
+  char resolved[4096];
+  REQUIRE(::realpath(grbl.path().c_str(), resolved) != nullptr);
+  std::string device = resolved;
+  if (device.rfind("/dev/", 0) == 0) device.erase(0, 5);
+  std::replace(device.begin(), device.end(), '/', '_');
+  const std::string target = dir + "/victim", link = dir + "/LCK.." + device;
+  { std::ofstream(target) << "keep\n"; }
+  REQUIRE(::symlink(target.c_str(), link.c_str()) == 0);
+  CHECK_THROWS_WITH(SerialPort(grbl.path(), MachineProfile{}.serial), Contains("lock file " + link));
+  std::string content;
+  {
+    std::ifstream in(target);
+    std::getline(in, content);
+  }
+  CHECK(content == "keep");
+  if (before) ::setenv("WIRESCULPT_LOCK_DIR", saved.c_str(), 1);
+  else ::unsetenv("WIRESCULPT_LOCK_DIR");
+  ::unlink(link.c_str());
+  ::unlink(target.c_str());
+  ::rmdir(dir.c_str());
 }

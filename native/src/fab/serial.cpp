@@ -112,7 +112,7 @@ std::string holder_of(const std::string& path) {
 void take_lock(SerialPort::Impl& impl) {
   impl.lock_path = lock_path_for(impl.name);
   for (int attempt = 0; attempt < 5; ++attempt) {
-    const int fd = ::open(impl.lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    const int fd = ::open(impl.lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
     if (fd < 0)
       open_failed(impl.name, "cannot create its lock file " + impl.lock_path + ": " + std::strerror(errno));
     if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
