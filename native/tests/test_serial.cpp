@@ -31,9 +31,10 @@ class GrblEmulator {
  public:
   // drop_at: line k is received, never answered, and the cable is pulled (the master end closed).
   // banner_on_hold / alarm_on_hold / ok_on_hold: on a feed hold ('!') the controller restarts (its
-  // banner), raises ALARM:3, or sends an 'ok' no line was waiting for.
+  // banner), raises ALARM:3, or sends an 'ok' no line was waiting for. banner_after: line k is
+  // answered "ok" and the controller restarts at once (the banner in the same write).
   enum class Mode { normal, error_at, alarm_at, slow, disconnect_after, garbage_at, double_ok_at, double_ok_always,
-                    binary_error_at, drop_at, banner_on_hold, alarm_on_hold, ok_on_hold };
+                    binary_error_at, drop_at, banner_on_hold, alarm_on_hold, ok_on_hold, banner_after };
 
   explicit GrblEmulator(Mode mode, std::size_t k = 0, int delay_ms = 0) : mode_(mode), k_(k), delay_ms_(delay_ms) {
     termios raw{};
@@ -91,6 +92,7 @@ class GrblEmulator {
     // An informational line first: the streamer must skip it. A doubled "ok" comes in one write,
     // as a device that echoes its answer twice sends it.
     const bool twice = (mode_ == Mode::double_ok_at && index == k_) || mode_ == Mode::double_ok_always;
+    if (mode_ == Mode::banner_after && index == k_) return send("[MSG:busy]\r\nok\r\n\r\nGrbl 1.1h ['$' for help]\r\n");
     send(twice ? "[MSG:busy]\r\nok\r\nok\r\n" : "[MSG:busy]\r\nok\r\n");
     if (mode_ == Mode::disconnect_after && index + 1 == k_) {
       std::this_thread::sleep_for(std::chrono::milliseconds(100));  // the ok reaches the streamer
@@ -617,4 +619,19 @@ TEST_CASE("serial: a lock file that is a symbolic link is not followed", "[fab][
   ::unlink(link.c_str());
   ::unlink(target.c_str());
   ::rmdir(dir.c_str());
+}
+
+TEST_CASE("serial: a controller restart seen before the next line is sent stops the stream", "[fab][serial][robustness]") {
+  // The restarted GRBL is back in G90 with an empty queue: sending the next relative line as if
+  // nothing happened would run it as an absolute move.
+  const auto lines = program_lines();
+  const std::size_t k = 4;  // step 1's bend line is answered, then the banner arrives
+  GrblEmulator grbl(GrblEmulator::Mode::banner_after, k);
+  StreamState state;
+  const auto r = stream_program(grbl.path(), lines, MachineProfile{}, state, quick());
+  CHECK(r.status == StreamStatus::disconnected);
+  CHECK(r.failed_line == static_cast<long>(k) + 1);
+  CHECK(grbl.received().size() == k + 1);  // line k+1 was never sent
+  CHECK_THAT(r.message, Contains("restarted") && Contains("step 1") && Contains("from line 4"));
+  CHECK(state.next_line == 3);  // step 1's queued feed and bend are lost: the resume makes it again
 }
