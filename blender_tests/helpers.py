@@ -144,6 +144,17 @@ def polyline_length(points, closed):
     return sum(math.dist(points[i], points[(i + 1) % n]) for i in edges)
 
 
+def step_start(lines, acknowledged):
+    """Where a resume starts after a stop that can lose GRBL's queued moves (a dropped link, a
+    cancel), when the first `acknowledged` lines were answered ok: after the last acknowledged
+    `G4 P0` (the end of the last step known made), or after the leading mode lines."""
+    start = 0
+    for j, line in enumerate(lines[:acknowledged]):
+        if line == "G4 P0" or (start == j and line in ("G21", "G91", "G94")):
+            start = j + 1
+    return start
+
+
 class GrblEmulator:
     """A small GRBL on a pseudo-terminal pair (os.openpty), answering in a thread: `ok` to every
     line, `error:20` to the `error_on`-th line received (1-based), silence and a pulled cable
