@@ -163,7 +163,7 @@ def run(argv):
     import bpy
     import numpy as np
 
-    from wiresculpt import native, pipeline
+    from wiresculpt import native, plane_search
     from wiresculpt.core.design import write_design
     from wiresculpt.core.meshcheck import check_output_folder, check_vertices
     from wiresculpt.core.staging import staged
@@ -192,7 +192,8 @@ def run(argv):
                 f"({time.perf_counter() - start:.3f} s)")
     planes = scaled_planes(scene.planes, factor)
     profile = machine_profile(scene, args, say)  # refused before the long work when it is wrong
-    design = pipeline.run(V, F, planes, scene.material, scene.settings, say)
+    # settings.plane_search "off" is pipeline.run; "nearby"/"auto" return the planes actually used
+    design, planes = plane_search.run(V, F, planes, scene.material, scene.settings, say)
     # Everything is written into a hidden folder first and replaces the earlier run's outputs
     # only when all of it is there: a failure half-way leaves the earlier set as it was.
     with staged(args.out, OUTPUTS) as folder:

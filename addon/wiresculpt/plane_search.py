@@ -1,0 +1,423 @@
+"""The plane assistant (issue 15): placements of the slicing planes that give a stable, buildable
+design. bpy-free, on top of the pipeline (pipeline.slice_and_pick, stages.layering, pipeline.solve);
+the batch (settings.plane_search) and the add-on's operators both call it.
+
+Two searches:
+
+- `nearby(...)`: the user's planes, changed as little as possible. A *change* moves a plane along
+  its normal by d, tilts it by an angle a about an axis in the plane (about the plane's point
+  nearest the mesh's centre) or changes which contours it takes ("largest" <-> "all"). Its cost,
+  the measure the search minimises, is
+
+      cost = sum over changed planes of ( |d| / S  +  a / 1 rad  +  0.05 per contour-rule change )
+
+  with S the model size (largest side of the mesh's bounding box): 5 % of the model's size costs
+  as much as a tilt of 0.05 rad (2.9 deg). Candidates are one-plane changes (offsets
+  +-{2, 4, 7, 10, 15, 20} % of S, tilts of 5, 10, 15 deg about two axes each way, the other
+  contour rule), then pairs of one-plane changes of two different planes, tried in order of cost.
+- `auto(...)`: planes from the mesh alone: `count` planes in families along the mesh's principal
+  axes (area-weighted), each family spread evenly over the mesh's extent along its axis (one plane
+  of a family goes through the centre: the mesh's symmetry plane when it has one). Candidates are
+  the ways to split `count` over the three axes (at least two families), ranked by coverage.
+
+Every candidate is screened cheaply first: slicing (each plane placement sliced once, cached) and
+the layering (stages.layering), whose first step is the hook-relaxed stability check (every
+crossing a ball joint: a mechanism is rejected in about a millisecond) and whose search then
+finds the hooks. Only survivors run the full pipeline (pipeline.solve: target shape, forces, rest
+shape, buildability), and a candidate is returned only when that says stable (which means
+buildable, fab/buildability).
+
+Score of a returned candidate (documented in docs/formats.md, higher is better):
+
+    score = coverage - 10 * max_deviation / S          (auto)
+    score = -cost                                      (nearby)
+
+coverage: the share of the mesh's vertices within 0.1 S of some wire's contour; max_deviation:
+the largest distance of a target shape from its contour (target_max_distance).
+"""
+import copy
+import itertools
+import math
+import time
+
+import numpy as np
+
+from . import pipeline
+from .core.scene import PlaneSpec
+from .stages import layering, slicing
+
+MODES = ("off", "nearby", "auto")
+OFFSETS = (0.02, 0.04, 0.07, 0.10, 0.15, 0.20)  # fractions of the model size S, both ways
+TILTS_DEG = (5.0, 10.0, 15.0)
+RULE_COST = 0.05
+COVERAGE_RADIUS = 0.1  # fraction of S
+FIDELITY_WEIGHT = 10.0
+BUDGET_SECONDS = 8.0  # the issue's 10 s for a nearby search on a five-plane scene, with room
+
+
+class Placement:
+    """One plane as the search places it (a PlaneSpec plus what changed and what that costs)."""
+
+    def __init__(self, name, origin, normal, contours, changes=(), cost=0.0):
+        self.name, self.origin, self.contours = name, tuple(float(c) for c in origin), contours
+        self.normal = tuple(float(c) for c in _unit(normal))
+        self.changes, self.cost = list(changes), cost
+
+    def spec(self):
+        return PlaneSpec(self.name, self.origin, self.normal, self.contours)
+
+    def key(self):
+        return (tuple(round(c, 12) for c in self.origin), tuple(round(c, 12) for c in self.normal))
+
+    def as_dict(self):
+        return {"name": self.name, "origin": [float(c) for c in self.origin],
+                "normal": [float(c) for c in self.normal], "contours": self.contours}
+
+
+def _unit(v):
+    v = np.asarray(v, dtype=float)
+    return v / np.linalg.norm(v)
+
+
+def mesh_frame(vertices, faces):
+    """(centre, axes 3x3 rows: principal axes by decreasing spread, size S) of the mesh surface
+    (area-weighted triangle centroids)."""
+    V = np.asarray(vertices, dtype=float)
+    F = np.asarray(faces, dtype=np.int64)
+    a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    w = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
+    cent = (a + b + c) / 3.0
+    if w.sum() <= 0:
+        w = np.ones(len(F))
+    centre = (w[:, None] * cent).sum(axis=0) / w.sum()
+    x = cent - centre
+    cov = (w[:, None] * x).T @ x / w.sum()
+    values, vectors = np.linalg.eigh(cov)
+    axes = vectors[:, ::-1].T.copy()
+    for k in range(3):  # each axis pointing to its largest positive world component
+        if axes[k][int(np.argmax(np.abs(axes[k])))] < 0:
+            axes[k] = -axes[k]
+    if np.ptp(values) < 1e-2 * max(values.max(), 1e-30):  # a sphere-like spread: the world axes
+        axes = np.eye(3)
+    size = float(np.max(V.max(axis=0) - V.min(axis=0)))
+    return centre, axes, size
+
+
+def _perpendiculars(n):
+    n = _unit(n)
+    u = np.cross(n, [0.0, 0.0, 1.0] if abs(n[2]) < 0.9 else [1.0, 0.0, 0.0])
+    u = _unit(u)
+    return u, np.cross(n, u)
+
+
+def _direction_word(n, sign):
+    """'up'/'down' for a z-like normal, else '+x'-style words for the move along sign*n."""
+    d = sign * _unit(n)
+    k = int(np.argmax(np.abs(d)))
+    if abs(d[k]) > 0.9:
+        if k == 2:
+            return "up" if d[k] > 0 else "down"
+        return f"{'+' if d[k] > 0 else '-'}{'xyz'[k]}"
+    return "along its normal" if sign > 0 else "against its normal"
+
+
+def single_changes(plane, centre, size):
+    """Every one-plane change of `plane` (a PlaneSpec) as Placements, cheapest first."""
+    n = _unit(plane.normal)
+    o = np.asarray(plane.origin, dtype=float)
+    pivot = centre - float((centre - o) @ n) * n  # the plane's point nearest the mesh's centre
+    out = []
+    for f in OFFSETS:
+        for sign in (1.0, -1.0):
+            d = sign * f * size
+            out.append(Placement(plane.name, pivot + d * n, n, plane.contours,
+                                 [f"move plane {plane.name} {_direction_word(n, sign)} {abs(d) * 1000:.0f} mm"],
+                                 abs(d) / size))
+    u, v = _perpendiculars(n)
+    for deg in TILTS_DEG:
+        a = math.radians(deg)
+        for axis, label in ((u, "u"), (-u, "u"), (v, "v"), (-v, "v")):
+            turned = n * math.cos(a) + np.cross(axis, n) * math.sin(a)  # n turned about `axis` by a
+            out.append(Placement(plane.name, pivot, _unit(turned), plane.contours,
+                                 [f"tilt plane {plane.name} by {deg:g}\N{DEGREE SIGN} "
+                                  f"(normal to {np.round(_unit(turned), 3).tolist()})"], a))
+    other = "all" if plane.contours != "all" else "largest"
+    out.append(Placement(plane.name, plane.origin, n, other,
+                         [f"plane {plane.name}: use {'every contour' if other == 'all' else 'the largest contour'}"],
+                         RULE_COST))
+    out.sort(key=lambda p: p.cost)
+    return out
+
+
+class Searcher:
+    """Slicing cache, screening and full solves for one mesh, material and settings."""
+
+    def __init__(self, vertices, faces, material, settings, progress=None, cancel=None):
+        self.V, self.F = vertices, faces
+        self.material, self.settings = material, settings
+        self.say = progress or (lambda stage, message: None)
+        self.cancel = cancel or (lambda: False)
+        self.cache = {}
+        self.screened = self.full_solves = 0
+        self.centre, self.axes, self.size = mesh_frame(vertices, faces)
+        self.sample = np.asarray(vertices, dtype=float)
+        if len(self.sample) > 4000:
+            self.sample = self.sample[np.linspace(0, len(self.sample) - 1, 4000).astype(int)]
+
+    def _contours(self, placement):
+        key = placement.key()
+        if key not in self.cache:
+            found, _ = slicing.slice_planes(self.V, self.F, [placement.spec()], self.settings.get("weld_tolerance"))
+            self.cache[key] = found[0]
+        return self.cache[key]
+
+    def settings_for(self, design):
+        """The settings with the user's cuts kept only for wires that exist in `design`."""
+        names = {w["name"] for w in design["wires"]}
+        cuts = {k: v for k, v in (self.settings.get("cuts") or {}).items() if k in names}
+        return {**self.settings, "cuts": cuts}
+
+    def sliced(self, placements):
+        """A new design from the placements' cached contours (the same wires slicing.run makes)."""
+        from .core import contours as rules
+        from .core.design import new_design, wire_entry
+
+        design = new_design(self.material, self.settings)
+        for p in placements:
+            found = self._contours(p)
+            if not found:
+                return None  # a change that removes a plane's wire is no answer
+            for k in rules.pick(found, p.contours, p.name):
+                c = found[k]
+                design["wires"].append(wire_entry(len(design["wires"]), f"{p.name}/{k}", list(p.origin),
+                                                  [float(x) for x in _unit(p.normal)], c["closed"], c["points"]))
+        design["stages"]["slicing"] = {"planes": len(placements), "search": True}
+        return design
+
+    def screen(self, placements):
+        """The layering's verdict on the placements (slicing + hook-relaxed check + hook search):
+        (passes, design) ; an input the network refuses (planes that coincide) does not pass."""
+        if self.cancel():
+            raise pipeline.Cancelled()
+        self.screened += 1
+        try:
+            design = self.sliced(placements)
+            if design is None or len(design["wires"]) < 2:
+                return False, design
+            probe = copy.deepcopy(design)
+            layering.run(probe, self.material, self.settings_for(design))
+            return bool(probe["stable"]), design
+        except (ValueError, RuntimeError):
+            return False, None
+
+    def solve(self, design):
+        """The full pipeline on a screened design; the solved design (stable means buildable)."""
+        self.full_solves += 1
+        try:
+            return pipeline.solve(design, self.material, self.settings_for(design), cancel=self.cancel)
+        except (ValueError, RuntimeError):
+            return None
+
+    def coverage(self, design):
+        """Share of the mesh's (sampled) vertices within COVERAGE_RADIUS * S of a contour point."""
+        points = np.concatenate([np.asarray(w["contour"], dtype=float) for w in design["wires"]])
+        radius = COVERAGE_RADIUS * self.size
+        near = np.zeros(len(self.sample), dtype=bool)
+        for chunk in np.array_split(points, max(1, len(points) // 256)):
+            d2 = ((self.sample[:, None, :] - chunk[None, :, :]) ** 2).sum(axis=2)
+            near |= (d2 <= radius * radius).any(axis=1)
+        return float(near.mean())
+
+    def max_deviation(self, design):
+        return max((w.get("target_max_distance", 0.0) for w in design["wires"]), default=0.0)
+
+
+def _figures(design):
+    """The stability figures a candidate shows: load capacity (least multiple of its weight over
+    the six directions), max deviation and largest closure gap."""
+    cap = design.get("load_capacity") or {}
+    multiples = [v for k, v in cap.items() if k in ("+x", "-x", "+y", "-y", "+z", "-z") and isinstance(v, (int, float))]
+    return {"load_capacity": min(multiples) if multiples else None,
+            "max_deviation": max((w.get("target_max_distance", 0.0) for w in design["wires"]), default=0.0),
+            "closure_gap": max((w.get("closure_gap", 0.0) for w in design["wires"]), default=0.0)}
+
+
+def _record(mode, before, candidate, searcher, start):
+    return {"mode": mode,
+            "planes_before": [Placement(p.name, p.origin, p.normal, p.contours).as_dict() for p in before],
+            "planes_after": [p.as_dict() for p in candidate["planes"]] if candidate else [],
+            "changes": candidate["changes"] if candidate else [],
+            "candidates": searcher.screened, "full_solves": searcher.full_solves,
+            "seconds": time.perf_counter() - start, "score": candidate["score"] if candidate else None,
+            "measure": ("cost = sum of |offset| / model size + tilt in radians + 0.05 per contour-rule change; "
+                        "score = -cost" if mode == "nearby" else
+                        "score = coverage (share of mesh vertices within 0.1 model size of a wire) "
+                        "- 10 * max target deviation / model size")}
+
+
+def nearby(vertices, faces, planes, material, settings, want=1, budget=BUDGET_SECONDS, progress=None, cancel=None):
+    """Up to `want` stable, buildable candidates near `planes`, cheapest change first:
+    [{"planes": [Placement], "changes": [sentence], "cost", "score", "design", "figures"}], and the
+    Searcher (its counts). The given planes themselves are candidate 0 (cost 0)."""
+    s = Searcher(vertices, faces, material, settings, progress, cancel)
+    start = time.perf_counter()
+    base = [Placement(p.name, p.origin, _unit(p.normal), p.contours) for p in planes]
+    singles = {i: single_changes(p, s.centre, s.size) for i, p in enumerate(planes)}
+    options = [(0.0, ())] + sorted(((c.cost, ((i, c),)) for i, cs in singles.items() for c in cs),
+                                   key=lambda t: t[0])
+    found = []
+
+    def consider(changes):
+        placements = list(base)
+        for i, c in changes:
+            placements[i] = c
+        ok, design = s.screen(placements)
+        if not ok:
+            return False
+        solved = s.solve(design)
+        if solved is None or not solved["stable"]:
+            return False
+        cost = sum(c.cost for _, c in changes)
+        found.append({"planes": placements, "changes": [t for _, c in changes for t in c.changes], "cost": cost,
+                      "score": -cost, "design": solved, "figures": _figures(solved)})
+        s.say("plane_search", f"candidate {len(found)}: {'; '.join(found[-1]['changes']) or 'the planes as given'} "
+                              f"(cost {cost:.3f}, {s.screened} screened, {s.full_solves} solved)")
+        return True
+
+    def out_of_time():
+        return time.perf_counter() - start > budget
+
+    for _cost, changes in options:
+        if len(found) >= want or out_of_time():
+            break
+        consider(changes)
+    if len(found) < want and not out_of_time():  # pairs of one-plane changes of two planes
+        pairs = []
+        for i, j in itertools.combinations(sorted(singles), 2):
+            for a in singles[i][:12]:
+                for b in singles[j][:12]:
+                    pairs.append((a.cost + b.cost, ((i, a), (j, b))))
+        pairs.sort(key=lambda t: t[0])
+        for _cost, changes in pairs:
+            if len(found) >= want or out_of_time():
+                break
+            consider(changes)
+    return found, s, start
+
+
+def _family_names(axes):
+    names = []
+    for k, a in enumerate(axes):
+        j = int(np.argmax(np.abs(a)))
+        names.append("XYZ"[j] if abs(a[j]) > 0.99 else "ABC"[k])
+    if len(set(names)) < 3:
+        names = ["A", "B", "C"]
+    return names
+
+
+def family_planes(searcher, counts, contours="largest"):
+    """Placements for `counts[k]` planes along principal axis k, spread evenly over the mesh's extent
+    (a family of one goes through the centre)."""
+    V = np.asarray(searcher.V, dtype=float)
+    names = _family_names(searcher.axes)
+    out = []
+    for k, count in enumerate(counts):
+        if not count:
+            continue
+        axis = searcher.axes[k]
+        t = (V - searcher.centre) @ axis
+        lo, hi = float(t.min()), float(t.max())
+        for i in range(count):
+            f = 0.5 if count == 1 else 0.2 + 0.6 * i / (count - 1)
+            origin = searcher.centre + (lo + f * (hi - lo)) * axis
+            out.append(Placement(f"{names[k]}{i}", origin, axis, contours))
+    return out
+
+
+def auto(vertices, faces, count, material, settings, want=2, budget=3 * BUDGET_SECONDS, progress=None, cancel=None):
+    """Up to `want` stable, buildable plane sets of `count` planes proposed from the mesh alone,
+    best score first (see the module's docstring), and the Searcher."""
+    s = Searcher(vertices, faces, material, settings, progress, cancel)
+    start = time.perf_counter()
+    splits = [c for c in itertools.product(range(count + 1), repeat=3) if sum(c) == count
+              and sum(1 for x in c if x) >= 2]
+    screened = []
+    for rule in ("largest", "all"):
+        for counts in splits:
+            placements = family_planes(s, counts, rule)
+            ok, design = s.screen(placements)
+            if ok:
+                screened.append((s.coverage(design), counts, rule, placements, design))
+        if screened:
+            break
+    screened.sort(key=lambda t: -t[0])
+    found = []
+    for cover, counts, rule, placements, design in screened:
+        if len(found) >= want or time.perf_counter() - start > budget:
+            break
+        solved = s.solve(design)
+        if solved is None or not solved["stable"]:
+            continue
+        score = cover - FIDELITY_WEIGHT * s.max_deviation(solved) / s.size
+        found.append({"planes": placements, "changes": [f"{len(placements)} planes: " + ", ".join(
+            f"{n} along {'xyz'[int(np.argmax(np.abs(s.axes[k])))] if abs(s.axes[k]).max() > 0.99 else f'axis {k}'}"
+            for k, n in enumerate(counts) if n)], "cost": 0.0, "score": score, "coverage": cover,
+            "design": solved, "figures": _figures(solved)})
+        s.say("plane_search", f"candidate {len(found)}: {found[-1]['changes'][0]} (score {score:.3f})")
+    found.sort(key=lambda c: -c["score"])
+    return found, s, start
+
+
+def run(vertices, faces, planes, material, settings, progress=None, cancel=None):
+    """The headless pipeline with settings.plane_search: "off" -> pipeline.run; "nearby" -> the
+    given planes first, the nearby search when they give no stable design; "auto" -> planes
+    from the mesh. The design carries `plane_search` whenever a search ran; when none is found the
+    design of the given planes (nearby) or of the first proposal (auto) is returned, not stable,
+    with the reason saying what was tried. Returns (design, planes actually used)."""
+    say = progress or (lambda stage, message: None)
+    mode = settings.get("plane_search", "off")
+    if mode == "off":
+        return pipeline.run(vertices, faces, planes, material, settings, progress, cancel), list(planes)
+    if mode == "nearby":
+        if not planes:
+            raise ValueError('settings.plane_search "nearby" needs planes to start from; give "planes" or use "auto"')
+        found, s, start = nearby(vertices, faces, planes, material, settings, 1, progress=say, cancel=cancel)
+        if found:
+            best = found[0]
+            design = best["design"]
+        else:
+            design = pipeline.run(vertices, faces, planes, material, settings, progress, cancel)
+            best = None
+            design["reason"] += (f"; no nearby placement ({s.screened} tried: offsets up to "
+                                 f"{OFFSETS[-1] * 100:g} % of the model size, tilts up to {TILTS_DEG[-1]:g} deg, "
+                                 f"contour rules, one or two planes at a time) gives a stable design")
+        design["plane_search"] = _record("nearby", planes, best, s, start)
+        used = [p.spec() for p in best["planes"]] if best else list(planes)
+        say("plane_search", _summary(design["plane_search"]))
+        return design, used
+    if mode == "auto":
+        count = int(settings.get("plane_count", 5))
+        found, s, start = auto(vertices, faces, count, material, settings, progress=say, cancel=cancel)
+        if found:
+            best = found[0]
+            design = best["design"]
+            used = [p.spec() for p in best["planes"]]
+        else:
+            best = None
+            used = [p.spec() for p in family_planes(s, (count - count // 2, count // 2, 0))]
+            design = pipeline.run(vertices, faces, used, material, settings, progress, cancel)
+            if not design["stable"]:
+                design["reason"] += (f"; no proposed set of {count} planes ({s.screened} tried) gives a "
+                                     f"stable design")
+        design["plane_search"] = _record("auto", planes, best or ({"planes": [
+            Placement(p.name, p.origin, p.normal, p.contours) for p in used], "changes": [], "score": None}
+            if design["stable"] else None), s, start)
+        say("plane_search", _summary(design["plane_search"]))
+        return design, used
+    raise ValueError(f'settings.plane_search must be one of {", ".join(MODES)}, got {mode!r}')
+
+
+def _summary(record):
+    what = "; ".join(record["changes"]) or ("the planes as given" if record["planes_after"] else "nothing stable")
+    return (f"{record['mode']}: {what} ({record['candidates']} candidates screened, {record['full_solves']} "
+            f"full solves, {record['seconds']:.2f} s)")
