@@ -23,6 +23,7 @@ from . import optimize
 from .progress import WorkerModal
 
 MAX_CANDIDATES = 3
+UI_BUDGET_SECONDS = 60.0  # the panel's search may take longer than the batch's: Esc stops it
 # What the panel shows: {"scene", "mode", "candidates": [...], "message"} of the last search, or None.
 RESULT = None
 
@@ -79,11 +80,11 @@ class SearchJob(WorkerJob):
         try:
             if self.mode == "nearby":
                 self.found, self.searched, _ = plane_search.nearby(
-                    self.V, self.F, self.planes, self.material, self.settings, MAX_CANDIDATES,
+                    self.V, self.F, self.planes, self.material, self.settings, MAX_CANDIDATES, UI_BUDGET_SECONDS,
                     progress=self._progress, cancel=self.cancel_event.is_set)
             else:
                 self.found, self.searched, _ = plane_search.auto(
-                    self.V, self.F, self.count, self.material, self.settings, MAX_CANDIDATES,
+                    self.V, self.F, self.count, self.material, self.settings, MAX_CANDIDATES, UI_BUDGET_SECONDS,
                     progress=self._progress, cancel=self.cancel_event.is_set)
         except pipeline.Cancelled:
             self.cancelled = True
@@ -292,5 +293,20 @@ class WIRESCULPT_OT_apply_planes(bpy.types.Operator):
         return {'FINISHED'}
 
 
+class WIRESCULPT_OT_find_planes_cancel(bpy.types.Operator):
+    """Stop the running plane search; the scene stays as it was"""
+    bl_idname = "wiresculpt.find_planes_cancel"
+    bl_label = "Cancel"
+    bl_options = {'INTERNAL'}
+
+    def execute(self, context):
+        if JOB is None:
+            self.report({'INFO'}, "Nothing to cancel: no plane search is running")
+            return {'CANCELLED'}
+        JOB.cancel_event.set()  # the modal finishes once the worker has ended
+        self.report({'INFO'}, "Cancelling the plane search…")
+        return {'FINISHED'}
+
+
 register, unregister = classes_factory((WIRESCULPT_OT_find_planes, WIRESCULPT_OT_suggest_planes,
-                                        WIRESCULPT_OT_apply_planes))
+                                        WIRESCULPT_OT_apply_planes, WIRESCULPT_OT_find_planes_cancel))

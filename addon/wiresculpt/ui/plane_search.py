@@ -33,6 +33,7 @@ class VIEW3D_PT_wiresculpt_planes(bpy.types.Panel):
             box.label(text=job.status().replace("wiresculpt: ", ""), icon='SORTTIME')
             for line in job.messages[-2:]:
                 wrap_labels(box, context, line)
+            box.operator(ops.WIRESCULPT_OT_find_planes_cancel.bl_idname, icon='CANCEL')
             return
         result = ops.RESULT
         if result is None or result["scene"] != context.scene.name:
