@@ -29,7 +29,8 @@ buildable, fab/buildability).
 
 Score of a returned candidate (documented in docs/formats.md, higher is better):
 
-    score = coverage - 10 * max_deviation / S          (auto)
+    score = coverage - 10 * max_deviation / S          (auto; a design with two-hand assembly
+                                                        steps ranks after every one without)
     score = -cost                                      (nearby)
 
 coverage: the share of the mesh's vertices within 0.1 S of some wire's contour; max_deviation:
@@ -315,44 +316,59 @@ def _family_names(axes):
     return names
 
 
-def family_planes(searcher, counts, contours="largest"):
-    """Placements for `counts[k]` planes along principal axis k, spread evenly over the mesh's extent
-    (a family of one goes through the centre)."""
+SPREADS = ((0.2, 0.8), (0.3, 0.7), (0.12, 0.88), (0.38, 0.62))  # a family's first and last plane
+
+
+def family_planes(searcher, counts, contours="largest", spread=SPREADS[0], axes=None):
+    """Placements for `counts[k]` planes along axis k of `axes` (default: the principal axes),
+    spread evenly from `spread[0]` to `spread[1]` of the mesh's extent along it (a family of one
+    goes through the centre)."""
     V = np.asarray(searcher.V, dtype=float)
-    names = _family_names(searcher.axes)
+    axes = searcher.axes if axes is None else axes
+    names = _family_names(axes)
     out = []
     for k, count in enumerate(counts):
         if not count:
             continue
-        axis = searcher.axes[k]
+        axis = axes[k]
         t = (V - searcher.centre) @ axis
         lo, hi = float(t.min()), float(t.max())
         for i in range(count):
-            f = 0.5 if count == 1 else 0.2 + 0.6 * i / (count - 1)
+            f = 0.5 if count == 1 else spread[0] + (spread[1] - spread[0]) * i / (count - 1)
             origin = searcher.centre + (lo + f * (hi - lo)) * axis
             out.append(Placement(f"{names[k]}{i}", origin, axis, contours))
     return out
 
 
+def _axis_word(axis, k):
+    j = int(np.argmax(np.abs(axis)))
+    return "xyz"[j] if abs(axis[j]) > 0.99 else f"principal axis {k + 1}"
+
+
 def auto(vertices, faces, count, material, settings, want=2, budget=3 * BUDGET_SECONDS, progress=None, cancel=None):
     """Up to `want` stable, buildable plane sets of `count` planes proposed from the mesh alone,
-    best score first (see the module's docstring), and the Searcher."""
+    best score first (see the module's docstring), and the Searcher. Proposals: every split of
+    `count` over three axes using at least two, every spread of SPREADS, in the principal axes'
+    frame and (when it differs) the world's."""
     s = Searcher(vertices, faces, material, settings, progress, cancel)
     start = time.perf_counter()
     splits = [c for c in itertools.product(range(count + 1), repeat=3) if sum(c) == count
               and sum(1 for x in c if x) >= 2]
+    frames = [s.axes] + ([np.eye(3)] if np.abs(np.abs(s.axes) - np.eye(3)).max() > 1e-6 else [])
     screened = []
     for rule in ("largest", "all"):
-        for counts in splits:
-            placements = family_planes(s, counts, rule)
+        for axes, spread, counts in itertools.product(frames, SPREADS, splits):
+            if time.perf_counter() - start > budget / 2:
+                break
+            placements = family_planes(s, counts, rule, spread, axes)
             ok, design = s.screen(placements)
             if ok:
-                screened.append((s.coverage(design), counts, rule, placements, design))
+                screened.append((s.coverage(design), counts, axes, rule, placements, design))
         if screened:
             break
     screened.sort(key=lambda t: -t[0])
     found = []
-    for cover, counts, rule, placements, design in screened:
+    for cover, counts, axes, rule, placements, design in screened:
         if len(found) >= want or time.perf_counter() - start > budget:
             break
         solved = s.solve(design)
@@ -360,11 +376,13 @@ def auto(vertices, faces, count, material, settings, want=2, budget=3 * BUDGET_S
             continue
         score = cover - FIDELITY_WEIGHT * s.max_deviation(solved) / s.size
         found.append({"planes": placements, "changes": [f"{len(placements)} planes: " + ", ".join(
-            f"{n} along {'xyz'[int(np.argmax(np.abs(s.axes[k])))] if abs(s.axes[k]).max() > 0.99 else f'axis {k}'}"
-            for k, n in enumerate(counts) if n)], "cost": 0.0, "score": score, "coverage": cover,
-            "design": solved, "figures": _figures(solved)})
+            f"{n} along {_axis_word(axes[k], k)}" for k, n in enumerate(counts) if n)
+            + ("" if rule == "largest" else ", every contour")],
+            "cost": 0.0, "score": score, "coverage": cover, "design": solved, "figures": _figures(solved)})
         s.say("plane_search", f"candidate {len(found)}: {found[-1]['changes'][0]} (score {score:.3f})")
-    found.sort(key=lambda c: -c["score"])
+    # a design whose assembly needs two wires placed at once (two_hand_steps) comes after every
+    # design that can be built one wire at a time, whatever its score
+    found.sort(key=lambda c: (bool(c["design"].get("two_hand_steps")), -c["score"]))
     return found, s, start
 
 
