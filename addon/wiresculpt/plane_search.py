@@ -159,6 +159,7 @@ class Searcher:
         self.say = progress or (lambda stage, message: None)
         self.cancel = cancel or (lambda: False)
         self.cache = {}
+        self.mesh_info = None  # the slicer's report on the mesh (stages.slicing.mesh), from its first call
         self.screened = self.full_solves = 0
         self.centre, self.axes, self.size = mesh_frame(vertices, faces)
         self.sample = np.asarray(vertices, dtype=float)
@@ -168,8 +169,9 @@ class Searcher:
     def _contours(self, placement):
         key = placement.key()
         if key not in self.cache:
-            found, _ = slicing.slice_planes(self.V, self.F, [placement.spec()], self.settings.get("weld_tolerance"))
+            found, info = slicing.slice_planes(self.V, self.F, [placement.spec()], self.settings.get("weld_tolerance"))
             self.cache[key] = found[0]
+            self.mesh_info = self.mesh_info or info
         return self.cache[key]
 
     def settings_for(self, design):
@@ -183,16 +185,21 @@ class Searcher:
         from .core import contours as rules
         from .core.design import new_design, wire_entry
 
+        began = time.perf_counter()
         design = new_design(self.material, self.settings)
+        contours = 0
         for p in placements:
             found = self._contours(p)
             if not found:
                 return None  # a change that removes a plane's wire is no answer
+            contours += len(found)
             for k in rules.pick(found, p.contours, p.name):
                 c = found[k]
                 design["wires"].append(wire_entry(len(design["wires"]), f"{p.name}/{k}", list(p.origin),
                                                   [float(x) for x in _unit(p.normal)], c["closed"], c["points"]))
-        design["stages"]["slicing"] = {"planes": len(placements), "search": True}
+        # as slicing.run records it (seconds: this design's share, each placement sliced once per search)
+        design["stages"]["slicing"] = {"seconds": time.perf_counter() - began, "planes": len(placements),
+                                       "contours": contours, "mesh": self.mesh_info}
         return design
 
     def screen(self, placements):

@@ -10,6 +10,7 @@ import unittest
 import numpy as np
 
 from wiresculpt import native, pipeline, plane_search
+from wiresculpt.core import design as vocabulary
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.scene import PlaneSpec, parse_scene
 from wiresculpt.core.settings import defaults
@@ -97,6 +98,10 @@ class Nearby(unittest.TestCase):
         d = round_trip(design)
         self.assertTrue(d["stable"], d["reason"])
         self.assertEqual(recheck.recheck(d), [])
+        # the design speaks the design's vocabulary (core/design.py), slicing recorded as slicing.run does
+        self.assertLessEqual(set(d), set(vocabulary.KEYS["top"]))
+        self.assertLessEqual(set(d["stages"]), set(vocabulary.KEYS["stages"]))
+        self.assertEqual(set(d["stages"]["slicing"]), {"seconds", "planes", "contours", "mesh"})
         # the hinge is gone: W crosses a second wire, off the line it turned about
         partners, points = crossing_partners(d, "W/0")
         self.assertGreaterEqual(len(partners), 2)
