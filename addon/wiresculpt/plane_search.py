@@ -204,19 +204,20 @@ class Searcher:
 
     def screen(self, placements):
         """The layering's verdict on the placements (slicing + hook-relaxed check + hook search):
-        (passes, design) ; an input the network refuses (planes that coincide) does not pass."""
+        (passes, the sliced design, whether the layering found crossings too close along a wire for
+        the machine); an input the network refuses (planes that coincide) does not pass."""
         if self.cancel():
             raise pipeline.Cancelled()
         self.screened += 1
         try:
             design = self.sliced(placements)
             if design is None or len(design["wires"]) < 2:
-                return False, design
+                return False, design, False
             probe = copy.deepcopy(design)
             layering.run(probe, self.material, self.settings_for(design))
-            return bool(probe["stable"]), design
+            return bool(probe["stable"]), design, bool(probe.get("close_crossings"))
         except (ValueError, RuntimeError):
-            return False, None
+            return False, None, False
 
     def solve(self, design):
         """The full pipeline on a screened design; the solved design (stable means buildable)."""
@@ -265,52 +266,66 @@ def _record(mode, before, candidate, searcher, start):
 
 def nearby(vertices, faces, planes, material, settings, want=1, budget=BUDGET_SECONDS, progress=None, cancel=None):
     """Up to `want` stable, buildable candidates near `planes`, cheapest change first:
-    [{"planes": [Placement], "changes": [sentence], "cost", "score", "design", "figures"}], and the
-    Searcher (its counts). The given planes themselves are candidate 0 (cost 0)."""
+    [{"planes": [Placement], "changes": [sentence], "cost", "score", "design", "figures"}], the
+    Searcher (its counts) and the start time. The given planes themselves are candidate 0 (cost 0).
+    Order: one-plane changes, then pairs; within each, by cost, except that a screened candidate
+    whose layering reports crossings closer along a wire than the machine's minimum segment
+    (`close_crossings`: the full pipeline mostly fails on them, at a second each) is solved only
+    after the others, and only while it is cheaper than the `want`-th found, so that the answer is
+    still the cheapest the budget allows."""
     s = Searcher(vertices, faces, material, settings, progress, cancel)
     start = time.perf_counter()
     base = [Placement(p.name, p.origin, _unit(p.normal), p.contours) for p in planes]
     singles = {i: single_changes(p, s.centre, s.size) for i, p in enumerate(planes)}
-    options = [(0.0, ())] + sorted(((c.cost, ((i, c),)) for i, cs in singles.items() for c in cs),
-                                   key=lambda t: t[0])
     found = []
-
-    def consider(changes):
-        placements = list(base)
-        for i, c in changes:
-            placements[i] = c
-        ok, design = s.screen(placements)
-        if not ok:
-            return False
-        solved = s.solve(design)
-        if solved is None or not solved["stable"]:
-            return False
-        cost = sum(c.cost for _, c in changes)
-        found.append({"planes": placements, "changes": [t for _, c in changes for t in c.changes], "cost": cost,
-                      "score": -cost, "design": solved, "figures": _figures(solved)})
-        s.say("plane_search", f"candidate {len(found)}: {'; '.join(found[-1]['changes']) or 'the planes as given'} "
-                              f"(cost {cost:.3f}, {s.screened} screened, {s.full_solves} solved)")
-        return True
 
     def out_of_time():
         return time.perf_counter() - start > budget
 
-    for _cost, changes in options:
-        if len(found) >= want or out_of_time():
-            break
-        consider(changes)
+    def bar():
+        """The cost a candidate must beat to matter: the want-th cheapest found, else infinity."""
+        costs = sorted(c["cost"] for c in found)
+        return costs[want - 1] if len(costs) >= want else math.inf
+
+    def solve(cost, changes, placements, design):
+        solved = s.solve(design)
+        if solved is None or not solved["stable"]:
+            return
+        found.append({"planes": placements, "changes": [t for _, c in changes for t in c.changes], "cost": cost,
+                      "score": -cost, "design": solved, "figures": _figures(solved)})
+        s.say("plane_search", f"candidate {len(found)}: {'; '.join(found[-1]['changes']) or 'the planes as given'} "
+                              f"(cost {cost:.3f}, {s.screened} screened, {s.full_solves} solved)")
+
+    def phase(options):
+        deferred = []
+        for cost, changes in options:
+            if cost >= bar() or out_of_time():
+                break
+            placements = list(base)
+            for i, c in changes:
+                placements[i] = c
+            ok, design, close = s.screen(placements)
+            if not ok:
+                continue
+            if close:
+                deferred.append((cost, changes, placements, design))
+            else:
+                solve(cost, changes, placements, design)
+        for cost, changes, placements, design in deferred:
+            if cost >= bar() or out_of_time():
+                break
+            solve(cost, changes, placements, design)
+
+    phase([(0.0, ())] + sorted(((c.cost, ((i, c),)) for i, cs in singles.items() for c in cs), key=lambda t: t[0]))
     if len(found) < want and not out_of_time():  # pairs of one-plane changes of two planes
         pairs = []
         for i, j in itertools.combinations(sorted(singles), 2):
             for a in singles[i][:12]:
                 for b in singles[j][:12]:
                     pairs.append((a.cost + b.cost, ((i, a), (j, b))))
-        pairs.sort(key=lambda t: t[0])
-        for _cost, changes in pairs:
-            if len(found) >= want or out_of_time():
-                break
-            consider(changes)
-    return found, s, start
+        phase(sorted(pairs, key=lambda t: t[0]))
+    found.sort(key=lambda c: c["cost"])
+    return found[:want], s, start
 
 
 def _family_names(axes):
@@ -368,7 +383,7 @@ def auto(vertices, faces, count, material, settings, want=2, budget=3 * BUDGET_S
             if time.perf_counter() - start > budget / 2:
                 break
             placements = family_planes(s, counts, rule, spread, axes)
-            ok, design = s.screen(placements)
+            ok, design, _close = s.screen(placements)
             if ok:
                 screened.append((s.coverage(design), counts, axes, rule, placements, design))
         if screened:
