@@ -56,6 +56,7 @@ def main(argv):
     parser.add_argument("names", nargs="*")
     args = parser.parse_args(argv)
     folder = os.path.join(args.cache, "scenes")
+    counts = [int(c) for c in args.counts.split(",") if c.strip()]  # --counts "": nearby only
     rows = []
     for name in sorted(os.listdir(folder)):
         mesh, config, size = name[:-5].rsplit("-", 2)
@@ -65,7 +66,7 @@ def main(argv):
         V, F, factor = mesh_of(scene)
         planes = [PlaneSpec(p.name, tuple(factor * c for c in p.origin), p.normal, p.contours) for p in scene.planes]
         row = {"mesh": mesh, "off": one(V, F, planes, scene), "nearby": one(V, F, planes, scene, plane_search="nearby")}
-        for n in (int(c) for c in args.counts.split(",")):
+        for n in counts:
             row[f"auto{n}"] = one(V, F, [], scene, plane_search="auto", plane_count=n)
         rows.append(row)
         print(json.dumps(row)[:600], flush=True)
@@ -73,8 +74,8 @@ def main(argv):
         with open(args.out, "w") as f:
             json.dump(rows, f, indent=1)
     print("\n| mesh | given planes | nearby | nearby s (screened / solved) | " +
-          " | ".join(f"auto N={n}" for n in args.counts.split(",")) + " |")
-    print("|---|---|---|---|" + "---|" * len(args.counts.split(",")))
+          " | ".join(f"auto N={n}" for n in counts) + " |")
+    print("|---|---|---|---|" + "---|" * len(counts))
 
     def verdict(r):
         if r["stable"]:
@@ -84,7 +85,7 @@ def main(argv):
         nb = row["nearby"]
         change = "; ".join(nb.get("changes") or []) if nb["stable"] else nb["reason"][-90:]
         autos = " | ".join(f"{verdict(row[f'auto{n}'])} ({row[f'auto{n}']['seconds']:.1f} s)"
-                           for n in args.counts.split(","))
+                           for n in counts)
         print(f"| {row['mesh']} | {verdict(row['off'])} | {verdict(nb)}: {change} | {nb['seconds']:.1f} "
               f"({nb.get('candidates', '-')} / {nb.get('full_solves', '-')}) | {autos} |")
 
