@@ -18,7 +18,8 @@ Two searches:
 - `auto(...)`: planes from the mesh alone: `count` planes in families along the mesh's principal
   axes (area-weighted), each family spread evenly over the mesh's extent along its axis (one plane
   of a family goes through the centre: the mesh's symmetry plane when it has one). Candidates are
-  the ways to split `count` over the three axes (at least two families), ranked by coverage.
+  the ways to split `count` over the three axes (at least two families), each with four spreads
+  (SPREADS), in the principal frame and the world's, solved in order of coverage.
 
 Every candidate is screened cheaply first: slicing (each plane placement sliced once, cached) and
 the layering (stages.layering), whose first step is the hook-relaxed stability check (every

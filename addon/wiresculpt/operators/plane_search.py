@@ -51,7 +51,7 @@ def gather(context, need_planes=True):
     return V, F, planes, material_of(ws), solver_settings(ws)
 
 
-def describe(candidate, scene):
+def describe(candidate):
     """The candidate's figures as one line for the panel."""
     f = candidate["figures"]
     load = "n/a" if f["load_capacity"] is None else f"{f['load_capacity']:.1f}x weight"

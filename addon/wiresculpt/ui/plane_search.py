@@ -10,7 +10,7 @@ from .panel import VIEW3D_PT_wiresculpt, wrap_labels
 
 def candidate_lines(candidate):
     """What the panel says of a candidate: its changes (or the planes' families) and its figures."""
-    return (candidate["changes"] or ["the planes as they are"]) + [ops.describe(candidate, None)]
+    return (candidate["changes"] or ["the planes as they are"]) + [ops.describe(candidate)]
 
 
 class VIEW3D_PT_wiresculpt_planes(bpy.types.Panel):
