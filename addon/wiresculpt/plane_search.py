@@ -161,7 +161,9 @@ class Searcher:
         self.cancel = cancel or (lambda: False)
         self.cache = {}
         self.mesh_info = None  # the slicer's report on the mesh (stages.slicing.mesh), from its first call
-        self.screened = self.full_solves = 0
+        self.screened = self.full_solves = self.timed_out = 0
+        self.deadline = math.inf  # perf_counter() time at which a full solve is stopped (the budget)
+        self.budget = None  # seconds
         self.centre, self.axes, self.size = mesh_frame(vertices, faces)
         self.sample = np.asarray(vertices, dtype=float)
         if len(self.sample) > 4000:
@@ -221,10 +223,18 @@ class Searcher:
             return False, None, False
 
     def solve(self, design):
-        """The full pipeline on a screened design; the solved design (stable means buildable)."""
+        """The full pipeline on a screened design; the solved design (stable means buildable), or
+        None when it fails or runs past the search's deadline (a solve is stopped there, like a
+        cancel, so the budget holds however long one solve would take)."""
         self.full_solves += 1
         try:
-            return pipeline.solve(design, self.material, self.settings_for(design), cancel=self.cancel)
+            return pipeline.solve(design, self.material, self.settings_for(design),
+                                  cancel=lambda: self.cancel() or time.perf_counter() > self.deadline)
+        except pipeline.Cancelled:
+            if self.cancel():
+                raise
+            self.timed_out += 1
+            return None
         except (ValueError, RuntimeError):
             return None
 
@@ -258,6 +268,7 @@ def _record(mode, before, candidate, searcher, start):
             "planes_after": [p.as_dict() for p in candidate["planes"]] if candidate else [],
             "changes": candidate["changes"] if candidate else [],
             "candidates": searcher.screened, "full_solves": searcher.full_solves,
+            "budget_seconds": searcher.budget, "solves_stopped": searcher.timed_out,
             "seconds": time.perf_counter() - start, "score": candidate["score"] if candidate else None,
             "measure": ("cost = sum of |offset| / model size + tilt in radians + 0.05 per contour-rule change; "
                         "score = -cost" if mode == "nearby" else
@@ -276,6 +287,7 @@ def nearby(vertices, faces, planes, material, settings, want=1, budget=BUDGET_SE
     still the cheapest the budget allows."""
     s = Searcher(vertices, faces, material, settings, progress, cancel)
     start = time.perf_counter()
+    s.deadline, s.budget = start + budget, budget
     base = [Placement(p.name, p.origin, _unit(p.normal), p.contours) for p in planes]
     singles = {i: single_changes(p, s.centre, s.size) for i, p in enumerate(planes)}
     found = []
@@ -375,6 +387,7 @@ def auto(vertices, faces, count, material, settings, want=2, budget=3 * BUDGET_S
     frame and (when it differs) the world's."""
     s = Searcher(vertices, faces, material, settings, progress, cancel)
     start = time.perf_counter()
+    s.deadline, s.budget = start + budget, budget
     splits = [c for c in itertools.product(range(count + 1), repeat=3) if sum(c) == count
               and sum(1 for x in c if x) >= 2]
     frames = [s.axes] + ([np.eye(3)] if np.abs(np.abs(s.axes) - np.eye(3)).max() > 1e-6 else [])
@@ -431,7 +444,9 @@ def run(vertices, faces, planes, material, settings, progress=None, cancel=None)
             best = None
             design["reason"] += (f"; no nearby placement ({s.screened} tried: offsets up to "
                                  f"{OFFSETS[-1] * 100:g} % of the model size, tilts up to {TILTS_DEG[-1]:g} deg, "
-                                 f"contour rules, one or two planes at a time) gives a stable design")
+                                 f"contour rules, one or two planes at a time) gives a stable design"
+                                 + (f" within the search's {s.budget:g} s budget" if time.perf_counter() - start > s.budget
+                                    else ""))
         design["plane_search"] = _record("nearby", planes, best, s, start)
         used = [p.spec() for p in best["planes"]] if best else list(planes)
         say("plane_search", _summary(design["plane_search"]))

@@ -3,6 +3,7 @@ known by hand: the planes z = c1 and x = c2 (c in units of the radius) cut circl
 c1^2 + c2^2 < 1, and a plane at distance c from the centre along (1, 1, 0)/sqrt2 meets y = 0 iff
 c < 1/sqrt2 and z = 0.7 iff c^2 < 0.51. Every stable design found is re-checked by
 blender_tests/pure/recheck.py (numpy/scipy only, no solver code), after a JSON round trip."""
+import copy
 import json
 import math
 import unittest
@@ -168,6 +169,20 @@ class Nearby(unittest.TestCase):
         self.assertEqual(design["plane_search"]["score"], 0.0)
         self.assertEqual([(p.origin, p.normal) for p in used],
                          [(tuple(float(c) for c in p.origin), tuple(float(c) for c in p.normal)) for p in BASE])
+
+    def test_a_solve_past_the_budget_is_stopped_and_a_cancel_still_cancels(self):
+        s = plane_search.Searcher(self.V, self.F, PRESETS["steel"], settings())
+        placements = [plane_search.Placement(p.name, p.origin, p.normal, p.contours) for p in BASE]
+        ok, design, _close = s.screen(placements)
+        self.assertTrue(ok)  # the base is stable (test_the_scenes_are_what_the_hand_says)
+        s.deadline = 0.0  # long past: the solve stops at its first check
+        self.assertIsNone(s.solve(copy.deepcopy(design)))
+        self.assertEqual((s.full_solves, s.timed_out), (1, 1))
+        s.deadline = math.inf
+        self.assertTrue(s.solve(copy.deepcopy(design))["stable"])
+        s.cancel = lambda: True
+        with self.assertRaises(pipeline.Cancelled):
+            s.solve(copy.deepcopy(design))
 
     def test_off_is_the_pipeline(self):
         design, used = plane_search.run(self.V, self.F, HINGE, PRESETS["steel"], settings())
