@@ -168,7 +168,7 @@ def run(argv):
     import bpy
     import numpy as np
 
-    from wiresculpt import native, pipeline
+    from wiresculpt import native, plane_search
     from wiresculpt.core.design import write_design
     from wiresculpt.core.meshcheck import check_output_folder, check_vertices
     from wiresculpt.core.staging import staged
@@ -200,7 +200,8 @@ def run(argv):
     profile = machine_profile(scene, args, say)  # refused before the long work when it is wrong
     stock = None if profile is None else (float(profile.get("stock_length", STOCK_LENGTH)),
                                           profile.get("name") or "the machine profile")
-    design = pipeline.run(V, F, planes, scene.material, scene.settings, say, stock=stock)
+    # settings.plane_search "off" is pipeline.run; "nearby"/"auto" return the planes actually used
+    design, planes = plane_search.run(V, F, planes, scene.material, scene.settings, say, stock=stock)
     # Everything is written into a hidden folder first and replaces the earlier run's outputs
     # only when all of it is there: a failure half-way leaves the earlier set as it was.
     with staged(args.out, OUTPUTS) as folder:
