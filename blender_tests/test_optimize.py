@@ -272,6 +272,12 @@ class OptimizeGlobe(Case):
                 self.assertIn(f"step_{k + 1:02d}.png", text)
             self.assertIn("Step 1: hold", text)
             self.assertTrue("passes" in text, text)
+            # how to close each loop: the gap between the rest shape's two ends, in mm and % of
+            # the wire's length, a sleeve up to 5% of it, else an overlap
+            for w in design["wires"]:
+                gap = math.dist(w["rest"][0], w["rest"][-1])
+                self.assertIn(f"stand {gap * 1000:.1f} mm apart ({100 * gap / w['length']:.1f}% of its length)", text)
+                self.assertIn("with a sleeve" if gap <= 0.05 * w["length"] else "with an overlap", text)
             self.assertFalse([n for n in os.listdir(folder) if n.endswith(".tmp") or n.startswith(".")])
         self.assertEqual(snapshot(), before, "rendering the guide must put the scene back")
 
@@ -364,6 +370,29 @@ class ReportText(unittest.TestCase):
         self.assertEqual(lines.shape, (6, 3))
         self.assertLess(lines[1][2], lines[0][2])  # the arrow points along the force
         self.assertIsNone(overlay.force_arrows(d, shown={0}))  # wire 1 not yet added
+
+    def test_closure_deflection_and_torque_rows(self):
+        d = self.design()
+        self.assertEqual(results_ui.wire_rows(d), [])
+        self.assertIsNone(results_ui.torque_text(d))
+        d["wires"][0].update(closed=True, closure_gap=0.116, length=0.785, out_of_plane_deflection=0.00125,
+                             out_of_plane_deflection_vertex=1, target=[[0, 0, 0], [1, 0, 0]])
+        d["wires"][1].update(out_of_plane_deflection=0.003, out_of_plane_deflection_vertex=0,
+                             target=[[0, 1, 0], [1, 1, 0]])
+        self.assertEqual(results_ui.wire_rows(d), [("A/0", "116.0 mm (14.8% of its length)", "1.25 mm"),
+                                                   ("B/0", None, "3.00 mm")])
+        d.update(stages={"forces": {}}, torque_fraction=0.0617,
+                 load_factor={"asked": 3.0, "reached": 3.0, "at_plastic_limit": 48.6, "weakest": "-x",
+                              "limited": False})
+        self.assertEqual(results_ui.torque_text(d), "Torque fraction 0.062 (load factor 3: holds 3.00x its weight)")
+        # whiskers: along the plane normal, 10x the deflection, red over 2 mm
+        whiskers = overlay.deflection_whiskers(d)
+        self.assertEqual(sorted(whiskers), [False, True])
+        blue, red = whiskers[False], whiskers[True]
+        self.assertEqual(blue.shape, (2, 3))
+        self.assertAlmostEqual(float(blue[1][2] - blue[0][2]), 0.0125, places=6)  # A/0: normal z
+        self.assertAlmostEqual(float(red[1][0] - red[0][0]), 0.03, places=6)     # B/0: normal x
+        self.assertEqual(overlay.deflection_whiskers(d, shown={0}).keys(), {False})
 
 
 class Panels(Case):

@@ -9,6 +9,7 @@ here, prose included, so every number in it comes from the measurements; do not 
 import argparse
 import datetime
 import json
+import re
 import math
 import os
 import platform
@@ -602,8 +603,26 @@ def main(argv=None):
         data["paper_table2"] = PAPER
         plot(data, args.plot or os.path.join(docs, "images", "performance.png"))
     write_atomic(os.path.join(docs, "performance.json"), json.dumps(data, indent=1) + "\n")
-    write_atomic(os.path.join(docs, "performance.md"), markdown(data))
+    text = markdown(data)
+    write_atomic(os.path.join(docs, "performance.md"), text + kept_sections(os.path.join(docs, "performance.md"), text))
     print(console_table(data))
+
+
+KEPT = re.compile(r"<!-- (\w+):begin -->.*?<!-- \1:end -->\n", re.S)
+
+
+def kept_sections(path, text):
+    """The sections of the earlier report that other runs write between `<!-- NAME:begin -->` and
+    `<!-- NAME:end -->` (the plane assistant's corpus table, scripts/plane_search_corpus.py), which
+    this report does not make: kept as they were, after it. The corpus section is put back by
+    scripts/corpus.py from docs/corpus.json."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            old = f.read()
+    except OSError:
+        return ""
+    return "".join("\n" + m.group(0) for m in KEPT.finditer(old)
+                   if m.group(1) != "corpus" and f"<!-- {m.group(1)}:begin -->" not in text)
 
 
 if __name__ == "__main__":

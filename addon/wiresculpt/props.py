@@ -44,8 +44,9 @@ def _setting(key, name, **kw):
     elif unit == "m":
         kw.update(subtype='DISTANCE', unit='LENGTH', default=default, min=low, max=high)
         text += " (metres)"
-    else:
-        kw.update(default=default, min=low, max=high, subtype='FACTOR')
+    else:  # no default in the table (chosen by the solver): the property starts at its maximum
+        kw.update(default=high if default is None else default, min=low, max=high,
+                  subtype='FACTOR' if high <= 1.0 else 'NONE')
     return FloatProperty(name=name, description=text, **kw)
 
 
@@ -79,7 +80,7 @@ def material_of(settings):
         name = str(settings.id_data.get(MATERIAL_NAME_KEY, "custom"))
         return {"name": name, "wire_diameter": d, "bending_stiffness": _f(settings.bending_stiffness),
                 "max_torque": _f(settings.max_torque), "friction": _f(settings.friction),
-                "density": _f(settings.density)}
+                "density": _f(settings.density), "shear_modulus": _f(settings.shear_modulus)}
     out = dict(materials.PRESETS[settings.material_preset])
     ratio = d / out["wire_diameter"]
     out["bending_stiffness"] *= ratio ** 4
@@ -102,6 +103,8 @@ def solver_settings(settings):
             out[key] = bool(value) if unit == "bool" else int(value)
         else:
             out[key] = _f(math.degrees(value) if unit == "deg" else value)
+    if settings.use_load_factor:  # the solver picks the least torque fraction that holds it
+        out["torque_fraction"] = None
     if out["min_bend_deg"] >= out["max_bend_deg"]:
         raise ValueError("the smallest bend must be smaller than the largest bend (Machine settings)")
     return out
@@ -109,7 +112,7 @@ def solver_settings(settings):
 
 # core/settings.py keys shown in the panel (weld_tolerance stays automatic)
 SETTING_PROPS = ("min_segment", "max_bend_deg", "min_bend_deg", "contact_angle_deg", "torque_fraction",
-                 "in_plane_tiebreak", "max_nodes", "relayer_rounds")
+                 "load_factor", "in_plane_tiebreak", "max_nodes", "relayer_rounds")
 ADVANCED_PROPS = ("in_plane_tiebreak", "max_nodes", "relayer_rounds")  # the panel's Advanced box
 
 
@@ -185,6 +188,9 @@ class WiresculptSettings(bpy.types.PropertyGroup):
         "friction", "Friction", "Custom material: friction coefficient between two wires")
     density: _material_field(
         "density", "Density", "Custom material: density, for the sculpture's weight")
+    shear_modulus: _material_field(
+        "shear_modulus", "Shear Modulus",
+        "Custom material: shear modulus G, for the wire's twist in the out-of-plane deflection check")
 
     # machine and solver (core/settings.py)
     min_segment: _setting("min_segment", "Min Segment", precision=4)
@@ -192,6 +198,12 @@ class WiresculptSettings(bpy.types.PropertyGroup):
     min_bend_deg: _setting("min_bend_deg", "Min Bend")
     contact_angle_deg: _setting("contact_angle_deg", "Contact Angle")
     torque_fraction: _setting("torque_fraction", "Torque Fraction")
+    load_factor: _setting("load_factor", "Load Factor", precision=1)
+    use_load_factor: BoolProperty(
+        name="Torque from Load Factor", default=True,
+        description="Use the least torque fraction (pre-stress) whose sculpture holds the load "
+                    "factor times its weight in each of the six directions; off: the torque "
+                    "fraction as set")
     in_plane_tiebreak: _setting("in_plane_tiebreak", "In-Plane Tie-Break")
     max_nodes: _setting("max_nodes", "Max Search Nodes")
     relayer_rounds: _setting("relayer_rounds", "Re-Layering Rounds")

@@ -62,7 +62,7 @@ class BindingInput(unittest.TestCase):
              "material['friction']: expected a number, got str"),
             (lambda: m.forces_and_rest(wires, [], [], {"colour": 1}),
              "material: unknown key 'colour' (expected bending_stiffness, max_torque, friction, wire_diameter, "
-             "density, name)"),
+             "density, shear_modulus, name)"),
             (lambda: m.forces_and_rest(wires, [], [], {}, {"algorithm": "newton"}),
              "settings['algorithm']: expected one of 'lp_then_slsqp', 'lp', 'slsqp', got 'newton'"),
             (lambda: m.forces_and_rest(wires, [], [], {}, {"max_iterations": 2.5}),

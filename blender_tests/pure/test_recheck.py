@@ -163,13 +163,21 @@ class Globe(unittest.TestCase):
         self.assertTrue(has(R.recheck(d), "crossing 3 (hook"))
 
     def test_hook_flipped_so_the_structure_falls_apart(self):
-        # Crossings 0 and 1 hold the Equator and Meridian0 with opposite hooks (a pinch); with one
-        # flipped both push the same way and the pair slides along their common line.
-        self.assertEqual(self.design["crossings"][0]["hook"], -self.design["crossings"][1]["hook"])
-        for cid in (0, 1):
-            d = mirror_kink(self.design, cid)
-            problems, _ = R.check_stability(d)
-            self.assertTrue(has(problems, "unstable: wires [0, 1, 2]: cannot carry"), problems)
+        # The globe's hooks are chosen by their forces (docs/method-forces.md §12): the "ellipse"
+        # hooks, under which no single mirrored flip (nor any pair) makes the sculpture fall apart.
+        # Without both crossings between the Equator and Meridian0 (hook 0, no force) those two
+        # hold each other only through Meridian90 and the sculpture cannot carry every load;
+        # without one of them it still stands.
+        pair = [c["id"] for c in self.design["crossings"] if sorted(c["wires"]) == [0, 1]]
+        self.assertEqual(len(pair), 2)
+        d = self.mutated()
+        for cid in pair:
+            d["crossings"][cid].update(hook=0, force=[0.0, 0.0, 0.0])
+        problems, _ = R.check_stability(d)
+        self.assertTrue(has(problems, "unstable: wires [0, 1, 2]: cannot carry"), problems)
+        d = self.mutated()
+        d["crossings"][pair[0]].update(hook=0, force=[0.0, 0.0, 0.0])
+        self.assertEqual(R.check_stability(d)[0], [])
         # a flip that keeps the structure stable is not reported
         problems, _ = R.check_stability(mirror_kink(self.design, 2))
         self.assertEqual(problems, [])
@@ -207,6 +215,31 @@ class Globe(unittest.TestCase):
         d = self.mutated()
         d["crossings"][5]["force"] = (1.5 * np.asarray(d["crossings"][5]["force"])).tolist()
         self.assertTrue(has(R.recheck(d), "contact forces do not balance"))
+
+class Prefixes(unittest.TestCase):
+    """Which assembly states the re-check examines: every prefix of 3 wires and more, or, with
+    assembly_steps, the states that end a step."""
+
+    def checked(self, steps):
+        import recheck as module
+
+        seen = []
+        real = module.carries_all_loads
+        module.carries_all_loads = lambda design, wires, pyramids: seen.append(len(wires))
+        try:
+            design = {"wires": [{"id": i} for i in range(5)], "crossings": [], "assembly_order": [0, 1, 2, 3, 4]}
+            if steps is not None:
+                design["assembly_steps"] = steps
+            self.assertEqual(module.check_stability(design)[0], [])
+        finally:
+            module.carries_all_loads = real
+        return seen
+
+    def test_two_hand_steps_are_one_state(self):
+        self.assertEqual(self.checked(None), [3, 4, 5])
+        self.assertEqual(self.checked([[0, 1], [2], [3], [4]]), [3, 4, 5])
+        self.assertEqual(self.checked([[0, 1], [2, 3], [4]]), [4, 5])
+        self.assertEqual(self.checked([[0, 1, 2], [3, 4]]), [3, 5])
 
 
 if __name__ == "__main__":

@@ -61,6 +61,16 @@ class SceneTest(unittest.TestCase):
         self.assertRefused('planes[0].normal[1]', planes=[{"origin": [0, 0, 0], "normal": [0, 1e308 * 10, 1]}])
         self.assertRefused('settings.min_segment', settings={"min_segment": 0})
 
+    def test_load_factor_and_torque_fraction(self):
+        s = self.parse()
+        self.assertEqual(s.settings["load_factor"], 3.0)
+        self.assertIsNone(s.settings["torque_fraction"])  # chosen by the load factor
+        s = self.parse(settings={"torque_fraction": 0.3, "load_factor": 5})
+        self.assertEqual((s.settings["torque_fraction"], s.settings["load_factor"]), (0.3, 5.0))
+        self.assertRefused('settings.load_factor', settings={"load_factor": 0})
+        self.assertRefused('settings.load_factor', settings={"load_factor": "3"})
+        self.assertRefused('settings.torque_fraction', settings={"torque_fraction": 1.5})
+
     def test_search_knobs(self):
         # FORMATS.md additions: in_plane_tiebreak (bool), max_nodes and relayer_rounds (integers).
         s = self.parse()

@@ -125,11 +125,17 @@ py::dict forces_and_rest_py(const py::object& wire_list, const py::object& cross
                                   field::number("max_torque", o.forces.max_torque),
                                   field::number("friction", o.forces.friction),
                                   field::number("wire_diameter", o.load.wire_diameter),
-                                  field::number("density", o.load.density), field::text("name", material_name)});
+                                  field::number("density", o.load.density),
+                                  field::number("shear_modulus", o.deflection_options.shear_modulus),
+                                  field::text("name", material_name)});
   o.load_capacity = std::find(given.begin(), given.end(), "density") != given.end();
+  o.deflection = std::find(given.begin(), given.end(), "shear_modulus") != given.end();
+  o.deflection_options.wire_diameter = o.load.wire_diameter;
   read_fields(settings, "settings",
               {field::number("torque_fraction", o.forces.torque_fraction), field::number("max_bend", o.rest.max_bend),
                field::number("assembly_weight", o.forces.assembly_weight), field::number("gravity", o.load.gravity),
+               field::number("load_factor", o.load_factor), field::number("tie_tolerance", o.forces.tie_tolerance),
+               field::boolean("least_out_of_plane", o.forces.least_out_of_plane), field::number("deflection_limit", o.deflection_limit),
                field::integer("max_iterations", o.forces.max_iterations),
                field::choice("torque_bound", o.forces.torque_bound,
                              {{"3d", TorqueBound::full_3d}, {"in_plane", TorqueBound::in_plane}}),
@@ -159,12 +165,18 @@ py::dict forces_and_rest_py(const py::object& wire_list, const py::object& cross
     py::list over;
     for (std::size_t i = 0; i < rest.over_bend.size(); ++i)
       over.append(py::dict(py::arg("vertex") = rest.over_bend[i], py::arg("angle_deg") = degrees(rest.over_bend_angle[i])));
-    wires.append(py::dict(py::arg("cut") = r.cuts[w], py::arg("rest") = to_lists(rest.rest),
+    py::dict wire;
+    if (!r.deflections.empty()) {
+      wire["out_of_plane_deflection"] = r.deflections[w].max_out_of_plane;
+      wire["out_of_plane_deflection_vertex"] = r.deflections[w].max_out_of_plane_vertex;
+    }
+    wire.attr("update")(py::dict(py::arg("cut") = r.cuts[w], py::arg("rest") = to_lists(rest.rest),
                           py::arg("rest_angles") = rest.rest_angles, py::arg("target_angles") = rest.target_angles,
                           py::arg("closure_gap") = rest.closure_gap, py::arg("max_torque") = fr.wires[w].max_torque,
                           py::arg("max_torque_vertex") = fr.wires[w].max_torque_vertex,
                           py::arg("max_out_of_plane_torque") = fr.wires[w].max_out_of_plane,
                           py::arg("max_torque_3d") = fr.wires[w].max_torque_3d, py::arg("rest_over_bend") = over));
+    wires.append(wire);
   }
   const py::object load_seconds = r.load_capacity ? py::object(py::float_(r.load_capacity->seconds)) : py::none();
   py::dict forces_stage(
@@ -178,15 +190,26 @@ py::dict forces_and_rest_py(const py::object& wire_list, const py::object& cross
       py::arg("torque_bound") = torque_bound_name(fr.torque_bound), py::arg("load_capacity_seconds") = load_seconds);
   py::dict rest_stage(py::arg("seconds") = r.rest_seconds, py::arg("max_closure_gap") = r.max_closure_gap,
                       py::arg("over_bend") = r.over_bend);
+  if (o.deflection) rest_stage["deflection_seconds"] = r.deflection_seconds;
+  std::vector<std::string> warnings = fr.warnings;
+  warnings.insert(warnings.end(), r.warnings.begin(), r.warnings.end());
   py::dict out_of_plane(py::arg("mean") = fr.mean_out_of_plane, py::arg("max") = fr.max_out_of_plane,
                         py::arg("mean_to_max_force") = fr.mean_out_of_plane_to_max_force,
                         py::arg("max_to_max_force") = fr.max_out_of_plane_to_max_force,
                         py::arg("crossings") = r.hooked_crossings);
+  // +inf (every direction holds any load) is None: JSON has no infinity.
+  auto multiple = [](double m) { return std::isfinite(m) ? py::object(py::float_(m)) : py::object(py::none()); };
+  py::object load_factor = py::none();
+  if (r.load_factor)
+    load_factor = py::dict(py::arg("asked") = r.load_factor->asked, py::arg("reached") = multiple(r.load_factor->reached),
+                           py::arg("at_plastic_limit") = multiple(r.load_factor->at_plastic_limit),
+                           py::arg("weakest") = r.load_factor->weakest, py::arg("limited") = r.load_factor->limited);
   return py::dict(py::arg("crossings") = crossings, py::arg("wires") = wires, py::arg("out_of_plane") = out_of_plane,
+                  py::arg("torque_fraction") = r.torque_fraction, py::arg("load_factor") = load_factor,
                   py::arg("load_capacity") = r.load_capacity ? py::object(load_capacity_dict(*r.load_capacity, in.net))
                                                              : py::object(py::none()),
                   py::arg("stages") = py::dict(py::arg("forces") = forces_stage, py::arg("rest_shape") = rest_stage),
-                  py::arg("warnings") = fr.warnings);
+                  py::arg("warnings") = warnings);
 }
 
 }  // namespace
@@ -201,18 +224,26 @@ wires: [{"name", "origin": 3 floats, "normal": 3 floats, "target": float64 (n, 3
 crossings: [{"wires": (i, j), "vertices": (r, s) into the targets, "hook": -1 | 0 | 1}];
 steps: the assembly, lists of wire ids (G_asm; may be empty);
 material: {"bending_stiffness" N m^2, "max_torque" N m, "friction", "wire_diameter" m,
-"density" kg/m^3 (without it no load capacity), "name" (ignored)};
-settings: {"torque_fraction" (1), "max_bend" rad (2pi/3), "assembly_weight" (0.05),
+"density" kg/m^3 (without it no load capacity), "shear_modulus" Pa (without it no out-of-plane
+deflection), "name" (ignored)};
+settings: {"torque_fraction" (1), "load_factor" (0: off; > 0: the torque fraction is the least
+whose load capacity holds this multiple of the weight in all six directions, capped at 1; needs
+a density; forces_and_rest.hpp), "max_bend" rad (2pi/3), "assembly_weight" (0.05),
 "algorithm" ("lp_then_slsqp" | "lp" | "slsqp"), "gravity" m/s^2 (9.81), "max_iterations",
-"torque_bound" ("3d": |t_v| <= t_max, default | "in_plane": its plane-normal part only)}.
+"torque_bound" ("3d": |t_v| <= t_max, default | "in_plane": its plane-normal part only),
+"least_out_of_plane" (True) and "tie_tolerance" (relative loss of G_stb allowed for it; forces.hpp)}.
 progress(stage, fraction) -> False cancels (raises Cancelled).
 Returns the design document's own keys (docs/formats.md), for the forces stage to copy:
 {"crossings": [{"force": [3] N on wires[0] by wires[1], "normal_force": N, "out_of_plane":
 [share on wires[0], on wires[1]]}], "wires": [{"cut", "rest": [[x, y]] metres in the plane frame,
 "rest_angles", "target_angles" (rad, per rest point), "closure_gap" m, "max_torque" N m,
 "max_torque_vertex", "max_out_of_plane_torque" N m, "max_torque_3d" N m, "rest_over_bend":
-[{"vertex", "angle_deg"}]}], "out_of_plane": {mean, max, mean_to_max_force, max_to_max_force,
-crossings}, "load_capacity": {"weight_N", "length", "+x", "-x", "+y", "-y", "+z", "-z"
+[{"vertex", "angle_deg"}], with a shear modulus "out_of_plane_deflection" m (the 3D frame,
+deflection.hpp; warnings name wires over settings "deflection_limit", m, 0.002) and
+"out_of_plane_deflection_vertex"}], "out_of_plane": {mean, max, mean_to_max_force, max_to_max_force,
+crossings}, "torque_fraction": the fraction used, "load_factor": {"asked", "reached" (the
+weakest multiple held at that fraction), "at_plastic_limit" (at fraction 1; None: unbounded),
+"weakest", "limited" (the plastic limit falls short)} or None, "load_capacity": {"weight_N", "length", "+x", "-x", "+y", "-y", "+z", "-z"
 (multiples of the weight; None when unbounded), "base" (wire names per direction), "status"} or
 None, "stages": {"forces": {seconds, lp_seconds, nlp_seconds, lp_iterations, lp_rounds,
 iterations, working_set_rounds, working_set_rows, method, nlopt_result, g_stb, g_asm,

@@ -85,7 +85,10 @@ void read_settings(py::handle d, NetworkOptions& net, LayeringOptions& lay, Forb
 /// The network in the design document's own keys (docs/formats.md): a wire's points are its
 /// `contour` (with the crossing points inserted); a crossing's indices into those contours are
 /// its `contour_vertices` (`vertices` always indexes the target, set by the target shape).
-py::dict network_dict(const Network& net, const std::vector<int>& hooks, const std::vector<double>& metric) {
+/// `hook_metrics`: e_c (Eq. 2) of hook -1 and of hook +1 (the choices a later stage may weigh
+/// against each other among equal costs, pipeline.hooks_by_forces).
+py::dict network_dict(const Network& net, const std::vector<int>& hooks, const std::vector<double>& metric,
+                      const ContactOptions& contact) {
   py::list wires, crossings, close;
   for (std::size_t w = 0; w < net.wires.size(); ++w) {
     const WireSpec& s = net.wires[w];
@@ -102,7 +105,9 @@ py::dict network_dict(const Network& net, const std::vector<int>& hooks, const s
     }
     crossings.append(py::dict(py::arg("id") = c, py::arg("wires") = pair_wires,
                               py::arg("contour_vertices") = pair_vertices, py::arg("point") = to_list(x.point),
-                              py::arg("hook") = hooks[c], py::arg("metric") = metric[c]));
+                              py::arg("hook") = hooks[c], py::arg("metric") = metric[c],
+                              py::arg("hook_metrics") = py::make_tuple(hook_metric(net, static_cast<int>(c), -1, contact),
+                                                                       hook_metric(net, static_cast<int>(c), 1, contact))));
   }
   for (const CrossingGap& g : net.close_crossings)
     close.append(py::dict(py::arg("wire") = g.wire, py::arg("crossings") = py::make_tuple(g.crossings[0], g.crossings[1]),
@@ -134,7 +139,7 @@ py::dict layering_py(const py::object& wire_list, const py::object& settings, co
   for (const auto& g : net.close_crossings) warnings.append(g.message);
   for (const auto& w : r.warnings) warnings.append(w);
   return py::dict(
-      py::arg("network") = network_dict(net, r.hooks, r.metric), py::arg("hook") = r.hooks, py::arg("metric") = r.metric,
+      py::arg("network") = network_dict(net, r.hooks, r.metric, options.contact), py::arg("hook") = r.hooks, py::arg("metric") = r.metric,
       py::arg("assembly_order") = r.assembly_order, py::arg("steps") = r.steps,
       py::arg("two_hand_steps") = r.two_hand_steps, py::arg("stable") = r.stable, py::arg("reason") = r.reason,
       py::arg("warnings") = warnings,
@@ -194,7 +199,7 @@ unknown keys raise ValueError.
 progress(stage, fraction) -> False cancels (raises _wiresculpt.Cancelled).
 Returns {"network": {"wires": [{id, name, origin, normal, closed, contour [[x, y, z]] (the points
 with the crossing points inserted)}], "crossings": [{id, wires, contour_vertices (indices into
-the wires' contours), point, hook, metric}] (the design document's keys, docs/formats.md), "close_crossings": [...], "min_scale", "size",
+the wires' contours), point, hook, metric, hook_metrics (e_c of hook -1 and of hook +1)}] (the design document's keys, docs/formats.md), "close_crossings": [...], "min_scale", "size",
 "required_size"}, "hook": [-1|0|1 per crossing], "metric": [e_c], "assembly_order": [wire ids],
 "steps": [[ids]], "two_hand_steps": [step indices], "stable": bool, "reason": str,
 "warnings": [str], "objective": {max_metric, null_crossings, sum_metric, unbalanced_in_plane},

@@ -361,8 +361,9 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
   const Eigen::MatrixXd& Nk = problem.normal_rows();
 
   const bool use_lp = options.algorithm != ForceAlgorithm::slsqp;
+  const bool least = options.least_out_of_plane && options.algorithm != ForceAlgorithm::slsqp;
   const bool use_nlp = options.algorithm == ForceAlgorithm::slsqp ||
-                       (options.algorithm == ForceAlgorithm::lp_then_slsqp && problem.weight() > 0 &&
+                       (options.algorithm == ForceAlgorithm::lp_then_slsqp && !least && problem.weight() > 0 &&
                         problem.assembly_matrix().squaredNorm() > 0);
   if (K > 0 && use_lp) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -424,7 +425,48 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
                                                                       : sol.reason) +
                         "); check the material's numbers and the model's size, or report this input");
     for (int j = 0; j < K; ++j) a(j) = std::max(0.0, sol.x[j]);
-    r.method = "lp";
+    if (least) {
+      // Near the optimum: minimise Σ s over s_{h,w} >= |f_h · n_w| (2 per hooked crossing h),
+      // keeping G_stb within tie_tolerance of the optimum and every other row.
+      const int H = K / 4;
+      const double best = problem.normal_weights().dot(a);
+      detail::LinearProgram tie = lp;
+      tie.maximise = false;
+      tie.obj.assign(K + 2 * H, 0.0);
+      for (int i = 0; i < 2 * H; ++i) tie.obj[K + i] = 1.0;
+      tie.col_lo.resize(K + 2 * H, 0.0);
+      tie.col_hi.resize(K + 2 * H, kInf);
+      int next = static_cast<int>(tie.row_lo.size());
+      auto entry = [&](int col, double v) {
+        tie.tri_row.push_back(next);
+        tie.tri_col.push_back(col);
+        tie.tri_val.push_back(v);
+      };
+      for (int j = 0; j < K; ++j) entry(j, problem.normal_weights()(j));
+      tie.row_lo.push_back((1.0 - options.tie_tolerance) * best);
+      tie.row_hi.push_back(kInf);
+      ++next;
+      for (int h = 0; h < H; ++h)
+        for (int w = 0; w < 2; ++w)
+          for (double sign : {1.0, -1.0}) {
+            const Crossing& x = net.crossings[r.column_crossing[4 * h]];
+            const Vec3& n = net.wires[x.wires[w]].plane.normal;
+            for (int q = 0; q < 4; ++q) entry(4 * h + q, -sign * n.dot(problem.pyramid(r.column_crossing[4 * h])[q]));
+            entry(K + 2 * h + w, 1.0);  // s - sign (f·n) >= 0
+            tie.row_lo.push_back(0.0);
+            tie.row_hi.push_back(kInf);
+            ++next;
+          }
+      detail::TorqueBlocks padded{Eigen::MatrixXd::Zero(blocks.A.rows(), K + 2 * H), blocks.c};
+      padded.A.leftCols(K) = blocks.A;
+      std::set<std::pair<int, int>> tie_added = added;
+      const detail::LpSolution tied =
+          detail::solve_lp_with_torque_rows(tie, padded, problem.polytope(), problem.t_max(), tie_added, &r.lp_rounds);
+      r.lp_iterations += tied.iterations;
+      if (tied.status == detail::LpSolution::optimal)
+        for (int j = 0; j < K; ++j) a(j) = std::max(0.0, tied.x[j]);
+    }
+    r.method = least ? "lp+least_out_of_plane" : "lp";
     r.lp_seconds = since(t0);
   }
   report_progress(progress, "forces", 0.5);

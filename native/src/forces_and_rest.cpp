@@ -2,6 +2,11 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "wiresculpt/error.hpp"
 
 namespace wiresculpt {
 
@@ -11,7 +16,41 @@ ForcesAndRestResult forces_and_rest(const Network& net, const std::vector<int>& 
                                     const ProgressFn& progress) {
   ForcesAndRestResult out;
   out.cuts = choose_cuts(net, requested_cuts);
-  out.forces = optimize_forces(net, hooks, steps, out.cuts, options.forces, progress);
+  ForceOptions force_options = options.forces;
+  LoadCapacityOptions load = options.load;
+  load.torque_bound = options.forces.torque_bound;  // the same bound as the forces
+  if (options.load_factor != 0.0) {
+    if (!std::isfinite(options.load_factor) || options.load_factor < 0)
+      throw InputError("load_factor must be a finite multiple of the weight >= 0");
+    if (!(options.min_torque_fraction > 0 && options.min_torque_fraction <= 1))
+      throw InputError("min_torque_fraction must be in (0, 1]");
+    if (!options.load_capacity)
+      throw InputError("the load factor needs the load capacity (a material with a density)");
+    // λ_d(1): the load capacity at the plastic limit; the pre-stress does not enter it (a0 = 0).
+    ForceOptions full = options.forces;
+    full.torque_fraction = 1.0;
+    const ForceProblem problem(net, hooks, steps, out.cuts, full);
+    const LoadCapacityResult at_one =
+        load_capacity(net, out.cuts, problem, Eigen::VectorXd::Zero(problem.columns()), load, progress);
+    LoadFactorResult lf;
+    lf.asked = options.load_factor;
+    lf.at_plastic_limit = std::numeric_limits<double>::infinity();
+    for (const LoadDirection& d : at_one.directions)
+      if (d.multiple < lf.at_plastic_limit) {
+        lf.at_plastic_limit = d.multiple;
+        lf.weakest = d.name;
+      }
+    double f = options.min_torque_fraction;
+    if (std::isfinite(lf.at_plastic_limit)) {
+      const double wanted = lf.at_plastic_limit > 0 ? lf.asked / lf.at_plastic_limit : std::numeric_limits<double>::infinity();
+      lf.limited = wanted > 1.0;
+      f = std::clamp(wanted, options.min_torque_fraction, 1.0);
+    }
+    force_options.torque_fraction = f;
+    out.load_factor = lf;
+  }
+  out.torque_fraction = force_options.torque_fraction;
+  out.forces = optimize_forces(net, hooks, steps, out.cuts, force_options, progress);
 
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t P = net.wires.size();
@@ -29,11 +68,37 @@ ForcesAndRestResult forces_and_rest(const Network& net, const std::vector<int>& 
   }
   for (int h : hooks) out.hooked_crossings += h != 0 ? 1 : 0;
 
+  if (options.deflection) {
+    if (!(std::isfinite(options.deflection_limit) && options.deflection_limit > 0))
+      throw InputError("deflection_limit must be a finite number of metres > 0");
+    const auto d0 = std::chrono::steady_clock::now();
+    DeflectionOptions d = options.deflection_options;
+    d.bending_stiffness = options.rest.bending_stiffness;
+    for (std::size_t w = 0; w < P; ++w) {
+      const int wi = static_cast<int>(w);
+      out.deflections.push_back(wire_deflection(net.wires[w], out.cuts[w], wire_loads(net, hooks, out.forces.forces, wi), d));
+      const double m = out.deflections.back().max_out_of_plane;
+      if (m > options.deflection_limit) {
+        char text[64];
+        std::snprintf(text, sizeof text, "%.2f mm", 1000.0 * m);
+        char limit[32];
+        std::snprintf(limit, sizeof limit, "%g mm", 1000.0 * options.deflection_limit);
+        out.warnings.push_back("wire '" + net.wires[w].name + "' deflects " + text + " out of its plane under its contact forces (at target vertex " +
+                               std::to_string(out.deflections.back().max_out_of_plane_vertex) + "), more than " + limit +
+                               ": lower the torque fraction or the load factor");
+      }
+    }
+    out.deflection_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
+  }
+
   if (options.load_capacity) {
-    LoadCapacityOptions load = options.load;
-    load.torque_bound = options.forces.torque_bound;  // the same bound as the forces
-    const ForceProblem problem(net, hooks, steps, out.cuts, options.forces);
+    const ForceProblem problem(net, hooks, steps, out.cuts, force_options);
     out.load_capacity = load_capacity(net, out.cuts, problem, out.forces.coefficients, load, progress);
+    if (out.load_factor) {
+      out.load_factor->reached = std::numeric_limits<double>::infinity();
+      for (const LoadDirection& d : out.load_capacity->directions)
+        out.load_factor->reached = std::min(out.load_factor->reached, d.multiple);
+    }
   }
   return out;
 }

@@ -618,3 +618,44 @@ TEST_CASE("forces: reported shares and 3D torques agree with a direct computatio
     CHECK(r.wires[w].max_torque_3d >= r.wires[w].max_torque * (1 - 1e-12));
   }
 }
+
+TEST_CASE("forces: least out of plane keeps G_stb within its tolerance and lowers the out-of-plane parts", "[forces][share]") {
+  std::mt19937 rng(47);
+  int tested = 0;
+  for (int attempt = 0; attempt < 200 && tested < 4; ++attempt) {
+    fixtures::HookedNetwork h;
+    if (!fixtures::random_hooked_sphere(rng, attempt, 24, h)) continue;
+    const std::vector<int> cuts = choose_cuts(h.net, std::vector<int>(h.net.wires.size(), -1));
+    ForceOptions o;
+    o.algorithm = ForceAlgorithm::lp;
+    ForceResult plain;
+    try {
+      plain = optimize_forces(h.net, h.hooks, h.steps, cuts, o);
+    } catch (const SolverError&) {
+      continue;
+    }
+    ++tested;
+    INFO("attempt " << attempt);
+    o.algorithm = ForceAlgorithm::lp_then_slsqp;  // the second LP's result is final
+    o.least_out_of_plane = true;
+    const ForceResult least = optimize_forces(h.net, h.hooks, h.steps, cuts, o);
+    CHECK(least.method == "lp+least_out_of_plane");
+    // Σ_k Σ_w |f_k · n_w|, summed here from the forces and the plane normals.
+    auto out_of_plane = [&](const ForceResult& r) {
+      double sum = 0.0;
+      for (std::size_t c = 0; c < h.net.crossings.size(); ++c)
+        for (int w : h.net.crossings[c].wires) sum += std::abs(r.forces[c].dot(h.net.wires[w].plane.normal));
+      return sum;
+    };
+    CHECK(least.g_stb >= (1 - o.tie_tolerance) * plain.g_stb * (1 - 1e-9));
+    CHECK(out_of_plane(least) <= out_of_plane(plain) + 1e-9 * plain.g_stb);
+    CHECK(least.equilibrium_residual < 1e-9);
+    for (const WireTorque& w : least.wires) CHECK(w.max_torque_3d <= least.t_max * (1 + 1e-7));
+    // A zero tolerance keeps the optimum itself.
+    o.tie_tolerance = 0.0;
+    const ForceResult tight = optimize_forces(h.net, h.hooks, h.steps, cuts, o);
+    CHECK(tight.g_stb == Approx(plain.g_stb).epsilon(1e-7));
+    CHECK(out_of_plane(tight) <= out_of_plane(plain) + 1e-9 * plain.g_stb);
+  }
+  CHECK(tested >= 2);
+}

@@ -2,6 +2,8 @@
 // stages called one by one, and its summaries (closure gap, over-bends, loaded crossings) are
 // those of the per-wire results.
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <catch2/catch.hpp>
 #include <random>
 
@@ -72,4 +74,82 @@ TEST_CASE("forces_and_rest: bad input is an input error naming the crossing", "[
   hooks[2] = 3;
   CHECK_THROWS_AS(forces_and_rest(net, hooks, {}, {}), InputError);
   CHECK_THROWS_WITH(forces_and_rest(net, hooks, {}, {}), Catch::Matchers::Contains("crossing 2"));
+}
+
+namespace {
+// The smallest of the six load multiples of `net` at torque fraction `f`, solved on its own:
+// the forces at f, then the load capacity LP (nothing of the load factor's choice is used).
+double weakest_multiple(const fixtures::HookedNetwork& h, const std::vector<int>& cuts, ForcesAndRestOptions o, double f) {
+  o.forces.torque_fraction = f;
+  const ForceResult forces = optimize_forces(h.net, h.hooks, h.steps, cuts, o.forces);
+  LoadCapacityOptions lo = o.load;
+  lo.torque_bound = o.forces.torque_bound;
+  const ForceProblem problem(h.net, h.hooks, h.steps, cuts, o.forces);
+  const LoadCapacityResult lc = load_capacity(h.net, cuts, problem, forces.coefficients, lo);
+  double m = std::numeric_limits<double>::infinity();
+  for (const LoadDirection& d : lc.directions) m = std::min(m, d.multiple);
+  return m;
+}
+}  // namespace
+
+TEST_CASE("forces_and_rest: the load factor picks the least torque fraction that holds it", "[forces][load]") {
+  std::mt19937 rng(43);
+  int tested = 0;
+  for (int attempt = 0; attempt < 200 && tested < 3; ++attempt) {
+    fixtures::HookedNetwork h;
+    if (!fixtures::random_hooked_sphere(rng, attempt, 24, h)) continue;
+    ForcesAndRestOptions o;
+    o.forces.algorithm = ForceAlgorithm::lp;
+    o.load_capacity = true;
+    std::vector<int> requested(h.net.wires.size(), -1);
+    const std::vector<int> cuts = choose_cuts(h.net, requested);
+    double at_one = 0.0;
+    try {
+      at_one = weakest_multiple(h, cuts, o, 1.0);
+    } catch (const SolverError&) {
+      continue;
+    }
+    if (!std::isfinite(at_one) || at_one < 1e-3) continue;
+    ++tested;
+    INFO("attempt " << attempt << ", weakest multiple at the plastic limit " << at_one);
+
+    // Reachable: 40% of what the plastic limit holds.
+    o.load_factor = 0.4 * at_one;
+    const ForcesAndRestResult r = forces_and_rest(h.net, h.hooks, h.steps, requested, o);
+    REQUIRE(r.load_factor.has_value());
+    CHECK_FALSE(r.load_factor->limited);
+    CHECK(r.torque_fraction < 1.0);
+    // Met within 1%, by the design's own load capacity and by an independent solve at its fraction.
+    CHECK(r.load_factor->reached == Approx(o.load_factor).epsilon(0.01));
+    const double held = weakest_multiple(h, cuts, o, r.torque_fraction);
+    CHECK(held >= 0.99 * o.load_factor);
+    CHECK(held <= 1.01 * o.load_factor);
+    // The least: 3% less pre-stress no longer holds it (a search from below, not the formula).
+    CHECK(weakest_multiple(h, cuts, o, 0.97 * r.torque_fraction) < o.load_factor);
+    CHECK(r.forces.t_max == Approx(o.forces.max_torque * r.torque_fraction).epsilon(1e-12));
+
+    // Unreachable: twice what the plastic limit holds: the limit is used, the factor reached is
+    // below the one asked and is what the plastic limit holds.
+    o.load_factor = 2.0 * at_one;
+    const ForcesAndRestResult u = forces_and_rest(h.net, h.hooks, h.steps, requested, o);
+    REQUIRE(u.load_factor.has_value());
+    CHECK(u.load_factor->limited);
+    CHECK(u.torque_fraction == 1.0);
+    CHECK(u.load_factor->reached < u.load_factor->asked);
+    CHECK(u.load_factor->reached == Approx(at_one).epsilon(1e-6));
+
+    // Monotone: a larger factor never asks for less pre-stress.
+    double previous = 0.0;
+    for (double share : {0.1, 0.25, 0.5, 0.75, 1.0, 1.5}) {
+      o.load_factor = share * at_one;
+      const double f = forces_and_rest(h.net, h.hooks, h.steps, requested, o).torque_fraction;
+      CHECK(f >= previous);
+      previous = f;
+    }
+
+    // The load factor needs the load capacity (a density).
+    o.load_capacity = false;
+    CHECK_THROWS_WITH(forces_and_rest(h.net, h.hooks, h.steps, requested, o), Catch::Matchers::Contains("load factor"));
+  }
+  CHECK(tested >= 2);
 }

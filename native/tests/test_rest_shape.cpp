@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "wire_fixtures.hpp"
 #include "wiresculpt/error.hpp"
 #include "wiresculpt/rest_shape.hpp"
 
@@ -164,11 +165,7 @@ TEST_CASE("rest: an independent cantilever (finite differences) checks the stiff
   for (int step = 1; step <= 8; ++step) phi = c.solve(P * step / 8, phi);
   const std::vector<Vec3> x = c.nodes(phi);
   REQUIRE(-x.back().y() > 0.25 * c.L);
-  WireSpec w;
-  w.name = "cantilever";
-  w.plane = Plane::make(Vec3::Zero(), Vec3::UnitZ());
-  w.closed = false;
-  w.points = x;
+  const WireSpec w = fixtures::flat_wire("cantilever", x);
   RestShapeOptions o;
   o.bending_stiffness = c.kb;
   const RestShapeResult r = rest_shape(w, -1, {{c.N, Vec3(0, -P, 0)}}, o);

@@ -52,6 +52,16 @@ inline std::vector<Vec3> circle_meets(const Cut& a, const Cut& b, double R) {
 
 /// The circle of `cut` on the sphere as a closed polyline of n uniform angles (starting at
 /// `phase`), plus the given extra points (which must lie on the circle) inserted in angle order.
+/// A wire named `name` through `points` in the plane z = 0 (normal +z), open unless `closed`.
+inline WireSpec flat_wire(const std::string& name, const Polyline3& points, bool closed = false) {
+  WireSpec w;
+  w.name = name;
+  w.plane = Plane::make(Vec3::Zero(), Vec3::UnitZ());
+  w.points = points;
+  w.closed = closed;
+  return w;
+}
+
 inline WireSpec circle_wire(const Cut& cut, double R, int n, const std::vector<Vec3>& extra = {},
                             double phase = 0.0) {
   const Plane plane = Plane::make(cut.offset * cut.normal, cut.normal);

@@ -60,7 +60,7 @@ def use_material(scene, m):
     else:
         ws.material_preset = 'CUSTOM'
         ws.wire_diameter = m["wire_diameter"]
-        for key in ("bending_stiffness", "max_torque", "friction", "density"):
+        for key in ("bending_stiffness", "max_torque", "friction", "density", "shear_modulus"):
             if key in m:
                 setattr(ws, key, m[key])
     scene[MATERIAL_NAME_KEY] = m["name"]

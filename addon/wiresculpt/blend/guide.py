@@ -13,6 +13,7 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
+from ..core import closure
 from ..core.design import crossing_direction
 from ..core.files import write_atomic
 from . import results
@@ -248,6 +249,9 @@ def page_html(design, pictures):
         if w.get("closed") and isinstance(w.get("cut"), int) and 0 <= w["cut"] < len(target):
             mm = ", ".join(f"{AXES[k]} {round(1000 * target[w['cut']][k]) or 0}" for k in range(3))
             text += f"; its two ends meet at ({mm} mm): join them there"
+            advice = closure.closure_advice(w, mat["wire_diameter"])
+            if advice is not None:
+                text += f" with {'a sleeve' if advice[0] == 'sleeve' else 'an overlap'}: {html.escape(advice[1])}"
         items.append(f"<li>{text}</li>")
     parts.append("<p>Wires:</p><ul>" + "".join(items) + "</ul>")
     for k, picture in enumerate(pictures):

@@ -29,7 +29,8 @@ VERSION = 1
 # answers when there are fewer than two wires; layering.recheck_verdict after a later stage nulls
 # crossings; fab/buildability.apply, through the pipeline, when a wire's bend program cannot be
 # made: "stable" means buildable). A crossing's `hook` and `metric` are the layering's; the target shape sets both to
-# 0 for a crossing it cannot realise.
+# 0 for a crossing it cannot realise. `torque_fraction` is the settings' (null when the load
+# factor chooses it) until the forces stage writes the fraction it used.
 KEYS = {
     "top": {
         "format": "design", "version": "design", "units": "design", "material": "design",
@@ -39,8 +40,8 @@ KEYS = {
         "crossings": "layering", "assembly_order": "layering", "assembly_steps": "layering",
         "two_hand_steps": "layering", "close_crossings": "layering", "required_size": "layering",
         "search_incomplete": "layering",
-        "out_of_plane": "forces", "load_capacity": "forces", "buildability": "pipeline",
-        "fabrication": "fabrication",
+        "out_of_plane": "forces", "load_capacity": "forces", "load_factor": "forces", "buildability": "pipeline",
+        "fabrication": "fabrication", "plane_search": "plane_search",
     },
     "wire": {
         "id": "slicing", "name": "slicing", "plane": "slicing", "closed": "slicing", "contour": "slicing",
@@ -49,26 +50,27 @@ KEYS = {
         "cut": "forces", "rest": "forces", "rest_angles": "forces", "target_angles": "forces",
         "closure_gap": "forces", "max_torque": "forces", "max_torque_vertex": "forces",
         "max_out_of_plane_torque": "forces", "max_torque_3d": "forces", "rest_over_bend": "forces",
+        "out_of_plane_deflection": "forces", "out_of_plane_deflection_vertex": "forces",
         "cut_override": "user", "cut_point": "user",
     },
     "crossing": {
         "id": "layering", "wires": "layering", "contour_vertices": "layering", "point": "layering",
-        "hook": "layering", "metric": "layering",
+        "hook": "layering", "metric": "layering", "hook_metrics": "layering",
         "vertices": "target_shape",
         "force": "forces", "normal_force": "forces", "out_of_plane": "forces",
     },
     "stages": {
         "slicing": "slicing", "layering": "layering", "target_shape": "target_shape",
-        "forces": "forces", "rest_shape": "forces", "relayering": "pipeline",
+        "forces": "forces", "rest_shape": "forces", "hook_search": "pipeline", "relayering": "pipeline",
     },
 }
 
 # Keys written only in some cases (a stage that ran may leave them out): close crossings, a
 # material without density, a user's cut, the batch's exports.
 OPTIONAL = {
-    "top": {"close_crossings", "required_size", "load_capacity", "fabrication", "warnings", "buildability",
-            "search_incomplete"},
-    "wire": {"cut_override", "cut_point"},
+    "top": {"close_crossings", "required_size", "load_capacity", "load_factor", "fabrication", "warnings",
+            "buildability", "search_incomplete", "plane_search"},
+    "wire": {"cut_override", "cut_point", "out_of_plane_deflection", "out_of_plane_deflection_vertex"},
     "crossing": set(),
     "stages": set(),
 }

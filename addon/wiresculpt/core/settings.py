@@ -9,8 +9,12 @@ SETTINGS = {
     "min_bend_deg": (1.0, 0.0, 45.0, "deg", "Smallest bend the machine makes reliably"),
     "contact_angle_deg": (120.0, 30.0, 175.0, "deg",
                           "Angle between a wire's two edges at an interlocked crossing (the kink)"),
-    "torque_fraction": (1.0, 0.01, 1.0, "",
-                        "Share of the wire's plastic-limit torque the design may use"),
+    "torque_fraction": (None, 0.01, 1.0, "",
+                        "Share of the wire's plastic-limit torque the design may use (default: the "
+                        "least that holds the load factor)"),
+    "load_factor": (3.0, 0.1, 1000.0, "",
+                    "Times its own weight the sculpture should hold in each of the six directions; "
+                    "the least pre-stress (torque fraction) that does so is used"),
     "weld_tolerance": (None, 0.0, 0.01, "m",
                        "Mesh vertices closer than this are merged (default: 1e-7 of the mesh size)"),
     # the layering's search knobs (docs/method-layering.md); unit "bool" / "int": not a number of
@@ -24,7 +28,18 @@ SETTINGS = {
     "relayer_rounds": (8, 0, 100, "int",
                        "How many times to layer again after the target shape could not realise a hook, "
                        "with that hook forbidden (0: layer once)"),
+    "max_solve_seconds": (600.0, 0.001, 86400.0, "s",
+                          "Wall-clock budget of one solve, every stage and round included; past it the "
+                          "solve stops with a message naming this key"),
+    # the plane assistant (issue 15, plane_search.py); unit "choice": one of CHOICES[key]
+    "plane_search": ("off", None, None, "choice",
+                     "off: the planes as given; nearby: when they give no stable design, the least change "
+                     "of them that does; auto: planes proposed from the mesh alone (\"planes\" may be [])"),
+    "plane_count": (5, 2, 12, "int", "How many planes plane_search \"auto\" proposes"),
 }
+
+# the allowed values of the "choice" keys
+CHOICES = {"plane_search": ("off", "nearby", "auto")}
 
 # the keys whose values are not floats
 BOOLEAN = tuple(k for k, spec in SETTINGS.items() if spec[3] == "bool")

@@ -11,7 +11,9 @@ and out-of-plane bending and twist together; bounded by t_max, stages.forces.tor
 `load_capacity` (weight_N and the multiple of it the sculpture holds with gravity along each
 axis direction; absent when the material has no density), `out_of_plane` statistics (mean and max of
 the shares; mean_to_max_force and max_to_max_force: |f.n| over the largest |f|, the paper's measure),
-`stages.forces` and `stages.rest_shape`. Only computed values are written.
+`stages.forces` and `stages.rest_shape`; `torque_fraction` (the one used) and, when the load
+factor chose it, `load_factor` ({asked, reached, at_plastic_limit, weakest, limited}). Only
+computed values are written.
 
 A user's cut for a closed wire may be given as the wire's `cut_override` (index into `target`,
 the batch scene's settings.cuts), validated by the solver (a ValueError names the wire), or as a
@@ -49,6 +51,30 @@ def requested_cut(design, wire):
     return -1
 
 
+def torque_choice(material, settings, design):
+    """(torque fraction, load factor) for the solver: an explicit settings.torque_fraction with no
+    load factor (0); otherwise the load factor, from which the solver picks the least fraction
+    that holds it (docs/method-forces.md §10). Without a density there is no weight to hold: the
+    plastic limit (fraction 1), with a warning."""
+    if settings.get("torque_fraction") is not None:
+        return settings["torque_fraction"], 0.0
+    if "density" not in material:
+        design.setdefault("warnings", []).append(
+            f"the material has no density, so the sculpture's weight and the load factor "
+            f"{settings['load_factor']:g} cannot be used; the full plastic-limit torque is (torque fraction 1)")
+        return 1.0, 0.0
+    return 1.0, settings["load_factor"]
+
+
+def load_factor_warnings(load_factor, fraction):
+    """A warning when even the plastic limit cannot hold the load factor asked."""
+    if not load_factor["limited"]:
+        return []
+    return [f"load factor {load_factor['asked']:g} not reached: at the plastic limit (torque fraction "
+            f"{fraction:g}) the sculpture holds {load_factor['reached']:.2f}x its weight in its weakest "
+            f"direction ({load_factor['weakest']})"]
+
+
 def _inputs(design):
     wires = [{"name": w["name"], "origin": w["plane"]["origin"], "normal": w["plane"]["normal"],
               "target": np.asarray(w["target"], dtype=np.float64), "closed": w["closed"],
@@ -63,12 +89,16 @@ def run(design, material, settings, native_progress=None):
     """Computes forces, rest shapes and load capacity into `design`. Returns the forces stage's
     progress line; rest_summary(design) gives the rest-shape stage's."""
     wires, crossings = _inputs(design)
-    mat = {k: material[k] for k in ("bending_stiffness", "max_torque", "friction", "wire_diameter", "density")
-           if k in material}
-    options = {"torque_fraction": settings["torque_fraction"], "max_bend": math.radians(settings["max_bend_deg"]),
+    mat = {k: material[k] for k in ("bending_stiffness", "max_torque", "friction", "wire_diameter", "density",
+                                    "shear_modulus") if k in material}
+    fraction, load_factor = torque_choice(material, settings, design)
+    options = {"torque_fraction": fraction, "load_factor": load_factor,
+               "max_bend": math.radians(settings["max_bend_deg"]),
                # "3d" (default: |t_v| <= t_max, Sec. 4.4) or "in_plane" (the plane-normal part only,
                # to compare with the earlier model); not a scene-file key
-               "torque_bound": settings.get("torque_bound", "3d")}
+               "torque_bound": settings.get("torque_bound", "3d"),
+               # within 3% of the optimal G_stb, the least out-of-plane force (docs/method-forces.md §12)
+               "least_out_of_plane": settings.get("least_out_of_plane", True)}
     steps = [list(s) for s in design.get("assembly_steps", [])]
     r = native.forces_and_rest(wires, crossings, steps, mat, options, native_progress)
 
@@ -79,6 +109,10 @@ def run(design, material, settings, native_progress=None):
     # in the bend program's numbering, after the pipeline's coupling rounds (Sec. 4.3).
     for w, out in zip(design["wires"], r["wires"]):
         w.update(out)
+    design["torque_fraction"] = r["torque_fraction"]
+    if r["load_factor"] is not None:
+        design["load_factor"] = r["load_factor"]
+        design.setdefault("warnings", []).extend(load_factor_warnings(r["load_factor"], r["torque_fraction"]))
     design["out_of_plane"] = r["out_of_plane"]
     if r["load_capacity"] is not None:
         design["load_capacity"] = r["load_capacity"]
@@ -97,6 +131,9 @@ def run(design, material, settings, native_progress=None):
         held = [lc[a] for a in AXES if lc[a] is not None]
         line += (f"; holds {min(held):.1f}x its weight ({lc['weight_N']:.2f} N) in the weakest direction"
                  if held else "")
+    line += f"; torque fraction {design['torque_fraction']:.3f}"
+    if "load_factor" in design:
+        line += f" (load factor {design['load_factor']['asked']:g})"
     return line
 
 

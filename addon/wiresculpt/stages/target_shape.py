@@ -23,6 +23,17 @@ from ..core.polylines import polyline_length
 from . import layering
 
 FAILED = ("too_close", "infeasible", "open_end")
+# The solver's words (native/src/target_shape.cpp) for failures that no hook can cure: a straight
+# piece between two crossings shorter than min_segment, and a kink the contact angle, friction or
+# machine rule out at every crossing. An "open_end" status is one too.
+SHORT_PIECE = "(the straight piece is shorter than the minimum segment)"
+EVERY_HOOK = (" asks for contact angle ", " needs a bend of at least ")
+
+
+def whatever_the_hook(status, message):
+    """A failed crossing status (its `status` and `message`) that the other hook cannot cure."""
+    return (status == "open_end" or (status == "too_close" and message.endswith(SHORT_PIECE))
+            or (status == "infeasible" and any(words in message for words in EVERY_HOOK)))
 # After the solve, a crossing counts as realised when its kink is inside the contact cone and its
 # segments and bends within the machine's limits to within what a bender can make at all (its
 # reliable minimum bend is 1 deg): SLSQP ends within about 0.02 deg, far below this, while the
@@ -173,31 +184,15 @@ class Memo:
 def unrealisable(design):
     """The (crossing id, hook) pairs this stage could not realise (stages.target_shape's nulled
     crossings), for the re-layering loop (pipeline.relayer) to forbid: the hook that failed, or
-    both hooks of a crossing "too_close" to a neighbour along its wire whose straight piece is
-    shorter than min_segment (the solver marks both ends of such a piece whatever their hooks). A
-    "too_close" crossing with a longer piece failed because that piece, fixed between the two
-    crossings, lies outside the kink this hook needs: the other hook may hold it. Empty when the
-    stage did not run."""
+    both hooks of a crossing whose failure no hook cures (`whatever_the_hook`, the solver's own
+    verdict on either of its wires: a straight piece to a neighbour shorter than min_segment, an
+    open end, a kink the contact angle rules out). A "too_close" crossing with a longer piece failed
+    because that piece, fixed between the two crossings, lies outside the kink this hook needs: the
+    other hook may hold it. Empty when the stage did not run."""
     pairs = set()
     for n in design["stages"].get("target_shape", {}).get("nulled_crossings", []):
-        short = n["status"] == "too_close" and _shortest_piece(design, n) < design["machine"]["min_segment"]
-        pairs.update((n["crossing"], h) for h in ((-1, 1) if short else (n["hook"],)))
+        pairs.update((n["crossing"], h) for h in ((-1, 1) if n.get("whatever_the_hook") else (n["hook"],)))
     return pairs
-
-
-def _shortest_piece(design, failure):
-    """The shorter straight piece (m) from a nulled crossing to its neighbouring crossings along the
-    wire it failed on (`failure["wire"]`, a name)."""
-    wire = next(w for w in design["wires"] if w["name"] == failure["wire"])
-    along = sorted((c["contour_vertices"][c["wires"].index(wire["id"])], c["id"]) for c in design["crossings"]
-                   if wire["id"] in c["wires"])
-    ids = [cid for _v, cid in along]
-    k = ids.index(failure["crossing"])
-    neighbours = [ids[k - 1] if k > 0 or wire["closed"] else None, ids[(k + 1) % len(ids)]
-                  if k + 1 < len(ids) or wire["closed"] else None]
-    point = np.asarray(design["crossings"][failure["crossing"]]["point"])
-    return min((float(np.linalg.norm(np.asarray(design["crossings"][o]["point"]) - point))
-                for o in neighbours if o is not None and o != failure["crossing"]), default=math.inf)
 
 
 def _ids(numbers):
@@ -250,9 +245,11 @@ def run(design, material, settings, native_progress=None, memo=None):
         for wire, (r, refs, _frame) in zip(design["wires"], solved):
             for (c, _k), status in zip(refs, r["crossings"]):
                 if c["hook"] != 0 and status["status"] in FAILED:
-                    failing.setdefault(c["id"], {"crossing": c["id"], "hook": c["hook"], "wire": wire["name"],
-                                                 "status": status["status"],
-                                                 "scale": status["scale"], "message": status["message"]})
+                    entry = failing.setdefault(c["id"], {"crossing": c["id"], "hook": c["hook"], "wire": wire["name"],
+                                                         "status": status["status"], "scale": status["scale"],
+                                                         "message": status["message"], "whatever_the_hook": False})
+                    # on either of its wires (the first one's words are kept)
+                    entry["whatever_the_hook"] |= whatever_the_hook(status["status"], status["message"])
         if not failing:
             break
         for cid, failure in failing.items():

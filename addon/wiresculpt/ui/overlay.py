@@ -1,8 +1,12 @@
-"""Viewport overlay: the contact force at every crossing as an arrow (gpu module, no bgl).
+"""Viewport overlay: the contact force at every crossing as an arrow (gpu module, no bgl), and
+each wire's predicted out-of-plane deflection as a whisker.
 
 Drawn only when the stored design has `force` per crossing and scene.wiresculpt.show_forces is
 on. The longest arrow is ARROW_SHARE of the sculpture's size; each arrow starts at the crossing
-and shows the force on wires[0] (FORMATS.md `force`).
+and shows the force on wires[0] (FORMATS.md `force`). A wire with `out_of_plane_deflection` gets a
+whisker at the target vertex where it deflects most, along its plane normal, DEFLECTION_SCALE times
+the deflection long (so 1 mm shows as 1 cm), red when over the limit (DEFLECTION_LIMIT, the
+solver's default 2 mm), else blue.
 """
 import bpy
 import gpu
@@ -14,10 +18,13 @@ from ..blend import compat, results
 ARROW_SHARE = 0.2
 HEAD_SHARE = 0.25  # arrow head length as a share of the arrow
 COLOUR = (1.0, 0.35, 0.05, 1.0)
+DEFLECTION_SCALE = 10.0
+DEFLECTION_LIMIT = 0.002  # m: the forces stage's default deflection_limit (native forces_and_rest)
+DEFLECTION_COLOURS = {False: (0.2, 0.45, 1.0, 1.0), True: (1.0, 0.1, 0.1, 1.0)}
 
 _handle = None
 _shader = None
-_arrows = {"design": None, "step": None, "lines": None}  # the last design drawn and its arrows
+_arrows = {"design": None, "step": None, "lines": None, "whiskers": None}  # the last design drawn
 
 
 def uniform_colour_shader():
@@ -60,6 +67,24 @@ def force_arrows(design, shown=None):
     return np.asarray(lines, dtype=np.float32) if lines else None
 
 
+def deflection_whiskers(design, shown=None):
+    """{over the limit (bool): (2k, 3) float32 segment end points}: one segment per wire with an
+    `out_of_plane_deflection`, from its target point of largest deflection along the plane normal,
+    DEFLECTION_SCALE x the deflection long. `shown` as force_arrows."""
+    out = {False: [], True: []}
+    for w in design.get("wires", []):
+        if "out_of_plane_deflection" not in w or (shown is not None and w["id"] not in shown):
+            continue
+        vertex = w.get("out_of_plane_deflection_vertex", -1)
+        if not 0 <= vertex < len(w.get("target", [])):
+            continue
+        start = np.asarray(w["target"][vertex], dtype=np.float64)
+        normal = np.asarray(w["plane"]["normal"], dtype=np.float64)
+        deflection = w["out_of_plane_deflection"]
+        out[deflection > DEFLECTION_LIMIT] += [start, start + DEFLECTION_SCALE * deflection * normal]
+    return {k: np.asarray(v, dtype=np.float32) for k, v in out.items() if v}
+
+
 def draw():
     scene = bpy.context.scene
     if scene is None or not scene.wiresculpt.show_forces:
@@ -71,17 +96,17 @@ def draw():
     # stored_design() returns the same dict until the text changes
     if _arrows["design"] is not design or _arrows["step"] != step:
         shown = results.visible_wires(design, step) if step else None
-        _arrows.update(design=design, step=step, lines=force_arrows(design, shown))
-    lines = _arrows["lines"]
-    if lines is None:
-        return
+        _arrows.update(design=design, step=step, lines=force_arrows(design, shown),
+                       whiskers=deflection_whiskers(design, shown))
     shader = uniform_colour_shader()
-    batch = batch_for_shader(shader, 'LINES', {"pos": lines})
     gpu.state.line_width_set(2.0)
     gpu.state.depth_test_set('NONE')
     shader.bind()
-    shader.uniform_float("color", COLOUR)
-    batch.draw(shader)
+    segments = [(COLOUR, _arrows["lines"])] if _arrows["lines"] is not None else []
+    segments += [(DEFLECTION_COLOURS[over], lines) for over, lines in _arrows["whiskers"].items()]
+    for colour, lines in segments:
+        shader.uniform_float("color", colour)
+        batch_for_shader(shader, 'LINES', {"pos": lines}).draw(shader)
     gpu.state.line_width_set(1.0)
 
 
@@ -97,4 +122,4 @@ def unregister():
         bpy.types.SpaceView3D.draw_handler_remove(_handle, 'WINDOW')
         _handle = None
     _shader = None
-    _arrows.update(design=None, step=None, lines=None)
+    _arrows.update(design=None, step=None, lines=None, whiskers=None)

@@ -8,6 +8,7 @@ import bpy
 from .. import native, props
 from ..blend import results as scene_results
 from ..blend.registration import classes_factory
+from ..core import closure
 from ..operators import optimize
 from ..operators.results import WIRESCULPT_OT_assembly_guide, WIRESCULPT_OT_clear_results
 from .panel import VIEW3D_PT_wiresculpt, length_text, wrap_labels
@@ -54,6 +55,33 @@ def load_capacity_rows(design):
     return rows
 
 
+def wire_rows(design):
+    """[(wire name, closure gap text or None, out-of-plane deflection text or None)] per wire that
+    has either figure: the gap in mm and % of the wire's length (core/closure.py), the deflection
+    in mm (the 3D check, `out_of_plane_deflection`)."""
+    rows = []
+    for w in design.get("wires", []):
+        gap = closure.closure_text(w)
+        bend = w.get("out_of_plane_deflection")
+        if gap is not None or bend is not None:
+            rows.append((w["name"], gap, f"{bend * 1000:.2f} mm" if bend is not None else None))
+    return rows
+
+
+def torque_text(design):
+    """"Torque fraction 0.412 (load factor 3: holds 3.00x its weight)", or None before the forces."""
+    fraction = design.get("torque_fraction")
+    if fraction is None or "stages" not in design or "forces" not in design["stages"]:
+        return None
+    text = f"Torque fraction {fraction:.3f}"
+    factor = design.get("load_factor")
+    if factor:
+        reached = factor.get("reached")
+        held = f"holds {reached:.2f}x its weight" if reached is not None else "holds any load"
+        text += f" (load factor {factor['asked']:g}: {held})"
+    return text
+
+
 def assembly_rows(design):
     """One row per wire in assembly order: "1. Equator/0", "   + Meridian0/0" for a wire added in
     the same step, "(two hands)" after a step that adds two wires at once beyond the first pair."""
@@ -96,7 +124,7 @@ class VIEW3D_PT_wiresculpt_settings(_Child, bpy.types.Panel):
         layout.prop(ws, "wire_diameter")
         if ws.material_preset == "CUSTOM":
             col = layout.column(align=True)
-            for key in ("bending_stiffness", "max_torque", "friction", "density"):
+            for key in ("bending_stiffness", "max_torque", "friction", "density", "shear_modulus"):
                 col.prop(ws, key)
         col = layout.column(align=True)
         col.prop(ws, "min_segment")
@@ -104,7 +132,13 @@ class VIEW3D_PT_wiresculpt_settings(_Child, bpy.types.Panel):
         col.prop(ws, "max_bend_deg")
         col = layout.column(align=True)
         col.prop(ws, "contact_angle_deg")
-        col.prop(ws, "torque_fraction")
+        col.prop(ws, "use_load_factor")
+        sub = col.column(align=True)
+        sub.active = ws.use_load_factor
+        sub.prop(ws, "load_factor")
+        sub = col.column(align=True)
+        sub.active = not ws.use_load_factor
+        sub.prop(ws, "torque_fraction")
         box = layout.box()  # the layering's search knobs (docs/user-guide.md, Advanced)
         box.prop(ws, "show_advanced", icon='TRIA_DOWN' if ws.show_advanced else 'TRIA_RIGHT', emboss=False)
         if ws.show_advanced:
@@ -161,13 +195,19 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
             row = layout.row()
             row.label(text="Max deviation")  # the largest distance of a wire from its contour
             row.label(text=length_text(context.scene, max(distances)))
-        gaps = [w["closure_gap"] for w in design["wires"] if w.get("closed") and "closure_gap" in w]
-        if gaps:
-            row = layout.row()
-            # how far the two ends of the largest rest shape stand apart before assembly
-            row.label(text="Closure gap")
-            row.label(text=length_text(context.scene, max(gaps)))
-            layout.label(text="Cuts: drag a sphere", icon='INFO')
+        torque = torque_text(design)
+        if torque:
+            _wrap(layout, context, torque)
+        wires = wire_rows(design)
+        if wires:
+            # per wire: how far its rest shape's ends stand apart before assembly, and how far its
+            # contact forces bend it out of its plane
+            col = layout.column(align=True)
+            col.label(text="Per wire: closure gap, out of plane")
+            for name, gap, bend in wires:
+                _wrap(col, context, f"{name}: gap {gap or '-'}, out of plane {bend or '-'}", icon='DOT')
+            if any(w.get("closed") and "closure_gap" in w for w in design["wires"]):
+                layout.label(text="Cuts: drag a sphere", icon='INFO')
         capacity = load_capacity_rows(design)
         if capacity:
             col = layout.column(align=True)

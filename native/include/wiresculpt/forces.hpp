@@ -91,6 +91,16 @@ struct ForceOptions {
   /// Which torque |t_v| <= t_max bounds (torque_bound.hpp): full_3d (default, the paper's 3D
   /// norm) or in_plane (n·t_v only, the behaviour before).
   TorqueBound torque_bound = TorqueBound::full_3d;
+  /// After the LP, a second LP: among the solutions within tie_tolerance of the optimal G_stb,
+  /// one with the least Σ_k Σ_w |f_k · n_w| (the forces' out-of-plane parts, w the crossing's two
+  /// wires). The first LP returns a vertex of its feasible set, which may carry out-of-plane
+  /// components that a near-optimal solution does not (docs/method-forces.md §12). Its result is
+  /// final: SLSQP's G_asm (which would move back to the G_stb optimum) does not run. The
+  /// pipeline's forces stage turns it on. Default false.
+  bool least_out_of_plane = false;
+  /// Relative: the second LP keeps G_stb >= (1 - tie_tolerance) × the first LP's optimum.
+  /// Default 0.03 (the bundled globe's ellipse hooks reach 0% out of plane at 3%, §12).
+  double tie_tolerance = 0.03;
 };
 
 /// The four unit pyramid vectors of hooked crossing `c` (hook ±1) from the actual incident
@@ -162,7 +172,7 @@ struct ForceResult {
   bool torque_active = false;
   TorqueBound torque_bound = TorqueBound::full_3d;  ///< the bound that was imposed
   int lp_rounds = 0;           ///< GLPK solves (the torque rows are added as solutions violate them)
-  std::string method;          ///< "lp", "lp+slsqp" or "slsqp" (what produced the result)
+  std::string method;          ///< "lp", "lp+least_out_of_plane", "lp+slsqp" or "slsqp" (what produced the result)
   std::string nlopt_result;    ///< NLopt's code as text, "" when NLopt did not run
   int lp_iterations = 0;       ///< GLPK simplex iterations
   int iterations = 0;          ///< NLopt objective evaluations
