@@ -115,7 +115,8 @@ def relayer(design, material, settings, say, native_progress, checkpoint):
     """Layering, then target shape, forces and rest shape (shape_and_rest); while the result is not
     stable because the target shape could not realise some crossing's hook, forbid those (crossing,
     hook) pairs (target_shape.unrealisable: the failed hook, or both hooks of a crossing too close to
-    a neighbour) and layer again from the same contours, with a fresh target-shape memo. Stops when
+    a neighbour) and layer again from the same contours, with a fresh target-shape memo (that shares only
+    the solves of identical wire problems: same contour, crossings, hooks and limits). Stops when
     the design is stable, when nothing new can be forbidden, when the layering finds no stable
     assembly under the forbidden hooks or stops at max_nodes (search incomplete), or after
     `relayer_rounds` re-layerings. Records every round in stages.relayering. Returns the design of
@@ -125,6 +126,7 @@ def relayer(design, material, settings, say, native_progress, checkpoint):
     # Layering replaces (never edits) each wire's contour, so the copies share the contours.
     pristine = _copy_sharing_contours(design) if extra_rounds else None
     forbidden, rounds, start, shaped = set(), [], time.perf_counter(), None
+    same_solves = {}  # target-shape solves by exact input, for every round (target_shape.Memo `same`)
     hook_deadline = time.monotonic() + HOOK_SECONDS  # one bound for the hook searches of every round
     for round_ in range(extra_rounds + 1):
         began = time.perf_counter()
@@ -139,7 +141,7 @@ def relayer(design, material, settings, say, native_progress, checkpoint):
             # cost that use no forbidden hook; the best forces win among the stable (buildable) ones,
             # and when none is, the layering's own pattern is kept, so the round learns from it.
             attempt = hooks_by_forces(attempt, material, settings, say, native_progress, checkpoint,
-                                      forbidden=forbidden, deadline=hook_deadline)
+                                      forbidden=forbidden, deadline=hook_deadline, same_solves=same_solves)
             shaped = attempt
         learnt = target_shape.unrealisable(attempt) - forbidden
         rounds.append({"forbidden": _pairs(forbidden), "stable": attempt["stable"],
@@ -232,7 +234,7 @@ def _tighten(design, memo, machine_limit_deg, floor_deg):
     return changed, stuck
 
 
-def shape_and_rest(design, material, settings, say, native_progress, checkpoint, solves=None):
+def shape_and_rest(design, material, settings, say, native_progress, checkpoint, solves=None, same_solves=None):
     """Target shape, then forces and rest shape, with the coupling of Sec. 4.3: the machine's
     maximum bend limits the rest shape, which is only known after the forces. A rest bend beyond
     it comes from the torque its vertex carries (Eq. 12), so the target shape is solved again with
@@ -245,7 +247,8 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint,
     (fab/buildability.py): a bend still over the limit makes the design not stable, by name.
     `solves`: a target_shape.Memo's per-wire solves to share with other calls (hooks_by_forces: a
     wire whose crossings keep their hooks is not solved again; the vertex limits are part of a
-    solve's key)."""
+    solve's key); `same_solves` (a dict, see target_shape.Memo) carries the solves of identical
+    problems across re-layering rounds."""
     import copy
 
     def fresh(d):
@@ -257,7 +260,7 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint,
     target_limit = machine_limit
     kink = 180.0 - settings["contact_angle_deg"]  # a hooked crossing bends at least this much
     before = fresh(design)
-    memo = target_shape.Memo()
+    memo = target_shape.Memo(same_solves)
     if solves is not None:
         memo.solves = solves
     totals = dict.fromkeys(("seconds", "iterations", "wire_solves", "reused_wires"), 0)
@@ -376,7 +379,7 @@ def choose(scores):
 
 
 def hooks_by_forces(design, material, settings, say, native_progress, checkpoint, patterns=None, seconds=None,
-                    forbidden=(), deadline=None):
+                    forbidden=(), deadline=None, same_solves=None):
     """shape_and_rest on the layering's hooks and on the other hook patterns of the same Eq. 2
     cost (equal_cost_patterns) whose assembly order stays stable (Eq. 1, layering.recheck), and
     keeps the design whose forces are best (force_score, choose): first the weakest-direction load
@@ -388,7 +391,8 @@ def hooks_by_forces(design, material, settings, say, native_progress, checkpoint
     `design` itself (and returned), as the stages do. `patterns` and `seconds`
     default to HOOK_PATTERNS and HOOK_SECONDS (read at the call). `forbidden`: (crossing id, hook)
     pairs no pattern may use (relayer's). `deadline` (time.monotonic()): no new pattern after it,
-    instead of `seconds` from the call (relayer's, shared by its rounds). When no pattern ends stable, the layering's own pattern
+    instead of `seconds` from the call (relayer's, shared by its rounds); `same_solves`: relayer's
+    solves of identical target-shape problems (shape_and_rest). When no pattern ends stable, the layering's own pattern
     is the result (relayer learns from its unrealisable hooks)."""
     patterns = HOOK_PATTERNS if patterns is None else patterns
     seconds = HOOK_SECONDS if seconds is None else seconds
@@ -418,7 +422,7 @@ def hooks_by_forces(design, material, settings, say, native_progress, checkpoint
                 continue
             stable += 1
             trial = shape_and_rest(trial, material, settings, say if index == 0 else _quiet, native_progress,
-                                   checkpoint, shared)
+                                   checkpoint, shared, same_solves)
         except (native.Cancelled, OutOfTime):
             raise
         except (ValueError, RuntimeError):  # another pattern the solver cannot finish: not a better one
@@ -435,7 +439,7 @@ def hooks_by_forces(design, material, settings, say, native_progress, checkpoint
         for index in dict.fromkeys((chosen, 0)):
             checkpoint()
             best = shape_and_rest(_with_hooks(base, candidates[index]), material, settings, _quiet, native_progress,
-                                  checkpoint, shared)
+                                  checkpoint, shared, same_solves)
             chosen, best_score = index, force_score(best)
             if best_score is not None:
                 break

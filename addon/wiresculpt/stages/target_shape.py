@@ -9,8 +9,10 @@ friction term left out (mu = 0 here: friction is already in the layering's pyram
 realised kink is then at least as sharp as the one the layering judged stable.
 """
 import math
+import os
 import re
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -39,6 +41,13 @@ def whatever_the_hook(status, message):
 REALISED_ANGLE = math.radians(0.1)
 REALISED_LENGTH = 1e-5  # metres
 MAX_ROUNDS = 4  # solve, null what cannot be realised, solve again (each round nulls at least one)
+# The window sweeps stop once a sweep lowers a wire's energy by less than this fraction: later sweeps
+# only creep points along the wire (TargetShapeOptions::sweep_ftol; docs/method-target-shape.md,
+# issue 17: the same distances to the contour and crossings, 3-6x fewer evaluations on long wires).
+SWEEP_FTOL = 1e-3
+# Wires are independent problems: up to this many are solved at once, each on its own thread (the
+# native call releases the GIL; each result depends only on its own wire, so the order is kept).
+MAX_THREADS = 2
 
 
 def desired_bisector(design, crossing, k):
@@ -52,6 +61,14 @@ def solve_wire(design, wire, material, settings, size, native_progress=None, mem
     """(result, [(crossing, k)], frame) of the native optimisation of one wire; with a `memo`, a
     result from an earlier coupling round is taken instead of solving when it is still optimal
     (Memo.reusable)."""
+    job = prepare_wire(design, wire, settings, size, memo)
+    return finish_wire(job, solve_job(job, native_progress), memo)
+
+
+def prepare_wire(design, wire, settings, size, memo=None):
+    """Everything one wire's solve needs, read from the design (call on the thread that owns the
+    design and the memo): {"contour", "closed", "specs", "options", "refs", "frame", "key",
+    "result"}, where "result" is the memo's reusable result or None (solve_job computes it)."""
     _n, u, v = plane_frame(wire["plane"]["normal"])
     origin = wire["plane"]["origin"]
     contact = math.radians(settings["contact_angle_deg"])
@@ -66,18 +83,44 @@ def solve_wire(design, wire, material, settings, size, native_progress=None, mem
         refs.append((c, k))
     options = {"min_segment": settings["min_segment"], "max_bend": math.radians(settings["max_bend_deg"]),
                "friction": 0.0, "model_size": size, "wire_name": wire["name"],
-               "angle_tolerance": REALISED_ANGLE, "length_tolerance": REALISED_LENGTH}
+               "angle_tolerance": REALISED_ANGLE, "length_tolerance": REALISED_LENGTH, "sweep_ftol": SWEEP_FTOL}
     limits = memo.vertex_limits.get(wire["name"]) if memo is not None else None
     if limits:  # the coupling's own limits at some points (pipeline._tighten), radians by target index
         options["vertex_max_bend"] = tuple(limits.get(i, 0.0) for i in range(max(limits) + 1))
     contour = to_2d(wire["contour"], origin, u, v)
     key = Memo.key(contour, wire["closed"], specs, options) if memo is not None else None
     result = memo.reusable(key, options["max_bend"]) if memo is not None else None
-    if result is None:
-        result = native.optimize_target_shape(contour, wire["closed"], specs, options, native_progress)
-        if memo is not None:
-            memo.remember(key, options["max_bend"], result)
-    return result, refs, (origin, u, v)
+    return {"contour": contour, "closed": wire["closed"], "specs": specs, "options": options, "refs": refs,
+            "frame": (origin, u, v), "key": key, "result": result}
+
+
+def solve_job(job, native_progress=None):
+    """The native result of a prepared wire (its memo's result when it had one). Touches neither the
+    design nor the memo, so several run at once."""
+    if job["result"] is not None:
+        return job["result"]
+    return native.optimize_target_shape(job["contour"], job["closed"], job["specs"], job["options"], native_progress)
+
+
+def finish_wire(job, result, memo=None):
+    """Remembers a new solve in the memo; (result, refs, frame) as solve_wire returns them."""
+    if memo is not None and job["result"] is None:
+        memo.remember(job["key"], job["options"]["max_bend"], result)
+    return result, job["refs"], job["frame"]
+
+
+def solve_all(jobs, native_progress=None):
+    """The results of solve_job for every job, in order: up to MAX_THREADS at once."""
+    todo = [k for k, job in enumerate(jobs) if job["result"] is None]
+    threads = min(MAX_THREADS, os.cpu_count() or 1, len(todo))
+    if threads <= 1:
+        return [solve_job(job, native_progress) for job in jobs]
+    results = [job["result"] for job in jobs]
+    with ThreadPoolExecutor(max_workers=threads, thread_name_prefix="wiresculpt-target") as pool:
+        futures = {k: pool.submit(solve_job, jobs[k], native_progress) for k in todo}
+        for k, future in futures.items():  # waits for all; the first error (e.g. Cancelled) is raised
+            results[k] = future.result()
+    return results
 
 
 class Memo:
@@ -97,10 +140,15 @@ class Memo:
 
     CONVERGED = ("NLOPT_SUCCESS", "NLOPT_FTOL_REACHED", "NLOPT_XTOL_REACHED", "none")  # "none": nothing free
 
-    def __init__(self):
+    def __init__(self, same=None):
+        """`same`: a dict {(key, max_bend): result} of earlier solves of exactly the same problem,
+        shared with other memos (pipeline.relayer hands one to every re-layering round: wires whose
+        crossings and hooks the new layering left alone are the same problems). Its results are
+        reused whatever they were: the solve is a deterministic function of its input."""
         self.nulled = []
         self.vertex_limits = {}
         self.solves = {}  # key -> (max_bend, result)
+        self.same = {} if same is None else same
         self.reused = 0
 
     @staticmethod
@@ -112,7 +160,11 @@ class Memo:
 
     def reusable(self, key, max_bend):
         """The remembered result for `key` if it is an optimum that the limit `max_bend` (radians)
-        leaves optimal, else None."""
+        leaves optimal, or the result of exactly this problem (same key and limit), else None."""
+        same = self.same.get((key, max_bend))
+        if same is not None:
+            self.reused += 1
+            return same
         entry = self.solves.get(key)
         if entry is None:
             return None
@@ -126,6 +178,7 @@ class Memo:
 
     def remember(self, key, max_bend, result):
         self.solves[key] = (max_bend, result)
+        self.same[(key, max_bend)] = result
 
 
 def unrealisable(design):
@@ -181,12 +234,12 @@ def run(design, material, settings, native_progress=None, memo=None):
     reused = [False] * len(design["wires"])
     pending = range(len(design["wires"]))  # the first round solves every wire
     for _round in range(MAX_ROUNDS):
-        for i in pending:
-            count = memo.reused if memo is not None else 0
-            solved[i] = solve_wire(design, design["wires"][i], material, settings, size, native_progress, memo)
-            reused[i] = memo is not None and memo.reused != count
+        jobs = [prepare_wire(design, design["wires"][i], settings, size, memo) for i in pending]
+        for i, job, result in zip(pending, jobs, solve_all(jobs, native_progress)):
+            reused[i] = job["result"] is not None
+            solved[i] = finish_wire(job, result, memo)
             if not reused[i]:
-                iterations += solved[i][0]["iterations"]
+                iterations += result["iterations"]
                 wire_solves += 1
         failing = {}
         for wire, (r, refs, _frame) in zip(design["wires"], solved):
