@@ -34,15 +34,16 @@ NO_EXECUTABLE = "starts a blender process; the bpy module has no blender executa
 NO_WINDOW = "needs a Blender window under Xvfb; the bpy module has none"
 
 
-def run_blender(script, *args, env=None, timeout=300):
+def run_blender(script, *args, env=None, timeout=300, preexec_fn=None):
     """Runs `script` in a fresh headless Blender with this process's environment updated by `env`
-    (a None value removes the variable); returns the CompletedProcess (text output)."""
+    (a None value removes the variable), `preexec_fn` run in the child before Blender starts (a
+    resource limit); returns the CompletedProcess (text output)."""
     if BPY_MODULE:
         raise unittest.SkipTest(NO_EXECUTABLE)
     cmd = [BLENDER, "--background", "--factory-startup", "--python-exit-code", "1",
            "--python", script, "--", *args]
     merged = {k: v for k, v in {**os.environ, **(env or {})}.items() if v is not None}
-    return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=merged)
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=merged, preexec_fn=preexec_fn)
 
 
 def run_under_xvfb(script, marker, timeout=180, args=()):
@@ -141,6 +142,17 @@ def polyline_length(points, closed):
     n = len(points)
     edges = range(n if closed else n - 1)
     return sum(math.dist(points[i], points[(i + 1) % n]) for i in edges)
+
+
+def step_start(lines, acknowledged):
+    """Where a resume starts after a stop that can lose GRBL's queued moves (a dropped link, a
+    cancel), when the first `acknowledged` lines were answered ok: after the last acknowledged
+    `G4 P0` (the end of the last step known made), or after the leading mode lines."""
+    start = 0
+    for j, line in enumerate(lines[:acknowledged]):
+        if line == "G4 P0" or (start == j and line in ("G21", "G91", "G94")):
+            start = j + 1
+    return start
 
 
 class GrblEmulator:

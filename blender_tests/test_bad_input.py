@@ -89,5 +89,64 @@ class BadInput(unittest.TestCase):
                     self.assertEqual(lookup(design, key), expected, key)
 
 
+def full_disk_at(limit):
+    """For the child: files cannot grow past `limit` bytes and a write past it fails with EFBIG
+    (SIGXFSZ ignored, as across exec), as a write to a full disk fails with ENOSPC."""
+    def apply():
+        import resource
+        import signal
+
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+    return apply
+
+
+class CommandLine(unittest.TestCase):
+    """The batch as a shell runs it, with what the shell can hand it: bytes that are not UTF-8, a
+    disk that fills up."""
+
+    SCENE = os.path.join(ROOT, "scripts", "examples", "globe", "scene.json")
+
+    def test_an_out_folder_name_that_is_not_utf8(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.fsencode(tmp) + b"/out\xff"
+            r = run_blender(BATCH, self.SCENE, "--out", out, timeout=120)
+            self.assertEqual(r.returncode, 1, r.stdout + r.stderr)
+            self.assertEqual(wiresculpt_lines(r.stderr),
+                             [f"wiresculpt: error: --out {tmp}/out\\xff: the folder name is not UTF-8; choose a name in UTF-8"])
+            self.assertEqual(os.listdir(tmp), [])
+
+    def test_a_disk_that_fills_during_the_blend_save_keeps_the_earlier_set(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.path.join(tmp, "out")
+            first = run_blender(BATCH, self.SCENE, "--out", out, timeout=300)
+            self.assertEqual(first.returncode, 0, first.stdout + first.stderr)
+            before = {}
+            for folder, _dirs, files in os.walk(out):
+                for name in files:
+                    with open(os.path.join(folder, name), "rb") as f:
+                        before[os.path.relpath(os.path.join(folder, name), out)] = f.read()
+            blend = len(before["sculpture.blend"])
+            # every other output fits (design.json, render.png and the rest are far smaller), the
+            # .blend does not
+            limit = blend // 2
+            self.assertLess(max(len(v) for k, v in before.items() if k != "sculpture.blend"), limit)
+            r = run_blender(BATCH, self.SCENE, "--out", out, timeout=300, preexec_fn=full_disk_at(limit))
+            self.assertEqual(r.returncode, 1, r.stdout + r.stderr)
+            lines = wiresculpt_lines(r.stderr)
+            self.assertEqual(len(lines), 1, lines)
+            self.assertTrue(lines[0].startswith("wiresculpt: error: Blender could not save sculpture.blend ("), lines)
+            self.assertTrue(lines[0].endswith("; is the disk full?); the earlier outputs are kept"), lines)
+            self.assertNotIn("wiresculpt: written:", r.stdout)
+            after = {}
+            for folder, _dirs, files in os.walk(out):
+                for name in files:
+                    with open(os.path.join(folder, name), "rb") as f:
+                        after[os.path.relpath(os.path.join(folder, name), out)] = f.read()
+            self.assertEqual(sorted(after), sorted(before))
+            self.assertTrue(all(after[k] == before[k] for k in before), "the earlier set changed")
+            self.assertEqual(os.listdir(tmp), ["out"])  # no staging folder left behind
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -15,7 +15,7 @@ import bpy  # noqa: E402
 import wiresculpt  # noqa: E402
 
 wiresculpt.register()
-from helpers import GrblEmulator, gcode_lines  # noqa: E402
+from helpers import GrblEmulator, gcode_lines, step_start  # noqa: E402
 from ui_steps import guarded, report, start_watchdog  # noqa: E402
 from wiresculpt.blend import results as scene_results  # noqa: E402
 from wiresculpt.fab import streaming  # noqa: E402
@@ -83,6 +83,7 @@ def check_cancelled():
         return 0.05
     first = links["first"]
     seen["acknowledged_at_cancel"] = len(first.acknowledged)
+    seen["step_start_at_cancel"] = step_start(seen["program"], len(first.acknowledged))
     stopped = streaming.PENDING.get(WIRE)
     seen["pending_next_line"] = stopped.next_line if stopped else None
     seen["realtime"] = list(first.realtime)
@@ -100,7 +101,10 @@ def check_resumed():
     second.close()
     program = seen.pop("program")
     modes = [line for line in program[:len(first.acknowledged)] if line in MODES]
-    seen["once"] = first.acknowledged + second.acknowledged[len(modes):] == program
+    # the lines acknowledged before the cancel, then from the first line of the step in doubt
+    start = step_start(program, len(first.acknowledged))
+    seen["once"] = first.acknowledged + second.acknowledged[len(modes):] == program[:len(first.acknowledged)] + \
+        program[start:]
     seen["pending_after"] = WIRE in streaming.PENDING
     seen["running_after"] = streaming.running()
     report(seen)

@@ -77,8 +77,9 @@ def solve_once(sliced, scene):
     last = [time.perf_counter(), time.process_time()]
 
     def progress(stage, _message):
-        # Wall time, and this process's CPU time (the solver is single-threaded, so on a quiet
-        # machine the two agree; on a shared one the CPU time is what the stage itself cost).
+        # Wall time, and this process's CPU time (on a quiet machine the two agree, except in the
+        # target shape, which solves two wires at once; on a shared one the CPU time is what the
+        # stage itself cost).
         now, cpu = time.perf_counter(), time.process_time()
         wall[stage] = wall.get(stage, 0.0) + now - last[0]
         wall[stage + "/cpu"] = wall.get(stage + "/cpu", 0.0) + cpu - last[1]

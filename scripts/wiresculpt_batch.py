@@ -115,8 +115,13 @@ def write_scene_outputs(design, objects, planes, factor, out, say, overlap=0.0):
     # uncompressed, so that the set's verification (core/staging.py) can see its end block, and so
     # that on Blender 3.4, which cannot set the sidebar's tab from Python, the tab can be written
     # into the saved file.
-    if bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False, compress=False) != {'FINISHED'}:
-        raise OSError(f"Blender could not save {os.path.basename(path)} (is the disk full?); "
+    try:  # a failed write (a full disk) is a RuntimeError with Blender's errno text, or a CANCELLED
+        saved = bpy.ops.wm.save_as_mainfile(filepath=path, check_existing=False, compress=False)
+        why = "" if saved == {'FINISHED'} else f"the save ended {', '.join(sorted(saved))}"
+    except RuntimeError as exc:
+        why = str(exc).strip().removeprefix("Error:").strip() or "no reason given"
+    if why:
+        raise OSError(f"Blender could not save {os.path.basename(path)} ({why}; is the disk full?); "
                       "the earlier outputs are kept")
     tab = f"{compat.SIDEBAR_TAB} tab"
     if not ready["tab_set"]:
@@ -186,12 +191,13 @@ def run(argv):
     import bpy
     import numpy as np
 
-    from wiresculpt import native, pipeline
+    from wiresculpt import native, plane_search
     from wiresculpt.core.calibration import closed_overlap
     from wiresculpt.core.design import write_design
     from wiresculpt.core.meshcheck import check_output_folder, check_vertices
     from wiresculpt.core.staging import staged
     from wiresculpt.core.scene import load_scene
+    from wiresculpt.core.sizes import STOCK_LENGTH
     from wiresculpt.blend.mesh import import_mesh
 
     def say(stage, message):
@@ -217,7 +223,10 @@ def run(argv):
     planes = scaled_planes(scene.planes, factor)
     profile = machine_profile(scene, args, say)  # refused before the long work when it is wrong
     model = machine_model(args, say)
-    design = pipeline.run(V, F, planes, scene.material, scene.settings, say)
+    stock = None if profile is None else (float(profile.get("stock_length", STOCK_LENGTH)),
+                                          profile.get("name") or "the machine profile")
+    # settings.plane_search "off" is pipeline.run; "nearby"/"auto" return the planes actually used
+    design, planes = plane_search.run(V, F, planes, scene.material, scene.settings, say, stock=stock)
     # Everything is written into a hidden folder first and replaces the earlier run's outputs
     # only when all of it is there: a failure half-way leaves the earlier set as it was.
     with staged(args.out, OUTPUTS) as folder:

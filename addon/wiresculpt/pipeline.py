@@ -8,6 +8,7 @@ import math
 import time
 
 from . import native
+from .core import settings as settings_table
 from .core.design import new_design
 from .core.sizes import size_warnings
 from .fab import buildability
@@ -30,6 +31,16 @@ class Cancelled(Exception):
     """The user cancelled; the caller keeps its previous state."""
 
 
+class OutOfTime(RuntimeError):
+    """The solve ran past settings.max_solve_seconds; the caller keeps its previous state."""
+
+    def __init__(self, budget, stage):
+        super().__init__(f"the solve stopped at its time budget, settings.max_solve_seconds = {budget:g} s, during "
+                         f"the {stage.replace('_', ' ')}: raise the budget, or give fewer planes or a smaller "
+                         f"max_nodes")
+        self.budget, self.stage = budget, stage
+
+
 def _quiet(stage, message):
     pass
 
@@ -42,20 +53,36 @@ def slice_and_pick(vertices, faces, planes, material, settings, progress=None):
     return design
 
 
-def solve(design, material, settings, progress=None, cancel=None):
+def solve(design, material, settings, progress=None, cancel=None, stock=None):
     """Runs every stage after slicing on `design` (its wires' contours set), re-layering while the
     target shape cannot realise a hook (relayer). `progress(stage, message)` is called once per
     finished stage; `cancel()` returning True stops at the next safe point with Cancelled.
-    `pending_stages` names the stages that did not run."""
-    say = progress or _quiet
+    `pending_stages` names the stages that did not run. `stock`: (length in m, profile name) of
+    the machine profile in use, for the stock-length warnings said before the long work (None:
+    the default profile's). Past settings.max_solve_seconds (wall
+    clock) the solve stops the same way and raises OutOfTime, naming the key and the stage."""
     cancelled = cancel or (lambda: False)
+    budget = float(settings.get("max_solve_seconds") or settings_table.SETTINGS["max_solve_seconds"][0])
+    deadline = time.monotonic() + budget
+    at = {"stage": "layering"}  # the stage under way, for OutOfTime's message
 
-    def native_progress(_stage, _fraction):
-        return not cancelled()
+    def say(stage, message):
+        at["stage"] = stage
+        (progress or _quiet)(stage, message)
+
+    def out_of_time():
+        return time.monotonic() > deadline
+
+    def native_progress(stage, _fraction):
+        if isinstance(stage, str) and stage:  # the solver's parts of the layering are the layering
+            at["stage"] = "layering" if stage in ("network", "check_assembly") else stage
+        return not (cancelled() or out_of_time())
 
     def checkpoint():
         if cancelled():
             raise Cancelled()
+        if out_of_time():
+            raise OutOfTime(budget, at["stage"])
 
     design["pending_stages"] = list(ALL_STAGES)
     if len(design["wires"]) < 2:
@@ -64,12 +91,14 @@ def solve(design, material, settings, progress=None, cancel=None):
                             else "a sculpture needs at least two wires: add a plane or pick more contours")
         return design
     apply_cuts(design, settings.get("cuts"))
-    for warning in size_warnings(design):  # before the long work: the figure, at once
+    for warning in size_warnings(design, *(stock or ())):  # before the long work: the figure, at once
         design.setdefault("warnings", []).append(warning)
         say("size", warning)
     try:
         return relayer(design, material, settings, say, native_progress, checkpoint)
     except native.Cancelled:
+        if not cancelled() and out_of_time():
+            raise OutOfTime(budget, at["stage"]) from None
         raise Cancelled() from None
 
 
@@ -86,7 +115,8 @@ def relayer(design, material, settings, say, native_progress, checkpoint):
     """Layering, then target shape, forces and rest shape (shape_and_rest); while the result is not
     stable because the target shape could not realise some crossing's hook, forbid those (crossing,
     hook) pairs (target_shape.unrealisable: the failed hook, or both hooks of a crossing too close to
-    a neighbour) and layer again from the same contours, with a fresh target-shape memo. Stops when
+    a neighbour) and layer again from the same contours, with a fresh target-shape memo (that shares only
+    the solves of identical wire problems: same contour, crossings, hooks and limits). Stops when
     the design is stable, when nothing new can be forbidden, when the layering finds no stable
     assembly under the forbidden hooks or stops at max_nodes (search incomplete), or after
     `relayer_rounds` re-layerings. Records every round in stages.relayering. Returns the design of
@@ -96,6 +126,8 @@ def relayer(design, material, settings, say, native_progress, checkpoint):
     # Layering replaces (never edits) each wire's contour, so the copies share the contours.
     pristine = _copy_sharing_contours(design) if extra_rounds else None
     forbidden, rounds, start, shaped = set(), [], time.perf_counter(), None
+    same_solves = {}  # target-shape solves by exact input, for every round (target_shape.Memo `same`)
+    hook_deadline = time.monotonic() + HOOK_SECONDS  # one bound for the hook searches of every round
     for round_ in range(extra_rounds + 1):
         began = time.perf_counter()
         checkpoint()
@@ -109,7 +141,7 @@ def relayer(design, material, settings, say, native_progress, checkpoint):
             # cost that use no forbidden hook; the best forces win among the stable (buildable) ones,
             # and when none is, the layering's own pattern is kept, so the round learns from it.
             attempt = hooks_by_forces(attempt, material, settings, say, native_progress, checkpoint,
-                                      forbidden=forbidden)
+                                      forbidden=forbidden, deadline=hook_deadline, same_solves=same_solves)
             shaped = attempt
         learnt = target_shape.unrealisable(attempt) - forbidden
         rounds.append({"forbidden": _pairs(forbidden), "stable": attempt["stable"],
@@ -202,7 +234,7 @@ def _tighten(design, memo, machine_limit_deg, floor_deg):
     return changed, stuck
 
 
-def shape_and_rest(design, material, settings, say, native_progress, checkpoint, solves=None):
+def shape_and_rest(design, material, settings, say, native_progress, checkpoint, solves=None, same_solves=None):
     """Target shape, then forces and rest shape, with the coupling of Sec. 4.3: the machine's
     maximum bend limits the rest shape, which is only known after the forces. A rest bend beyond
     it comes from the torque its vertex carries (Eq. 12), so the target shape is solved again with
@@ -215,7 +247,8 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint,
     (fab/buildability.py): a bend still over the limit makes the design not stable, by name.
     `solves`: a target_shape.Memo's per-wire solves to share with other calls (hooks_by_forces: a
     wire whose crossings keep their hooks is not solved again; the vertex limits are part of a
-    solve's key)."""
+    solve's key); `same_solves` (a dict, see target_shape.Memo) carries the solves of identical
+    problems across re-layering rounds."""
     import copy
 
     def fresh(d):
@@ -227,7 +260,7 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint,
     target_limit = machine_limit
     kink = 180.0 - settings["contact_angle_deg"]  # a hooked crossing bends at least this much
     before = fresh(design)
-    memo = target_shape.Memo()
+    memo = target_shape.Memo(same_solves)
     if solves is not None:
         memo.solves = solves
     totals = dict.fromkeys(("seconds", "iterations", "wire_solves", "reused_wires"), 0)
@@ -332,36 +365,39 @@ def force_score(design):
     return (float("inf") if capacity is None else capacity), design["out_of_plane"]["mean_to_max_force"]
 
 
-def better(score, best):
-    """score beats best: a load capacity more than CAPACITY_TIE above, or within CAPACITY_TIE and
-    a smaller out-of-plane measure."""
-    if best is None:
-        return score is not None
-    if score is None:
-        return False
-    capacity, share = score
-    top = best[0]
-    if capacity > top * (1 + CAPACITY_TIE):
-        return True
-    return capacity >= top * (1 - CAPACITY_TIE) and share < best[1] - 1e-12
+def choose(scores):
+    """The position in `scores` (force_score values in pattern order, None for a pattern without
+    one) of the best: among the scores whose load capacity is within CAPACITY_TIE of the highest,
+    the least out-of-plane measure, ties to the earliest. Compared with the highest, not pairwise,
+    so a chain of near-ties cannot drift below it. None when no pattern has a score."""
+    known = [(k, s) for k, s in enumerate(scores) if s is not None]
+    if not known:
+        return None
+    top = max(s[0] for _k, s in known)
+    near = [(round(s[1], 12), k) for k, s in known if s[0] >= top * (1 - CAPACITY_TIE)]
+    return min(near)[1]
 
 
 def hooks_by_forces(design, material, settings, say, native_progress, checkpoint, patterns=None, seconds=None,
-                    forbidden=()):
+                    forbidden=(), deadline=None, same_solves=None):
     """shape_and_rest on the layering's hooks and on the other hook patterns of the same Eq. 2
     cost (equal_cost_patterns) whose assembly order stays stable (Eq. 1, layering.recheck), and
-    keeps the design whose forces are best (force_score, better): first the weakest-direction load
+    keeps the design whose forces are best (force_score, choose): first the weakest-direction load
     capacity, then the paper's out-of-plane measure. Bounded: at most `patterns` patterns, none
     started after `seconds`; `stages.hook_search` records patterns (equal cost, in all), checked,
-    stable, solved, the chosen pattern's index (0: the layering's), its score, seconds and
+    stable, solved, failed (patterns after the first that the solver could not finish: skipped),
+    the chosen pattern's index (0: the layering's), its score, seconds and
     `complete` (false, with a warning, when a bound cut the choice). The result is written into
     `design` itself (and returned), as the stages do. `patterns` and `seconds`
     default to HOOK_PATTERNS and HOOK_SECONDS (read at the call). `forbidden`: (crossing id, hook)
-    pairs no pattern may use (relayer's). When no pattern ends stable, the layering's own pattern
+    pairs no pattern may use (relayer's). `deadline` (time.monotonic()): no new pattern after it,
+    instead of `seconds` from the call (relayer's, shared by its rounds); `same_solves`: relayer's
+    solves of identical target-shape problems (shape_and_rest). When no pattern ends stable, the layering's own pattern
     is the result (relayer learns from its unrealisable hooks)."""
     patterns = HOOK_PATTERNS if patterns is None else patterns
     seconds = HOOK_SECONDS if seconds is None else seconds
     start = time.monotonic()
+    stop_at = start + seconds if deadline is None else deadline
     candidates, total = equal_cost_patterns(design, patterns if design["stable"] else 1, forbidden)
     shared = {}  # the target shape's per-wire solves, shared by the patterns
     base = _copy_sharing_contours(design)
@@ -371,32 +407,45 @@ def hooks_by_forces(design, material, settings, say, native_progress, checkpoint
     # with the user's.
     user_cuts = len(candidates) > 1 and any("cut_override" in w or "cut_point" in w for w in base["wires"])
     scored = _without_user_cuts(base) if user_cuts else base
-    best, best_score, chosen = None, None, 0
-    checked = stable = solved = 0
+    solutions, scores = [], []  # the solved patterns in order, (index, design), and their force_score
+    checked = stable = failed = 0
     cut = design["stable"] and len(candidates) < total
     for index, hooks in enumerate(candidates):
-        if index and time.monotonic() - start > seconds:
+        if index and time.monotonic() > stop_at:
             cut = True
             break
         checkpoint()
         trial = _with_hooks(scored, hooks)
         checked += 1
-        if index and not layering.recheck(trial, material, settings, native_progress)["stable"]:
+        try:
+            if index and not layering.recheck(trial, material, settings, native_progress)["stable"]:
+                continue
+            stable += 1
+            trial = shape_and_rest(trial, material, settings, say if index == 0 else _quiet, native_progress,
+                                   checkpoint, shared, same_solves)
+        except (native.Cancelled, OutOfTime):
+            raise
+        except (ValueError, RuntimeError):  # another pattern the solver cannot finish: not a better one
+            if index == 0:
+                raise
+            failed += 1
             continue
-        stable += 1
-        trial = shape_and_rest(trial, material, settings, say if index == 0 else _quiet, native_progress, checkpoint,
-                               shared)
-        solved += 1
-        score = force_score(trial)
-        if best is None or better(score, best_score):
-            best, best_score, chosen = trial, score, index
-    if user_cuts and best is not None:  # the chosen pattern again, with the user's cuts
-        checkpoint()
-        best = shape_and_rest(_with_hooks(base, candidates[chosen]), material, settings, _quiet, native_progress,
-                              checkpoint, shared)
-        best_score = force_score(best) or best_score
+        solutions.append((index, trial))
+        scores.append(force_score(trial))
+    pick = choose(scores)
+    chosen, best = solutions[0 if pick is None else pick]
+    best_score = None if pick is None else scores[pick]
+    if user_cuts:  # the chosen pattern again, with the user's cuts; the layering's when that breaks it
+        for index in dict.fromkeys((chosen, 0)):
+            checkpoint()
+            best = shape_and_rest(_with_hooks(base, candidates[index]), material, settings, _quiet, native_progress,
+                                  checkpoint, shared, same_solves)
+            chosen, best_score = index, force_score(best)
+            if best_score is not None:
+                break
     search = {"patterns": len(candidates), "equal_cost": total, "checked": checked, "stable": stable,
-              "solved": solved, "chosen": chosen, "seconds": time.monotonic() - start, "complete": not cut}
+              "solved": len(solutions), "failed": failed, "chosen": chosen, "seconds": time.monotonic() - start,
+              "complete": not cut}
     if best_score is not None:
         search["load_capacity"], search["out_of_plane"] = best_score
         if search["load_capacity"] == float("inf"):
@@ -405,8 +454,9 @@ def hooks_by_forces(design, material, settings, say, native_progress, checkpoint
     if cut:
         best.setdefault("warnings", []).append(
             f"hooks by forces: {checked} of {total} hook patterns of equal Eq. 2 cost were tried (bounded to "
-            f"{patterns} patterns and {seconds:g} s); a better one may exist")
-    if chosen:
+            f"{patterns} patterns and {seconds:g} s{' over every re-layering round' if deadline is not None else ''}); "
+            "a better one may exist")
+    if chosen and best_score is not None:
         say("forces", f"hooks by forces: pattern {chosen} of {checked} tried (weakest load "
                       f"{best_score[0]:.2f}x the weight at the plastic limit, out of plane "
                       f"{100 * best_score[1]:.1f}% of the largest force)")
@@ -415,7 +465,7 @@ def hooks_by_forces(design, material, settings, say, native_progress, checkpoint
     return design
 
 
-def run(vertices, faces, planes, material, settings, progress=None, cancel=None):
+def run(vertices, faces, planes, material, settings, progress=None, cancel=None, stock=None):
     """slice_and_pick then solve: the whole pipeline from a mesh and planes."""
     design = slice_and_pick(vertices, faces, planes, material, settings, progress)
-    return solve(design, material, settings, progress, cancel)
+    return solve(design, material, settings, progress, cancel, stock)

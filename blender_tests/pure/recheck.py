@@ -32,7 +32,9 @@ What is checked (FORMATS.md "Design file"; Miguel, Lepoutre, Bickel 2016, Sec. 4
     (scipy.optimize.linprog, HiGHS, objective sum a as in Eq. 1). Torques are taken about the
     crossings' centroid with lengths in units of their RMS distance to it (a choice of units for
     the couples that changes no verdict of a single load). Every prefix of `assembly_order` of
-    length >= 3 is checked the same way (the wires so far and the crossings among them).
+    length >= 3 is checked the same way (the wires so far and the crossings among them); when the
+    design gives `assembly_steps`, only the prefixes that end a step (a two-hand step adds two
+    wires at once: the state between them never exists).
 
 (c) forces (`force`, on wires[0] by wires[1], present only after the forces stage)
     - zero at null crossings;
@@ -267,6 +269,12 @@ def check_stability(design, prefixes=True):
     if len(order) < 2:
         return problems, pyramids
     lengths = range(3, len(order) + 1) if prefixes else [len(order)]
+    steps = design.get("assembly_steps")
+    if prefixes and steps and [w for step in steps for w in step] == order:
+        # a step that adds two wires at once (two_hand_steps) is one state, not two: only the
+        # prefixes that end a step are real
+        ends = [sum(len(step) for step in steps[:i + 1]) for i in range(len(steps))]
+        lengths = [k for k in ends if k >= 3]
     if len(order) == 2:
         lengths = [2]  # only one pair: check it with torques too (the finished sculpture)
     for k in lengths:

@@ -18,7 +18,8 @@ from helpers import PLANES, ROOT, sphere
 FORMATS = os.path.join(ROOT, "docs", "formats.md")
 # Each bullet of the doc's design-file section and the writers (KEYS owners) it describes.
 BULLETS = {"Top": {"design", "pipeline", "every stage"}, "Slicing": {"slicing"}, "Layering": {"layering"},
-           "Target shape": {"target_shape"}, "Forces and rest shape": {"forces"}, "Fabrication": {"fabrication"}}
+           "Target shape": {"target_shape"}, "Forces and rest shape": {"forces"}, "Fabrication": {"fabrication"},
+           "Plane search": {"plane_search"}}
 PREFIX = {"top": "", "wire": "wires[].", "crossing": "crossings[].", "stages": "stages."}
 
 

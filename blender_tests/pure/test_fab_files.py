@@ -259,6 +259,28 @@ class StreamThroughBinding(unittest.TestCase):
         finally:
             grbl.close()
 
+    def test_a_link_dropped_at_a_steps_g4_resumes_from_the_steps_first_line(self):
+        """GRBL answers ok when it queues a line: a step's feed and bend are acknowledged at once and
+        only its G4 P0 waits for the moves. A link dropped then leaves the step in doubt: the message
+        names it, the state resumes from its first line, and the resume sends every line of it again."""
+        w = native.require()
+        lines = w.stream_lines(w.write_gcode(None, square(), {}, "A/0", "steel"))
+        syncs = [i for i, line in enumerate(lines) if line == "G4 P0"]
+        first, end = syncs[0] + 1, syncs[1]  # step 2, 0-based
+        fast = dict(settle=0.05, response_timeout=1.0)
+        state = {}
+        with GrblEmulator(drop_on=end + 1) as grbl:  # the cable is pulled as step 2's G4 P0 arrives
+            r = w.stream_program(grbl.port, lines, {}, state, **fast)
+        self.assertEqual(r["status"], "disconnected")
+        self.assertEqual(r["last_acknowledged"], end - 1)
+        self.assertEqual((state["next_line"], state["confirmed"]), (first, first))
+        self.assertIn(f"step 2 (lines {first + 1}-{end + 1}: feed 60.000 mm, bend 90.000 deg)", r["message"])
+        self.assertIn(f"check the wire: the resume restarts the step from line {first + 1}", r["message"])
+        with GrblEmulator() as again:
+            r = w.stream_program(again.port, lines, {}, state, **fast)
+        self.assertEqual(r["status"], "completed")
+        self.assertEqual(again.received, ["G21", "G91", "G94"] + lines[first:])
+
     def test_strict_accounting_lenient_decoding_and_one_stream_per_port(self):
         """Issue 18: 'ok ok' to one line stops before the next line is counted (the resume sends
         it); invalid UTF-8 in error: is a status, not UnicodeDecodeError; a second stream on a

@@ -1,6 +1,6 @@
 """The add-on's import rule (DESIGN.md): imports point down only,
 
-    ui -> operators -> props -> blend -> pipeline -> {stages, fab} -> core -> native,
+    ui -> operators -> props -> blend -> plane_search -> pipeline -> {stages, fab} -> core -> native,
 
 a module may import its own folder's modules, and no import circle exists. Every import counts,
 lazy ones inside functions too, except those inside register()/unregister() (the package's
@@ -14,7 +14,7 @@ from helpers import ROOT
 PACKAGE = os.path.join(ROOT, "addon", "wiresculpt")
 # Layer of each top-level part of the package: a module may import parts of a lower number, or of
 # its own part.
-LAYERS = {"ui": 8, "operators": 7, "props": 6, "blend": 5, "pipeline": 4, "stages": 3, "fab": 3, "core": 2,
+LAYERS = {"ui": 8, "operators": 7, "props": 6, "blend": 5, "plane_search": 4.5, "pipeline": 4, "stages": 3, "fab": 3, "core": 2,
           "native": 1, "_wiresculpt": 0}
 
 

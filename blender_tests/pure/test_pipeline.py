@@ -113,6 +113,79 @@ class Cancelling(unittest.TestCase):
                 pipeline.solve(design, PRESETS["steel"], defaults(), cancel=cancel)
 
 
+class Clock:
+    """A stand-in for the time module in pipeline: monotonic() advances `step` seconds per call."""
+
+    def __init__(self, step):
+        import time
+
+        self.now, self.step, self.perf_counter = 0.0, step, time.perf_counter
+
+    def monotonic(self):
+        self.now += self.step
+        return self.now
+
+
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class TimeBudget(unittest.TestCase):
+    """settings.max_solve_seconds: past it the solve stops with OutOfTime naming the key and the
+    stage, whether the budget runs out between stages or inside the native solver's polls."""
+
+    def solve(self, budget, step, cancel=None):
+        V, F = sphere()
+        settings = dict(defaults(), max_solve_seconds=budget)
+        design = pipeline.slice_and_pick(V, F, PLANES, PRESETS["steel"], settings)
+        saved, pipeline.time = pipeline.time, Clock(step)
+        try:
+            return pipeline.solve(design, PRESETS["steel"], settings, cancel=cancel)
+        finally:
+            pipeline.time = saved
+
+    def test_the_budget_stops_the_solve_and_names_the_key(self):
+        stages = ("layering", "target shape", "forces", "rest shape", "load capacity", "relayering", "size")
+        for budget in (1.5, 40.0):  # the first checkpoint, and somewhere inside the work
+            with self.subTest(budget=budget), self.assertRaises(pipeline.OutOfTime) as ctx:
+                self.solve(budget, 1.0)
+            text = str(ctx.exception)
+            self.assertTrue(text.startswith(f"the solve stopped at its time budget, settings.max_solve_seconds = "
+                                            f"{budget:g} s, during the "), text)
+            self.assertTrue(any(f"during the {s}:" in text for s in stages), text)
+            self.assertIsInstance(ctx.exception, RuntimeError)  # the batch's one-line error, exit 1
+
+    def test_the_same_clock_with_room_to_spare_finishes(self):
+        design = self.solve(1e12, 1.0)
+        self.assertTrue(design["stable"], design.get("reason"))
+        self.assertEqual(design["pending_stages"], [])
+
+    def test_a_cancel_is_a_cancel_even_out_of_time(self):
+        with self.assertRaises(pipeline.Cancelled) as ctx:
+            self.solve(1.5, 1.0, cancel=lambda: True)
+        self.assertNotIsInstance(ctx.exception, pipeline.OutOfTime)
+
+
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class StockBeforeSolving(unittest.TestCase):
+    def test_wires_longer_than_the_profiles_stock_are_said_before_the_layering(self):
+        V, F = sphere()
+        design = pipeline.slice_and_pick(V, F, PLANES, PRESETS["steel"], defaults())
+        # the contours' lengths from their points, apart from core/sizes.py
+        lengths = {w["name"]: sum(math.dist(a, b) for a, b in zip(w["contour"], w["contour"][1:] + w["contour"][:1]))
+                   for w in design["wires"]}
+        stock = 0.5 * (min(lengths.values()) + max(lengths.values()))
+        said = []
+        pipeline.solve(design, PRESETS["steel"], defaults(), progress=lambda s, m: said.append((s, m)),
+                       stock=(stock, "shop bender"))
+        longer = sorted(n for n, l in lengths.items() if l > stock)
+        self.assertTrue(0 < len(longer) < len(lengths))
+        warned = [m for s, m in said if s == "size"]
+        self.assertEqual(sorted(m.split()[1] for m in warned), longer)
+        for m in warned:
+            self.assertIn(f"longer than the {stock * 1000:.0f} mm stock of shop bender", m)
+        stages = [s for s, _m in said]
+        self.assertLess(max(i for i, s in enumerate(stages) if s == "size"), stages.index("layering"))
+        self.assertTrue(all(m in design["warnings"] for m in warned))
+
+
 if __name__ == "__main__":
     unittest.main()
 

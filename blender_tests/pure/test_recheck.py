@@ -216,6 +216,31 @@ class Globe(unittest.TestCase):
         d["crossings"][5]["force"] = (1.5 * np.asarray(d["crossings"][5]["force"])).tolist()
         self.assertTrue(has(R.recheck(d), "contact forces do not balance"))
 
+class Prefixes(unittest.TestCase):
+    """Which assembly states the re-check examines: every prefix of 3 wires and more, or, with
+    assembly_steps, the states that end a step."""
+
+    def checked(self, steps):
+        import recheck as module
+
+        seen = []
+        real = module.carries_all_loads
+        module.carries_all_loads = lambda design, wires, pyramids: seen.append(len(wires))
+        try:
+            design = {"wires": [{"id": i} for i in range(5)], "crossings": [], "assembly_order": [0, 1, 2, 3, 4]}
+            if steps is not None:
+                design["assembly_steps"] = steps
+            self.assertEqual(module.check_stability(design)[0], [])
+        finally:
+            module.carries_all_loads = real
+        return seen
+
+    def test_two_hand_steps_are_one_state(self):
+        self.assertEqual(self.checked(None), [3, 4, 5])
+        self.assertEqual(self.checked([[0, 1], [2], [3], [4]]), [3, 4, 5])
+        self.assertEqual(self.checked([[0, 1], [2, 3], [4]]), [4, 5])
+        self.assertEqual(self.checked([[0, 1, 2], [3, 4]]), [3, 5])
+
 
 if __name__ == "__main__":
     unittest.main()

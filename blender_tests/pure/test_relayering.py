@@ -30,6 +30,7 @@ from wiresculpt import native, pipeline
 from wiresculpt.core.design import new_design, wire_entry
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.settings import defaults
+from wiresculpt.stages import target_shape
 
 from recheck import recheck
 
@@ -157,6 +158,35 @@ class Relayering(unittest.TestCase):
         with self.assertRaises(pipeline.Cancelled):
             self.solve(8, progress=lambda stage, message: seen.append((stage, message)), cancel=cancel)
         self.assertTrue(any(stage == "relayering" for stage, _m in seen))
+
+
+class Unrealisable(unittest.TestCase):
+    """Which (crossing, hook) pairs a failed target shape forbids: the failed hook, or both when the
+    solver's verdict on either wire says no hook cures it (the reviewer's case: a crossing 25 mm
+    along the wire from its neighbour, whose fixed piece lies outside this hook's kink, must keep
+    its other hook however close another crossing is in space)."""
+
+    GAP = ("crossings 0 and 1 on wire A/0 are 25.0 mm apart along the wire; a free bending point between "
+           "them needs 30.0 mm: scale the model up by 1.2x")
+
+    def forbidden(self, *failures):
+        nulled = [{"crossing": c, "hook": h, "status": status, "message": message,
+                   "whatever_the_hook": target_shape.whatever_the_hook(status, message)}
+                  for c, h, status, message in failures]
+        return target_shape.unrealisable({"stages": {"target_shape": {"nulled_crossings": nulled}}})
+
+    def test_the_failed_hook_or_both(self):
+        self.assertEqual(self.forbidden((0, 1, "too_close", self.GAP)), {(0, 1)})
+        short = self.GAP + " (the straight piece is shorter than the minimum segment)"
+        self.assertEqual(self.forbidden((0, 1, "too_close", short)), {(0, 1), (0, -1)})
+        self.assertEqual(self.forbidden((3, -1, "open_end", "crossing 3 is at an end of the open wire")),
+                         {(3, 1), (3, -1)})
+        cone = "crossing 2 on wire B/0 misses its contact cone by 3.1 deg"
+        self.assertEqual(self.forbidden((2, -1, "infeasible", cone)), {(2, -1)})
+        rule = ("crossing 2 needs a bend of at least 130 deg (contact angle 60 deg minus twice the friction angle) "
+                "but the machine bends at most 120 deg")
+        self.assertEqual(self.forbidden((2, -1, "infeasible", rule)), {(2, 1), (2, -1)})
+        self.assertEqual(target_shape.unrealisable({"stages": {}}), set())
 
 
 if __name__ == "__main__":

@@ -45,6 +45,16 @@ class Reusable(unittest.TestCase):
         self.assertIsNone(self.memo_with(result(status="infeasible")).reusable("key", 1.5))
         self.assertIsNone(target_shape.Memo().reusable("key", 1.5))
 
+    def test_the_same_problem_is_reused_across_memos_whatever_its_result(self):
+        same = {}
+        r = result(feasible=False, nlopt="NLOPT_ROUNDOFF_LIMITED")  # never reused under another limit
+        target_shape.Memo(same).remember("key", 2.0, r)
+        other = target_shape.Memo(same)
+        self.assertIs(other.reusable("key", 2.0), r)  # exactly the same problem: the same answer
+        self.assertEqual(other.reused, 1)
+        self.assertIsNone(other.reusable("key", 1.5))
+        self.assertIsNone(target_shape.Memo().reusable("key", 2.0))  # a memo of its own shares nothing
+
     def test_the_key_sees_every_input_but_the_bend_limit(self):
         contour = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
         specs = [{"vertex": 1, "bisector": (0.0, 1.0), "contact_angle": 2.0, "active": True}]

@@ -260,6 +260,9 @@ py::dict stream_program_py(const std::string& port, const std::vector<std::strin
   py::dict state = state_arg ? *state_arg : py::dict();
   StreamState s;
   if (state.contains("next_line")) s.next_line = to_integer<std::size_t>(state["next_line"], "state['next_line']");
+  // Without "confirmed" the lines before next_line are taken as done (a state set by hand).
+  s.confirmed = state.contains("confirmed") ? to_integer<std::size_t>(state["confirmed"], "state['confirmed']")
+                                            : s.next_line;
   StreamOptions o;
   o.dry_run = dry_run;
   o.response_timeout = response_timeout;
@@ -271,14 +274,16 @@ py::dict stream_program_py(const std::string& port, const std::vector<std::strin
   try {
     r = reporter.run([&] { return stream_program(port, lines, m, s, o, fn); });
   } catch (...) {
-    state["next_line"] = s.next_line;  // what was acknowledged stays acknowledged: resume from here
+    state["next_line"] = s.next_line;  // resume from here
+    state["confirmed"] = s.confirmed;
     throw;
   }
   state["next_line"] = s.next_line;
+  state["confirmed"] = s.confirmed;
   return py::dict(py::arg("status") = std::string(to_string(r.status)), py::arg("sent") = r.sent,
                   py::arg("acknowledged") = r.acknowledged, py::arg("last_acknowledged") = r.last_acknowledged,
                   py::arg("failed_line") = r.failed_line, py::arg("code") = r.code, py::arg("message") = r.message,
-                  py::arg("next_line") = s.next_line);
+                  py::arg("next_line") = s.next_line, py::arg("confirmed") = s.confirmed);
 }
 
 }  // namespace
@@ -357,11 +362,15 @@ point. Writes atomically when path is not None; returns the text.)");
         py::arg("dry_run") = false, py::arg("response_timeout") = 30.0, py::arg("settle") = 2.0,
         R"(Stream G-code lines to a GRBL bender (send one line, wait for ok / error:N; ALARM stops).
 
-state: dict whose "next_line" (0-based, first unacknowledged line) is read and updated in place,
-so calling again after an error or a disconnect resumes without repeating or skipping a line.
+state: dict whose "next_line" (0-based: where a call starts) and "confirmed" (the line after the last
+step known complete: after the last acknowledged G4/M2) are read and updated in place. GRBL answers
+ok when it queues a line; after a stop that can lose queued moves (disconnected, timeout, aborted,
+alarm) inside a step, the message names the step and next_line goes back to its first line, so
+calling again makes the whole step again; after error or protocol_error it is the first
+unacknowledged line. No line is skipped.
 progress(stage, fraction) -> False aborts. control: a StreamControl to pause/resume/abort from
 another thread. Returns {"status": completed|dry_run|error|alarm|disconnected|timeout|aborted|protocol_error,
-"sent", "acknowledged", "last_acknowledged", "failed_line", "code", "message", "next_line"}.)");
+"sent", "acknowledged", "last_acknowledged", "failed_line", "code", "message", "next_line", "confirmed"}.)");
 }
 
 }  // namespace wiresculpt::python

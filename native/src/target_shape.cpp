@@ -81,6 +81,7 @@ void validate(const Polyline2& contour, bool closed, const std::vector<TargetCro
     bad("max_seconds must be more than 0 and at most " + std::to_string(static_cast<int>(kMaxSeconds)) + " seconds");
   if (!(o.model_size <= 1e6)) bad("model_size must be at most 1e6 metres");
   if (!positive(o.sweep_tol)) bad("sweep_tol must be a positive number of metres");
+  if (!(std::isfinite(o.sweep_ftol) && o.sweep_ftol >= 0.0 && o.sweep_ftol < 1.0)) bad("sweep_ftol must be from 0 to less than 1");
   if (!(std::isfinite(o.model_size) && o.model_size >= 0.0)) bad("model_size must be >= 0 metres");
   const std::size_t n = contour.size();
   if (n < (closed ? 3u : 2u))
@@ -608,10 +609,15 @@ std::array<int, 3> constraint_points(const TargetShapeProblem::Constraint& c, in
   return {-1, -1, -1};
 }
 
+// The progress callback is polled at the first evaluation and then every this many: a Python
+// callback takes the GIL, and polled at every evaluation (20-100 µs each) it serialised the wires
+// that the pipeline solves on two threads. 16 evaluations are at most a few milliseconds.
+constexpr int kProgressEvery = 16;
+
 double objective(unsigned, const double* x, double* g, void* data) {
   auto* d = static_cast<SolverData*>(data);
   ++d->evaluations;
-  if (d->progress && *d->progress) {
+  if (d->progress && *d->progress && (d->evaluations - 1) % kProgressEvery == 0) {
     try {
       report_progress(*d->progress, "target_shape",
                       std::min(1.0, static_cast<double>(d->evaluations) / d->max_evaluations));
@@ -868,6 +874,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     // moved by more than move_tol since it was last solved.
     const double move_tol = o.sweep_tol;
     std::vector<char> dirty(blocks.size(), 1);
+    double last_energy = std::numeric_limits<double>::infinity();  // E after the previous sweep
     std::vector<std::vector<int>> watchers(m);  // point -> blocks whose terms read it
     for (std::size_t k = 0; k < blocks.size(); ++k)
       for (int t : blocks[k].terms)
@@ -896,6 +903,17 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
       if (data.evaluations >= o.max_iterations) {
         result.nlopt_result = "NLOPT_MAXEVAL_REACHED";
         break;
+      }
+      // Stop once a whole sweep, with every constraint met, lowered the wire's energy by no more
+      // than sweep_ftol of it: what is left is creep along the wire (see sweep_ftol).
+      if (o.sweep_ftol > 0.0) {
+        const double energy = problem.energy(data.p);
+        double violation = 0.0;
+        for (std::size_t k = 0; k < problem.constraints().size(); ++k)
+          violation = std::max(violation, problem.constraint(k, data.p));
+        const bool small = last_energy - energy <= o.sweep_ftol * std::abs(energy);
+        last_energy = energy;
+        if (small && violation <= o.constraint_tol) break;
       }
     }
   }

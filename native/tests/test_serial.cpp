@@ -7,8 +7,11 @@
 #include <termios.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdlib>
+#include <fstream>
 #include <limits>
 #include <mutex>
 #include <thread>
@@ -26,8 +29,12 @@ namespace {
 
 class GrblEmulator {
  public:
+  // drop_at: line k is received, never answered, and the cable is pulled (the master end closed).
+  // banner_on_hold / alarm_on_hold / ok_on_hold: on a feed hold ('!') the controller restarts (its
+  // banner), raises ALARM:3, or sends an 'ok' no line was waiting for. banner_after: line k is
+  // answered "ok" and the controller restarts at once (the banner in the same write).
   enum class Mode { normal, error_at, alarm_at, slow, disconnect_after, garbage_at, double_ok_at, double_ok_always,
-                    binary_error_at };
+                    binary_error_at, drop_at, banner_on_hold, alarm_on_hold, ok_on_hold, banner_after };
 
   explicit GrblEmulator(Mode mode, std::size_t k = 0, int delay_ms = 0) : mode_(mode), k_(k), delay_ms_(delay_ms) {
     termios raw{};
@@ -61,6 +68,12 @@ class GrblEmulator {
       index = received_.size();
       received_.push_back(line);
     }
+    if (mode_ == Mode::drop_at && index == k_) {
+      ::close(master_);  // the cable is pulled while this line waits for its answer
+      master_ = -1;
+      stop_ = true;
+      return;
+    }
     if (locked_) return send("error:9\r\n");  // GRBL refuses everything while in alarm
     if (mode_ == Mode::error_at && index == k_) return send("error:20\r\n");
     if (mode_ == Mode::alarm_at && index == k_) {
@@ -79,6 +92,7 @@ class GrblEmulator {
     // An informational line first: the streamer must skip it. A doubled "ok" comes in one write,
     // as a device that echoes its answer twice sends it.
     const bool twice = (mode_ == Mode::double_ok_at && index == k_) || mode_ == Mode::double_ok_always;
+    if (mode_ == Mode::banner_after && index == k_) return send("[MSG:busy]\r\nok\r\n\r\nGrbl 1.1h ['$' for help]\r\n");
     send(twice ? "[MSG:busy]\r\nok\r\nok\r\n" : "[MSG:busy]\r\nok\r\n");
     if (mode_ == Mode::disconnect_after && index + 1 == k_) {
       std::this_thread::sleep_for(std::chrono::milliseconds(100));  // the ok reaches the streamer
@@ -86,6 +100,15 @@ class GrblEmulator {
       master_ = -1;
       stop_ = true;
     }
+  }
+
+  void on_hold() {
+    if (mode_ == Mode::banner_on_hold) send("\r\nGrbl 1.1h ['$' for help]\r\n");  // reset: modes and queue lost
+    if (mode_ == Mode::alarm_on_hold) {
+      locked_ = true;
+      send("ALARM:3\r\n");
+    }
+    if (mode_ == Mode::ok_on_hold) send("ok\r\n");
   }
 
   void run() {
@@ -99,8 +122,11 @@ class GrblEmulator {
       for (ssize_t i = 0; i < n && !stop_; ++i) {
         const char c = buf[i];
         if (c == '!' || c == '~' || c == '?' || c == '\x18') {
-          std::lock_guard<std::mutex> g(mu_);
-          realtime_ += c;
+          {
+            std::lock_guard<std::mutex> g(mu_);
+            realtime_ += c;
+          }
+          if (c == '!') on_hold();
         } else if (c == '\n') {
           if (!buffer.empty() && buffer.back() == '\r') buffer.pop_back();
           answer(buffer);
@@ -239,9 +265,12 @@ TEST_CASE("serial: a device answering garbage acknowledges nothing and the strea
   CHECK_FALSE(r.message.empty());
 }
 
-TEST_CASE("serial: after a disconnect, a resume restores the modes, then finishes with every line acknowledged exactly once", "[fab][serial]") {
+TEST_CASE("serial: after a disconnect mid-step, a resume restores the modes, then makes the step again from its "
+          "first line", "[fab][serial]") {
   const auto lines = program_lines();
-  const std::size_t k = 5;
+  const std::size_t k = 5;  // step 1 is lines 3-6 (0-based): its feed and bend acknowledged, line 5 not
+  REQUIRE(lines[3].rfind("G1 X", 0) == 0);
+  REQUIRE(lines[6] == "G4 P0");
   StreamState state;
   std::vector<std::string> received, acknowledged;
   {
@@ -252,8 +281,9 @@ TEST_CASE("serial: after a disconnect, a resume restores the modes, then finishe
     CHECK(r.status == StreamStatus::disconnected);
     CHECK(r.last_acknowledged == static_cast<long>(k) - 1);
     CHECK(r.failed_line == static_cast<long>(k));
-    CHECK(state.next_line == k);
-    CHECK_THAT(r.message, Contains("resume from line 6"));
+    CHECK(state.next_line == 3);  // the step's first line: its queued moves may be lost
+    CHECK(state.confirmed == 3);  // the mode lines moved nothing: done
+    CHECK_THAT(r.message, Contains("step 1 (lines 4-7") && Contains("restarts the step from line 4"));
     received = grbl.received();
     acknowledged = grbl.acknowledged();
   }
@@ -268,7 +298,7 @@ TEST_CASE("serial: after a disconnect, a resume restores the modes, then finishe
     GrblEmulator grbl(GrblEmulator::Mode::normal);  // the machine again, on a new device name
     const auto r = stream_program(grbl.path(), lines, MachineProfile{}, state, quick());
     CHECK(r.status == StreamStatus::completed);
-    CHECK(r.sent == lines.size() - k);
+    CHECK(r.sent == lines.size() - 3);
     auto more_received = grbl.received(), more_acknowledged = grbl.acknowledged();
     REQUIRE(more_received.size() >= modes.size());
     CHECK(std::vector<std::string>(more_received.begin(), more_received.begin() + 3) == modes);
@@ -278,8 +308,11 @@ TEST_CASE("serial: after a disconnect, a resume restores the modes, then finishe
     acknowledged.insert(acknowledged.end(), more_acknowledged.begin(), more_acknowledged.end());
   }
   CHECK(state.next_line == lines.size());
-  CHECK(acknowledged == lines);  // program lines in order, none twice, none skipped
-  CHECK(received == lines);      // and none sent twice (besides the mode lines restored above)
+  // Over the two links: lines 1-5, then step 1 from its first line again (line 4 on), none skipped.
+  std::vector<std::string> expected(lines.begin(), lines.begin() + static_cast<long>(k));
+  expected.insert(expected.end(), lines.begin() + 3, lines.end());
+  CHECK(acknowledged == expected);
+  CHECK(received == expected);  // line 6 never reached the first device
 }
 
 TEST_CASE("serial: pause, resume and abort", "[fab][serial]") {
@@ -315,8 +348,13 @@ TEST_CASE("serial: pause, resume and abort", "[fab][serial]") {
     const auto r = stream_program(grbl.path(), lines, MachineProfile{}, state, quick(),
                                   [&](std::string_view, double f) { return f < 0.5; });
     CHECK(r.status == StreamStatus::aborted);
-    CHECK(state.next_line == grbl.acknowledged().size());
-    CHECK(state.next_line >= lines.size() / 2);
+    // The soft reset drops the queued moves: the resume starts at the first line after the last
+    // step known complete (its G4 P0 acknowledged).
+    CHECK(grbl.acknowledged().size() >= lines.size() / 2);
+    CHECK(state.next_line == state.confirmed);
+    CHECK(state.next_line <= grbl.acknowledged().size());
+    REQUIRE(state.next_line > 0);
+    CHECK(lines[state.next_line - 1] == "G4 P0");
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
     CHECK(grbl.realtime() == "!\x18");
   }
@@ -442,4 +480,158 @@ TEST_CASE("serial: parse_answer classifies GRBL's lines; device bytes become pri
   CHECK(parse_answer("Grbl 1.1h ['$' for help]").kind == K::banner);
   CHECK(parse_answer("[MSG:busy]").kind == K::info);
   CHECK(parse_answer(std::string("a\0b\x7f", 4)).text == "a\\x00b\\x7f");
+}
+
+namespace {
+
+std::vector<std::size_t> sync_lines(const std::vector<std::string>& lines) {
+  std::vector<std::size_t> out;
+  for (std::size_t j = 0; j < lines.size(); ++j)
+    if (lines[j] == "G4 P0") out.push_back(j);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("serial: a link dropped while a step's G4 P0 waits names the step in doubt; the resume sends the whole "
+          "step again", "[fab][serial][robustness]") {
+  // GRBL answers "ok" when a line is queued: step 2's feed and bend lines were all acknowledged at
+  // once, and only its G4 P0 waits for the moves. Reopening the port resets the controller in the
+  // middle of them, so the step may be half made: the resume must start at the step's first line.
+  const auto lines = program_lines();
+  const auto syncs = sync_lines(lines);
+  REQUIRE(syncs.size() >= 3);
+  const std::size_t first = syncs[0] + 1, end = syncs[1];  // step 2: lines first..end (0-based)
+  REQUIRE(end - first >= 3);                               // a feed and a bend before its G4 P0
+  StreamState state;
+  {
+    GrblEmulator grbl(GrblEmulator::Mode::drop_at, end);
+    const auto r = stream_program(grbl.path(), lines, MachineProfile{}, state, quick());
+    CHECK(r.status == StreamStatus::disconnected);
+    CHECK(r.failed_line == static_cast<long>(end));
+    CHECK(r.last_acknowledged == static_cast<long>(end) - 1);  // the step's moves were queued ...
+    CHECK(state.confirmed == first);                           // ... but only step 1 is known made
+    CHECK(state.next_line == first);                           // the resume restarts step 2
+    CHECK(grbl.received() == std::vector<std::string>(lines.begin(), lines.begin() + static_cast<long>(end) + 1));
+    CHECK_THAT(r.message, Contains("step 2") &&
+                              Contains("lines " + std::to_string(first + 1) + "-" + std::to_string(end + 1)) &&
+                              Contains("feed 40.000 mm") && Contains("bend 90.000 deg") &&
+                              Contains("check the wire") && Contains("from line " + std::to_string(first + 1)));
+    CHECK_THAT(r.message, !Contains("from line " + std::to_string(end + 1)));
+  }
+  GrblEmulator again(GrblEmulator::Mode::normal);  // the machine again, on a new device name
+  const auto r = stream_program(again.path(), lines, MachineProfile{}, state, quick());
+  CHECK(r.status == StreamStatus::completed);
+  CHECK(r.sent == lines.size() - first);
+  CHECK(state.confirmed == lines.size());
+  // The restored mode lines, then every line of step 2 again (its feed, bend and G4 P0), then the rest.
+  std::vector<std::string> expected{"G21", "G91", "G94"};
+  expected.insert(expected.end(), lines.begin() + static_cast<long>(first), lines.end());
+  CHECK(again.received() == expected);
+}
+
+TEST_CASE("serial: a controller restart, an ALARM or a stray 'ok' while paused stops the stream",
+          "[fab][serial][robustness]") {
+  // Paused after step 1's feed (line 4) was acknowledged, in the middle of the step.
+  const auto lines = program_lines();
+  const std::size_t at = 4;
+  REQUIRE(lines[3].rfind("G1 X", 0) == 0);
+  REQUIRE(lines[6] == "G4 P0");
+  auto paused_run = [&](GrblEmulator::Mode mode, StreamState& state, std::size_t& received) {
+    GrblEmulator grbl(mode);
+    StreamControl control;
+    StreamOptions o = quick();
+    o.control = &control;
+    std::thread releaser;
+    const auto r = stream_program(grbl.path(), lines, MachineProfile{}, state, o, [&](std::string_view, double) {
+      if (state.next_line == at && !releaser.joinable()) {
+        control.pause = true;
+        // A streamer that ignored the answers while paused would wait for this forever: release it
+        // later so that the test ends (and fails) instead of hanging.
+        releaser = std::thread([&] {
+          std::this_thread::sleep_for(std::chrono::milliseconds(300));
+          control.pause = false;
+        });
+      }
+      return true;
+    });
+    releaser.join();
+    received = grbl.received().size();
+    return r;
+  };
+  StreamState state;
+  std::size_t received = 0;
+  SECTION("a banner: the controller restarted (modes and queued moves lost)") {
+    const auto r = paused_run(GrblEmulator::Mode::banner_on_hold, state, received);
+    CHECK(r.status == StreamStatus::disconnected);
+    CHECK(received == at);  // the next line was never sent as if nothing happened
+    CHECK(r.failed_line == static_cast<long>(at));
+    CHECK_THAT(r.message, Contains("restarted") && Contains("step 1") && Contains("check the wire"));
+    CHECK(state.next_line == 3);  // step 1 was in doubt: the resume restarts it
+    CHECK(state.confirmed == 3);
+  }
+  SECTION("an ALARM") {
+    const auto r = paused_run(GrblEmulator::Mode::alarm_on_hold, state, received);
+    CHECK(r.status == StreamStatus::alarm);
+    CHECK(r.code == 3);
+    CHECK(received == at);
+    CHECK_THAT(r.message, Contains("ALARM:3") && Contains("$X") && Contains("step 1"));
+    CHECK(state.next_line == 3);  // an alarm loses the queued moves: step 1 is restarted
+  }
+  SECTION("an 'ok' no line was waiting for") {
+    const auto r = paused_run(GrblEmulator::Mode::ok_on_hold, state, received);
+    CHECK(r.status == StreamStatus::protocol_error);
+    CHECK(received == at);
+    CHECK_THAT(r.message, Contains("unexpected 'ok'") && Contains("step 1"));
+    // The stream stopped in a feed hold: the step's queued moves have not run, and the resume
+    // (reopening the port resets the controller) restarts the step.
+    CHECK(state.next_line == 3);
+  }
+}
+
+TEST_CASE("serial: a lock file that is a symbolic link is not followed", "[fab][serial][robustness]") {
+  // Another user's link at the lock path would otherwise make the stream truncate and write the
+  // file it points to.
+  GrblEmulator grbl(GrblEmulator::Mode::normal);
+  char dir_template[] = "/tmp/wiresculpt-lock-XXXXXX";
+  REQUIRE(::mkdtemp(dir_template) != nullptr);
+  const std::string dir = dir_template;
+  const char* before = std::getenv("WIRESCULPT_LOCK_DIR");
+  const std::string saved = before ? before : "";
+  ::setenv("WIRESCULPT_LOCK_DIR", dir.c_str(), 1);
+  char resolved[4096];
+  REQUIRE(::realpath(grbl.path().c_str(), resolved) != nullptr);
+  std::string device = resolved;
+  if (device.rfind("/dev/", 0) == 0) device.erase(0, 5);
+  std::replace(device.begin(), device.end(), '/', '_');
+  const std::string target = dir + "/victim", link = dir + "/LCK.." + device;
+  { std::ofstream(target) << "keep\n"; }
+  REQUIRE(::symlink(target.c_str(), link.c_str()) == 0);
+  CHECK_THROWS_WITH(SerialPort(grbl.path(), MachineProfile{}.serial), Contains("lock file " + link));
+  std::string content;
+  {
+    std::ifstream in(target);
+    std::getline(in, content);
+  }
+  CHECK(content == "keep");
+  if (before) ::setenv("WIRESCULPT_LOCK_DIR", saved.c_str(), 1);
+  else ::unsetenv("WIRESCULPT_LOCK_DIR");
+  ::unlink(link.c_str());
+  ::unlink(target.c_str());
+  ::rmdir(dir.c_str());
+}
+
+TEST_CASE("serial: a controller restart seen before the next line is sent stops the stream", "[fab][serial][robustness]") {
+  // The restarted GRBL is back in G90 with an empty queue: sending the next relative line as if
+  // nothing happened would run it as an absolute move.
+  const auto lines = program_lines();
+  const std::size_t k = 4;  // step 1's bend line is answered, then the banner arrives
+  GrblEmulator grbl(GrblEmulator::Mode::banner_after, k);
+  StreamState state;
+  const auto r = stream_program(grbl.path(), lines, MachineProfile{}, state, quick());
+  CHECK(r.status == StreamStatus::disconnected);
+  CHECK(r.failed_line == static_cast<long>(k) + 1);
+  CHECK(grbl.received().size() == k + 1);  // line k+1 was never sent
+  CHECK_THAT(r.message, Contains("restarted") && Contains("step 1") && Contains("from line 4"));
+  CHECK(state.next_line == 3);  // step 1's queued feed and bend are lost: the resume makes it again
 }

@@ -298,6 +298,11 @@ TEST_CASE("target shape: bad input is rejected with the wire and crossing named"
   CHECK_THROWS_WITH(optimize_target_shape(bad, false, {}, o), Contains("point 4"));
   o.max_bend = 4.0;
   CHECK_THROWS_WITH(optimize_target_shape(contour, false, {}, o), Contains("max_bend"));
+  o.max_bend = 2.0;
+  for (double v : {-1e-3, 1.0, std::nan("")}) {
+    o.sweep_ftol = v;
+    CHECK_THROWS_WITH(optimize_target_shape(contour, false, {}, o), Contains("sweep_ftol"));
+  }
 }
 
 TEST_CASE("target shape: the progress callback can cancel", "[target]") {
@@ -527,4 +532,71 @@ TEST_CASE("target shape: a kink whose neighbour breaks the bend limit is not rea
   CHECK_THAT(r.crossings[0].message, Contains("its kink cannot be made") && Contains("point " + std::to_string(at)));
   CHECK_FALSE(r.feasible);
   CHECK(r.crossings[1].status == "inactive");
+}
+
+namespace {
+// A closed loop r = r0 + 0.04 cos 5t + 0.02 sin 3t at 1 mm sampling with `count` active crossings
+// whose bisectors alternate inwards and outwards (the 2 m wire above for r0 = 0.3).
+std::pair<Polyline2, std::vector<TargetCrossing>> long_loop(double r0, int count) {
+  Polyline2 contour;
+  const int n = static_cast<int>(2 * pi * r0 / 1e-3);
+  for (int k = 0; k < n; ++k) {
+    const double t = 2 * pi * k / n;
+    const double rr = r0 + 0.04 * std::cos(5 * t) + 0.02 * std::sin(3 * t);
+    contour.emplace_back(rr * std::cos(t), rr * std::sin(t));
+  }
+  std::vector<TargetCrossing> xs;
+  for (int k = 0; k < count; ++k) {
+    const int v = k * n / count + 7;
+    xs.push_back({v, (k % 2 ? 1.0 : -1.0) * contour[v].normalized(), 2 * pi / 3, true});
+  }
+  return {contour, xs};
+}
+}  // namespace
+
+TEST_CASE("target shape: sweep_ftol stops the sweeps with the distances and crossings of converged sweeps",
+          "[target]") {
+  // The reference runs the sweeps until no window moves a point by 1 nm (sweep_ftol off); the
+  // energy-based stop must give the same distances to the contour (within 0.1 mm, the tolerance of
+  // issue 17) and the same realised crossings, for fewer sweeps.
+  const auto wavy = wavy_loop();
+  const auto two_metres = long_loop(0.3, 10);
+  const auto three_metres = long_loop(0.47, 6);
+  for (const auto* c : {&wavy, &two_metres, &three_metres}) {
+    const auto& [contour, xs] = *c;
+    TargetShapeOptions reference, fast;
+    reference.sweep_tol = 1e-9;
+    reference.max_iterations = 1'000'000;
+    fast.sweep_ftol = 1e-3;
+    const TargetShapeResult a = optimize_target_shape(contour, true, xs, fast);
+    const TargetShapeResult b = optimize_target_shape(contour, true, xs, reference);
+    INFO(contour.size() << " contour points, " << a.sweeps << " / " << b.sweeps << " sweeps");
+    REQUIRE(a.points.size() == b.points.size());
+    CHECK(b.nlopt_result != "NLOPT_MAXEVAL_REACHED");
+    CHECK(a.sweeps < b.sweeps);
+    CHECK(a.iterations < b.iterations);
+    CHECK(std::abs(a.max_distance - b.max_distance) < 1e-4);
+    CHECK(std::abs(a.rms_distance - b.rms_distance) < 1e-4);
+    // What is left after the stop lowers the energy by less than a percent.
+    CHECK(a.energy == Approx(b.energy).epsilon(1e-2));
+    CHECK(a.feasible == b.feasible);
+    for (std::size_t k = 0; k < xs.size(); ++k) {
+      CHECK(a.crossings[k].status == b.crossings[k].status);
+      CHECK(a.crossings[k].realised == b.crossings[k].realised);
+    }
+    check_constraints(a, true, xs, fast, 1e-6);
+  }
+}
+
+TEST_CASE("target shape: a 3 m wire converges within the default evaluation budget with sweep_ftol", "[target]") {
+  // Without the energy-based stop, each sweep of a 3 m wire moves points along it by more than
+  // sweep_tol, and the sweeps used up the 20,000 evaluations (scripts/bench, length-3.0m).
+  const auto [contour, xs] = long_loop(0.47, 6);
+  TargetShapeOptions o;
+  o.sweep_ftol = 1e-3;
+  const TargetShapeResult r = optimize_target_shape(contour, true, xs, o);
+  CHECK(r.nlopt_result != "NLOPT_MAXEVAL_REACHED");
+  CHECK(r.iterations < o.max_iterations);
+  CHECK(r.feasible);
+  for (const auto& s : r.crossings) CHECK(s.status == "ok");
 }

@@ -41,7 +41,7 @@ KEYS = {
         "two_hand_steps": "layering", "close_crossings": "layering", "required_size": "layering",
         "search_incomplete": "layering",
         "out_of_plane": "forces", "load_capacity": "forces", "load_factor": "forces", "buildability": "pipeline",
-        "fabrication": "fabrication",
+        "fabrication": "fabrication", "plane_search": "plane_search",
     },
     "wire": {
         "id": "slicing", "name": "slicing", "plane": "slicing", "closed": "slicing", "contour": "slicing",
@@ -69,7 +69,7 @@ KEYS = {
 # material without density, a user's cut, the batch's exports.
 OPTIONAL = {
     "top": {"close_crossings", "required_size", "load_capacity", "load_factor", "fabrication", "warnings",
-            "buildability", "search_incomplete"},
+            "buildability", "search_incomplete", "plane_search"},
     "wire": {"cut_override", "cut_point", "out_of_plane_deflection", "out_of_plane_deflection_vertex"},
     "crossing": set(),
     "stages": set(),

@@ -133,7 +133,12 @@ def _settings(value):
             out["cuts"] = _cuts(raw)
             continue
         _default, low, high, unit, _text = settings_table.SETTINGS[key]
-        if unit == "bool":
+        if unit == "choice":
+            if raw not in settings_table.CHOICES[key]:
+                raise ValueError(f'scene key "settings.{key}" must be one of '
+                                 f'{", ".join(json.dumps(c) for c in settings_table.CHOICES[key])}, got {json.dumps(raw)}')
+            out[key] = raw
+        elif unit == "bool":
             if not isinstance(raw, bool):
                 raise ValueError(f'scene key "settings.{key}" must be true or false, got {json.dumps(raw)}')
             out[key] = raw
@@ -163,9 +168,13 @@ def parse_scene(data, path="scene.json"):
     size = data.get("size")
     if size is not None:
         size = _number(size, "size", 0.0, MAX_SIZE, low_open=True)
+    settings = _settings(data.get("settings"))
     planes = data.get("planes")
-    if not isinstance(planes, list) or not planes:
-        raise ValueError('scene key "planes" must be a non-empty list of planes')
+    if settings["plane_search"] == "auto" and isinstance(planes, list):
+        pass  # "auto" proposes the planes: an empty list is allowed, given planes are still checked
+    elif not isinstance(planes, list) or not planes:
+        raise ValueError('scene key "planes" must be a non-empty list of planes (or set "settings.plane_search" '
+                         'to "auto" to have them proposed)')
     if len(planes) > MAX_PLANES:
         raise ValueError(f'scene key "planes" has {len(planes)} planes; at most {MAX_PLANES} are allowed')
     names = set()
@@ -178,7 +187,7 @@ def parse_scene(data, path="scene.json"):
         if not os.path.isfile(profile):
             raise ValueError(f'scene key "machine_profile": file not found: {profile}')
     return Scene(os.path.abspath(path), mesh, size, _material(data.get("material")), parsed,
-                 _settings(data.get("settings")), profile)
+                 settings, profile)
 
 
 def load_scene(path):

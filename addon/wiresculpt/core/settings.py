@@ -28,7 +28,18 @@ SETTINGS = {
     "relayer_rounds": (8, 0, 100, "int",
                        "How many times to layer again after the target shape could not realise a hook, "
                        "with that hook forbidden (0: layer once)"),
+    "max_solve_seconds": (600.0, 0.001, 86400.0, "s",
+                          "Wall-clock budget of one solve, every stage and round included; past it the "
+                          "solve stops with a message naming this key"),
+    # the plane assistant (issue 15, plane_search.py); unit "choice": one of CHOICES[key]
+    "plane_search": ("off", None, None, "choice",
+                     "off: the planes as given; nearby: when they give no stable design, the least change "
+                     "of them that does; auto: planes proposed from the mesh alone (\"planes\" may be [])"),
+    "plane_count": (5, 2, 12, "int", "How many planes plane_search \"auto\" proposes"),
 }
+
+# the allowed values of the "choice" keys
+CHOICES = {"plane_search": ("off", "nearby", "auto")}
 
 # the keys whose values are not floats
 BOOLEAN = tuple(k for k, spec in SETTINGS.items() if spec[3] == "bool")

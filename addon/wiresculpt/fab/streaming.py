@@ -1,9 +1,11 @@
 """Sending one wire's bend program to a GRBL bender (Sec. 5.1; protocol: docs/machine-protocol.md).
 
 The G-code comes from the design's rest shape and the machine profile (export.machine_profile),
-is streamed by the native stream_program in a worker thread (it releases the GIL), and what the
-machine acknowledged is kept per wire in PENDING, so a Resume after an error, a dropped link or a
-cancel continues from the first unacknowledged line: no line is sent twice, none is skipped.
+is streamed by the native stream_program in a worker thread (it releases the GIL), and its state is
+kept per wire in PENDING, so a Resume after an error, a dropped link or a cancel continues where the
+native state says: the first unacknowledged line, or, when the stop may have lost moves GRBL had
+acknowledged (queued) but not run, the first line of that step (the stop's message names it and
+asks to check the wire). No line is skipped.
 
 Free of bpy: the add-on's operators, and the tests, call it.
 """
@@ -43,7 +45,7 @@ def wire_program(design, wire_name, profile=None):
 
 class Stopped:
     """A wire whose stream stopped before its end: the program, the profile and the state
-    ({"next_line"}) the native stream_program updates in place."""
+    ({"next_line", "confirmed"}) the native stream_program updates in place."""
 
     def __init__(self, lines, profile, state, port, result):
         self.lines, self.profile, self.state, self.port, self.result = lines, profile, state, port, result
@@ -149,9 +151,13 @@ def _outcome(job):
     PENDING[job.wire] = Stopped(job.lines, job.profile, state, job.port, r)
     last = quoted(job.lines, r["last_acknowledged"])
     what = "cancelled" if r["status"] == "aborted" else f"stopped ({r['status']})"
+    if done <= r["last_acknowledged"]:  # acknowledged (queued) moves may be lost: the step again
+        resume = f"Resume restarts the step in doubt from line {done + 1} of {n} (check the wire first)"
+    else:
+        resume = f"Resume continues from line {done + 1} of {n}"
     return {'WARNING'} if r["status"] == "aborted" else {'ERROR'}, (
         f"Wire {job.wire} {what} on {job.port}{start}: the last acknowledged line is {last}; "
-        f"Resume continues from line {done + 1} of {n}. {r['message']}")
+        f"{resume}. {r['message']}")
 
 
 def running():

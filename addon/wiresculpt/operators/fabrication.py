@@ -1,9 +1,10 @@
 """Fabrication (Sec. 5.1): Export writes every wire's SVG, DXF, G-code and bend table into a
 folder; Send to Machine streams one wire's G-code to a GRBL bender over a serial port, in a worker
 thread under a modal operator (progress in the status bar and the panel, Esc cancels), and Resume
-continues a stopped stream from its first unacknowledged line. Both use the machine profile chosen
-in the panel (docs/user-guide.md, Fabrication). In background mode (batch, tests) there is no
-event loop and Send runs to its end inside execute().
+continues a stopped stream where its state says (after a stop that may have lost queued moves, the
+first line of the step in doubt). Both use the machine profile chosen in the panel
+(docs/user-guide.md, Fabrication). In background mode (batch, tests) there is no event loop and
+Send runs to its end inside execute().
 """
 import os
 
@@ -126,7 +127,8 @@ class WIRESCULPT_OT_pick_port(bpy.types.Operator):
 
 class WIRESCULPT_OT_send_to_machine(WorkerModal, bpy.types.Operator):
     """Stream a wire's bend program (G-code) to the bender on the chosen serial port; Esc cancels,
-    and Resume continues a stopped stream without repeating or skipping a line"""
+    and Resume continues a stopped stream without skipping a line (from the first line of a step
+    whose moves a stop may have lost)"""
     bl_idname = "wiresculpt.send_to_machine"
     bl_label = "Send to Machine"
     bl_options = {'REGISTER'}
@@ -134,7 +136,8 @@ class WIRESCULPT_OT_send_to_machine(WorkerModal, bpy.types.Operator):
     wire: StringProperty(name="Wire", default="", description="Wire name (empty: the panel's wire)")
     port: StringProperty(name="Port", default="", description="Serial port (empty: the panel's port)")
     resume: BoolProperty(name="Resume", default=False,
-                         description="Continue the wire's stopped stream from its first unacknowledged line")
+                         description="Continue the wire's stopped stream from the line its stop message names: the "
+                                     "first unacknowledged line, or the first line of the step in doubt")
     dry_run: BoolProperty(name="Dry Run", default=False,
                           description="Only check the program; also when the panel's Dry Run is ticked")
     settle: FloatProperty(name="Settle", default=2.0, min=0.0, max=30.0, unit='TIME_ABSOLUTE',
@@ -146,7 +149,8 @@ class WIRESCULPT_OT_send_to_machine(WorkerModal, bpy.types.Operator):
     @classmethod
     def description(cls, context, properties):
         if properties.resume:
-            return "Continue the wire's stopped stream from its first unacknowledged line"
+            return ("Continue the wire's stopped stream from the line its stop message names: the first "
+                    "unacknowledged line, or the first line of the step in doubt")
         return cls.__doc__
 
     @classmethod

@@ -104,7 +104,9 @@ class Job(WorkerJob):
 
     def _progress(self, stage, message):
         self.messages.append(f"{stage}: {message}")
-        if stage in pipeline.ALL_STAGES:
+        if stage == "relayering":  # another round starts from the layering
+            self.done, self.stage = 0, pipeline.ALL_STAGES[0]
+        elif stage in pipeline.ALL_STAGES:
             k = pipeline.ALL_STAGES.index(stage) + 1
             self.done = max(self.done, k)
             if k < len(pipeline.ALL_STAGES):
@@ -127,6 +129,9 @@ class Job(WorkerJob):
         label = STAGE_LABELS.get(self.stage, self.stage)
         if self.cancel_event.is_set():
             return "wiresculpt: cancelling…"
+        if self.done >= len(pipeline.ALL_STAGES):  # the other hook patterns, the coupling rounds
+            return (f"wiresculpt: comparing hook patterns… stage {len(pipeline.ALL_STAGES)} of "
+                    f"{len(pipeline.ALL_STAGES)}, {time.perf_counter() - self.started:.0f} s (Esc to cancel)")
         return (f"wiresculpt: {label}… stage {self.done + 1} of {len(pipeline.ALL_STAGES)}, "
                 f"{time.perf_counter() - self.started:.0f} s (Esc to cancel)")
 

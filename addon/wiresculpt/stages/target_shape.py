@@ -9,8 +9,10 @@ friction term left out (mu = 0 here: friction is already in the layering's pyram
 realised kink is then at least as sharp as the one the layering judged stable.
 """
 import math
+import os
 import re
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -21,6 +23,17 @@ from ..core.polylines import polyline_length
 from . import layering
 
 FAILED = ("too_close", "infeasible", "open_end")
+# The solver's words (native/src/target_shape.cpp) for failures that no hook can cure: a straight
+# piece between two crossings shorter than min_segment, and a kink the contact angle, friction or
+# machine rule out at every crossing. An "open_end" status is one too.
+SHORT_PIECE = "(the straight piece is shorter than the minimum segment)"
+EVERY_HOOK = (" asks for contact angle ", " needs a bend of at least ")
+
+
+def whatever_the_hook(status, message):
+    """A failed crossing status (its `status` and `message`) that the other hook cannot cure."""
+    return (status == "open_end" or (status == "too_close" and message.endswith(SHORT_PIECE))
+            or (status == "infeasible" and any(words in message for words in EVERY_HOOK)))
 # After the solve, a crossing counts as realised when its kink is inside the contact cone and its
 # segments and bends within the machine's limits to within what a bender can make at all (its
 # reliable minimum bend is 1 deg): SLSQP ends within about 0.02 deg, far below this, while the
@@ -28,6 +41,13 @@ FAILED = ("too_close", "infeasible", "open_end")
 REALISED_ANGLE = math.radians(0.1)
 REALISED_LENGTH = 1e-5  # metres
 MAX_ROUNDS = 4  # solve, null what cannot be realised, solve again (each round nulls at least one)
+# The window sweeps stop once a sweep lowers a wire's energy by less than this fraction: later sweeps
+# only creep points along the wire (TargetShapeOptions::sweep_ftol; docs/method-target-shape.md,
+# issue 17: the same distances to the contour and crossings, 3-6x fewer evaluations on long wires).
+SWEEP_FTOL = 1e-3
+# Wires are independent problems: up to this many are solved at once, each on its own thread (the
+# native call releases the GIL; each result depends only on its own wire, so the order is kept).
+MAX_THREADS = 2
 
 
 def desired_bisector(design, crossing, k):
@@ -41,6 +61,14 @@ def solve_wire(design, wire, material, settings, size, native_progress=None, mem
     """(result, [(crossing, k)], frame) of the native optimisation of one wire; with a `memo`, a
     result from an earlier coupling round is taken instead of solving when it is still optimal
     (Memo.reusable)."""
+    job = prepare_wire(design, wire, settings, size, memo)
+    return finish_wire(job, solve_job(job, native_progress), memo)
+
+
+def prepare_wire(design, wire, settings, size, memo=None):
+    """Everything one wire's solve needs, read from the design (call on the thread that owns the
+    design and the memo): {"contour", "closed", "specs", "options", "refs", "frame", "key",
+    "result"}, where "result" is the memo's reusable result or None (solve_job computes it)."""
     _n, u, v = plane_frame(wire["plane"]["normal"])
     origin = wire["plane"]["origin"]
     contact = math.radians(settings["contact_angle_deg"])
@@ -55,18 +83,44 @@ def solve_wire(design, wire, material, settings, size, native_progress=None, mem
         refs.append((c, k))
     options = {"min_segment": settings["min_segment"], "max_bend": math.radians(settings["max_bend_deg"]),
                "friction": 0.0, "model_size": size, "wire_name": wire["name"],
-               "angle_tolerance": REALISED_ANGLE, "length_tolerance": REALISED_LENGTH}
+               "angle_tolerance": REALISED_ANGLE, "length_tolerance": REALISED_LENGTH, "sweep_ftol": SWEEP_FTOL}
     limits = memo.vertex_limits.get(wire["name"]) if memo is not None else None
     if limits:  # the coupling's own limits at some points (pipeline._tighten), radians by target index
         options["vertex_max_bend"] = tuple(limits.get(i, 0.0) for i in range(max(limits) + 1))
     contour = to_2d(wire["contour"], origin, u, v)
     key = Memo.key(contour, wire["closed"], specs, options) if memo is not None else None
     result = memo.reusable(key, options["max_bend"]) if memo is not None else None
-    if result is None:
-        result = native.optimize_target_shape(contour, wire["closed"], specs, options, native_progress)
-        if memo is not None:
-            memo.remember(key, options["max_bend"], result)
-    return result, refs, (origin, u, v)
+    return {"contour": contour, "closed": wire["closed"], "specs": specs, "options": options, "refs": refs,
+            "frame": (origin, u, v), "key": key, "result": result}
+
+
+def solve_job(job, native_progress=None):
+    """The native result of a prepared wire (its memo's result when it had one). Touches neither the
+    design nor the memo, so several run at once."""
+    if job["result"] is not None:
+        return job["result"]
+    return native.optimize_target_shape(job["contour"], job["closed"], job["specs"], job["options"], native_progress)
+
+
+def finish_wire(job, result, memo=None):
+    """Remembers a new solve in the memo; (result, refs, frame) as solve_wire returns them."""
+    if memo is not None and job["result"] is None:
+        memo.remember(job["key"], job["options"]["max_bend"], result)
+    return result, job["refs"], job["frame"]
+
+
+def solve_all(jobs, native_progress=None):
+    """The results of solve_job for every job, in order: up to MAX_THREADS at once."""
+    todo = [k for k, job in enumerate(jobs) if job["result"] is None]
+    threads = min(MAX_THREADS, os.cpu_count() or 1, len(todo))
+    if threads <= 1:
+        return [solve_job(job, native_progress) for job in jobs]
+    results = [job["result"] for job in jobs]
+    with ThreadPoolExecutor(max_workers=threads, thread_name_prefix="wiresculpt-target") as pool:
+        futures = {k: pool.submit(solve_job, jobs[k], native_progress) for k in todo}
+        for k, future in futures.items():  # waits for all; the first error (e.g. Cancelled) is raised
+            results[k] = future.result()
+    return results
 
 
 class Memo:
@@ -86,10 +140,15 @@ class Memo:
 
     CONVERGED = ("NLOPT_SUCCESS", "NLOPT_FTOL_REACHED", "NLOPT_XTOL_REACHED", "none")  # "none": nothing free
 
-    def __init__(self):
+    def __init__(self, same=None):
+        """`same`: a dict {(key, max_bend): result} of earlier solves of exactly the same problem,
+        shared with other memos (pipeline.relayer hands one to every re-layering round: wires whose
+        crossings and hooks the new layering left alone are the same problems). Its results are
+        reused whatever they were: the solve is a deterministic function of its input."""
         self.nulled = []
         self.vertex_limits = {}
         self.solves = {}  # key -> (max_bend, result)
+        self.same = {} if same is None else same
         self.reused = 0
 
     @staticmethod
@@ -101,7 +160,11 @@ class Memo:
 
     def reusable(self, key, max_bend):
         """The remembered result for `key` if it is an optimum that the limit `max_bend` (radians)
-        leaves optimal, else None."""
+        leaves optimal, or the result of exactly this problem (same key and limit), else None."""
+        same = self.same.get((key, max_bend))
+        if same is not None:
+            self.reused += 1
+            return same
         entry = self.solves.get(key)
         if entry is None:
             return None
@@ -115,36 +178,21 @@ class Memo:
 
     def remember(self, key, max_bend, result):
         self.solves[key] = (max_bend, result)
+        self.same[(key, max_bend)] = result
 
 
 def unrealisable(design):
     """The (crossing id, hook) pairs this stage could not realise (stages.target_shape's nulled
     crossings), for the re-layering loop (pipeline.relayer) to forbid: the hook that failed, or
-    both hooks of a crossing "too_close" to a neighbour along its wire whose straight piece is
-    shorter than min_segment (the solver marks both ends of such a piece whatever their hooks). A
-    "too_close" crossing with a longer piece failed because that piece, fixed between the two
-    crossings, lies outside the kink this hook needs: the other hook may hold it. Empty when the
-    stage did not run."""
+    both hooks of a crossing whose failure no hook cures (`whatever_the_hook`, the solver's own
+    verdict on either of its wires: a straight piece to a neighbour shorter than min_segment, an
+    open end, a kink the contact angle rules out). A "too_close" crossing with a longer piece failed
+    because that piece, fixed between the two crossings, lies outside the kink this hook needs: the
+    other hook may hold it. Empty when the stage did not run."""
     pairs = set()
     for n in design["stages"].get("target_shape", {}).get("nulled_crossings", []):
-        short = n["status"] == "too_close" and _shortest_piece(design, n) < design["machine"]["min_segment"]
-        pairs.update((n["crossing"], h) for h in ((-1, 1) if short else (n["hook"],)))
+        pairs.update((n["crossing"], h) for h in ((-1, 1) if n.get("whatever_the_hook") else (n["hook"],)))
     return pairs
-
-
-def _shortest_piece(design, failure):
-    """The shorter straight piece (m) from a nulled crossing to its neighbouring crossings along the
-    wire it failed on (`failure["wire"]`, a name)."""
-    wire = next(w for w in design["wires"] if w["name"] == failure["wire"])
-    along = sorted((c["contour_vertices"][c["wires"].index(wire["id"])], c["id"]) for c in design["crossings"]
-                   if wire["id"] in c["wires"])
-    ids = [cid for _v, cid in along]
-    k = ids.index(failure["crossing"])
-    neighbours = [ids[k - 1] if k > 0 or wire["closed"] else None, ids[(k + 1) % len(ids)]
-                  if k + 1 < len(ids) or wire["closed"] else None]
-    point = np.asarray(design["crossings"][failure["crossing"]]["point"])
-    return min((float(np.linalg.norm(np.asarray(design["crossings"][o]["point"]) - point))
-                for o in neighbours if o is not None and o != failure["crossing"]), default=math.inf)
 
 
 def _ids(numbers):
@@ -186,20 +234,22 @@ def run(design, material, settings, native_progress=None, memo=None):
     reused = [False] * len(design["wires"])
     pending = range(len(design["wires"]))  # the first round solves every wire
     for _round in range(MAX_ROUNDS):
-        for i in pending:
-            count = memo.reused if memo is not None else 0
-            solved[i] = solve_wire(design, design["wires"][i], material, settings, size, native_progress, memo)
-            reused[i] = memo is not None and memo.reused != count
+        jobs = [prepare_wire(design, design["wires"][i], settings, size, memo) for i in pending]
+        for i, job, result in zip(pending, jobs, solve_all(jobs, native_progress)):
+            reused[i] = job["result"] is not None
+            solved[i] = finish_wire(job, result, memo)
             if not reused[i]:
-                iterations += solved[i][0]["iterations"]
+                iterations += result["iterations"]
                 wire_solves += 1
         failing = {}
         for wire, (r, refs, _frame) in zip(design["wires"], solved):
             for (c, _k), status in zip(refs, r["crossings"]):
                 if c["hook"] != 0 and status["status"] in FAILED:
-                    failing.setdefault(c["id"], {"crossing": c["id"], "hook": c["hook"], "wire": wire["name"],
-                                                 "status": status["status"],
-                                                 "scale": status["scale"], "message": status["message"]})
+                    entry = failing.setdefault(c["id"], {"crossing": c["id"], "hook": c["hook"], "wire": wire["name"],
+                                                         "status": status["status"], "scale": status["scale"],
+                                                         "message": status["message"], "whatever_the_hook": False})
+                    # on either of its wires (the first one's words are kept)
+                    entry["whatever_the_hook"] |= whatever_the_hook(status["status"], status["message"])
         if not failing:
             break
         for cid, failure in failing.items():

@@ -105,6 +105,13 @@ struct TargetShapeOptions {
   /// flat along the wire) for 10-20 times as many evaluations without changing the energy's
   /// first 7 digits; see docs/method-target-shape.md.
   double sweep_tol = 1e-7;
+  /// Relative energy decrease per sweep, in [0, 1). With windows, the sweeps also stop once every
+  /// constraint holds (to constraint_tol) and a whole sweep lowered the wire's energy E by no more
+  /// than sweep_ftol × E. The optimum is flat along the wire, and sweeps after the first few mostly
+  /// move points along it (millimetres on a 3 m wire, each sweep a little) without changing their
+  /// distance to the contour; see docs/method-target-shape.md. 0: off, the sweeps run until no
+  /// window moves a point by more than sweep_tol. Default 0; the pipeline uses 1e-3.
+  double sweep_ftol = 0.0;
   /// Maximum number of sweeps over the windows, 1 to 100000. Default 200.
   int max_sweeps = 200;
   /// Seconds: the wall-clock budget of the whole call, in (0, 86400]. When it runs out the

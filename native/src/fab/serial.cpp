@@ -16,7 +16,10 @@
 #include <cctype>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -109,7 +112,7 @@ std::string holder_of(const std::string& path) {
 void take_lock(SerialPort::Impl& impl) {
   impl.lock_path = lock_path_for(impl.name);
   for (int attempt = 0; attempt < 5; ++attempt) {
-    const int fd = ::open(impl.lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    const int fd = ::open(impl.lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
     if (fd < 0)
       open_failed(impl.name, "cannot create its lock file " + impl.lock_path + ": " + std::strerror(errno));
     if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
@@ -463,6 +466,87 @@ bool is_modal_setup(const std::string& line) {
   return count > 0;
 }
 
+// The words of a (validated) program line: upper-case letter and number. "$" lines have none.
+struct Word {
+  char letter;
+  double value;
+};
+std::vector<Word> words_of(const std::string& line) {
+  std::vector<Word> out;
+  if (line.empty() || line[0] == '$') return out;
+  std::string compact;
+  for (char c : line)
+    if (c != ' ' && c != '\t') compact += c;
+  for (std::size_t k = 0; k < compact.size();) {
+    const unsigned char c = static_cast<unsigned char>(compact[k]);
+    if (!std::isalpha(c)) {
+      ++k;
+      continue;
+    }
+    std::size_t e = k + 1;
+    std::string number;
+    while (e < compact.size() && (std::isdigit(static_cast<unsigned char>(compact[e])) || compact[e] == '.' ||
+                                  compact[e] == '-' || compact[e] == '+'))
+      number += compact[e++];
+    char* end = nullptr;
+    const double v = number.empty() ? 0.0 : std::strtod(number.c_str(), &end);
+    out.push_back({static_cast<char>(std::toupper(c)), std::isfinite(v) ? v : 0.0});
+    k = e;
+  }
+  return out;
+}
+
+// A dwell (G4) or a program end (M2, M30): GRBL answers it only when every queued move has run,
+// so its "ok" says that every line before it was executed, not only queued.
+bool is_sync(const std::string& line) {
+  for (const Word& w : words_of(line))
+    if ((w.letter == 'G' && w.value == 4.0) || (w.letter == 'M' && (w.value == 2.0 || w.value == 30.0))) return true;
+  return false;
+}
+
+bool is_dwell(const std::string& line) {
+  for (const Word& w : words_of(line))
+    if (w.letter == 'G' && w.value == 4.0) return true;
+  return false;
+}
+
+// A line that moves nothing: done when its "ok" arrives with nothing queued before it.
+bool is_motionless(const std::string& line) { return (!line.empty() && line[0] == '$') || is_modal_setup(line); }
+
+std::string mm3(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.3f", v);
+  return std::string(std::strcmp(buf, "-0.000") == 0 ? "0.000" : buf);
+}
+
+// What lines a..b (0-based, inclusive) move: "feed 40.000 mm, bend 90.000 deg" (the bend as
+// commanded, the first bend-axis move; the head's return is not repeated).
+std::string moves_of(const std::vector<std::string>& lines, const MachineProfile& profile, std::size_t a,
+                     std::size_t b) {
+  const AxisMapping& ax = profile.axes;
+  const auto up = [](char c) { return static_cast<char>(std::toupper(static_cast<unsigned char>(c))); };
+  double feed = 0.0, bend = 0.0;
+  bool fed = false, bent = false, pin = false;
+  for (std::size_t j = a; j <= b && j < lines.size(); ++j)
+    for (const Word& w : words_of(lines[j])) {
+      if (w.letter == up(ax.feed_axis)) {
+        feed += w.value;
+        fed = true;
+      } else if (w.letter == up(ax.bend_axis) && !bent && w.value != 0.0) {
+        bend = w.value;
+        bent = true;
+      } else if (ax.pin_axis != '\0' && w.letter == up(ax.pin_axis)) {
+        pin = true;
+      }
+    }
+  std::string out;
+  auto add = [&](const std::string& part) { out += (out.empty() ? "" : ", ") + part; };
+  if (fed) add("feed " + mm3(feed / ax.feed_units_per_mm) + " mm");
+  if (pin) add("pin moved");
+  if (bent) add("bend " + mm3(bend / ax.bend_units_per_deg * (profile.left_is_positive ? 1.0 : -1.0)) + " deg");
+  return out.empty() ? "no feed or bend" : out;
+}
+
 }  // namespace
 
 void validate(const StreamOptions& o) {
@@ -487,6 +571,7 @@ StreamResult stream_program(SerialPort& port, const std::vector<std::string>& li
   if (state.next_line > lines.size())
     throw InputError("the stream state's next line (" + std::to_string(state.next_line) +
                      ") is past the program's " + std::to_string(lines.size()) + " lines");
+  state.confirmed = std::min(state.confirmed, state.next_line);
   StreamResult r;
   r.last_acknowledged = static_cast<long>(state.next_line) - 1;
   const std::size_t total = lines.size();
@@ -504,15 +589,76 @@ StreamResult stream_program(SerialPort& port, const std::vector<std::string>& li
     r.message = std::move(message);
     return r;
   };
+  // Where a resume goes on after a stop: "; N lines are done; resume from line N+1".
+  auto resume_at = [&] {
+    return "; " + std::to_string(state.next_line) + " lines are done; resume from line " +
+           std::to_string(state.next_line + 1);
+  };
+  // A stop after which the controller's queued moves may be lost (a dropped link or a timeout,
+  // then the reset of reopening the port; an alarm; our own soft reset; a restart; a feed hold
+  // left in place). GRBL answers "ok" when it queues a line, so the lines acknowledged since the
+  // last sync line (state.confirmed) are in doubt: the message names that step, and state.next_line
+  // goes back to its first line, so that a resume makes the whole step again.
+  auto interrupted = [&](StreamStatus status, long line, const std::string& cause) {
+    if (state.next_line <= state.confirmed) return stop(status, line, cause + resume_at());
+    const std::size_t a = state.confirmed, acked = state.next_line - 1;
+    std::size_t b = a;
+    while (b + 1 < total && !is_sync(lines[b])) ++b;  // the step's end: its sync line (or the last line)
+    bool steps = false;
+    std::size_t step = 1;
+    for (std::size_t j = 0; j < total; ++j)
+      if (is_dwell(lines[j])) {
+        steps = true;
+        if (j < a) ++step;
+      }
+    const std::string span = std::to_string(a + 1) + "-" + std::to_string(b + 1);
+    const std::string what = (steps ? "step " + std::to_string(step) + " (lines " : "the moves of lines (") + span +
+                             ": " + moves_of(lines, profile, a, b) + ")";
+    const std::string done = a ? "lines 1-" + std::to_string(a) + " are done" : "no line is known done";
+    state.next_line = a;
+    return stop(status, line,
+                cause + "; " + what + " may be half made: GRBL answers 'ok' when it queues a line, and " +
+                    (acked > a ? "lines " + std::to_string(a + 1) + "-" + std::to_string(acked + 1) + " were"
+                               : "line " + std::to_string(a + 1) + " was") +
+                    " acknowledged but not " + quoted(lines, b) +
+                    ", which is answered only when the moves have run; a reset of the controller drops queued "
+                    "moves; check the wire: the resume restarts " + (steps ? "the step" : "these lines") +
+                    " from line " + std::to_string(a + 1) + " (" + done + "); if the wire shows " +
+                    (steps ? "the step" : "them") + " made in full, continue from line " + std::to_string(b + 2) +
+                    " instead (next_line " + std::to_string(b + 1) + ")");
+  };
   auto abort_machine = [&](long line) {
     port.write(std::string("!") + '\x18', write_ms);  // feed hold, then soft reset
-    return stop(StreamStatus::aborted, line,
-                "aborted by request before " + (line >= 0 ? quoted(lines, static_cast<std::size_t>(line)) : "the end") +
-                    " was acknowledged; the machine was stopped with a feed hold and a soft reset; " +
-                    std::to_string(state.next_line) + " lines are done and a resume starts at line " +
-                    std::to_string(state.next_line + 1));
+    return interrupted(StreamStatus::aborted, line,
+                       "aborted by request before " +
+                           (line >= 0 ? quoted(lines, static_cast<std::size_t>(line)) : std::string("the end")) +
+                           " was acknowledged; the machine was stopped with a feed hold and a soft reset");
   };
   auto report = [&] { return !progress || progress("stream", fraction()); };
+  // An answer with no line of ours outstanding (before a line is sent, or while paused). `held`:
+  // the machine is in a feed hold, so its queued moves have not run.
+  auto unexpected = [&](const GrblAnswer& answer, long li, const std::string& when,
+                        bool held) -> std::optional<StreamResult> {
+    if (answer.kind == Kind::banner)
+      return interrupted(StreamStatus::disconnected, li,
+                         "the controller restarted " + when + " (its banner '" + answer.text +
+                             "' arrived): it is back in its default modes and dropped its queued moves; the resume "
+                             "restores the program's modes first");
+    if (answer.kind == Kind::alarm) {
+      r.code = answer.code;
+      return interrupted(StreamStatus::alarm, li,
+                         "GRBL raised " + answer.text + " " + when + "; the machine is locked: " + kUnlock);
+    }
+    if (answer.kind == Kind::ok || answer.kind == Kind::error) {
+      const std::string cause = "protocol error: the controller sent an unexpected '" + answer.text +
+                                "' (more answers than lines sent) " + when + "; " +
+                                std::to_string(state.next_line) +
+                                " lines are acknowledged; check the device and the port settings";
+      if (held) return interrupted(StreamStatus::protocol_error, li, cause + " (the machine is in a feed hold)");
+      return stop(StreamStatus::protocol_error, li, cause + ", then resume from line " + std::to_string(li + 1));
+    }
+    return std::nullopt;  // [MSG:...], <status>, blank: informational
+  };
 
   if (!report()) return abort_machine(static_cast<long>(state.next_line));
 
@@ -545,6 +691,9 @@ StreamResult stream_program(SerialPort& port, const std::vector<std::string>& li
         return stop(answer.kind == Kind::error ? StreamStatus::error : StreamStatus::alarm, lj,
                     "GRBL answered " + answer.text + " to " + quoted(lines, j) +
                     " while its modes were restored before resuming (" + kUnlock + ")" + resume);
+      else if (answer.kind == Kind::banner)
+        return stop(StreamStatus::disconnected, lj, "the controller restarted (its banner '" + answer.text +
+                    "' arrived) while its modes were restored before resuming" + resume);
     }
   }
 
@@ -554,40 +703,30 @@ StreamResult stream_program(SerialPort& port, const std::vector<std::string>& li
     if (wants_abort()) return abort_machine(li);
     if (control && control->pause.load()) {
       if (!port.write("!", write_ms))
-        return stop(StreamStatus::disconnected, li, "the link to " + port.name() + " dropped while pausing; resume starts at line " + std::to_string(i + 1));
+        return interrupted(StreamStatus::disconnected, li, "the link to " + port.name() + " dropped while pausing");
+      // Nothing is outstanding while paused: every answer is news (a restart, an alarm, a stray ok).
       while (control->pause.load()) {
         if (wants_abort() || !report()) return abort_machine(li);
-        GrblAnswer ignored;
-        if (reader.next(ignored, kSliceMs * 5) == LineReader::Got::lost)
-          return stop(StreamStatus::disconnected, li, "the link to " + port.name() + " dropped while paused; resume starts at line " + std::to_string(i + 1));
+        GrblAnswer answer;
+        const auto got = reader.next(answer, kSliceMs * 5);
+        if (got == LineReader::Got::lost)
+          return interrupted(StreamStatus::disconnected, li, "the link to " + port.name() + " dropped while paused");
+        if (got == LineReader::Got::line)
+          if (auto stopped = unexpected(answer, li, "while the stream was paused (feed hold)", true)) return *stopped;
       }
       if (!port.write("~", write_ms))
-        return stop(StreamStatus::disconnected, li, "the link to " + port.name() + " dropped on resuming; resume starts at line " + std::to_string(i + 1));
+        return interrupted(StreamStatus::disconnected, li, "the link to " + port.name() + " dropped on resuming");
     }
 
     // Strict accounting: with nothing outstanding, any answer already here is not for a line of
     // ours. An "ok" would otherwise be taken as the next line's acknowledgement (a device that
     // doubles its "ok" would skip a bend on resume), so it stops the stream; next_line stays.
-    for (GrblAnswer early; reader.pending(early) == LineReader::Got::line;) {
-      if (early.kind == Kind::ok)
-        return stop(StreamStatus::protocol_error, li,
-                    "protocol error: the controller sent an unexpected 'ok' (more answers than lines sent) before " +
-                        quoted(lines, i) + " was sent; " + std::to_string(i) +
-                        " lines are acknowledged; check the device and the port settings, then resume from line " +
-                        std::to_string(i + 1));
-      if (early.kind == Kind::alarm) {
-        r.code = early.code;
-        return stop(StreamStatus::alarm, li,
-                    "GRBL raised " + early.text + " before " + quoted(lines, i) +
-                        " was sent; the machine is locked: clear the alarm ($X or reset), check the wire, and resume "
-                        "from line " + std::to_string(i + 1));
-      }
-    }
+    for (GrblAnswer early; reader.pending(early) == LineReader::Got::line;)
+      if (auto stopped = unexpected(early, li, "before " + quoted(lines, i) + " was sent", false)) return *stopped;
     if (!port.write(lines[i] + "\n", write_ms))
-      return stop(StreamStatus::disconnected, li,
-                  "the link to " + port.name() + " dropped (or stopped accepting data) before " + quoted(lines, i) +
-                      " was sent; " + std::to_string(i) + " lines are done; reconnect and resume from line " +
-                      std::to_string(i + 1));
+      return interrupted(StreamStatus::disconnected, li,
+                         "the link to " + port.name() + " dropped (or stopped accepting data) before " +
+                             quoted(lines, i) + " was sent");
     ++r.sent;
 
     const auto deadline = Clock::now() + std::chrono::milliseconds(answer_ms);
@@ -596,17 +735,16 @@ StreamResult stream_program(SerialPort& port, const std::vector<std::string>& li
       if (wants_abort()) return abort_machine(li);
       const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
       if (left <= 0)
-        return stop(StreamStatus::timeout, li,
-                    "no answer to " + quoted(lines, i) + " within " + std::to_string(answer_ms) +
-                        " ms; it is not acknowledged, so a resume sends it again after you check the machine");
+        return interrupted(StreamStatus::timeout, li,
+                           "no answer to " + quoted(lines, i) + " within " + std::to_string(answer_ms) +
+                               " ms; it is not acknowledged, so a resume sends it again after you check the machine");
       GrblAnswer answer;
       const auto got = reader.next(answer, static_cast<int>(std::min<long long>(left, kSliceMs)));
       if (got == LineReader::Got::nothing) continue;
       if (got == LineReader::Got::lost)
-        return stop(StreamStatus::disconnected, li,
-                    "the link to " + port.name() + " dropped while " + quoted(lines, i) +
-                        " was waiting for its answer; the last acknowledged line is line " + std::to_string(i) +
-                        "; reconnect and resume from line " + std::to_string(i + 1));
+        return interrupted(StreamStatus::disconnected, li,
+                           "the link to " + port.name() + " dropped while " + quoted(lines, i) +
+                               " was waiting for its answer");
       if (answer.kind == Kind::ok) {
         acknowledged = true;
       } else if (answer.kind == Kind::error) {
@@ -621,18 +759,19 @@ StreamResult stream_program(SerialPort& port, const std::vector<std::string>& li
                         " (the line was not executed); fix it and resume from line " + std::to_string(i + 1));
       } else if (answer.kind == Kind::alarm) {
         r.code = answer.code;
-        return stop(StreamStatus::alarm, li,
-                    "GRBL raised " + answer.text + " while " + quoted(lines, i) +
-                        " was in flight; the machine is locked: " + kUnlock + ", check the wire, and "
-                        "resume from line " + std::to_string(i + 1));
+        return interrupted(StreamStatus::alarm, li,
+                           "GRBL raised " + answer.text + " while " + quoted(lines, i) +
+                               " was in flight; the machine is locked: " + kUnlock);
       } else if (answer.kind == Kind::banner) {
-        return stop(StreamStatus::disconnected, li,
-                    "the controller restarted while " + quoted(lines, i) +
-                        " was in flight (its banner arrived); resume from line " + std::to_string(i + 1));
+        return interrupted(StreamStatus::disconnected, li,
+                           "the controller restarted while " + quoted(lines, i) + " was in flight (its banner '" +
+                               answer.text + "' arrived): it is back in its default modes and dropped its queued "
+                               "moves; the resume restores the program's modes first");
       }
       // Anything else ([MSG:...], <status>, blank) is informational.
     }
     ++state.next_line;
+    if (is_sync(lines[i]) || (state.confirmed == i && is_motionless(lines[i]))) state.confirmed = i + 1;
     ++r.acknowledged;
     r.last_acknowledged = li;
     if (!report()) return abort_machine(state.next_line < total ? static_cast<long>(state.next_line) : -1);

@@ -5,11 +5,15 @@
 // Every read and write has a timeout, so nothing here can hang; the full protocol, the resume
 // semantics and the realtime characters are described in docs/machine-protocol.md.
 //
-// Resume: the caller keeps a StreamState between calls. state.next_line is the index (0-based)
-// of the first line GRBL has not acknowledged; lines before it were each acknowledged exactly
-// once. A stream starts at state.next_line and advances it on each "ok" only, so after an error,
-// alarm, timeout, disconnect or abort, calling again (on the same or a re-opened port) continues
-// with the first unacknowledged line: no acknowledged line is sent again, none is skipped.
+// Resume: the caller keeps a StreamState between calls. GRBL answers "ok" when it has queued a
+// line, not when the line has run; only a sync line (G4 P0 at the end of each bend step, M2) is
+// answered after every queued move has run. state.next_line is where the next call starts: after
+// each "ok" the line after it; state.confirmed is the line after the last step known complete.
+// A stop that can lose queued moves (disconnected, timeout, aborted, alarm, a controller restart,
+// a stop in a feed hold) with lines acknowledged past state.confirmed names that step in its
+// message (step k, lines a-b, its feed and bend) and sets next_line back to state.confirmed: the
+// resume makes the whole step again, after the user has checked the wire. After error:N or a
+// protocol error (the queued moves run on) next_line stays at the first unacknowledged line.
 #include <atomic>
 #include <cstddef>
 #include <memory>
@@ -57,7 +61,11 @@ class SerialPort {
 
 /// What the caller keeps between stream calls (see Resume above).
 struct StreamState {
-  std::size_t next_line = 0;  ///< first line not yet acknowledged (0-based)
+  std::size_t next_line = 0;  ///< the line a stream (or a resume) starts at (0-based); see Resume above
+  std::size_t confirmed = 0;  ///< the line after the last step known complete: after the last
+                              ///< acknowledged sync line (G4, M2, M30; GRBL answers it only when every
+                              ///< queued move has run), or after motionless lines acknowledged with
+                              ///< nothing queued (mode lines, $ settings); at most next_line
 };
 
 /// Pause / resume / abort from another thread while a stream runs.
@@ -82,11 +90,12 @@ enum class StreamStatus {
   dry_run,       ///< validated only
   error,         ///< GRBL answered error:N to failed_line (not executed)
   alarm,         ///< GRBL raised ALARM:N while failed_line was in flight
-  disconnected,  ///< the link dropped (or GRBL restarted) with failed_line in flight (or next)
+  disconnected,  ///< the link dropped (or GRBL restarted: its banner arrived) with failed_line in flight (or next)
   timeout,       ///< no answer to failed_line within response_timeout
   aborted,       ///< StreamControl::abort or the progress callback returned false
-  protocol_error ///< an answer no line was waiting for ("ok" with nothing outstanding): stopped
-                 ///< before failed_line was sent; next_line is not advanced by it
+  protocol_error ///< an answer no line was waiting for ("ok" or "error:N" with nothing outstanding:
+                 ///< before a line is sent or while paused): stopped before failed_line was sent;
+                 ///< next_line is not advanced by it
 };
 
 const char* to_string(StreamStatus status);

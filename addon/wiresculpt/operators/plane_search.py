@@ -1,0 +1,312 @@
+"""Find Stable Planes and Suggest Planes (issue 15): the plane assistant (plane_search.py) on a
+worker thread under a modal like Optimize's (progress, Esc cancels, the scene untouched until the
+user applies a candidate), and Apply: the candidate's planes become the slicing handles' placement
+(Find) or new slicing handles (Suggest), with the candidate's design as the result, in one undo
+step. In background mode (tests, scripts) the search runs inline.
+"""
+import copy
+import threading
+import time
+
+import bpy
+from mathutils import Matrix, Vector
+
+from .. import native, pipeline, plane_search
+from ..blend import mesh
+from ..blend import results as scene_results
+from ..blend.handles import add_handle, handle_plane, handles, target_problem
+from ..blend.registration import classes_factory
+from ..core.jobs import WorkerJob
+from ..core.scene import PlaneSpec
+from ..props import material_of, solver_settings
+from . import optimize
+from .progress import WorkerModal
+
+MAX_CANDIDATES = 3
+UI_BUDGET_SECONDS = 60.0  # the panel's search may take longer than the batch's: Esc stops it
+# What the panel shows: {"scene", "mode", "candidates": [...], "message"} of the last search, or None.
+RESULT = None
+
+
+def gather(context, need_planes=True):
+    """(V, F, planes, material, settings) from the scene: the target's evaluated triangles, the
+    handles as planes (each taking its ticked contours, else its largest). ValueError when not
+    possible, naming what is missing."""
+    scene = context.scene
+    ws = scene.wiresculpt
+    problem = target_problem(scene, ws.target)
+    if problem:
+        raise ValueError(problem)
+    if not native.available():
+        raise RuntimeError(native.LOAD_ERROR)
+    depsgraph = context.evaluated_depsgraph_get()
+    ticked = {}
+    for item in ws.contours:
+        if item.use:
+            ticked.setdefault(item.plane, []).append(item.index)
+    planes = [PlaneSpec(*handle_plane(h, depsgraph), contours=ticked.get(h.name, "largest")) for h in handles(scene)]
+    if need_planes and not planes:
+        raise ValueError("No slicing plane: add planes first, or use Suggest Planes")
+    V, F = mesh.object_triangles(ws.target, depsgraph)
+    return V, F, planes, material_of(ws), solver_settings(ws)
+
+
+def describe(candidate):
+    """The candidate's figures as one line for the panel."""
+    f = candidate["figures"]
+    load = "n/a" if f["load_capacity"] is None else f"{f['load_capacity']:.1f}x weight"
+    return (f"holds {load}, deviation {f['max_deviation'] * 1000:.1f} mm, "
+            f"closure gap {f['closure_gap'] * 1000:.1f} mm")
+
+
+class SearchJob(WorkerJob):
+    name = "wiresculpt plane search"
+
+    def __init__(self, mode, V, F, planes, material, settings, count):
+        super().__init__()
+        self.mode, self.V, self.F, self.planes = mode, V, F, planes
+        self.material, self.settings, self.count = material, settings, count
+        self.found, self.searched = [], None
+        self.cancel_event = threading.Event()
+        self.cancelled = False
+        self.messages = []
+        self.scene_name = ""
+        self.started = time.perf_counter()
+
+    def _progress(self, stage, message):
+        self.messages.append(message)
+
+    def work(self):
+        try:
+            if self.mode == "nearby":
+                self.found, self.searched, _ = plane_search.nearby(
+                    self.V, self.F, self.planes, self.material, self.settings, MAX_CANDIDATES, UI_BUDGET_SECONDS,
+                    progress=self._progress, cancel=self.cancel_event.is_set)
+            else:
+                self.found, self.searched, _ = plane_search.auto(
+                    self.V, self.F, self.count, self.material, self.settings, MAX_CANDIDATES, UI_BUDGET_SECONDS,
+                    progress=self._progress, cancel=self.cancel_event.is_set)
+        except pipeline.Cancelled:
+            self.cancelled = True
+
+    def stop(self, timeout=optimize.JOIN_SECONDS):
+        self.cancel_event.set()
+        self.thread.join(timeout)
+        return not self.thread.is_alive()
+
+    def status(self):
+        if self.cancel_event.is_set():
+            return "wiresculpt: cancelling…"
+        return (f"wiresculpt: searching planes… {len(self.found)} found, "
+                f"{time.perf_counter() - self.started:.0f} s (Esc to cancel)")
+
+
+JOB = None
+
+
+def running():
+    return JOB is not None or optimize.running()
+
+
+def _store(job):
+    global RESULT
+    RESULT = {"scene": job.scene_name, "mode": job.mode, "candidates": job.found,
+              "message": (f"{len(job.found)} stable candidate{'s' if len(job.found) != 1 else ''} "
+                          f"({job.searched.screened} screened, {job.searched.full_solves} solved, "
+                          f"{time.perf_counter() - job.started:.1f} s)" if job.found else
+                          f"No stable placement found ({job.searched.screened} screened, "
+                          f"{job.searched.full_solves} solved)")}
+    return RESULT
+
+
+class _SearchOperator(WorkerModal):
+    mode = "nearby"
+    verb = "Find Stable Planes"
+
+    @classmethod
+    def poll(cls, context):
+        return not running()
+
+    def _count(self, context):
+        return 5
+
+    def _finish(self, job):
+        if job.cancelled or job.cancel_event.is_set():
+            self.report({'WARNING'}, f"{self.verb} cancelled; the scene is unchanged")
+            return {'CANCELLED'}
+        if job.error is not None:
+            self.report({'ERROR'}, f"{self.verb}: {job.error}")
+            return {'CANCELLED'}
+        result = _store(job)
+        self.report({'INFO'} if job.found else {'WARNING'}, f"{self.verb}: {result['message']}")
+        return {'FINISHED'}
+
+    def _job(self, context):
+        V, F, planes, material, settings = gather(context, self.mode == "nearby")
+        job = SearchJob(self.mode, V, F, planes, material, settings, self._count(context))
+        job.scene_name = context.scene.name
+        return job
+
+    def execute(self, context):
+        try:
+            job = self._job(context)
+        except (ValueError, RuntimeError) as exc:
+            self.report({'ERROR'}, f"{self.verb}: {exc}")
+            return {'CANCELLED'}
+        job.run()
+        return self._finish(job)
+
+    def invoke(self, context, event):
+        global JOB
+        if bpy.app.background or context.window is None:
+            return self.execute(context)
+        try:
+            JOB = self._job(context)
+        except (ValueError, RuntimeError) as exc:
+            self.report({'ERROR'}, f"{self.verb}: {exc}")
+            return {'CANCELLED'}
+        JOB.thread.start()
+        self.begin_watch(context, 1)
+        self._show(context)
+        return {'RUNNING_MODAL'}
+
+    def _show(self, context):
+        if JOB is not None:
+            self.show_progress(context, 0, JOB.status())
+
+    def modal(self, context, event):
+        global JOB
+        job = JOB
+        if job is None:
+            return {'CANCELLED'}
+        answer = self.watch_event(context, event, job.thread, job.stop)
+        if answer is not None:
+            return answer
+        self.end_watch(context)
+        JOB = None
+        return self._finish(job)
+
+    def cancel(self, context):
+        global JOB
+        if JOB is not None:
+            try:
+                self.end_watch(context)
+            except (AttributeError, ReferenceError, RuntimeError):
+                pass
+            JOB.stop()
+            JOB = None
+
+
+class WIRESCULPT_OT_find_planes(_SearchOperator, bpy.types.Operator):
+    """Search placements near the slicing planes (offsets, small tilts, other contours) for the
+    smallest change that gives a stable, buildable sculpture; the scene is not changed until you
+    Apply a candidate (Esc cancels)"""
+    bl_idname = "wiresculpt.find_planes"
+    bl_label = "Find Stable Planes"
+    bl_options = {'REGISTER'}
+    mode = "nearby"
+    verb = "Find Stable Planes"
+
+
+class WIRESCULPT_OT_suggest_planes(_SearchOperator, bpy.types.Operator):
+    """Propose slicing planes from the mesh alone (families along its principal axes), ranked by
+    coverage and fidelity; Apply adds them as ordinary slicing planes (Esc cancels)"""
+    bl_idname = "wiresculpt.suggest_planes"
+    bl_label = "Suggest Planes"
+    bl_options = {'REGISTER'}
+    mode = "auto"
+    verb = "Suggest Planes"
+
+    count: bpy.props.IntProperty(name="Planes", description="How many planes to propose", default=5, min=2, max=12)
+
+    def _count(self, context):
+        return self.count
+
+
+def _place(obj, origin, normal):
+    """Moves `obj` (a handle) so that its world Z axis is `normal` and its world location `origin`,
+    keeping its scale and its turn about Z as far as the new normal allows."""
+    loc, rot, scale = obj.matrix_world.decompose()
+    z = (rot @ Vector((0.0, 0.0, 1.0))).normalized()
+    new_rot = z.rotation_difference(Vector(normal).normalized()) @ rot
+    obj.matrix_world = Matrix.LocRotScale(Vector(origin), new_rot, scale)
+
+
+def apply_candidate(context, index):
+    """The candidate's planes into the scene (moved handles, or new ones for Suggest), sliced, the
+    design's contours ticked, and its design as the result. ValueError when there is no such
+    candidate or a plane it moves is gone."""
+    if RESULT is None or RESULT["scene"] != context.scene.name or not 0 <= index < len(RESULT["candidates"]):
+        raise ValueError("no such candidate: run Find Stable Planes or Suggest Planes first")
+    candidate = RESULT["candidates"][index]
+    scene = context.scene
+    design = candidate["design"]
+    if RESULT["mode"] == "nearby":
+        by_name = {h.name: h for h in handles(scene)}
+        missing = [p.name for p in candidate["planes"] if p.name not in by_name]
+        if missing:
+            raise ValueError(f"slicing plane {missing[0]} is gone: search again")
+        for p in candidate["planes"]:
+            _place(by_name[p.name], p.origin, p.normal)
+    else:
+        V, _F = mesh.object_triangles(scene.wiresculpt.target, context.evaluated_depsgraph_get())
+        renamed = {}
+        for p in candidate["planes"]:
+            obj = add_handle(context, V.min(axis=0), V.max(axis=0))
+            obj.name = p.name  # Blender adds a suffix when the name is taken
+            obj.data.name = obj.name
+            renamed[p.name] = obj.name
+            _place(obj, p.origin, p.normal)
+        design = copy.deepcopy(design)
+        for w in design["wires"]:
+            plane, index = w["name"].split("/")
+            w["name"] = f"{renamed[plane]}/{index}"
+    context.view_layer.update()
+    bpy.ops.wiresculpt.slice()
+    picked = {w["name"] for w in design["wires"]}
+    for item in scene.wiresculpt.contours:
+        item.use = f"{item.plane}/{item.index}" in picked
+    scene_results.write_results(scene, design)
+    return candidate
+
+
+class WIRESCULPT_OT_apply_planes(bpy.types.Operator):
+    """Move the slicing planes to this candidate (or add its planes) and show its sculpture; one
+    Undo takes it all back"""
+    bl_idname = "wiresculpt.apply_planes"
+    bl_label = "Apply"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    index: bpy.props.IntProperty(default=0, min=0)
+
+    @classmethod
+    def poll(cls, context):
+        return not running() and RESULT is not None and bool(RESULT["candidates"])
+
+    def execute(self, context):
+        try:
+            candidate = apply_candidate(context, self.index)
+        except ValueError as exc:
+            self.report({'ERROR'}, f"Cannot apply: {exc}")
+            return {'CANCELLED'}
+        self.report({'INFO'}, "Applied: " + ("; ".join(candidate["changes"]) or "the planes as they were"))
+        return {'FINISHED'}
+
+
+class WIRESCULPT_OT_find_planes_cancel(bpy.types.Operator):
+    """Stop the running plane search; the scene stays as it was"""
+    bl_idname = "wiresculpt.find_planes_cancel"
+    bl_label = "Cancel"
+    bl_options = {'INTERNAL'}
+
+    def execute(self, context):
+        if JOB is None:
+            self.report({'INFO'}, "Nothing to cancel: no plane search is running")
+            return {'CANCELLED'}
+        JOB.cancel_event.set()  # the modal finishes once the worker has ended
+        self.report({'INFO'}, "Cancelling the plane search…")
+        return {'FINISHED'}
+
+
+register, unregister = classes_factory((WIRESCULPT_OT_find_planes, WIRESCULPT_OT_suggest_planes,
+                                        WIRESCULPT_OT_apply_planes, WIRESCULPT_OT_find_planes_cancel))

@@ -1,0 +1,49 @@
+"""The plane assistant's panel (issue 15), under the Wire panel: Find Stable Planes, Suggest
+Planes, and up to three candidates with what changes, their figures and Apply."""
+import bpy
+
+from .. import native
+from ..blend.registration import classes_factory
+from ..operators import plane_search as ops
+from .panel import VIEW3D_PT_wiresculpt, wrap_labels
+
+
+def candidate_lines(candidate):
+    """What the panel says of a candidate: its changes (or the planes' families) and its figures."""
+    return (candidate["changes"] or ["the planes as they are"]) + [ops.describe(candidate)]
+
+
+class VIEW3D_PT_wiresculpt_planes(bpy.types.Panel):
+    bl_space_type = 'VIEW_3D'
+    bl_region_type = 'UI'
+    bl_category = "Wire"
+    bl_parent_id = VIEW3D_PT_wiresculpt.__name__
+    bl_label = "Plane Assistant"
+    bl_options = {'DEFAULT_CLOSED'}
+
+    def draw(self, context):
+        layout = self.layout
+        col = layout.column(align=True)
+        col.enabled = native.available() and not ops.running()
+        col.operator(ops.WIRESCULPT_OT_find_planes.bl_idname, icon='VIEWZOOM')
+        col.operator(ops.WIRESCULPT_OT_suggest_planes.bl_idname, icon='LIGHTPROBE_PLANAR')
+        job = ops.JOB
+        if job is not None:
+            box = layout.box()
+            box.label(text=job.status().replace("wiresculpt: ", ""), icon='SORTTIME')
+            for line in job.messages[-2:]:
+                wrap_labels(box, context, line)
+            box.operator(ops.WIRESCULPT_OT_find_planes_cancel.bl_idname, icon='CANCEL')
+            return
+        result = ops.RESULT
+        if result is None or result["scene"] != context.scene.name:
+            return
+        wrap_labels(layout, context, result["message"], icon='INFO')
+        for k, candidate in enumerate(result["candidates"]):
+            box = layout.box()
+            for i, line in enumerate(candidate_lines(candidate)):
+                wrap_labels(box, context, line, icon='CHECKMARK' if i == 0 else 'NONE')
+            box.operator(ops.WIRESCULPT_OT_apply_planes.bl_idname, text=f"Apply candidate {k + 1}").index = k
+
+
+register, unregister = classes_factory((VIEW3D_PT_wiresculpt_planes,))

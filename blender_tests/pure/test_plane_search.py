@@ -1,0 +1,255 @@
+"""The plane assistant (plane_search.py, issue 15) in-process, on a sphere whose plane circles are
+known by hand: the planes z = c1 and x = c2 (c in units of the radius) cut circles that cross iff
+c1^2 + c2^2 < 1, and a plane at distance c from the centre along (1, 1, 0)/sqrt2 meets y = 0 iff
+c < 1/sqrt2 and z = 0.7 iff c^2 < 0.51. Every stable design found is re-checked by
+blender_tests/pure/recheck.py (numpy/scipy only, no solver code), after a JSON round trip."""
+import copy
+import json
+import math
+import unittest
+
+import numpy as np
+
+from wiresculpt import native, pipeline, plane_search
+from wiresculpt.core import design as vocabulary
+from wiresculpt.core.materials import PRESETS
+from wiresculpt.core.scene import PlaneSpec, parse_scene
+from wiresculpt.core.settings import defaults
+
+from helpers import ROOT, sphere
+import recheck
+
+R = 0.125  # the sphere's radius (m); its size S is 0.25 m
+
+
+def P(name, origin, normal):
+    return PlaneSpec(name, tuple(R * c for c in origin), normal)
+
+
+# Z1, Z2 (z = +-0.7), X1 (x = -0.3) and Y (y = 0) all cross each other where they can: a stable base.
+BASE = [P("Z1", (0, 0, 0.7), (0, 0, 1)), P("Z2", (0, 0, -0.7), (0, 0, 1)), P("X1", (-0.3, 0, 0), (1, 0, 0)),
+        P("Y", (0, 0, 0), (0, 1, 0))]
+# W at x = 0.8 misses Z1 and Z2 (0.64 + 0.49 > 1) and is parallel to X1: it crosses Y alone, at two
+# points on the line x = 0.8, y = 0, so it turns about that line (a hinge).
+HINGE = BASE + [P("W", (0.8, 0, 0), (1, 0, 0))]
+# W at distance 0.9 along (1, 1, 0): misses Y (0.9 > 0.707), Z1, Z2 (0.81 > 0.51) and X1.
+MISS = BASE + [P("W", (0.9 / math.sqrt(2), 0.9 / math.sqrt(2), 0), (1, 1, 0))]
+
+
+def torus(major=0.1, minor=0.04, n=64, m=24):
+    V = [((major + minor * math.cos(2 * math.pi * j / m)) * math.cos(2 * math.pi * i / n),
+          (major + minor * math.cos(2 * math.pi * j / m)) * math.sin(2 * math.pi * i / n),
+          minor * math.sin(2 * math.pi * j / m)) for i in range(n) for j in range(m)]
+    F = []
+    for i in range(n):
+        for j in range(m):
+            a, b, c, d = i * m + j, ((i + 1) % n) * m + j, ((i + 1) % n) * m + (j + 1) % m, i * m + (j + 1) % m
+            F += [(a, b, c), (a, c, d)]
+    return np.array(V), np.array(F)
+
+
+def settings(**kw):
+    s = defaults()
+    s["cuts"] = {}
+    s.update(kw)
+    return s
+
+
+def round_trip(design):
+    return json.loads(json.dumps(design))
+
+
+def crossing_partners(design, wire_name):
+    """{names of the other wires} that the wire crosses, and the crossing points of the wire."""
+    ids = {w["id"]: w["name"] for w in design["wires"]}
+    me = [w["id"] for w in design["wires"] if w["name"] == wire_name][0]
+    partners, points = set(), []
+    for c in design["crossings"]:
+        if me in c["wires"]:
+            partners |= {ids[w] for w in c["wires"] if w != me}
+            points.append(c["point"])
+    return partners, np.array(points)
+
+
+def collinear(points, tol=1e-6):
+    if len(points) < 3:
+        return True
+    x = points - points[0]
+    return np.linalg.svd(x, compute_uv=False)[1] < tol
+
+
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class Nearby(unittest.TestCase):
+    def setUp(self):
+        self.V, self.F = sphere()
+
+    def test_the_scenes_are_what_the_hand_says(self):
+        hinge = pipeline.run(self.V, self.F, HINGE, PRESETS["steel"], settings())
+        self.assertFalse(hinge["stable"])
+        partners, points = crossing_partners(hinge, "W/0")
+        self.assertEqual(partners, {"Y/0"})
+        self.assertTrue(collinear(points))
+        miss = pipeline.run(self.V, self.F, MISS, PRESETS["steel"], settings())
+        self.assertFalse(miss["stable"])
+        self.assertEqual(crossing_partners(miss, "W/0")[0], set())
+        base = pipeline.run(self.V, self.F, BASE, PRESETS["steel"], settings())
+        self.assertTrue(base["stable"], base["reason"])
+
+    def check_found(self, design, used):
+        d = round_trip(design)
+        self.assertTrue(d["stable"], d["reason"])
+        self.assertEqual(recheck.recheck(d), [])
+        # the design speaks the design's vocabulary (core/design.py), slicing recorded as slicing.run does
+        self.assertLessEqual(set(d), set(vocabulary.KEYS["top"]))
+        self.assertLessEqual(set(d["stages"]), set(vocabulary.KEYS["stages"]))
+        self.assertEqual(set(d["stages"]["slicing"]), {"seconds", "planes", "contours", "mesh"})
+        # the hinge is gone: W crosses a second wire, off the line it turned about
+        partners, points = crossing_partners(d, "W/0")
+        self.assertGreaterEqual(len(partners), 2)
+        self.assertFalse(collinear(points))
+        # the wires' planes are the planes used and recorded
+        after = {p["name"]: p for p in d["plane_search"]["planes_after"]}
+        self.assertEqual(sorted(after), sorted(p.name for p in used))
+        for w in d["wires"]:
+            plane = after[w["name"].split("/")[0]]
+            self.assertLess(np.linalg.norm(np.subtract(w["plane"]["normal"], plane["normal"])), 1e-12)
+            self.assertLess(abs(np.dot(np.subtract(w["plane"]["origin"], plane["origin"]), plane["normal"])), 1e-12)
+        return d
+
+    def changed(self, record):
+        before = {p["name"]: p for p in record["planes_before"]}
+        return {p["name"] for p in record["planes_after"]
+                if p["origin"] != before[p["name"]]["origin"] or p["normal"] != before[p["name"]]["normal"]
+                or p["contours"] != before[p["name"]]["contours"]}
+
+    def test_a_hinged_wire_gets_a_second_partner(self):
+        design, used = plane_search.run(self.V, self.F, HINGE, PRESETS["steel"], settings(plane_search="nearby"))
+        d = self.check_found(design, used)
+        record = d["plane_search"]
+        self.assertEqual(record["mode"], "nearby")
+        self.assertTrue(self.changed(record))
+        self.assertGreater(record["candidates"], record["full_solves"])  # the screen rejected some
+        self.assertLess(record["score"], 0.0)
+        self.assertTrue(record["changes"])
+
+    def test_a_plane_that_crosses_nothing_is_moved_until_it_does(self):
+        design, used = plane_search.run(self.V, self.F, MISS, PRESETS["steel"], settings(plane_search="nearby"))
+        d = self.check_found(design, used)
+        # only W can make the difference: no other plane's change reaches it (the base keeps |c| <= 0.7)
+        self.assertIn("W", self.changed(d["plane_search"]))
+        w = [p for p in d["plane_search"]["planes_after"] if p["name"] == "W"][0]
+        distance = abs(np.dot(w["origin"], w["normal"])) / R
+        self.assertLess(distance, 0.9)  # W moved towards the centre (or turned), never away
+
+    def test_every_candidate_returned_passes_the_recheck(self):
+        found, searcher, _start = plane_search.nearby(self.V, self.F, HINGE, PRESETS["steel"],
+                                                      settings(plane_search="nearby"), want=3, budget=60.0)
+        self.assertTrue(found)
+        costs = [c["cost"] for c in found]
+        self.assertEqual(costs, sorted(costs))
+        for c in found:
+            d = round_trip(c["design"])
+            self.assertTrue(d["stable"])
+            self.assertEqual(recheck.recheck(d), [], c["changes"])
+            # the cost is the documented measure of the placements, recomputed from them
+            by_name = {p.name: p for p in HINGE}
+            cost = 0.0
+            for p in c["planes"]:
+                q = by_name[p.name]
+                n0 = np.asarray(q.normal, float) / np.linalg.norm(q.normal)
+                tilt = math.acos(max(-1.0, min(1.0, float(np.dot(n0, p.normal)))))
+                shift = abs(float(np.dot(np.subtract(p.origin, q.origin), p.normal))) if tilt < 1e-9 else 0.0
+                cost += shift / 0.25 + tilt + (plane_search.RULE_COST if p.contours != q.contours else 0.0)
+            self.assertAlmostEqual(c["cost"], cost, delta=1e-9)
+
+    def test_stable_planes_are_kept(self):
+        design, used = plane_search.run(self.V, self.F, BASE, PRESETS["steel"], settings(plane_search="nearby"))
+        self.assertTrue(design["stable"])
+        self.assertEqual(design["plane_search"]["changes"], [])
+        self.assertEqual(design["plane_search"]["score"], 0.0)
+        self.assertEqual([(p.origin, p.normal) for p in used],
+                         [(tuple(float(c) for c in p.origin), tuple(float(c) for c in p.normal)) for p in BASE])
+
+    def test_a_solve_past_the_budget_is_stopped_and_a_cancel_still_cancels(self):
+        s = plane_search.Searcher(self.V, self.F, PRESETS["steel"], settings())
+        placements = [plane_search.Placement(p.name, p.origin, p.normal, p.contours) for p in BASE]
+        ok, design, _close = s.screen(placements)
+        self.assertTrue(ok)  # the base is stable (test_the_scenes_are_what_the_hand_says)
+        s.deadline = 0.0  # long past: the solve stops at its first check
+        self.assertIsNone(s.solve(copy.deepcopy(design)))
+        self.assertEqual((s.full_solves, s.timed_out), (1, 1))
+        s.deadline = math.inf
+        self.assertTrue(s.solve(copy.deepcopy(design))["stable"])
+        s.cancel = lambda: True
+        with self.assertRaises(pipeline.Cancelled):
+            s.solve(copy.deepcopy(design))
+
+    def test_off_is_the_pipeline(self):
+        design, used = plane_search.run(self.V, self.F, HINGE, PRESETS["steel"], settings())
+        self.assertNotIn("plane_search", design)
+        self.assertFalse(design["stable"])
+        self.assertEqual(used, HINGE)
+
+
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class Auto(unittest.TestCase):
+    def check(self, V, F, count):
+        design, used = plane_search.run(V, F, [], PRESETS["steel"], settings(plane_search="auto", plane_count=count))
+        d = round_trip(design)
+        self.assertTrue(d["stable"], d["reason"])
+        self.assertEqual(recheck.recheck(d), [])
+        self.assertEqual(len(used), count)
+        self.assertEqual(len(d["plane_search"]["planes_after"]), count)
+        self.assertEqual(d["plane_search"]["planes_before"], [])
+        # every plane cuts the mesh: its centre-distance is inside the mesh's extent along its normal
+        for p in used:
+            t = np.asarray(V) @ np.asarray(p.normal)
+            self.assertTrue(t.min() < np.dot(p.origin, p.normal) < t.max(), p.name)
+        return d
+
+    def test_sphere(self):
+        V, F = sphere()
+        self.check(V, F, 5)
+
+    def test_torus(self):
+        V, F = torus()
+        self.check(V, F, 5)
+
+
+class SceneSettings(unittest.TestCase):
+    def scene(self, **extra):
+        data = {"mesh": "globe/globe.obj", "planes": [{"origin": [0, 0, 0], "normal": [0, 0, 1]}]}
+        data.update(extra)
+        return parse_scene(data, f"{ROOT}/scripts/examples/scene.json")
+
+    def test_defaults(self):
+        s = self.scene().settings
+        self.assertEqual((s["plane_search"], s["plane_count"]), ("off", 5))
+
+    def test_bad_values_name_the_key(self):
+        for value, text in ((("near"), 'scene key "settings.plane_search" must be one of "off", "nearby", "auto", got "near"'),
+                            ((3), 'scene key "settings.plane_search" must be one of')):
+            with self.assertRaises(ValueError) as cm:
+                self.scene(settings={"plane_search": value})
+            self.assertIn(text, str(cm.exception))
+        with self.assertRaises(ValueError) as cm:
+            self.scene(settings={"plane_count": 1})
+        self.assertIn('"settings.plane_count" must be at least 2', str(cm.exception))
+        with self.assertRaises(ValueError) as cm:
+            self.scene(settings={"plane_count": 4.5})
+        self.assertIn('"settings.plane_count" must be a whole number', str(cm.exception))
+
+    def test_empty_planes_only_with_auto(self):
+        self.assertEqual(self.scene(planes=[], settings={"plane_search": "auto"}).planes, [])
+        with self.assertRaises(ValueError) as cm:
+            self.scene(planes=[], settings={"plane_search": "nearby"})
+        self.assertIn('scene key "planes" must be a non-empty list', str(cm.exception))
+
+    def test_nearby_without_planes_is_refused_in_process(self):
+        with self.assertRaises(ValueError) as cm:
+            plane_search.run(None, None, [], PRESETS["steel"], settings(plane_search="nearby"))
+        self.assertIn('plane_search "nearby" needs planes', str(cm.exception))
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,128 @@
+"""The target shape as the pipeline runs it (window sweeps stopped by SWEEP_FTOL, wires on threads;
+issue 17) against a reference run of the old method pushed further: one wire at a time, no
+energy-based stop, sweeps until no window moves a point by 1 nm. On the bench's Table 2 stand-ins,
+the bundled globe and the 3 m wire of the length sweep, both must reach the same distances to the
+contour (within 0.1 mm) and realise the same crossings. Correctness only: no timing."""
+import copy
+import os
+import tempfile
+import unittest
+from unittest import mock
+
+import bench_scenes
+from wiresculpt import native
+from wiresculpt.stages import layering, target_shape
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+GLOBE = os.path.join(ROOT, "scripts", "examples", "globe", "scene.json")
+STAND_INS = ["duck", "teddy", "airplane", "car", "chair", "length-3.0m"]
+REFERENCE = {"sweep_ftol": 0.0, "sweep_tol": 1e-9, "max_iterations": 1_000_000}
+
+
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class AgainstConvergedSweeps(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.dir = tempfile.TemporaryDirectory()
+        cases = bench_scenes.generate(cls.dir.name, STAND_INS, run_check=False, say=lambda _line: None)
+        cls.scenes = {c["name"]: os.path.join(cls.dir.name, c["scene"]) for c in cases}
+        cls.scenes["globe"] = GLOBE
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.dir.cleanup()
+
+    def layered(self, name):
+        scene, _V, _F, _planes, design = bench_scenes.load_and_slice(self.scenes[name])
+        layering.run(design, scene.material, scene.settings)
+        return scene, design
+
+    def reference(self, design, scene):
+        real = native.optimize_target_shape
+        calls = []
+
+        def converged(points, closed, crossings, options=None, progress=None):
+            calls.append(options)
+            return real(points, closed, crossings, {**(options or {}), **REFERENCE}, progress)
+
+        with mock.patch.object(target_shape, "MAX_THREADS", 1), \
+                mock.patch.object(target_shape.native, "optimize_target_shape", converged):
+            target_shape.run(design, scene.material, scene.settings)
+        self.assertTrue(calls)
+        self.assertTrue(all(o["sweep_ftol"] == target_shape.SWEEP_FTOL for o in calls))  # what REFERENCE replaced
+        return design
+
+    def test_same_distances_and_crossings(self):
+        self.assertGreater(target_shape.SWEEP_FTOL, 0.0)
+        for name in ["globe"] + STAND_INS:
+            with self.subTest(name):
+                scene, design = self.layered(name)
+                fast = copy.deepcopy(design)
+                target_shape.run(fast, scene.material, scene.settings)
+                slow = self.reference(copy.deepcopy(design), scene)
+                stage_f, stage_s = fast["stages"]["target_shape"], slow["stages"]["target_shape"]
+                for wf, ws in zip(fast["wires"], slow["wires"]):
+                    self.assertAlmostEqual(wf["target_max_distance"], ws["target_max_distance"], delta=1e-4,
+                                           msg=wf["name"])
+                    self.assertAlmostEqual(wf["target_rms_distance"], ws["target_rms_distance"], delta=1e-4,
+                                           msg=wf["name"])
+                    self.assertEqual(len(wf["target"]), len(ws["target"]), wf["name"])
+                self.assertEqual([c["hook"] for c in fast["crossings"]], [c["hook"] for c in slow["crossings"]])
+                self.assertEqual(sorted(n["crossing"] for n in stage_f["nulled_crossings"]),
+                                 sorted(n["crossing"] for n in stage_s["nulled_crossings"]))
+                self.assertEqual(fast.get("stable"), slow.get("stable"))
+                self.assertFalse([w["id"] for w in stage_f["wires"] if "MAXEVAL" in w["nlopt_result"]])
+                self.assertFalse([w["id"] for w in stage_s["wires"] if "MAXEVAL" in w["nlopt_result"]])
+                self.assertLessEqual(stage_f["iterations"], stage_s["iterations"])
+
+
+    def test_no_wire_problem_is_solved_twice(self):
+        # The Chair stand-in re-layers (issue 20) and its new layering leaves some wires' crossings
+        # and hooks alone; their problems, identical to the first round's, are taken from the
+        # shared solves (Memo `same`) instead of being solved again.
+        from wiresculpt import pipeline
+
+        scene, _V, _F, _planes, design = bench_scenes.load_and_slice(self.scenes["chair"])
+        real, keys = native.optimize_target_shape, []
+
+        def counted(points, closed, crossings, options=None, progress=None):
+            keys.append(target_shape.Memo.key(points, closed, crossings, options) + (options["max_bend"],))
+            return real(points, closed, crossings, options, progress)
+
+        with mock.patch.object(target_shape.native, "optimize_target_shape", counted):
+            solved = pipeline.solve(design, scene.material, scene.settings)
+        self.assertGreaterEqual(len(solved["stages"]["relayering"]["rounds"]), 2)  # the case it is about
+        self.assertEqual(len(keys), len(set(keys)))
+
+
+class Threads(unittest.TestCase):
+    """solve_all keeps the order of its jobs and hands back the memo's results untouched."""
+
+    def test_order_and_reused_results(self):
+        kept = {"kept": True}
+        jobs = [{"result": None, "n": k} for k in range(5)]
+        jobs[2]["result"] = kept
+
+        def solve(job, _progress=None):
+            return job["result"] if job["result"] is not None else {"n": job["n"]}
+
+        with mock.patch.object(target_shape, "solve_job", solve), mock.patch.object(target_shape, "MAX_THREADS", 2):
+            results = target_shape.solve_all(jobs)
+        self.assertIs(results[2], kept)
+        self.assertEqual([r.get("n") for k, r in enumerate(results) if k != 2], [0, 1, 3, 4])
+
+    def test_an_error_on_a_thread_reaches_the_caller(self):
+        def solve(job, _progress=None):
+            if job["n"] == 1:
+                raise native.Cancelled()
+            return {}
+
+        jobs = [{"result": None, "n": k} for k in range(3)]
+        with mock.patch.object(target_shape, "solve_job", solve), mock.patch.object(target_shape, "MAX_THREADS", 2), \
+                mock.patch.object(target_shape.os, "cpu_count", lambda: 2):
+            with self.assertRaises(native.Cancelled):
+                target_shape.solve_all(jobs)
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,148 @@
+"""Find Stable Planes / Suggest Planes / Apply in Blender (issue 15), background mode (the search
+runs inline): the globe with five slicing planes of which "Slice E" (x = 0.8 R) crosses only the
+plane y = 0, on one line (a hinge: planes z = c1 and x = c2 cut circles of the unit sphere that
+cross iff c1^2 + c2^2 < 1, and Slice A/B are at z = +-0.7).
+
+    blender --background --factory-startup --python-exit-code 1 --python blender_tests/run.py -- plane_assistant
+"""
+import json
+import math
+import os
+import sys
+
+import bpy
+import numpy as np
+
+from wiresculpt import native
+from wiresculpt.blend import results as scene_results
+from wiresculpt.blend.handles import handle_plane, handles
+from wiresculpt.operators import plane_search as ops
+from wiresculpt.ui import plane_search as panel
+
+from helpers import GLOBE_RADIUS as R
+from helpers import BlenderCase as Case
+from helpers import GLOBE_OBJ, add_handle, draw
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "pure"))
+import recheck  # noqa: E402
+
+HINGE = (((0, 0, 0), (0, 0, 0.7 * R)), ((0, 0, 0), (0, 0, -0.7 * R)), ((0, math.pi / 2, 0), (-0.3 * R, 0, 0)),
+         ((math.pi / 2, 0, 0), (0, 0, 0)), ((0, math.pi / 2, 0), (0.8 * R, 0, 0)))
+
+
+def globe_target():
+    """globe.obj at radius R as the target, no slicing plane yet."""
+    from wiresculpt.blend.mesh import import_mesh
+
+    _V, _F, objects = import_mesh(GLOBE_OBJ)
+    objects[0].scale = (R,) * 3
+    bpy.context.view_layer.update()
+    bpy.context.scene.wiresculpt.target = objects[0]
+
+
+def hinge_scene():
+    globe_target()
+    for rotation, location in HINGE:
+        add_handle(rotation, location)
+    bpy.context.view_layer.update()
+    assert bpy.ops.wiresculpt.slice() == {'FINISHED'}
+
+
+def placements():
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    return {h.name: handle_plane(h, depsgraph)[1:] for h in handles(bpy.context.scene)}
+
+
+def wire_names():
+    return sorted(o.name for o in bpy.context.scene.objects if scene_results.WIRE_KEY in o)
+
+
+class FindStablePlanes(Case):
+    def setUp(self):
+        super().setUp()
+        if not native.available():
+            self.skipTest(native.LOAD_ERROR)
+        ops.RESULT = None
+        hinge_scene()
+
+    def test_the_scene_is_a_hinge(self):
+        self.assertEqual(bpy.ops.wiresculpt.optimize(), {'FINISHED'})
+        design = json.loads(bpy.data.texts[scene_results.DESIGN_TEXT].as_string())
+        self.assertFalse(design["stable"])
+        self.assertIn("Slice E/0", design["reason"])
+
+    def test_find_then_apply(self):
+        before = placements()
+        self.assertEqual(bpy.ops.wiresculpt.find_planes(), {'FINISHED'})
+        self.assertEqual(placements(), before)  # searching changes nothing
+        result = ops.RESULT
+        self.assertTrue(1 <= len(result["candidates"]) <= 3)
+        for c in result["candidates"]:
+            d = json.loads(json.dumps(c["design"]))
+            self.assertTrue(d["stable"])
+            self.assertEqual(recheck.recheck(d), [], c["changes"])
+            self.assertTrue(c["changes"])
+        log = draw(panel.VIEW3D_PT_wiresculpt_planes, bpy.context)
+        texts = [kw.get("text", "") for _name, _a, kw in log]
+        for k in range(len(result["candidates"])):
+            self.assertIn(f"Apply candidate {k + 1}", texts)
+        self.assertTrue(any(t.startswith(("move plane", "tilt plane", "plane ")) for t in texts), texts)
+        self.assertEqual(bpy.ops.wiresculpt.apply_planes(index=0), {'FINISHED'})
+        after = placements()
+        chosen = {p.name: p for p in result["candidates"][0]["planes"]}
+        moved = 0
+        for name, (origin, normal) in after.items():
+            p = chosen[name]
+            self.assertLess(np.linalg.norm(np.subtract(normal, p.normal)), 1e-5, name)
+            self.assertLess(abs(np.dot(np.subtract(origin, p.origin), p.normal)), 1e-6, name)
+            b_origin, b_normal = before[name]
+            moved += (np.linalg.norm(np.subtract(normal, b_normal)) > 1e-6
+                      or abs(np.dot(np.subtract(origin, b_origin), b_normal)) > 1e-6)
+        self.assertGreaterEqual(moved, 1)
+        # the candidate's wires are in the scene and its contours are the ticked ones
+        self.assertEqual(len(wire_names()), len(result["candidates"][0]["design"]["wires"]))
+        ticked = sorted(f"{i.plane}/{i.index}" for i in bpy.context.scene.wiresculpt.contours if i.use)
+        self.assertEqual(ticked, sorted(w["name"] for w in result["candidates"][0]["design"]["wires"]))
+        # and Optimize from the panel now gives a stable design from the moved planes
+        self.assertEqual(bpy.ops.wiresculpt.optimize(), {'FINISHED'})
+        self.assertTrue(json.loads(bpy.data.texts[scene_results.DESIGN_TEXT].as_string())["stable"])
+
+    def test_a_cancelled_search_leaves_the_scene_and_the_candidates(self):
+        before = placements()
+        objects = sorted(bpy.data.objects.keys())
+        V, F, planes, material, settings = ops.gather(bpy.context)
+        job = ops.SearchJob("nearby", V, F, planes, material, settings, 5)
+        job.cancel_event.set()  # Esc before the first candidate
+        job.run()
+        self.assertTrue(job.cancelled)
+        self.assertIsNone(job.error)
+        self.assertEqual(placements(), before)
+        self.assertEqual(sorted(bpy.data.objects.keys()), objects)
+        self.assertIsNone(ops.RESULT)
+
+    def test_apply_without_a_search_is_refused(self):
+        self.assertFalse(ops.WIRESCULPT_OT_apply_planes.poll(bpy.context))
+
+
+class SuggestPlanes(Case):
+    def setUp(self):
+        super().setUp()
+        if not native.available():
+            self.skipTest(native.LOAD_ERROR)
+        ops.RESULT = None
+        globe_target()
+
+    def test_suggest_then_apply_adds_ordinary_planes(self):
+        self.assertEqual(bpy.ops.wiresculpt.suggest_planes(count=4), {'FINISHED'})
+        self.assertEqual(handles(bpy.context.scene), [])  # nothing added before Apply
+        candidates = ops.RESULT["candidates"]
+        self.assertTrue(candidates)
+        for c in candidates:
+            self.assertEqual(len(c["planes"]), 4)
+            self.assertEqual(recheck.recheck(json.loads(json.dumps(c["design"]))), [])
+        self.assertEqual(bpy.ops.wiresculpt.apply_planes(index=0), {'FINISHED'})
+        added = handles(bpy.context.scene)
+        self.assertEqual(len(added), 4)
+        self.assertEqual(len(wire_names()), len(candidates[0]["design"]["wires"]))
+        self.assertEqual(bpy.ops.wiresculpt.optimize(), {'FINISHED'})
+        self.assertTrue(json.loads(bpy.data.texts[scene_results.DESIGN_TEXT].as_string())["stable"])

@@ -1,0 +1,103 @@
+"""settings.plane_search in the headless batch (issue 15): exit status, design.json's record, the
+wires' planes and the saved slicing handles are the planes used. The globe (radius 1 in the file,
+size 0.25: radius 0.125 m) with planes whose circles cross by hand (z = c1, x = c2 cross iff
+c1^2 + c2^2 < 1): W at x = 0.8 crosses only Y, on one line (a hinge)."""
+import json
+import os
+import sys
+import tempfile
+import unittest
+
+import numpy as np
+
+from helpers import BATCH, ROOT, run_blender, wiresculpt_lines
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "pure"))
+import recheck  # noqa: E402
+
+GLOBE_OBJ = os.path.join(ROOT, "scripts", "examples", "globe", "globe.obj")
+HINGE = [{"name": "Z1", "origin": [0, 0, 0.7], "normal": [0, 0, 1]},
+         {"name": "Z2", "origin": [0, 0, -0.7], "normal": [0, 0, 1]},
+         {"name": "X1", "origin": [-0.3, 0, 0], "normal": [1, 0, 0]},
+         {"name": "Y", "origin": [0, 0, 0], "normal": [0, 1, 0]},
+         {"name": "W", "origin": [0.8, 0, 0], "normal": [1, 0, 0]}]
+
+
+class PlaneSearchBatch(unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.TemporaryDirectory()
+        self.out = os.path.join(self.dir.name, "out")
+
+    def tearDown(self):
+        self.dir.cleanup()
+
+    def run_scene(self, planes, **settings):
+        path = os.path.join(self.dir.name, "scene.json")
+        with open(path, "w") as f:
+            json.dump({"mesh": GLOBE_OBJ, "size": 0.25, "planes": planes, "settings": settings}, f)
+        r = run_blender(BATCH, path, "--out", self.out)
+        design = None
+        if os.path.exists(os.path.join(self.out, "design.json")):
+            with open(os.path.join(self.out, "design.json")) as f:
+                design = json.load(f)
+        return r, design
+
+    def test_off_keeps_the_hinge_and_exits_2(self):
+        r, d = self.run_scene(HINGE)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertNotIn("plane_search", d)
+        self.assertIn("W/0", d["reason"])
+
+    def test_nearby_moves_a_plane_and_exits_0(self):
+        r, d = self.run_scene(HINGE, plane_search="nearby")
+        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+        self.assertTrue(d["stable"])
+        self.assertEqual(recheck.recheck(d), [])
+        rec = d["plane_search"]
+        self.assertEqual(rec["mode"], "nearby")
+        # before: the scene's planes scaled by 0.125 (size 0.25 over the globe's 2 units)
+        self.assertEqual([p["origin"] for p in rec["planes_before"]],
+                         [[0.125 * c for c in p["origin"]] for p in HINGE])
+        moved = [a["name"] for a, b in zip(rec["planes_after"], rec["planes_before"])
+                 if a["origin"] != b["origin"] or a["normal"] != b["normal"]]
+        self.assertTrue(moved)
+        self.assertTrue(rec["changes"])
+        for key in ("candidates", "full_solves", "seconds", "score"):
+            self.assertIn(key, rec)
+        after = {p["name"]: p for p in rec["planes_after"]}
+        for w in d["wires"]:
+            p = after[w["name"].split("/")[0]]
+            self.assertLess(abs(np.dot(np.subtract(w["plane"]["origin"], p["origin"]), p["normal"])), 1e-9)
+            self.assertLess(np.linalg.norm(np.subtract(w["plane"]["normal"], p["normal"])), 1e-9)
+        self.assertTrue(any(line.startswith("wiresculpt: plane_search: nearby:") for line in wiresculpt_lines(r.stdout)))
+
+    def test_nearby_that_finds_nothing_exits_2_and_says_so(self):
+        # bad_input.json's no_stable_layering: B (z = 0.999) is parallel to A and 0.1 m above it, and
+        # T is the only wire both cross; no offset or small tilt of one or two planes makes A and B meet.
+        planes = [{"name": "A", "origin": [0, 0, 0], "normal": [0, 0, 1]},
+                  {"name": "B", "origin": [0, 0, 0.999], "normal": [0, 0, 1]},
+                  {"name": "T", "origin": [0, 0, 0], "normal": [1, 0, 0]}]
+        r, d = self.run_scene(planes, plane_search="nearby")
+        self.assertEqual(r.returncode, 2, r.stdout + r.stderr)
+        self.assertFalse(d["stable"])
+        self.assertEqual(d["plane_search"]["planes_after"], [])
+        self.assertIsNone(d["plane_search"]["score"])
+        self.assertIn("no nearby placement", d["reason"])
+
+    def test_auto_with_no_planes(self):
+        r, d = self.run_scene([], plane_search="auto", plane_count=4)
+        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+        self.assertEqual(recheck.recheck(d), [])
+        self.assertEqual(len(d["plane_search"]["planes_after"]), 4)
+        self.assertEqual(len({w["name"].split("/")[0] for w in d["wires"]}), 4)
+
+    def test_bad_mode_is_one_clear_error(self):
+        r, _d = self.run_scene(HINGE, plane_search="everywhere")
+        self.assertEqual(r.returncode, 1)
+        errors = wiresculpt_lines(r.stderr)
+        self.assertEqual(len(errors), 1, r.stderr)
+        self.assertIn('scene key "settings.plane_search" must be one of "off", "nearby", "auto"', errors[0])
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,113 @@
+"""Driven by test_plane_assistant_modal.py in a Blender with a window (under Xvfb): Find Stable
+Planes as the panel runs it (INVOKE: worker thread, modal timer) on the hinged globe
+(test_plane_assistant.py), cancelled mid-search, then to the end, then Apply and one Undo. Prints
+one line `MODAL {json}` with what it saw, then quits."""
+import json
+import math
+import os
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [os.path.join(os.path.dirname(HERE), "addon"), HERE]
+
+import bpy  # noqa: E402
+
+import wiresculpt  # noqa: E402
+
+wiresculpt.register()
+from wiresculpt.blend.mesh import import_mesh  # noqa: E402
+from wiresculpt.operators import plane_search as ops  # noqa: E402
+from ui_steps import guarded, report, start_watchdog  # noqa: E402
+
+R = 0.125
+HINGE = (((0, 0, 0), (0, 0, 0.7 * R)), ((0, 0, 0), (0, 0, -0.7 * R)), ((0, math.pi / 2, 0), (-0.3 * R, 0, 0)),
+         ((math.pi / 2, 0, 0), (0, 0, 0)), ((0, math.pi / 2, 0), (0.8 * R, 0, 0)))
+seen = {}
+
+
+def state():
+    objects = {o.name: (o.type, tuple(round(x, 9) for x in o.matrix_world.col[3]),
+                        tuple(round(x, 9) for x in o.matrix_world.col[2]), o.hide_viewport) for o in bpy.data.objects}
+    ticks = [(i.plane, i.index, i.use) for i in bpy.context.scene.wiresculpt.contours]
+    return json.dumps([objects, {t.name: t.as_string() for t in bpy.data.texts}, ticks], sort_keys=True)
+
+
+def setup():
+    for o in list(bpy.data.objects):
+        bpy.data.objects.remove(o)
+    _V, _F, objs = import_mesh(os.path.join(os.path.dirname(HERE), "scripts", "examples", "globe", "globe.obj"))
+    objs[0].scale = (R,) * 3
+    bpy.context.view_layer.update()
+    bpy.context.scene.wiresculpt.target = objs[0]
+    for rotation, location in HINGE:
+        bpy.ops.wiresculpt.add_plane()
+        handle = bpy.context.view_layer.objects.active
+        handle.rotation_euler, handle.location = rotation, location
+    bpy.context.view_layer.update()
+    bpy.ops.wiresculpt.slice()
+
+
+def override():
+    win = bpy.context.window_manager.windows[0]
+    return bpy.context.temp_override(window=win, area=next(a for a in win.screen.areas if a.type == 'VIEW_3D'))
+
+
+def invoke():
+    with override():
+        return sorted(bpy.ops.wiresculpt.find_planes('INVOKE_DEFAULT'))
+
+
+def start_cancelled():
+    seen["before_cancel"] = state()
+    seen["cancel_invoke"] = invoke()
+    seen["cancel_running"] = ops.running()
+    seen["status_while_running"] = ops.JOB.status() if ops.JOB else ""
+    bpy.app.timers.register(guarded(seen, cancel_mid_search), first_interval=0.3)
+
+
+def cancel_mid_search():
+    seen["cancel_still_running"] = ops.running()  # the search takes seconds: still at work
+    seen["cancel_op"] = sorted(bpy.ops.wiresculpt.find_planes_cancel())
+    bpy.app.timers.register(guarded(seen, check_cancelled), first_interval=0.2)
+
+
+def check_cancelled():
+    if ops.running():
+        return 0.2
+    seen["cancel_unchanged"] = state() == seen.pop("before_cancel")
+    seen["cancel_no_candidates"] = ops.RESULT is None
+    bpy.app.timers.register(guarded(seen, start_full), first_interval=0.1)
+    return None
+
+
+def start_full():
+    seen["before_full"] = state()
+    seen["invoke"] = invoke()
+    bpy.app.timers.register(guarded(seen, check_full), first_interval=0.5)
+
+
+def check_full():
+    if ops.running():
+        return 0.2
+    seen["candidates"] = len(ops.RESULT["candidates"]) if ops.RESULT else 0
+    seen["search_unchanged"] = state() == seen["before_full"]
+    with override():
+        bpy.ops.ed.undo_push(message="before Apply")
+        seen["apply"] = sorted(bpy.ops.wiresculpt.apply_planes('EXEC_DEFAULT', index=0))
+    seen["apply_changed"] = state() != seen["before_full"]
+    with override():
+        bpy.ops.ed.undo()  # one step takes the applied planes and design away
+    seen["undo_restores"] = state() == seen.pop("before_full")
+    report(seen)
+    return None
+
+
+def begin():
+    setup()
+    with override():
+        bpy.ops.ed.undo_push(message="scene set up by the test")
+    start_cancelled()
+
+
+start_watchdog(seen, seconds=120.0)
+bpy.app.timers.register(guarded(seen, begin), first_interval=0.5)
