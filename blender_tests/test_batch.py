@@ -97,6 +97,10 @@ class BatchTest(unittest.TestCase):
             self.assertTrue(names and all(n.endswith(ext) for n in names), (folder, names))
         self.assertEqual(len(d["fabrication"]["wires"]), 3)
         self.assertEqual(d["fabrication"]["errors"], [])
+        for w in d["fabrication"]["wires"]:  # the default profile compensates and predicts: only the
+            # small-bend rule moves the predicted wire off the rest shape
+            self.assertAlmostEqual(w["preview_distance"], w["shape_error"], delta=1e-9)
+            self.assertNotIn("predicted", w)
 
     def check_targets(self, d):
         """The target shapes against FORMATS.md and the machine, computed from the points alone."""
@@ -201,8 +205,10 @@ class BatchTest(unittest.TestCase):
                 json.dump({"format": "wiresculpt-machine-profile", "version": 1, "name": name,
                            "springback_a": a, "springback_b_deg": -2.0, "paper": paper}, f)
         scene = self.scene(**globe, machine_profile="scene.json-bender.json")
+        # the second run also predicts what a machine keeping 0.9 c - 2 deg makes of programs compensated for 0.95
         runs = (((), "scene.json-bender", 0.9, "215.900mm"),
-                (("--profile", os.path.join(self.dir.name, "option-bender.json")), "option-bender", 0.95, "210.000mm"))
+                (("--profile", os.path.join(self.dir.name, "option-bender.json"), "--machine-model",
+                  os.path.join(self.dir.name, "scene.json-bender.json")), "option-bender", 0.95, "210.000mm"))
         for extra, name, a, width in runs:
             with self.subTest(name):
                 r = run_blender(BATCH, scene, "--out", self.out, *extra)
@@ -215,6 +221,14 @@ class BatchTest(unittest.TestCase):
                 pages = os.path.join(self.out, "templates", "pages")
                 with open(os.path.join(pages, sorted(os.listdir(pages))[0])) as f:
                     self.assertIn(f'width="{width}"', f.read())
+                with open(os.path.join(self.out, "design.json")) as f:
+                    fab = json.load(f)["fabrication"]
+                if extra:  # every bend comes out short: the loops drift by centimetres
+                    self.assertIn("wiresculpt: machine model: scene.json-bender (", r.stdout)
+                    self.assertIn("0.9000 × commanded -2.000°", fab["preview_model"])
+                    self.assertTrue(all(w["preview_distance"] > 0.01 for w in fab["wires"]), fab["wires"])
+                else:  # compensated and predicted with one line: only the small-bend rule moves it
+                    self.assertTrue(all(abs(w["preview_distance"] - w["shape_error"]) < 1e-9 for w in fab["wires"]))
         missing = self.scene(**globe, machine_profile="nowhere.json")
         self.out = os.path.join(self.dir.name, "out-missing")
         self.assertFailsWith('"machine_profile": file not found', missing)

@@ -102,7 +102,7 @@ class CsvTest(unittest.TestCase):
 class FitTest(unittest.TestCase):
     def test_cantilever_recovers_k_b_and_the_plastic_onset(self):
         for kb, onset in ((0.73, 600), (0.42, 400)):
-            fit = cal.fit_cantilever(cantilever_csv(kb=kb, onset_g=onset))
+            fit = cal.fit_cantilever(cantilever_csv(kb=kb, onset_g=onset), include_weight=False)
             self.assertAlmostEqual(fit["bending_stiffness"] / kb, 1.0, delta=0.02)
             self.assertEqual(fit["plastic_load_g"], onset)
             self.assertTrue(fit["plastic_reached"])
@@ -144,7 +144,7 @@ class FilesTest(unittest.TestCase):
         self.tmp.cleanup()
 
     def test_material_json_round_trip_listed_with_presets(self):
-        fit = cal.fit_cantilever(cantilever_csv())
+        fit = cal.fit_cantilever(cantilever_csv(), include_weight=False)
         tilt = cal.fit_friction("repeat,angle_deg\n1,17.7\n2,17.9\n")
         m = cal.calibrated_material("My steel", materials.PRESETS["steel"], fit, tilt)
         path = cal.save_material(m, self.tmp.name)
@@ -256,6 +256,34 @@ class OperatorTest(unittest.TestCase):
         self.assertEqual(bpy.ops.wiresculpt.calibration_save_profile(filepath=out), {'FINISHED'})
         self.assertAlmostEqual(cal.load_profile(out)["springback_a"], self.store.results(scene)["springback"]["springback_a"])
         self.assertEqual(scene.wiresculpt.machine_profile, out)  # selected for Export and Send
+
+    def test_the_panel_and_fit_cantilever_count_the_wires_weight_alike(self):
+        # a capture of 3 mm steel under its own weight (0.0555 kg/m) and the tip loads
+        scene = bpy.context.scene
+        density = 7850 * math.pi * 0.0015 ** 2
+        path = os.path.join(self.tmp.name, "heavy.csv")
+        with open(path, "w") as f:
+            f.write(cantilever_csv(density=density))
+        for key in ("material_preset", "wire_diameter"):
+            scene.wiresculpt.property_unset(key)  # the panel's defaults: steel, 3 mm
+        scene.wiresculpt_calibration.property_unset("include_weight")  # ticked by default
+        self.assertEqual(bpy.ops.wiresculpt.calibration_load(filepath=path, kind='CANTILEVER'), {'FINISHED'})
+        panel = self.store.results(scene)["cantilever"]
+        script = cal.fit_cantilever(path)  # a script's call with the defaults
+        # equal but for the panel's overhang and diameter, float32 properties (to 1e-8 relative)
+        self.assertAlmostEqual(panel["linear_density"], density, delta=1e-7 * density)
+        self.assertAlmostEqual(script["linear_density"], density, delta=1e-12)
+        self.assertAlmostEqual(script["bending_stiffness"], panel["bending_stiffness"], delta=1e-6)
+        self.assertAlmostEqual(panel["bending_stiffness"] / 0.73, 1.0, delta=0.02)
+        # ignoring the weight is a different k_b: the two ways would disagree
+        light = cal.fit_cantilever(path, include_weight=False)["bending_stiffness"]
+        self.assertGreater(abs(light / panel["bending_stiffness"] - 1.0), 0.005)
+        # unticked, the panel ignores it as the script does with include_weight=False
+        scene.wiresculpt_calibration.include_weight = False
+        self.addCleanup(scene.wiresculpt_calibration.property_unset, "include_weight")
+        self.assertEqual(bpy.ops.wiresculpt.calibration_load(filepath=path, kind='CANTILEVER'), {'FINISHED'})
+        self.assertAlmostEqual(self.store.results(scene)["cantilever"]["bending_stiffness"], light, delta=1e-6)
+        self.assertEqual(self.store.results(scene)["cantilever"]["linear_density"], 0.0)
 
     def test_malformed_capture_is_cancelled_naming_the_line(self):
         bad = os.path.join(self.tmp.name, "bad.csv")

@@ -121,6 +121,56 @@ class FabricationOperators(unittest.TestCase):
                 self.assertIn(f"measured = {SPRINGBACK_A:.4f} * commanded + {SPRINGBACK_B:.3f} deg", f.read())
         self.assertGreater(bends, 10)
 
+    def test_export_shows_the_predicted_wires_as_ghosts_replaced_not_accumulated(self):
+        from wiresculpt.blend import calibration as scene_calibration
+        from wiresculpt.blend import preview
+
+        scene = bpy.context.scene
+        scene.pop(scene_calibration.RESULTS_KEY, None)
+        self.addCleanup(lambda: scene.pop(scene_calibration.RESULTS_KEY, None))
+
+        def ghosts():
+            return {o[preview.PREVIEW_KEY]: o for o in scene.objects if preview.PREVIEW_KEY in o}
+        names = sorted(w["name"] for w in self.design["wires"])
+        for _ in range(2):  # the second export replaces the first one's ghosts
+            self.export_to("ghosts")
+            self.assertEqual(sorted(ghosts()), names)
+        self.assertEqual(len([o for o in bpy.data.collections[preview.PREVIEW_COLLECTION].objects]), len(names))
+        for wire in self.design["wires"]:
+            obj = ghosts()[wire["name"]]
+            self.assertEqual(obj.type, 'CURVE')
+            pts = [tuple(obj.matrix_world @ p.co.xyz) for p in obj.data.splines[0].points]
+            normal = [float(x) for x in wire["plane"]["normal"]]
+            length = math.sqrt(sum(x * x for x in normal))
+            for p in pts:  # on the wire's plane
+                off = sum((p[k] - wire["plane"]["origin"][k]) * normal[k] for k in range(3)) / length
+                self.assertLess(abs(off), 1e-6)
+            # a rigid copy of the program's walk: its length is the wire's (float32 coordinates)
+            walked = sum(math.dist(a, b) for a, b in zip(pts, pts[1:]))
+            rest = wire["rest"]
+            self.assertAlmostEqual(walked, sum(math.dist(a, b) for a, b in zip(rest, rest[1:])), delta=1e-5)
+            # no fit loaded: the machine is modelled by the export profile, nothing drifts
+            self.assertLess(obj["wiresculpt_preview_distance_mm"], 0.1)
+        # a loaded spring-back fit 5 % below the (default, a = 1) profile: every wire drifts
+        scene_calibration.store(scene, "springback", {"springback_a": 0.95, "springback_b_deg": 0.0, "rms_deg": 0.1,
+                                                      "max_residual_deg": 0.1, "samples": 5})
+        self.export_to("ghosts")
+        self.assertEqual(sorted(ghosts()), names)
+        for obj in ghosts().values():
+            self.assertGreater(obj["wiresculpt_preview_distance_mm"], 1.0)
+        rows, model = preview.figures(scene)  # what the Fabrication panel lists
+        self.assertEqual([r[0] for r in rows], names)
+        self.assertEqual([r[1] for r in rows], [ghosts()[n]["wiresculpt_preview_distance_mm"] for n in names])
+        self.assertEqual(model, (0.95, 0.0))
+        # a new design (Optimize writes the results) makes them stale: they go until the next export
+        scene_results.write_results(scene, self.design)
+        self.addCleanup(lambda: (scene_results.clear_results(scene), scene_results.store_design(self.design)))
+        self.assertEqual(ghosts(), {})
+        self.export_to("ghosts")
+        self.assertEqual(sorted(ghosts()), names)
+        scene_results.clear_results(scene)
+        self.assertEqual(ghosts(), {})
+
     def test_export_reports_a_missing_profile_naming_the_file(self):
         bpy.context.scene.wiresculpt.machine_profile = os.path.join(self.tmp.name, "nowhere.json")
         with self.assertRaisesRegex(RuntimeError, "nowhere.json does not exist"):

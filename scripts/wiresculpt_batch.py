@@ -32,7 +32,8 @@ OUTPUTS = ("design.json", "sculpture.blend", "sculpture.blend1", "render.png", "
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message):
-        raise ValueError(f"usage: wiresculpt_batch.py -- SCENE.json --out DIR [--profile PROFILE.json] ({message})")
+        raise ValueError(f"usage: wiresculpt_batch.py -- SCENE.json --out DIR [--profile PROFILE.json] "
+                         f"[--machine-model PROFILE.json] ({message})")
 
 
 def parse_args(argv):
@@ -40,6 +41,7 @@ def parse_args(argv):
     parser.add_argument("scene")
     parser.add_argument("--out", required=True)
     parser.add_argument("--profile", default=None)
+    parser.add_argument("--machine-model", default=None)
     return parser.parse_args(argv)
 
 
@@ -68,7 +70,7 @@ def add_handles(scene, planes, design):
         item.use = f"{item.plane}/{item.index}" in picked
 
 
-def write_scene_outputs(design, objects, planes, factor, out, say):
+def write_scene_outputs(design, objects, planes, factor, out, say, overlap=0.0):
     """sculpture.blend, render.png and assembly/ in `out`, from the design (progress lines name
     them relative to `out`, which is the run's staging folder)."""
     import bpy
@@ -102,7 +104,7 @@ def write_scene_outputs(design, objects, planes, factor, out, say):
         say("render", f"render.png ({time.perf_counter() - start:.3f} s)")
     if design.get("assembly_steps"):
         start = time.perf_counter()
-        path = assembly_guide.write_guide(scene, design, os.path.join(out, "assembly"))
+        path = assembly_guide.write_guide(scene, design, os.path.join(out, "assembly"), overlap=overlap)
         say("guide", f"{os.path.relpath(path, out)}, {len(design['assembly_steps'])} steps "
                      f"({time.perf_counter() - start:.3f} s)")
     # the file opens ready: the 3D views framed on the sculpture, the sidebar on the Wire tab,
@@ -146,7 +148,22 @@ def machine_profile(scene, args, say):
     return profile
 
 
-def write_fabrication(design, out, say, profile=None):
+def machine_model(args, say):
+    """The profile whose spring-back line models the machine for the preview (--machine-model),
+    or None (the run's profile itself); ValueError naming the file when it cannot be used."""
+    from wiresculpt.core.calibration import load_profile
+
+    if not args.machine_model:
+        return None
+    if not os.path.isfile(args.machine_model):
+        raise ValueError(f"machine model {args.machine_model} does not exist (--machine-model: a machine profile "
+                         "JSON whose spring-back line the preview uses)")
+    model = load_profile(args.machine_model)
+    say("machine model", f"{model.get('name') or os.path.basename(args.machine_model)} ({args.machine_model})")
+    return model
+
+
+def write_fabrication(design, out, say, profile=None, machine=None):
     """svg/, dxf/, templates/, gcode/, bends/ and bendlist/ in `out` for every wire with a rest shape; the programs'
     summary goes into the design as `fabrication`."""
     from wiresculpt.fab import export
@@ -154,12 +171,18 @@ def write_fabrication(design, out, say, profile=None):
     if not any("rest" in w for w in design["wires"]):
         return  # no folders: the earlier run's are removed with the rest of its set
     start = time.perf_counter()
-    result = export.export(design, out, profile)
-    design["fabrication"] = {"wires": result["wires"], "errors": result["errors"]}
+    result = export.export(design, out, profile, machine=machine)
+    # the predicted polylines stay in the templates; the design keeps each wire's preview distance (m)
+    design["fabrication"] = {"wires": [{k: v for k, v in w.items() if k != "predicted"} for w in result["wires"]],
+                             "errors": result["errors"], "preview_model": result["preview_model"]}
     minutes = sum(w["machine_seconds"] for w in result["wires"]) / 60
     say("fabrication", f"{len(result['wires'])} bend programs ({sum(w['bend_count'] for w in result['wires'])} "
                        f"bends, about {minutes:.0f} min on the machine), {len(result['files'])} files in svg/, dxf/, templates/, "
                        f"gcode/, bends/, bendlist/ ({time.perf_counter() - start:.3f} s)")
+    if result["wires"]:
+        worst = max(result["wires"], key=lambda w: w["preview_distance"])
+        say("fabrication", f"predicted wires within {worst['preview_distance'] * 1000:.1f} mm of the rest shapes "
+                           f"(largest: {worst['name']}; spring-back {result['preview_model']})")
     for error in result["errors"]:
         say("fabrication", error)
 
@@ -169,6 +192,7 @@ def run(argv):
     import numpy as np
 
     from wiresculpt import native, plane_search
+    from wiresculpt.core.calibration import closed_overlap
     from wiresculpt.core.design import write_design
     from wiresculpt.core.meshcheck import check_output_folder, check_vertices
     from wiresculpt.core.staging import staged
@@ -198,6 +222,7 @@ def run(argv):
                 f"({time.perf_counter() - start:.3f} s)")
     planes = scaled_planes(scene.planes, factor)
     profile = machine_profile(scene, args, say)  # refused before the long work when it is wrong
+    model = machine_model(args, say)
     stock = None if profile is None else (float(profile.get("stock_length", STOCK_LENGTH)),
                                           profile.get("name") or "the machine profile")
     # settings.plane_search "off" is pipeline.run; "nearby"/"auto" return the planes actually used
@@ -205,9 +230,10 @@ def run(argv):
     # Everything is written into a hidden folder first and replaces the earlier run's outputs
     # only when all of it is there: a failure half-way leaves the earlier set as it was.
     with staged(args.out, OUTPUTS) as folder:
-        write_fabrication(design, folder, say, profile)
+        write_fabrication(design, folder, say, profile, model)
         write_design(os.path.join(folder, "design.json"), design)
-        write_scene_outputs(design, objects, planes, factor, folder, say)
+        write_scene_outputs(design, objects, planes, factor, folder, say,
+                            closed_overlap(profile))  # the guide says how the loops close
     say("written", os.path.join(args.out, "design.json"))
     if design["stable"]:
         return EXIT_STABLE

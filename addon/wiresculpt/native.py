@@ -197,9 +197,12 @@ def validate_machine_profile(profile):
     return require().validate_machine_profile(profile)
 
 
-def make_bend_program(points, profile=None):
-    """Feeds and bends that make a 2D wire; points (n, 2) m from the cut."""
-    return require().make_bend_program(as_points(points, "points", 2), {} if profile is None else profile)
+def make_bend_program(points, profile=None, machine=None):
+    """Feeds and bends that make a 2D wire; points (n, 2) m from the cut. `machine`: the profile
+    whose spring-back line models the real machine for "predicted" and "preview_distance" (None:
+    `profile`)."""
+    return require().make_bend_program(as_points(points, "points", 2), {} if profile is None else profile,
+                                       machine)
 
 
 def bend_program_problems(points, profile=None):

@@ -276,7 +276,8 @@ class WiresculptCalibrationSettings(bpy.types.PropertyGroup):
     plastic_tolerance: FloatProperty(
         name="Return Tolerance", subtype='DISTANCE', unit='LENGTH', default=0.001, min=1e-5, max=0.05,
         precision=4,
-        description="An unloaded wire has returned when no mark is farther than this from the initial shape")
+        description="An unloaded wire has returned unless its smoothed shape is farther than this from the "
+                    "initial one by more than the marks' reading noise can explain (metres)")
     material_name: StringProperty(
         name="Name", default="calibrated steel",
         description="Name of the calibrated material (saved as JSON in the user's config folder)")

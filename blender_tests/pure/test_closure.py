@@ -33,6 +33,19 @@ class ClosureTest(unittest.TestCase):
         self.assertEqual(closure.closure_advice(edge, d)[0], "sleeve")
         self.assertIsNone(closure.closure_advice({"closed": False}, d))
 
+    def test_advice_with_the_profiles_overlap_allowance(self):
+        d = 0.003
+        small = {"closed": True, "closure_gap": 0.01, "length": 1.0}
+        large = {"closed": True, "closure_gap": 0.116, "length": 0.785}
+        method, text = closure.closure_advice(large, d, overlap=0.025)
+        self.assertEqual(method, "overlap")
+        self.assertIn("the bend program feeds 25 mm of extra wire past the cut", text)
+        self.assertNotIn("leave", text)
+        method, text = closure.closure_advice(small, d, overlap=0.025)
+        self.assertEqual(method, "sleeve")
+        self.assertIn("trim the 25 mm the bend program fed past the cut", text)
+        self.assertNotIn("trim", closure.closure_advice(small, d)[1])
+
 
 if __name__ == "__main__":
     unittest.main()

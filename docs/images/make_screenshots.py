@@ -6,6 +6,12 @@
 Sets up the globe example (three handles through the centre, normals z, x, y), slices, optimizes,
 opens the sidebar's Wire tab (Blender 3.4 has no API for the tab: a simulated click), saves
 screenshots after a timer and quits.
+
+With SHOTS=fabrication (and a taller screen, "-screen 0 1600x2050x24", so the Fabrication panel
+fits below the others) it makes docs/images/panel-fabrication.png instead: a spring-back fit 5 % softer than the
+default profile is loaded (as Calibration > Load Capture would store it) and Export runs into a
+temporary folder, so the machine preview's violet ghosts show how far an uncompensated bender
+would miss.
 """
 import math
 import os
@@ -34,6 +40,13 @@ for name, rot in (("Equator", (0, 0, 0)), ("Meridian0", (0, math.pi / 2, 0)), ("
 bpy.context.view_layer.update()
 bpy.ops.wiresculpt.slice()
 bpy.ops.wiresculpt.optimize()
+FABRICATION = os.environ.get("SHOTS") == "fabrication"
+if FABRICATION:
+    import tempfile
+    from wiresculpt.blend import calibration as calibration_store
+    calibration_store.store(bpy.context.scene, "springback", {
+        "springback_a": 0.95, "springback_b_deg": 0.0, "rms_deg": 0.1, "max_residual_deg": 0.2, "samples": 8})
+    assert bpy.ops.wiresculpt.export_fabrication(directory=tempfile.mkdtemp(prefix="wiresculpt_shot_")) == {'FINISHED'}
 win = bpy.context.window_manager.windows[0]
 screen = win.screen
 area = max((a for a in screen.areas if a.type == 'VIEW_3D'), key=lambda a: a.width * a.height)
@@ -49,15 +62,17 @@ region = next(r for r in area.regions if r.type == 'WINDOW')
 ui = next(r for r in area.regions if r.type == 'UI')
 bpy.context.preferences.view.show_splash = False
 for o in bpy.context.scene.objects:
-    o.select_set("wiresculpt_wire" in o)
+    o.select_set("wiresculpt_wire" in o or "wiresculpt_preview" in o)
 with bpy.context.temp_override(window=win, area=area, region=region):
     bpy.ops.view3d.view_axis(type='FRONT')
     bpy.ops.view3d.view_orbit(angle=0.5, type='ORBITRIGHT')
     bpy.ops.view3d.view_orbit(angle=0.35, type='ORBITUP')
     bpy.ops.view3d.view_selected()
+    if FABRICATION:
+        bpy.ops.view3d.zoom(delta=-1)  # room for the ghosts beside the sidebar
 for o in bpy.context.scene.objects:
     o.select_set(False)
-shots = [("panel.png", 0), ("panel-step1.png", 1)]
+shots = [("panel-fabrication.png", 0)] if FABRICATION else [("panel.png", 0), ("panel-step1.png", 1)]
 
 def close_splash():
     x, y = win.width // 2, 40

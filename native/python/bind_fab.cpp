@@ -96,7 +96,9 @@ std::vector<TemplateWire> to_templates(py::handle wires) {
                  {"bend_points", [&](py::handle v, const std::string& at) { w.bend_points = to_integers<std::size_t>(v, at); }},
                  {"crossing_points",
                   [&](py::handle v, const std::string& at) { w.crossing_points = to_integers<std::size_t>(v, at); }},
-                 {"self_crossings", [&](py::handle v, const std::string& at) { w.self_crossings = to_points<2>(v, at); }}});
+                 {"self_crossings", [&](py::handle v, const std::string& at) { w.self_crossings = to_points<2>(v, at); }},
+                 {"preview", [&](py::handle v, const std::string& at) { w.preview = to_points<2>(v, at); }},
+                 field::number("preview_distance", w.preview_distance), field::number("overlap", w.overlap)});
     out.push_back(std::move(w));
   });
   return out;
@@ -136,15 +138,23 @@ py::dict program_dict(const BendProgram& p) {
                   py::arg("bend_vertices") = bend_vertices(p), py::arg("rebuilt") = to_array(rebuild_polyline(p)));
 }
 
-py::dict make_bend_program_py(const py::object& points, const py::object& profile) {
+py::dict make_bend_program_py(const py::object& points, const py::object& profile, const py::object& machine) {
   const MachineProfile m = to_profile(profile);
+  const MachineProfile made_by = machine.is_none() ? m : to_profile(machine);
   const Polyline2 poly = to_points<2>(points, "points");
   BendProgram p;
+  Polyline2 predicted;
+  double distance = 0.0;
   {
     py::gil_scoped_release release;
     p = make_bend_program(poly, m);
+    predicted = predict_polyline(p, made_by);
+    distance = arclength_distance(poly, predicted);
   }
-  return program_dict(p);
+  py::dict out = program_dict(p);
+  out["predicted"] = to_array(predicted);
+  out["preview_distance"] = distance;
+  return out;
 }
 
 py::list bend_program_problems_py(const py::object& points, const py::object& profile) {
@@ -295,9 +305,13 @@ void bind_fab(py::module_& m) {
         "The profile dict checked (every key optional, the defaults filled in), or ValueError naming the key "
         "at fault: an unknown key, a wrong type or a value out of range.");
   m.def("make_bend_program", &make_bend_program_py, py::arg("points"), py::arg("profile") = py::dict(),
+        py::arg("machine") = py::none(),
         R"(Feeds and bends that make a 2D wire.
 
 points: (n, 2) metres, open, starting at the cut. profile: dict (see default_machine_profile()).
+machine: the profile whose spring-back line models the real machine for the preview (None: profile).
+Also returns "predicted" (k, 2) m, the wire the machine makes (predict_polyline), and
+"preview_distance" (m), its largest distance by arc length from points.
 Returns {"steps": [{"feed_mm", "bend_deg", "commanded_deg", "vertex"}], "feeds_mm", "bends_deg",
 "commanded_deg", "wire_length" (m), "bend_count", "machine_seconds", "shape_error" (m),
 "merged_points", "small_turns", "rounded_bends", "dropped_turn_deg", "start", "start_heading_deg",

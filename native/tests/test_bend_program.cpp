@@ -143,6 +143,50 @@ TEST_CASE("bend program: compensation inverts the calibration fit", "[fab][bend_
   CHECK(max_vertex_distance(rebuild_polyline(p), zig) < 1e-9);
 }
 
+TEST_CASE("bend program: the preview through the compensating fit is the input", "[fab][bend_program][preview]") {
+  MachineProfile m;
+  m.springback_a = 0.9;
+  m.springback_b = 1.5 * deg;
+  // a regular hexagon of 40 mm sides, open at the cut (6 sides, 5 bends of 60 deg)
+  std::vector<double> feeds(6, 0.04), turns(5, 60 * deg);
+  const Polyline2 hex = walk({0.01, -0.02}, 0.3, feeds, turns);
+  const BendProgram p = make_bend_program(hex, m);
+  const Polyline2 made = predict_polyline(p, m);
+  REQUIRE(made.size() == hex.size());
+  CHECK(max_vertex_distance(made, hex) < 1e-9);
+  CHECK(dense_distance(made, hex, 2000) < 1e-4);  // 0.1 mm, the issue's bound, with room
+}
+
+TEST_CASE("bend program: a wrong slope shows the drift predicted by hand", "[fab][bend_program][preview]") {
+  // One 90 deg bend between arms of 30 mm and 50 mm. The machine keeps 0.9 c; the program was
+  // compensated with a slope 5 % too steep (0.945), so it commands 90 / 0.945 deg and the wire
+  // keeps 90 * 0.9 / 0.945 = 85.714 deg: an angle error of 4.286 deg. The second arm swings about
+  // the bend, so its end is off by the chord 2 * 50 mm * sin(error / 2) and nothing is further off.
+  MachineProfile truth;
+  truth.springback_a = 0.9;
+  MachineProfile wrong = truth;
+  wrong.springback_a = 0.9 * 1.05;
+  const Polyline2 ell = walk({0, 0}, 0.0, {0.03, 0.05}, {90 * deg});
+  const BendProgram p = make_bend_program(ell, wrong);
+  const Polyline2 made = predict_polyline(p, truth);
+  const double error = 90 * deg - 90 * deg * 0.9 / 0.945;
+  CHECK(to_deg(error) == Approx(4.285714).epsilon(1e-6));
+  const double chord = 2 * 0.05 * std::sin(error / 2);
+  CHECK((made.back() - ell.back()).norm() == Approx(chord).epsilon(1e-9));
+  CHECK(dense_distance(made, ell, 4000) == Approx(chord).epsilon(1e-6));
+  CHECK(arclength_distance(ell, made) == Approx(chord).epsilon(1e-9));
+  // the offset b is the inverse of a compensated offset the same way: machine b = -2 deg,
+  // compensated for 0: every bend comes out 2 deg short
+  MachineProfile offset = truth;
+  offset.springback_b = -2 * deg;
+  const Polyline2 short2 = predict_polyline(make_bend_program(ell, truth), offset);
+  CHECK((short2.back() - ell.back()).norm() == Approx(2 * 0.05 * std::sin(1 * deg)).epsilon(1e-9));
+  // a profile out of range is refused, naming the key
+  MachineProfile bad = truth;
+  bad.springback_a = -1.0;
+  CHECK_THROWS_WITH(predict_polyline(p, bad), Contains("springback_a"));
+}
+
 TEST_CASE("bend program: limits are refused with messages naming the bend or step", "[fab][bend_program]") {
   const MachineProfile m;
   SECTION("a bend over the maximum reliable angle") {

@@ -146,6 +146,66 @@ TEST_CASE("svg: the template marks the start, the feed direction and the cut", "
   CHECK(number(svg, "data-dy=\"([-0-9.]+)\"") == Approx(-0.8).margin(1e-4));
 }
 
+TEST_CASE("svg: the predicted wire is drawn dashed over the rest shape and named in the legend", "[fab][svg][preview]") {
+  TemplateWire w = square_wire();
+  CHECK(count(svg_wire(w), "class=\"preview\"") == 0);  // no preview given: none drawn, no legend
+  CHECK(count(svg_wire(w), "class=\"legend\"") == 0);
+  // the predicted wire 2 mm to the right and 1 mm up of the rest shape (inside its bounding box's width + 2 mm)
+  for (const Vec2& p : w.points) w.preview.push_back(p + Vec2(0.002, 0.001));
+  w.preview_distance = 0.00224;
+  const std::string svg = svg_wire(w);
+  CHECK(balanced_tags(svg));
+  CHECK(count(svg, "class=\"preview\"") == 1);
+  CHECK(count(svg, "stroke-dasharray") == 2);  // the preview and its sample in the legend
+  CHECK(count(svg, "class=\"legend\"") == 1);
+  CHECK(count(svg, "predicted wire") == 1);
+  CHECK(count(svg, "up to 2.2 mm from the rest shape") == 1);
+  const auto q = polyline_points(svg);
+  const std::regex re("class=\"preview\"[^>]*points=\"([^\"]*)\"");
+  std::smatch m;
+  REQUIRE(std::regex_search(svg, m, re));
+  std::istringstream in(m[1].str());
+  std::vector<Vec2> pv;
+  for (std::string pair; in >> pair;) {
+    const auto comma = pair.find(',');
+    pv.emplace_back(std::stod(pair.substr(0, comma)), std::stod(pair.substr(comma + 1)));
+  }
+  REQUIRE(pv.size() == q.size());
+  for (std::size_t i = 0; i < q.size(); ++i) {  // 1:1, y down on the page
+    CHECK(pv[i].x() - q[i].x() == Approx(2.0).margin(1e-3));
+    CHECK(pv[i].y() - q[i].y() == Approx(-1.0).margin(1e-3));
+  }
+  // the cell grows to hold the preview: 80 + 2 mm wide, 50 + 1 mm tall, plus margins
+  CHECK(attribute(svg, "width") == Approx(82.0 + 20.0).margin(1e-3));
+  CHECK(attribute(svg, "height") == Approx(51.0 + 20.0).margin(1e-3));
+}
+
+TEST_CASE("svg: a closed wire's overlap is drawn over the last stretch of its path", "[fab][svg][overlap]") {
+  TemplateWire w = square_wire();  // 80 x 50 mm, walked (0,0) (80,0) (80,50) (0,50) (0,0)
+  w.points.push_back({0.0, -0.02});  // 20 mm past the cut, straight on
+  w.overlap = 0.03;                  // the band: 20 mm back to the cut, 10 mm more along the last side
+  const std::string svg = svg_wire(w);
+  CHECK(balanced_tags(svg));
+  CHECK(count(svg, "class=\"overlap\"") == 1);
+  CHECK(count(svg, "overlap 30.0 mm") == 1);
+  const auto q = polyline_points(svg);
+  std::smatch m;
+  REQUIRE(std::regex_search(svg, m, std::regex("class=\"overlap\"[^>]*><polyline[^>]*points=\"([^\"]*)\"")));
+  std::istringstream in(m[1].str());
+  std::vector<Vec2> band;
+  for (std::string pair; in >> pair;) {
+    const auto comma = pair.find(',');
+    band.emplace_back(std::stod(pair.substr(0, comma)), std::stod(pair.substr(comma + 1)));
+  }
+  REQUIRE(band.size() == 3);  // the end, the cut, 10 mm before the cut on the last side
+  CHECK((band[0] - q.back()).norm() < 1e-3);
+  CHECK((band[1] - q[q.size() - 2]).norm() < 1e-3);
+  CHECK((band[2] - q[q.size() - 2]).norm() == Approx(10.0).margin(1e-3));
+  CHECK((band[2] - q[q.size() - 3]).norm() == Approx(40.0).margin(1e-3));
+  w.overlap = -1.0;
+  CHECK_THROWS_WITH(svg_wire(w), Contains("overlap"));
+}
+
 TEST_CASE("svg: one wire at 1:1 with width and height of the bounding box plus margins", "[fab][svg]") {
   SvgOptions o;
   o.margin_mm = 12.0;

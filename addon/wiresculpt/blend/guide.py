@@ -228,7 +228,7 @@ def _wire_html(design, wire_id):
             f"<b>{html.escape(w['name'])}</b>")
 
 
-def page_html(design, pictures):
+def page_html(design, pictures, overlap=0.0):
     """The guide page; `pictures` [file name per step]."""
     parts = ["<!DOCTYPE html>", '<html><head><meta charset="utf-8"><title>wiresculpt assembly guide</title>',
              f"<style>{PAGE_STYLE}</style></head><body>", "<h1>Assembly guide</h1>"]
@@ -249,7 +249,7 @@ def page_html(design, pictures):
         if w.get("closed") and isinstance(w.get("cut"), int) and 0 <= w["cut"] < len(target):
             mm = ", ".join(f"{AXES[k]} {round(1000 * target[w['cut']][k]) or 0}" for k in range(3))
             text += f"; its two ends meet at ({mm} mm): join them there"
-            advice = closure.closure_advice(w, mat["wire_diameter"])
+            advice = closure.closure_advice(w, mat["wire_diameter"], overlap)
             if advice is not None:
                 text += f" with {'a sleeve' if advice[0] == 'sleeve' else 'an overlap'}: {html.escape(advice[1])}"
         items.append(f"<li>{text}</li>")
@@ -265,9 +265,10 @@ def page_html(design, pictures):
     return "\n".join(parts)
 
 
-def write_guide(scene, design, folder, resolution=RESOLUTION):
+def write_guide(scene, design, folder, resolution=RESOLUTION, overlap=0.0):
     """Writes folder/index.html and folder/step_NN.png (the design must be in the scene: see
-    results.write_results). Returns the page's path. ValueError without an assembly order."""
+    results.write_results). Returns the page's path. ValueError without an assembly order.
+    `overlap`: m the bend programs feed past a closed wire's cut (the profile's closed_overlap)."""
     steps = design.get("assembly_steps") or []
     if not steps:
         raise ValueError("the design has no assembly order (" + (design.get("reason") or "not solved") + ")")
@@ -276,7 +277,7 @@ def write_guide(scene, design, folder, resolution=RESOLUTION):
             for k, name in enumerate(pictures)]
     render_pictures(scene, design, jobs, resolution)
     path = os.path.join(folder, "index.html")
-    write_atomic(path, page_html(design, pictures))
+    write_atomic(path, page_html(design, pictures, overlap))
     return path
 
 

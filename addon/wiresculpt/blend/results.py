@@ -11,7 +11,7 @@ import bpy
 import numpy as np
 
 from ..core.design import crossing_direction, dumps
-from . import cut_handles
+from . import cut_handles, preview
 from .objects import remove_object, scene_collection, tagged, write_polyline
 
 DESIGN_TEXT = "wiresculpt_design.json"  # Text datablock holding the last design
@@ -165,6 +165,7 @@ def write_results(scene, design):
     """Makes the scene show `design`: wire curves in "Wires", markers in "Crossings", the Text
     datablock. Returns (wires written, wire objects removed)."""
     store_design(design)
+    preview.clear_ghosts(scene)  # they showed the programs of the design before this one
     radius = 0.5 * design["material"]["wire_diameter"]
     existing = tagged(scene, WIRE_KEY)
     shapes = wire_shapes(design)
@@ -254,7 +255,8 @@ def apply_assembly_step(scene):
 
 
 def clear_results(scene):
-    """Removes the wire curves, markers and stored design."""
+    """Removes the wire curves, markers, machine-preview ghosts and stored design."""
+    preview.clear_ghosts(scene)
     for obj in tagged(scene, WIRE_KEY).values():
         remove_object(obj)
     for obj in tagged(scene, CROSSING_KEY).values():

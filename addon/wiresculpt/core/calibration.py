@@ -184,8 +184,23 @@ def linear_density(material):
     return material["density"] * math.pi * 0.25 * material["wire_diameter"] ** 2
 
 
-def fit_cantilever(source, overhang=0.30, linear_density=0.0, plastic_tolerance=0.001):
-    """k_b (Eq. 13) and the plastic limit of a cantilever capture (a path or CSV text)."""
+def weight_density(material=None, include_weight=True):
+    """kg/m of the wire's own weight the cantilever fit counts: the one rule of the Calibration
+    panel and of fit_cantilever. With include_weight (the panel's *Wire's Own Weight*, ticked by
+    default) the weight of `material` (the Material & Machine panel's; None: the steel preset, the
+    panel's default material), else 0."""
+    if not include_weight:
+        return 0.0
+    return linear_density(materials.PRESETS["steel"] if material is None else material)
+
+
+def fit_cantilever(source, overhang=0.30, linear_density=None, plastic_tolerance=0.001, material=None,
+                   include_weight=True):
+    """k_b (Eq. 13) and the plastic limit of a cantilever capture (a path or CSV text). The wire's
+    own weight is counted as the Calibration panel counts it (weight_density(material,
+    include_weight)) unless `linear_density` (kg/m) is given."""
+    if linear_density is None:
+        linear_density = weight_density(material, include_weight)
     c = read_cantilever(source)
     singles = {}
     for load, loaded, line in zip(c["load_g"], c["loaded"], c["lines"]):
@@ -344,9 +359,23 @@ def with_springback(profile, fit, source=""):
 FILE_MARKERS = ("format", "version")  # written by save_profile, dropped by load_profile
 # Checked here, not by the native module: the wire stock's length (m, default core.sizes.STOCK_LENGTH)
 # and the paper the print templates are tiled onto ("A4", the default, or "Letter"; fab/tiles.py).
-PYTHON_KEYS = ("stock_length", "paper")
+# The overlap allowance of a closed wire (m, default 0, at most CLOSED_OVERLAP_MAX): extra straight
+# wire fed past the cut so the loop's ends overlap (fab/export.py, docs/machine-protocol.md).
+PYTHON_KEYS = ("stock_length", "paper", "closed_overlap")
+CLOSED_OVERLAP_MAX = 0.2
 PAPERS = ("A4", "Letter")
 PROFILE_FILE_KEYS = FILE_MARKERS + ("springback_fit",) + PYTHON_KEYS  # not native machine settings
+
+
+def closed_overlap(profile, where="machine profile"):
+    """m: the profile's overlap allowance for closed wires (0 when absent); ValueError naming the
+    key when it is not a length between 0 and CLOSED_OVERLAP_MAX."""
+    value = (profile or {}).get("closed_overlap", 0.0)
+    if (isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value)
+            or not 0 <= value <= CLOSED_OVERLAP_MAX):
+        raise ValueError(f"{where}: closed_overlap must be a length in metres between 0 and {CLOSED_OVERLAP_MAX:g} "
+                         f"(e.g. 0.02 for 20 mm of overlap), got {value!r}")
+    return float(value)
 
 
 def validate_profile(profile, where="machine profile"):
@@ -357,6 +386,7 @@ def validate_profile(profile, where="machine profile"):
     stock = profile.get("stock_length", 1.0)
     if isinstance(stock, bool) or not isinstance(stock, (int, float)) or not 0 < stock < 100:
         raise ValueError(f"{where}: stock_length must be a length in metres between 0 and 100, got {stock!r}")
+    closed_overlap(profile, where)
     paper = profile.get("paper", "A4")
     if not isinstance(paper, str) or paper.upper() not in (p.upper() for p in PAPERS):
         raise ValueError(f"{where}: paper must be one of {', '.join(PAPERS)}, got {paper!r}")

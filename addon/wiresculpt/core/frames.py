@@ -19,3 +19,21 @@ def to_2d(points, origin, u, v):
 def to_3d(points2, origin, u, v):
     q = np.asarray(points2, dtype=np.float64)
     return np.asarray(origin, dtype=np.float64) + np.outer(q[:, 0], u) + np.outer(q[:, 1], v)
+
+
+def rigid_fit_2d(src, dst):
+    """(M, t): the rigid map x -> M x + t (a rotation, or a rotation and a mirror when that fits
+    better) taking the 2D points `src` closest to `dst` in least squares (both (n, 2), matched by
+    row; Kabsch). Used to lay a wire's rest frame onto its plane."""
+    a, b = np.asarray(src, dtype=np.float64), np.asarray(dst, dtype=np.float64)
+    ca, cb = a.mean(axis=0), b.mean(axis=0)
+    U, _s, Vt = np.linalg.svd((a - ca).T @ (b - cb))
+    d = 1.0 if np.linalg.det(Vt.T @ U.T) >= 0 else -1.0  # diag(1, d): the best rotation (Kabsch)
+    best = None
+    for last in (d, -d):  # the rotation, then the mirrored map
+        M = Vt.T @ np.diag([1.0, last]) @ U.T
+        t = cb - M @ ca
+        residual = float(np.sum((a @ M.T + t - b) ** 2))
+        if best is None or residual < best[0] - 1e-18:
+            best = (residual, M, t)
+    return best[1], best[2]

@@ -21,7 +21,7 @@ import numpy as np
 
 from .. import native
 from . import bendlist, tiles
-from ..core.calibration import machine_dict
+from ..core.calibration import closed_overlap, machine_dict
 from ..core.sizes import STOCK_LENGTH, size_warnings
 from ..core.polylines import self_crossings
 
@@ -107,40 +107,74 @@ def no_rest_reason(design):
     return "no wire has a rest shape yet: optimize until the rest shape stage has run"
 
 
-def export(design, out_dir, profile=None, paper=None):
+def with_overlap(rest, closed, overlap):
+    """The polyline the machine bends: a closed wire's rest shape with its last segment fed on
+    straight by `overlap` m past the cut (the profile's closed_overlap), so the loop's ends
+    overlap; an open wire, or no allowance, unchanged. Moving the last point keeps the program's
+    bends and lengthens its final feed by exactly `overlap`."""
+    rest = np.asarray(rest, dtype=np.float64)
+    if not closed or overlap <= 0 or len(rest) < 2:
+        return rest
+    d = rest[-1] - rest[-2]
+    out = rest.copy()
+    out[-1] = rest[-1] + overlap * d / np.linalg.norm(d)
+    return out
+
+
+def preview_model(native_profile):
+    """The words for a spring-back line: "measured = a x commanded + b deg (name)"."""
+    return (f"measured = {float(native_profile['springback_a']):.4f} × commanded "
+            f"{float(native_profile['springback_b_deg']):+.3f}° ({native_profile.get('name') or 'machine profile'})")
+
+
+def export(design, out_dir, profile=None, paper=None, machine=None):
     """Writes the fabrication files of every wire that has a rest shape into out_dir/{svg, dxf,
     templates, templates/pages, gcode, bends, bendlist} (see the module's text), with the machine `profile`
-    (None: the default; see machine_profile), the template pages on `paper` ("A4" or "Letter";
+    (None: the default; see machine_profile; its "closed_overlap" lengthens every closed wire's
+    last feed, with_overlap), the template pages on `paper` ("A4" or "Letter";
     None: the profile's key "paper", else A4). Returns
     {"files": [paths], "wires": [per-wire program summary], "errors": [one sentence per wire that
-    cannot be bent], "notes": [limits where the profile is stricter than the design]}."""
+    cannot be bent], "notes": [limits where the profile is stricter than the design],
+    "preview_model": the spring-back line of the preview in words, "preview_springback": its (a, b in
+    degrees)}.
+
+    The preview (issue 21 item 7): each wire's program run forward through `machine`'s spring-back
+    line (a profile as for `profile`, e.g. the fit the Calibration panel loaded; None: the export
+    profile itself, so only the small-bend rule shows), drawn dashed on the annotated template; each
+    wire's summary has "predicted" ((k, 2) m, in the rest shape's frame) and "preview_distance" (m,
+    the largest distance from the rest shape by arc length)."""
     paper = paper or (profile or {}).get("paper") or "A4"
     tiles.layout(1.0, 1.0, paper)  # an unknown paper is refused before anything is written
     stock = float((profile or {}).get("stock_length", STOCK_LENGTH))
+    overlap = closed_overlap(profile)  # refused before anything is written
     stock_notes = [n for n in size_warnings(design, stock, (profile or {}).get("name") or "the machine profile")
                    if n.startswith("wire ")]
     profile, notes = machine_profile(design, profile)  # and a missing module (RuntimeError)
+    made_by = profile if machine is None else machine_profile(design, machine)[0]
+    native.validate_machine_profile(made_by)  # a bad model is one message before anything is written
     notes += stock_notes
     clear(out_dir)
     material = design["material"].get("name", "")
     files, summaries, errors, templates = [], [], [], []
     wires = [x for x in design["wires"] if "rest" in x]
     for wire in wires:
-        rest = np.asarray(wire["rest"], dtype=np.float64)
+        rest = with_overlap(wire["rest"], wire.get("closed"), overlap)
         try:
-            program = native.make_bend_program(rest, profile)
+            program = native.make_bend_program(rest, profile, made_by)
         except ValueError as exc:
             errors.append(f"wire {wire['name']}: {exc}")
             continue
         stem = file_stem(wire)
         template = {"name": wire["name"], "points": rest, "bend_points": list(program["bend_vertices"]),
-                    "crossing_points": crossing_indices(design, wire)}
-        crosses = self_crossings(rest, wire["closed"])
+                    "crossing_points": crossing_indices(design, wire),
+                    "preview": program["predicted"], "preview_distance": program["preview_distance"],
+                    "overlap": overlap if wire.get("closed") else 0.0}
+        crosses = self_crossings(np.asarray(wire["rest"], dtype=np.float64), wire["closed"])  # not the overlap
         if crosses:  # marked on the template: the wire must pass over itself there
             template["self_crossings"] = np.array([c[2] for c in crosses], dtype=np.float64)
         templates.append(template)
         for folder, name, write in (
-            ("svg", f"{stem}.svg", lambda p: native.write_machine_svg(p, template)),
+            ("svg", f"{stem}.svg", lambda p: native.write_machine_svg(p, {"name": wire["name"], "points": rest})),
             ("dxf", f"{stem}.dxf", lambda p: native.write_dxf(p, [template], layout="start_at_origin")),
             ("templates", f"{stem}.svg", lambda p: native.write_svg(p, [template], False)),
             ("gcode", f"{stem}.gcode", lambda p: native.write_gcode(p, rest, profile, wire["name"], material)),
@@ -156,7 +190,9 @@ def export(design, out_dir, profile=None, paper=None):
                 files += tiles.write_pages(text, os.path.join(out_dir, "templates", "pages"), stem, wire["name"], paper)
         summaries.append({"id": wire["id"], "name": wire["name"], "bend_count": program["bend_count"],
                           "wire_length": program["wire_length"], "machine_seconds": program["machine_seconds"],
-                          "shape_error": program["shape_error"]})
+                          "shape_error": program["shape_error"], "predicted": np.asarray(program["predicted"]),
+                          "preview_distance": program["preview_distance"],
+                          "overlap": overlap if wire.get("closed") else 0.0})
     if templates:
         for folder, name, write in (("templates", "sheet.svg", lambda p: native.write_svg(p, templates, True)),
                                     ("dxf", "sculpture.dxf",
@@ -166,7 +202,8 @@ def export(design, out_dir, profile=None, paper=None):
             write(path)
             files.append(path)
     return {"files": files, "wires": summaries, "errors": errors, "notes": notes,
-            "empty_reason": "" if wires else no_rest_reason(design)}
+            "empty_reason": "" if wires else no_rest_reason(design), "preview_model": preview_model(made_by),
+            "preview_springback": (float(made_by["springback_a"]), float(made_by["springback_b_deg"]))}
 
 
 def summary(result, out_dir):
@@ -180,7 +217,10 @@ def summary(result, out_dir):
         reason = result.get("empty_reason") or "no wire has a rest shape yet: optimize until the rest shape stage has run"
         return "ERROR", "Nothing to export: " + reason
     parts = [f"{w['name']}: {w['bend_count']} bends, {w['wire_length'] * 1000:.0f} mm, "
-             f"about {w['machine_seconds']:.0f} s" for w in done]
+             f"about {w['machine_seconds']:.0f} s, predicted within {w['preview_distance'] * 1000:.1f} mm"
+             for w in done]
+    if done and result.get("preview_model"):
+        parts.append(f"prediction by spring-back {result['preview_model']}")
     head = (f"Exported {len(done)} of {len(done) + len(refused)} wires to {out_dir} ("
             + ", ".join(f"{counts[f]} {f}" for f in FOLDERS) + " files)")
     text = "; ".join([head] + parts + [f"not bendable: {e}" for e in refused] + list(result.get("notes", [])))

@@ -42,8 +42,8 @@ class WIRESCULPT_OT_calibration_load(bpy.types.Operator, ImportHelper):
         name = os.path.basename(path)
         try:
             if self.kind == 'CANTILEVER':
-                density = cal.linear_density(base_material(scene)) if settings.include_weight else 0.0
-                fit = cal.fit_cantilever(path, settings.overhang, density, settings.plastic_tolerance)
+                fit = cal.fit_cantilever(path, settings.overhang, plastic_tolerance=settings.plastic_tolerance,
+                                         material=base_material(scene), include_weight=settings.include_weight)
                 png = cal.plot_cantilever(fit)
                 text = (f"k_b {fit['bending_stiffness']:.4g} N m², position RMS {fit['position_rms'] * 1000:.2f} mm"
                         + (f", plastic torque {fit['max_torque']:.3g} N m at {fit['plastic_load_g']:g} g"

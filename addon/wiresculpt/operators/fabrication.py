@@ -12,6 +12,8 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, StringProperty
 
 from .. import native
+from ..blend import calibration as scene_calibration
+from ..blend import preview as scene_preview
 from ..blend import results as scene_results
 from ..blend.registration import classes_factory
 from ..fab import export, streaming
@@ -35,6 +37,17 @@ def chosen_profile(scene):
         raise ValueError(f"machine profile {full}: {exc.strerror or exc}") from None
 
 
+def preview_machine(scene, profile):
+    """The spring-back model of the machine preview: the export profile with the spring-back line
+    the Calibration panel loaded last (the machine as measured), else None (the export profile
+    itself: the preview then shows only what the small-bend rule changes)."""
+    fit = scene_calibration.results(scene).get("springback")
+    if not fit:
+        return None
+    return dict(cal.with_springback(profile or cal.default_profile(), fit, fit.get("source", "")),
+                name="the loaded spring-back fit")
+
+
 def _design_or_error(op):
     design = scene_results.stored_design()
     if design is None:
@@ -44,7 +57,8 @@ def _design_or_error(op):
 
 class WIRESCULPT_OT_export_fabrication(bpy.types.Operator):
     """Write every wire's 1:1 SVG template, G-code and bend table, an SVG sheet and a DXF into a
-    folder (svg/, dxf/, gcode/, bends/), using the chosen machine profile"""
+    folder (svg/, dxf/, gcode/, bends/), using the chosen machine profile; show the wire the machine
+    is predicted to make as a ghost curve per wire"""
     bl_idname = "wiresculpt.export_fabrication"
     bl_label = "Export Fabrication Files"
     bl_options = {'REGISTER'}
@@ -77,10 +91,11 @@ class WIRESCULPT_OT_export_fabrication(bpy.types.Operator):
         try:
             profile = chosen_profile(context.scene)
             os.makedirs(folder, exist_ok=True)
-            result = export.export(design, folder, profile)
+            result = export.export(design, folder, profile, machine=preview_machine(context.scene, profile))
         except (ValueError, RuntimeError, OSError) as exc:
             self.report({'ERROR'}, f"Cannot export: {exc}")
             return {'CANCELLED'}
+        scene_preview.write_ghosts(context.scene, design, result)
         level, text = export.summary(result, folder)
         self.report({level}, text)
         return {'CANCELLED'} if level == "ERROR" else {'FINISHED'}

@@ -6,6 +6,8 @@ import bpy
 from ..blend import guide as assembly_guide
 from ..blend import results as scene_results
 from ..blend.registration import classes_factory
+from ..core import calibration as cal
+from .fabrication import chosen_profile
 
 
 class WIRESCULPT_OT_assembly_guide(bpy.types.Operator):
@@ -26,7 +28,8 @@ class WIRESCULPT_OT_assembly_guide(bpy.types.Operator):
             return {'CANCELLED'}
         folder = os.path.normpath(bpy.path.abspath(folder))
         try:
-            path = assembly_guide.write_guide(scene, design, folder)
+            overlap = cal.closed_overlap(chosen_profile(scene))  # the profile Export uses
+            path = assembly_guide.write_guide(scene, design, folder, overlap=overlap)
         except (ValueError, RuntimeError, OSError) as exc:
             self.report({'ERROR'}, f"Cannot write the assembly guide: {exc}")
             return {'CANCELLED'}

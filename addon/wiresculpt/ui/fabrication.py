@@ -3,6 +3,7 @@ port, wire, progress, Cancel and Resume."""
 import bpy
 
 from .. import native
+from ..blend import preview
 from ..blend import results as scene_results
 from ..blend.registration import classes_factory
 from ..fab import streaming
@@ -23,6 +24,16 @@ class VIEW3D_PT_wiresculpt_fabrication(_Child, bpy.types.Panel):
         ws = context.scene.wiresculpt
         layout.prop(ws, "machine_profile", text="Profile")
         layout.operator(ops.WIRESCULPT_OT_export_fabrication.bl_idname, text="Export…", icon='EXPORT')
+        rows, model = preview.figures(context.scene)
+        if rows:  # the last export's machine preview: how far each predicted wire is from its rest shape
+            box = layout.box()
+            box.label(text="Machine preview", icon='HIDE_OFF')
+            col = box.column(align=True)
+            for name, mm in rows:
+                col.label(text=f"{name}: {mm:.1f} mm off")
+            if model is not None:
+                col.label(text="Spring-back fit used:")
+                col.label(text=f"a {model[0]:.4f}, b {model[1]:+.2f}°")
 
         box = layout.box()
         box.label(text="Send to Machine", icon='PLUGIN')

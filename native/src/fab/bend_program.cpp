@@ -219,6 +219,21 @@ Polyline2 rebuild_polyline(const BendProgram& program, bool from_origin) {
   return out;
 }
 
+Polyline2 predict_polyline(const BendProgram& program, const MachineProfile& machine) {
+  validate(machine);
+  Polyline2 out;
+  Vec2 p = program.start;
+  double heading = program.start_heading;
+  out.push_back(p);
+  for (const BendStep& s : program.steps) {
+    p += s.feed * Vec2(std::cos(heading), std::sin(heading));
+    out.push_back(p);
+    if (s.vertex >= 0 && s.commanded != 0.0)
+      heading += std::copysign(machine.springback_a * std::abs(s.commanded) + machine.springback_b, s.commanded);
+  }
+  return out;
+}
+
 std::vector<std::size_t> bend_vertices(const BendProgram& program) {
   std::vector<std::size_t> out;
   for (const BendStep& s : program.steps)

@@ -41,7 +41,8 @@ struct Box {
 
 Box bbox_mm(const TemplateWire& w) {
   Box b{to_mm(w.points[0].x()), to_mm(w.points[0].y()), to_mm(w.points[0].x()), to_mm(w.points[0].y())};
-  for (const Vec2& p : w.points) {
+  for (const Polyline2* line : {&w.points, &w.preview})
+  for (const Vec2& p : *line) {
     b.min_x = std::min(b.min_x, to_mm(p.x()));
     b.max_x = std::max(b.max_x, to_mm(p.x()));
     b.min_y = std::min(b.min_y, to_mm(p.y()));
@@ -82,6 +83,47 @@ std::string wire_group(const TemplateWire& w, std::size_t index, double ox, doub
     s += num(q[i].y());
   }
   s += "\"/>\n";
+  if (w.overlap > 0.0 && q.size() >= 2) {  // the closing overlap: the last `overlap` of the path, a wide band
+    double left = to_mm(w.overlap);
+    std::vector<Vec2> band{q.back()};
+    for (std::size_t i = q.size() - 1; i > 0 && left > 0.0; --i) {
+      const double len = (q[i] - q[i - 1]).norm();
+      if (len >= left) {
+        band.push_back(q[i] + (left / len) * (q[i - 1] - q[i]));
+        left = 0.0;
+      } else {
+        band.push_back(q[i - 1]);
+        left -= len;
+      }
+    }
+    s += "    <g class=\"overlap\" data-mm=\"" + num(to_mm(w.overlap)) + "\"><polyline fill=\"none\" stroke=\"#00a070\" "
+         "stroke-opacity=\"0.45\" stroke-width=\"" + num(4 * o.stroke_mm) + "\" stroke-linecap=\"butt\" points=\"";
+    for (std::size_t i = 0; i < band.size(); ++i) {
+      if (i) s += ' ';
+      s += num(band[i].x());
+      s += ',';
+      s += num(band[i].y());
+    }
+    char words[96];
+    std::snprintf(words, sizeof words, "overlap %.1f mm past the loop's cut", to_mm(w.overlap));
+    const Vec2 at = band.back();
+    s += "\"/><text x=\"" + num(at.x() + o.tick_mm) + "\" y=\"" + num(at.y() + o.tick_mm + 0.6 * o.label_mm) +
+         "\" font-family=\"sans-serif\" font-size=\"" + num(0.6 * o.label_mm) + "\" fill=\"#00a070\">" + words +
+         "</text></g>\n";
+  }
+  const std::string preview_colour = "#8000c0";
+  if (w.preview.size() >= 2) {  // the predicted wire: dashed, thinner, violet (named in the legend)
+    s += "    <polyline class=\"preview\" fill=\"none\" stroke=\"" + preview_colour + "\" stroke-width=\"" +
+         num(o.stroke_mm * 0.6) + "\" stroke-dasharray=\"" + num(4 * o.stroke_mm) + " " + num(3 * o.stroke_mm) +
+         "\" stroke-linejoin=\"round\" points=\"";
+    for (std::size_t i = 0; i < w.preview.size(); ++i) {
+      if (i) s += ' ';
+      s += num(ox + m + to_mm(w.preview[i].x()) - b.min_x);
+      s += ',';
+      s += num(oy + m + b.max_y - to_mm(w.preview[i].y()));
+    }
+    s += "\"/>\n";
+  }
   for (std::size_t i : w.bend_points) {
     Vec2 d = Vec2::Zero();
     if (i > 0 && (q[i] - q[i - 1]).norm() > 0) d += (q[i] - q[i - 1]).normalized();
@@ -116,6 +158,21 @@ std::string wire_group(const TemplateWire& w, std::size_t index, double ox, doub
   s += "    <text class=\"label\" x=\"" + num(ox + m) + "\" y=\"" + num(oy + 0.75 * m) +
        "\" font-family=\"sans-serif\" font-size=\"" + num(o.label_mm) + "\">" + xml_escape(w.name) + "  (" + len +
        ")</text>\n";
+  if (w.preview.size() >= 2) {  // the legend, in the bottom margin: a dashed sample and its name
+    const double ly = oy + m + b.height() + 0.6 * m, lx = ox + m;
+    s += "    <g class=\"legend\">";
+    s += "<line x1=\"" + num(lx) + "\" y1=\"" + num(ly - 0.3 * o.label_mm) + "\" x2=\"" + num(lx + 8.0) + "\" y2=\"" +
+         num(ly - 0.3 * o.label_mm) + "\" stroke=\"" + preview_colour + "\" stroke-width=\"" + num(o.stroke_mm * 0.6) +
+         "\" stroke-dasharray=\"" + num(4 * o.stroke_mm) + " " + num(3 * o.stroke_mm) + "\"/>";
+    std::string words = "predicted wire (the machine's spring-back model)";
+    if (w.preview_distance >= 0.0) {
+      char dist[64];
+      std::snprintf(dist, sizeof dist, "%.1f mm", to_mm(w.preview_distance));
+      words += ": up to " + std::string(dist) + " from the rest shape";
+    }
+    s += "<text x=\"" + num(lx + 10.0) + "\" y=\"" + num(ly) + "\" font-family=\"sans-serif\" font-size=\"" +
+         num(0.6 * o.label_mm) + "\" fill=\"" + preview_colour + "\">" + words + "</text></g>\n";
+  }
   // Where the bender starts (a dot on the first point), which way the wire comes out of it (an
   // arrow beside the first segment, pointing along it) and where it is cut (a bar across the
   // last point). All in green, away from the black centreline, ticks and rings.

@@ -1,5 +1,6 @@
 #include "wiresculpt/fab/template_wire.hpp"
 
+#include <cmath>
 #include <string>
 
 #include "wiresculpt/error.hpp"
@@ -23,6 +24,11 @@ void validate(const TemplateWire& wire, std::size_t index) {
   for (std::size_t i = 0; i < wire.self_crossings.size(); ++i)
     if (!wire.self_crossings[i].allFinite())
       throw InputError(who + ": self-crossing " + std::to_string(i) + " has a non-finite coordinate");
+  if (!(std::isfinite(wire.overlap) && wire.overlap >= 0.0))
+    throw InputError(who + ": the overlap must be a finite, non-negative length");
+  for (std::size_t i = 0; i < wire.preview.size(); ++i)
+    if (!wire.preview[i].allFinite())
+      throw InputError(who + ": preview point " + std::to_string(i) + " has a non-finite coordinate");
 }
 
 }  // namespace wiresculpt::fab

@@ -111,6 +111,16 @@ BendProgram make_bend_program(const Polyline2& points, const MachineProfile& pro
 /// (before compensation), so a program without merged points rebuilds its input exactly.
 Polyline2 rebuild_polyline(const BendProgram& program, bool from_origin = false);
 
+/// What the machine makes of `program` (issue 21 item 7: the preview): the program run forward
+/// through `machine`'s spring-back line, the inverse of the compensation. Each step feeds as
+/// programmed; each commanded angle c leaves the wire turned by sign(c) * (a * |c| + b) with
+/// a = machine.springback_a, b = machine.springback_b (the fit measured = a * commanded + b).
+/// Walked from the program's start point and heading (as rebuild_polyline: bend points only,
+/// #steps + 1 points, metres). With the profile that compensated the program it equals
+/// rebuild_polyline(program); with another fit it shows the drift that fit predicts.
+/// Throws InputError when `machine` is not a valid profile (validate()).
+Polyline2 predict_polyline(const BendProgram& program, const MachineProfile& machine);
+
 /// Input-polyline indices of the bend points, in order (for tick marks on templates).
 std::vector<std::size_t> bend_vertices(const BendProgram& program);
 

@@ -35,8 +35,10 @@ struct CantileverOptions {
   /// (ρ π d² / 4: 3 mm steel 0.0555). 0 ignores it (the paper's model). Default 0.
   double linear_density = 0.0;
   double gravity = 9.81;           ///< m/s²; default 9.81
-  /// m: an unloaded shape "returns" when no mark is farther than this from the initial shape
-  /// (the 0 g frame). Default 0.001 (1 mm, five times a photo's typical 0.2 mm noise).
+  /// m: an unloaded shape "returns" unless its smoothed shape is farther than this from the
+  /// smoothed initial shape (the 0 g frame) at some mark by more than 2 standard deviations of
+  /// that difference under the marks' noise (the frames' pooled scatter about their polynomials):
+  /// noise alone does not refuse a wire that came back. Default 0.001 (1 mm).
   double plastic_tolerance = 0.001;
   /// Highest power of s of the clamped polynomial w(s) = Σ_{k=2..d} c_k s^k each frame is
   /// smoothed with before its curvature is taken. Each frame starts from the cubic (the tip-loaded
@@ -63,7 +65,9 @@ struct CantileverFrame {
   /// m: deflection of the rod model with the fitted k_b at each mark (used frames; else empty).
   std::vector<double> simulated;
   double position_rms = 0.0;   ///< m, RMS distance model-measured (used frames)
-  double return_error = 0.0;   ///< m, unloaded frames: max |deflection - initial| over the marks
+  /// m, unloaded frames: max over the marks of |w(s) - w_0(s)|, w and w_0 the smoothing polynomials
+  /// (smoothing_degree) of this frame and of the 0 g frame: reading noise mostly averages out.
+  double return_error = 0.0;
   double clamp_torque = 0.0;   ///< N·m, external torque at the clamp (Eq. 11) in this shape
 };
 

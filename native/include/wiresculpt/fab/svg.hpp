@@ -13,6 +13,11 @@
 //   <g class="feed">               an arrow beside the first segment pointing along it (the way the
 //                                  wire leaves the bender); data-dx/data-dy its direction on the page
 //   <line class="cut">, <text class="cut-label">   a bar across the last point: where it is cut
+//   <g class="overlap">              when given: the closing overlap of a closed wire (its last
+//                                  `overlap` of path) as a wide translucent band, with its length
+//   <polyline class="preview">      when given: the wire the machine is predicted to make, dashed,
+//                                  violet, with <g class="legend"> in the bottom margin naming it
+//                                  (and its largest distance from the rest shape in mm)
 // A wire occupies a cell of (bounding box + 2 * margin) in each direction; the label, ticks and
 // rings stay inside the margin when tick_mm, crossing_radius_mm and label_mm are below margin_mm.
 #include <string>

@@ -16,6 +16,15 @@ struct TemplateWire {
   /// Metres, in the wire's frame: where the wire crosses itself (the rest shape must pass over
   /// itself on the bender), marked so the maker sees it before bending.
   Polyline2 self_crossings;
+  /// Metres, in the wire's frame: the wire the machine is predicted to make (predict_polyline),
+  /// drawn dashed over the rest shape and named in the legend; empty: none drawn.
+  Polyline2 preview;
+  /// m, the preview's largest distance from the rest shape (arclength_distance), for the legend;
+  /// negative: not given.
+  double preview_distance = -1.0;
+  /// m, the last stretch of `points` fed past a closed wire's cut so its ends overlap (the
+  /// profile's closed_overlap): drawn as a wide band labelled with its length; 0: none.
+  double overlap = 0.0;
 };
 
 /// Throws InputError naming the wire (`index`, name) when it has no point, a non-finite point
