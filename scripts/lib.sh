@@ -27,6 +27,9 @@ BPY_VERSIONS=(4.2.23 5.0.1)
 # The numpy they run with: what bpy 5.0 requires (<2) and what Blender bundles; bpy 4.2 would take
 # numpy 2, which our module (Debian's pybind11 2.10) predates.
 BPY_NUMPY=1.26.4
+# The independent re-check (blender_tests/pure/recheck.py) that the plane-assistant suites run
+# needs scipy: a release built for numpy 1.x and Python 3.11.
+BPY_SCIPY=1.13.1
 BPY_CACHE=${WIRESCULPT_BPY_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/wiresculpt}
 
 # The sanitizer and fuzz builds (scripts/test, scripts/fuzz).
@@ -115,19 +118,25 @@ summarize_outputs() {
 
 # Prints the python of a venv of $PYTHON holding bpy==$1, making it once (a ~350 MB download; the
 # wheel is kept in $BPY_CACHE/wheels); a venv is used only after its install finished.
+# .complete holds the requirements it was made with; a venv made with fewer (an older checkout)
+# gets the missing ones installed.
 bpy_python() {
   local version=$1 venv="$BPY_CACHE/bpy-$1"
+  local want=("bpy==$version" "numpy==$BPY_NUMPY" "scipy==$BPY_SCIPY")
+  if [ -f "$venv/.complete" ] && [ "$(cat "$venv/.complete")" = "${want[*]}" ]; then
+    echo "$venv/bin/python"
+    return
+  fi
+  ensure_packages python3.11-venv
   if [ ! -f "$venv/.complete" ]; then
-    ensure_packages python3.11-venv
     rm -rf "$venv"
     mkdir -p "$BPY_CACHE/wheels"
     say "installing bpy $version into $venv"
     "$PYTHON" -m venv "$venv" >&2
     "$venv/bin/python" -m pip download -q --no-deps -d "$BPY_CACHE/wheels" "bpy==$version" >&2
-    "$venv/bin/python" -m pip install -q --find-links "$BPY_CACHE/wheels" "bpy==$version" \
-      "numpy==$BPY_NUMPY" >&2
-    touch "$venv/.complete"
   fi
+  "$venv/bin/python" -m pip install -q --find-links "$BPY_CACHE/wheels" "${want[@]}" >&2
+  echo "${want[*]}" >"$venv/.complete"
   echo "$venv/bin/python"
 }
 
