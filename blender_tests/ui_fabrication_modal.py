@@ -2,8 +2,10 @@
 the panel runs it (INVOKE: worker thread, modal timer) to a GRBL emulator on a pseudo-terminal,
 cancelled mid-program, then Resume (also modal) to the end on a new link. Prints one line
 `MODAL {json}` with what it saw, then quits."""
+import atexit
 import math
 import os
+import shutil
 import sys
 import tempfile
 
@@ -25,6 +27,7 @@ MODES = ("G21", "G91", "G94")
 seen = {}
 links = {}
 tmp = tempfile.mkdtemp(prefix="wiresculpt_modal_")
+atexit.register(shutil.rmtree, tmp, True)  # every run used to leave its export folder in /tmp
 
 
 def ring(n=12, side=0.04):

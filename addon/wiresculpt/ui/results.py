@@ -203,7 +203,7 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
             # per wire: how far its rest shape's ends stand apart before assembly, and how far its
             # contact forces bend it out of its plane
             col = layout.column(align=True)
-            col.label(text="Per wire: closure gap, out of plane")
+            _wrap(col, context, "Per wire: closure gap, out of plane")
             for name, gap, bend in wires:
                 _wrap(col, context, f"{name}: gap {gap or '-'}, out of plane {bend or '-'}", icon='DOT')
             if any(w.get("closed") and "closure_gap" in w for w in design["wires"]):
@@ -219,7 +219,7 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
                 row.label(text=f"{grams:.0f} g" if grams is not None else "no limit found")
         pending = design.get("pending_stages") or []
         if pending:
-            layout.label(text="Pending: " + ", ".join(p.replace("_", " ") for p in pending), icon='INFO')
+            _wrap(layout, context, "Pending: " + ", ".join(p.replace("_", " ") for p in pending), icon='INFO')
         crossing = [c["message"] for c in (design.get("buildability") or {}).get("self_crossings", [])]
         if crossing:  # a rest shape that crosses itself: shown first, the maker must see it before bending
             col = layout.column(align=True)
