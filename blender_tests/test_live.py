@@ -6,7 +6,7 @@ import os
 import shutil
 import unittest
 
-from helpers import ROOT, run_under_xvfb
+from helpers import ROOT, BlenderCase, run_under_xvfb
 
 SCRIPT = os.path.join(ROOT, "blender_tests", "ui_live.py")
 TICK_LIMIT = 0.050  # issue 17: no step blocks the UI for more than 50 ms (the one time assertion)
@@ -34,6 +34,13 @@ class Live(unittest.TestCase):
         self.assertTrue(lines[1].startswith("Live: not stable — "), lines)
         self.assertGreater(len(lines[1]), len("Live: not stable — ") + 3, lines)  # the reason's first words
         self.assertEqual(lines[2], "Live: stable")
+        # the preview: the three wires when stable, none when the plane cuts nothing
+        self.assertEqual([v["preview_wires"] for v in self.seen["verdicts"]], [3, 0, 3])
+
+    def test_preview_is_drawn(self):
+        self.assertGreater(self.seen["verdicts"][-1]["drawn"], 0)  # the overlay drew the live wires
+        self.assertNotIn("Traceback", self.result.stderr[-5000:])
+        self.assertEqual(self.seen["off_preview"], 0)
 
     def test_latest_position_wins(self):
         self.assertTrue(self.seen["first_job_cancelled"])
@@ -57,3 +64,29 @@ class Live(unittest.TestCase):
         self.assertFalse(self.seen["load_timer"])
         self.assertTrue(self.seen["load_job_cancelled"])
         self.assertEqual(self.seen["load_line"], "")
+
+
+class LiveRefused(BlenderCase):
+    """The toggle refuses targets over live.MAX_TRIANGLES with a sentence the panel shows."""
+
+    def test_large_mesh_is_refused(self):
+        import bpy
+
+        from wiresculpt.operators import live
+
+        bpy.ops.mesh.primitive_grid_add(x_subdivisions=320, y_subdivisions=320)  # 320² quads: 204,800 triangles
+        target = bpy.context.view_layer.objects.active
+        ws = bpy.context.scene.wiresculpt
+        ws.target = target
+        ws.live = True
+        self.assertFalse(ws.live)
+        self.assertFalse(bpy.app.timers.is_registered(live.tick))
+        self.assertIn("204,800 triangles", live.STATE.message)
+        self.assertIn("200,000", live.STATE.message)
+        bpy.ops.mesh.primitive_cube_add()
+        ws.target = bpy.context.view_layer.objects.active
+        ws.live = True
+        self.assertTrue(ws.live)
+        self.assertTrue(bpy.app.timers.is_registered(live.tick))
+        ws.live = False
+        self.assertFalse(bpy.app.timers.is_registered(live.tick))

@@ -76,7 +76,8 @@ def step(k):
             if time.monotonic() - began > SETTLE_SECONDS:
                 raise RuntimeError(f"step {k} did not settle: {live.STATE.verdict!r}")
             return 0.05
-        seen["verdicts"].append({"z": STEPS[k], "line": live.line(), "seconds": time.monotonic() - began})
+        seen["verdicts"].append({"z": STEPS[k], "line": live.line(), "seconds": time.monotonic() - began,
+                                 "preview_wires": len(live.STATE.preview), "drawn": live.STATE.drawn})
         if k + 1 < len(STEPS):
             step(k + 1)
         else:
@@ -149,6 +150,7 @@ def turn_off():
     bpy.context.scene.wiresculpt.live = False
     seen["off_timer"] = bpy.app.timers.is_registered(live.tick)
     seen["off_line"] = live.line()
+    seen["off_preview"] = len(live.STATE.preview)
     bpy.context.scene.wiresculpt.live = True  # on again, then a file is loaded
     plane().location.z = 0.05
     bpy.app.timers.register(guarded(seen, load), first_interval=0.25)

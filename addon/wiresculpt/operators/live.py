@@ -9,10 +9,11 @@ layering's own pattern (hook_patterns=1) and the user's relayer_rounds. Latest p
 running job whose snapshot is no longer current is cancelled (its cancel event; it is never waited
 for) and a new one starts; a result is shown only when its snapshot is still the current one.
 
-Nothing is written to the scene or the .blend: the verdict lives in STATE (module state, shown
-by the Wire panel), so no live update touches the undo history. The wires' preview curves are not
-updated (blend/results.write_results would also replace the stored design of the last Optimize
-and its markers and cut handles); Optimize writes them.
+Nothing is written to the scene or the .blend: the verdict and the wires' preview (STATE.preview,
+line segments in each wire's colour, computed on the worker by blend/results.wire_shapes) live in
+module state, shown by the Wire panel and drawn by ui/overlay.py, so no live update touches the
+undo history. The wire curves themselves are not rewritten (blend/results.write_results would also
+replace the stored design of the last Optimize and its markers and cut handles); Optimize does.
 
 Turning Live off, loading a file (load_pre) or unregistering stops the timer and cancels the job.
 Meshes over MAX_TRIANGLES triangles are refused (the panel says why).
@@ -25,6 +26,7 @@ import numpy as np
 
 from .. import native, pipeline
 from ..blend import cut_handles, mesh
+from ..blend import results as scene_results
 from ..blend.handles import handle_plane, handles, target_problem
 from ..core.jobs import WorkerJob
 from ..core.scene import PlaneSpec
@@ -48,10 +50,12 @@ class LiveState:
         self.solved = None  # the snapshot of the shown verdict
         self.job = None  # the LiveJob of the current snapshot, while it runs
         self.verdict = ""  # "stable", "not stable — …", "solving…" (the panel adds "Live: ")
+        self.preview = []  # [(RGBA, (2k, 3) float32 segment end points)], one per wire of the shown verdict
         self.mesh_key = None  # the target's matrix the cached triangles belong to
         self.mesh = None  # (V, F) world coordinates
         self.durations = []  # seconds of each tick (the test reads them)
-        self.results = []  # (snapshot, verdict) applied, in order
+        self.results = []  # the verdicts shown, in order
+        self.drawn = 0  # overlay draws of the preview (the test reads it)
 
 
 STATE = LiveState()
@@ -94,6 +98,21 @@ def first_words(text, n=REASON_WORDS):
     return " ".join(words[:n]) + ("…" if len(words) > n else "")
 
 
+def preview_segments(design):
+    """[(RGBA, (2k, 3) float32 segment end points)] of each wire's shape (interlock offsets
+    applied), in the wire's colour: what the overlay draws."""
+    out = []
+    for wire_id, points in scene_results.wire_shapes(design).items():
+        points = np.asarray(points, dtype=np.float32)
+        if len(points) < 2:
+            continue
+        wire = next(w for w in design["wires"] if w["id"] == wire_id)
+        ends = np.concatenate([points[1:], points[:1]]) if wire["closed"] else points[1:]
+        starts = points[:len(ends)]
+        out.append((scene_results.wire_colour(wire_id), np.stack([starts, ends], axis=1).reshape(-1, 3)))
+    return out
+
+
 class LiveJob(WorkerJob):
     """One live solve of one snapshot: slice the cached triangles, solve with the layering's own hooks."""
 
@@ -107,6 +126,7 @@ class LiveJob(WorkerJob):
         self.cancel_event = threading.Event()
         self.cancelled = False
         self.design = None
+        self.preview = []
 
     def work(self):
         try:
@@ -116,6 +136,7 @@ class LiveJob(WorkerJob):
                     wire["cut_point"] = list(self.cuts[wire["name"]])
             self.design = pipeline.solve(design, self.material, self.settings, cancel=self.cancel_event.is_set,
                                          hook_patterns=LIVE_HOOK_PATTERNS)
+            self.preview = preview_segments(self.design)
         except pipeline.Cancelled:
             self.cancelled = True
 
@@ -181,6 +202,7 @@ def _step():
         STATE.job = None
         if job.key == key and not job.cancelled and not job.cancel_event.is_set():
             STATE.verdict, STATE.solved = job.verdict(), job.key
+            STATE.preview = job.preview if job.error is None else []
             STATE.results.append(STATE.verdict)
         job = None
     if job is not None and job.key != key:  # the planes moved on: latest position wins
@@ -196,7 +218,7 @@ def _step():
             return None
         started = _start(scene, key)
         if isinstance(started, str):
-            STATE.verdict, STATE.solved = started, key
+            STATE.verdict, STATE.solved, STATE.preview = started, key, []
             STATE.results.append(started)
         else:
             STATE.job, STATE.verdict = started, "solving…"
@@ -239,9 +261,14 @@ def stop():
         bpy.app.timers.unregister(tick)
     if STATE.job is not None:
         STATE.job.cancel_event.set()
-    durations = STATE.durations
+    durations, drawn = STATE.durations, STATE.preview
     STATE.reset()
     STATE.durations = durations  # what the last run's ticks took, for the test
+    if drawn:  # the preview goes from the viewport
+        try:
+            _redraw()
+        except (AttributeError, ReferenceError):  # no window (closing, background)
+            pass
 
 
 def line():
