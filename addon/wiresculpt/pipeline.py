@@ -53,13 +53,14 @@ def slice_and_pick(vertices, faces, planes, material, settings, progress=None):
     return design
 
 
-def solve(design, material, settings, progress=None, cancel=None, stock=None):
+def solve(design, material, settings, progress=None, cancel=None, stock=None, hook_patterns=None):
     """Runs every stage after slicing on `design` (its wires' contours set), re-layering while the
     target shape cannot realise a hook (relayer). `progress(stage, message)` is called once per
     finished stage; `cancel()` returning True stops at the next safe point with Cancelled.
     `pending_stages` names the stages that did not run. `stock`: (length in m, profile name) of
     the machine profile in use, for the stock-length warnings said before the long work (None:
-    the default profile's). Past settings.max_solve_seconds (wall
+    the default profile's). `hook_patterns`: at most this many hook patterns per round in
+    hooks_by_forces (None: HOOK_PATTERNS; 1: the layering's own, as Live does). Past settings.max_solve_seconds (wall
     clock) the solve stops the same way and raises OutOfTime, naming the key and the stage."""
     cancelled = cancel or (lambda: False)
     budget = float(settings.get("max_solve_seconds") or settings_table.SETTINGS["max_solve_seconds"][0])
@@ -95,7 +96,7 @@ def solve(design, material, settings, progress=None, cancel=None, stock=None):
         design.setdefault("warnings", []).append(warning)
         say("size", warning)
     try:
-        return relayer(design, material, settings, say, native_progress, checkpoint)
+        return relayer(design, material, settings, say, native_progress, checkpoint, hook_patterns)
     except native.Cancelled:
         if not cancelled() and out_of_time():
             raise OutOfTime(budget, at["stage"]) from None
@@ -111,7 +112,7 @@ def _pairs(pairs):
     return [[c, h] for c, h in sorted(pairs)]
 
 
-def relayer(design, material, settings, say, native_progress, checkpoint):
+def relayer(design, material, settings, say, native_progress, checkpoint, hook_patterns=None):
     """Layering, then target shape, forces and rest shape (shape_and_rest); while the result is not
     stable because the target shape could not realise some crossing's hook, forbid those (crossing,
     hook) pairs (target_shape.unrealisable: the failed hook, or both hooks of a crossing too close to
@@ -121,7 +122,8 @@ def relayer(design, material, settings, say, native_progress, checkpoint):
     assembly under the forbidden hooks or stops at max_nodes (search incomplete), or after
     `relayer_rounds` re-layerings. Records every round in stages.relayering. Returns the design of
     the last round, or, when the last layering found no stable assembly under the forbidden hooks,
-    of the last round that reached the target shape (its shapes and reason show why), saying so."""
+    of the last round that reached the target shape (its shapes and reason show why), saying so.
+    `hook_patterns`: hooks_by_forces' `patterns` bound (None: HOOK_PATTERNS)."""
     extra_rounds = int(layering.knob(settings, "relayer_rounds"))
     # Layering replaces (never edits) each wire's contour, so the copies share the contours.
     pristine = _copy_sharing_contours(design) if extra_rounds else None
@@ -141,7 +143,7 @@ def relayer(design, material, settings, say, native_progress, checkpoint):
             # cost that use no forbidden hook; the best forces win among the stable (buildable) ones,
             # and when none is, the layering's own pattern is kept, so the round learns from it.
             attempt = hooks_by_forces(attempt, material, settings, say, native_progress, checkpoint,
-                                      forbidden=forbidden, deadline=hook_deadline, same_solves=same_solves)
+                                      patterns=hook_patterns, forbidden=forbidden, deadline=hook_deadline, same_solves=same_solves)
             shaped = attempt
         learnt = target_shape.unrealisable(attempt) - forbidden
         rounds.append({"forbidden": _pairs(forbidden), "stable": attempt["stable"],

@@ -116,6 +116,14 @@ SETTING_PROPS = ("min_segment", "max_bend_deg", "min_bend_deg", "contact_angle_d
 ADVANCED_PROPS = ("in_plane_tiebreak", "max_nodes", "relayer_rounds")  # the panel's Advanced box
 
 
+LIVE_HOOKS = []  # operators/live.py's live_changed (props may not import operators)
+
+
+def _live_changed(settings, context):
+    for hook in LIVE_HOOKS:
+        hook(settings, context)
+
+
 def _assembly_step_changed(settings, context):
     scene_results.apply_assembly_step(context.scene)
 
@@ -210,6 +218,12 @@ class WiresculptSettings(bpy.types.PropertyGroup):
     show_advanced: BoolProperty(
         name="Advanced", default=False,
         description="Show the layering's search settings (tie-break, node budget, re-layering rounds)")
+
+    live: BoolProperty(
+        name="Live", default=False, update=_live_changed,
+        description="While a slicing plane or the target moves, re-slice and re-solve in the background "
+                    "and show stable / not stable (the layering's own hooks only; Optimize may pick "
+                    "others). Refused for meshes over 200,000 triangles")
 
     # results display
     show_forces: BoolProperty(

@@ -1,4 +1,4 @@
-"""Viewport overlay: the contact force at every crossing as an arrow (gpu module, no bgl), and
+"""Viewport overlay: Live's preview wires (operators/live.STATE.preview) while Live is on; the contact force at every crossing as an arrow (gpu module, no bgl), and
 each wire's predicted out-of-plane deflection as a whisker.
 
 Drawn only when the stored design has `force` per crossing and scene.wiresculpt.show_forces is
@@ -14,6 +14,7 @@ import numpy as np
 from gpu_extras.batch import batch_for_shader
 
 from ..blend import compat, results
+from ..operators import live
 
 ARROW_SHARE = 0.2
 HEAD_SHARE = 0.25  # arrow head length as a share of the arrow
@@ -85,7 +86,23 @@ def deflection_whiskers(design, shown=None):
     return {k: np.asarray(v, dtype=np.float32) for k, v in out.items() if v}
 
 
+def draw_live():
+    """The live verdict's wires (operators/live.py) as thin lines in their colours."""
+    shader = uniform_colour_shader()
+    gpu.state.line_width_set(1.5)
+    gpu.state.depth_test_set('LESS_EQUAL')
+    shader.bind()
+    for colour, lines in live.STATE.preview:
+        shader.uniform_float("color", colour)
+        batch_for_shader(shader, 'LINES', {"pos": lines}).draw(shader)
+    gpu.state.depth_test_set('NONE')
+    gpu.state.line_width_set(1.0)
+    live.STATE.drawn += 1
+
+
 def draw():
+    if live.STATE.running and live.STATE.preview:
+        draw_live()
     scene = bpy.context.scene
     if scene is None or not scene.wiresculpt.show_forces:
         return

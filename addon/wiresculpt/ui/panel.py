@@ -5,6 +5,7 @@ import bpy
 
 from .. import native
 from ..blend.registration import classes_factory
+from ..operators import live
 from ..operators.slicing import WIRESCULPT_OT_add_plane, WIRESCULPT_OT_slice
 
 CHARS_PER_PIXEL = 1 / 7.5  # rough width of a label character, for wrapping long messages
@@ -95,6 +96,15 @@ class VIEW3D_PT_wiresculpt(bpy.types.Panel):
         col = layout.column(align=True)
         col.operator(WIRESCULPT_OT_add_plane.bl_idname, icon='MESH_PLANE')
         col.operator(WIRESCULPT_OT_slice.bl_idname, icon='MOD_BOOLEAN')
+        row = layout.row()
+        row.enabled = native.available()
+        row.prop(settings, "live", toggle=True, icon='REC' if settings.live else 'PLAY')
+        if live.line():
+            wrap_labels(layout, context, live.line(),
+                        icon='CHECKMARK' if live.STATE.verdict == "stable" else
+                        'SORTTIME' if live.STATE.verdict == "solving…" else 'ERROR')
+        elif live.STATE.message and not settings.live:
+            wrap_labels(layout.box(), context, live.STATE.message, icon='INFO')
         layout.label(text="Contours (ticked: wires)")
         layout.template_list(WIRESCULPT_UL_contours.__name__, "", settings, "contours",
                              settings, "active_contour", rows=4)

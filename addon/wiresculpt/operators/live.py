@@ -1,0 +1,317 @@
+"""Live: while a slicing plane (or the target) moves, re-slice and re-solve in the background and
+show the verdict (docs/user-guide.md, Live).
+
+A bpy.app.timers callback (tick, every TICK_SECONDS) compares a snapshot of the slicing planes'
+and the target's matrix_world (and the ticked contours) with the last one it saw. A snapshot that
+stayed the same for one tick and differs from the one solved (or being solved) starts a LiveJob on
+a worker thread: slice_and_pick then pipeline.solve with the hook search limited to the
+layering's own pattern (hook_patterns=1) and the user's relayer_rounds. Latest position wins: a
+running job whose snapshot is no longer current is cancelled (its cancel event; it is never waited
+for) and a new one starts; a result is shown only when its snapshot is still the current one.
+
+Nothing is written to the scene or the .blend: the verdict and the wires' preview (STATE.preview,
+line segments in each wire's colour, computed on the worker by blend/results.wire_shapes) live in
+module state, shown by the Wire panel and drawn by ui/overlay.py, so no live update touches the
+undo history. The wire curves themselves are not rewritten (blend/results.write_results would also
+replace the stored design of the last Optimize and its markers and cut handles); Optimize does.
+
+Turning Live off, loading a file (load_pre) or unregistering stops the timer and cancels the job.
+Meshes over MAX_TRIANGLES triangles are refused (the panel says why).
+"""
+import threading
+import time
+
+import bpy
+import numpy as np
+
+from .. import native, pipeline
+from ..blend import cut_handles, mesh
+from ..blend import results as scene_results
+from ..blend.handles import handle_plane, handles, target_problem
+from ..core.jobs import WorkerJob
+from ..core.scene import PlaneSpec
+from ..props import LIVE_HOOKS, material_of, solver_settings
+
+TICK_SECONDS = 0.1
+MAX_TRIANGLES = 200_000  # Live is refused on larger targets (re-slicing alone would lag)
+LIVE_HOOK_PATTERNS = 1  # the layering's own hook pattern only: Optimize may pick other hooks
+REASON_WORDS = 8  # words of the reason the panel shows
+DURATIONS_KEPT = 10_000
+
+
+class LiveState:
+    def __init__(self):
+        self.reset()
+        self.message = ""  # why Live was refused or stopped; kept across resets
+
+    def reset(self):
+        self.running = False  # the timer is registered
+        self.seen = None  # the snapshot of the previous tick
+        self.solved = None  # the snapshot of the shown verdict
+        self.job = None  # the LiveJob of the current snapshot, while it runs
+        self.verdict = ""  # "stable", "not stable — …", "solving…" (the panel adds "Live: ")
+        self.preview = []  # [(RGBA, (2k, 3) float32 segment end points)], one per wire of the shown verdict
+        self.mesh_key = None  # the target's matrix the cached triangles belong to
+        self.mesh = None  # (V, F) world coordinates
+        self.durations = []  # seconds of each tick (the test reads them)
+        self.results = []  # the verdicts shown, in order
+        self.drawn = 0  # overlay draws of the preview (the test reads it)
+
+
+STATE = LiveState()
+
+
+def triangle_count(obj):
+    """Triangles of the mesh `obj` (its own data: modifiers not counted), from its polygons."""
+    polygons = obj.data.polygons
+    totals = np.empty(len(polygons), dtype=np.int32)
+    polygons.foreach_get("loop_total", totals)
+    return int((totals - 2).sum())
+
+
+def refusal(target):
+    """Why Live cannot run on `target`, or ""."""
+    if target is not None and target.type == 'MESH':
+        n = triangle_count(target)
+        if n > MAX_TRIANGLES:
+            return (f"Live is off: {target.name} has {n:,} triangles, over the {MAX_TRIANGLES:,} Live "
+                    f"re-slices as a plane moves; use Optimize")
+    return ""
+
+
+def _rounded(matrix):
+    return tuple(round(x, 9) for row in matrix for x in row)
+
+
+def snapshot(scene):
+    """What a live solve depends on that moves in the viewport: the planes' and the target's
+    matrix_world, and the ticked contours."""
+    ws = scene.wiresculpt
+    target = ws.target
+    return (target.name if target else "", _rounded(target.matrix_world) if target else (),
+            tuple((h.name, _rounded(h.matrix_world)) for h in handles(scene)),
+            tuple((item.plane, item.index) for item in ws.contours if item.use))
+
+
+def first_words(text, n=REASON_WORDS):
+    words = text.split()
+    return " ".join(words[:n]) + ("…" if len(words) > n else "")
+
+
+def preview_segments(design):
+    """[(RGBA, (2k, 3) float32 segment end points)] of each wire's shape (interlock offsets
+    applied), in the wire's colour: what the overlay draws."""
+    out = []
+    for wire_id, points in scene_results.wire_shapes(design).items():
+        points = np.asarray(points, dtype=np.float32)
+        if len(points) < 2:
+            continue
+        wire = next(w for w in design["wires"] if w["id"] == wire_id)
+        ends = np.concatenate([points[1:], points[:1]]) if wire["closed"] else points[1:]
+        starts = points[:len(ends)]
+        out.append((scene_results.wire_colour(wire_id), np.stack([starts, ends], axis=1).reshape(-1, 3)))
+    return out
+
+
+class LiveJob(WorkerJob):
+    """One live solve of one snapshot: slice the cached triangles, solve with the layering's own hooks."""
+
+    name = "wiresculpt live"
+
+    def __init__(self, key, vertices, faces, planes, cuts, material, settings):
+        super().__init__()
+        self.key = key
+        self.vertices, self.faces, self.planes, self.cuts = vertices, faces, planes, cuts
+        self.material, self.settings = material, settings
+        self.cancel_event = threading.Event()
+        self.cancelled = False
+        self.design = None
+        self.preview = []
+
+    def work(self):
+        try:
+            design = pipeline.slice_and_pick(self.vertices, self.faces, self.planes, self.material, self.settings)
+            for wire in design["wires"]:  # the user's moved cut handles, as build_design gives them
+                if wire["closed"] and wire["name"] in self.cuts:
+                    wire["cut_point"] = list(self.cuts[wire["name"]])
+            self.design = pipeline.solve(design, self.material, self.settings, cancel=self.cancel_event.is_set,
+                                         hook_patterns=LIVE_HOOK_PATTERNS)
+            self.preview = preview_segments(self.design)
+        except pipeline.Cancelled:
+            self.cancelled = True
+
+    def verdict(self):
+        if self.error is not None:
+            return "not stable — " + first_words(self.error)
+        if self.design["stable"]:
+            return "stable"
+        return "not stable — " + first_words(self.design.get("reason") or "")
+
+
+def _start(scene, key):
+    """A LiveJob for snapshot `key` (the scene read here, on Blender's thread); the verdict when
+    the scene cannot be solved at all."""
+    ws = scene.wiresculpt
+    problem = target_problem(scene, ws.target)
+    if problem:
+        return "not stable — " + first_words(problem)
+    if not native.available():
+        return "not stable — solver not loaded"
+    rules = {}
+    for item in ws.contours:
+        if item.use:
+            rules.setdefault(item.plane, []).append(item.index)
+    if not rules:
+        return "not stable — no contour is ticked: Slice and tick contours"
+    by_name = {h.name: h for h in handles(scene)}
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    try:
+        missing = [name for name in rules if name not in by_name]
+        if missing:
+            raise ValueError(f"slicing plane {missing[0]} of a ticked contour is gone: Slice again")
+        planes = [PlaneSpec(*handle_plane(by_name[name], depsgraph), contours=indices)
+                  for name, indices in rules.items()]
+    except ValueError as exc:
+        return "not stable — " + first_words(str(exc))
+    mesh_key = key[:2]
+    if STATE.mesh_key != mesh_key:
+        STATE.mesh = mesh.object_triangles(ws.target, depsgraph)
+        STATE.mesh_key = mesh_key
+    job = LiveJob(key, *STATE.mesh, planes, cut_handles.user_cut_points(scene), material_of(ws),
+                  solver_settings(ws))
+    job.thread.start()
+    return job
+
+
+def _redraw():
+    for window in bpy.context.window_manager.windows:
+        for area in (window.screen.areas if window.screen else []):
+            if area.type == 'VIEW_3D':
+                area.tag_redraw()
+
+
+def _step():
+    scene = bpy.context.scene
+    if scene is None or not scene.wiresculpt.live:
+        stop()
+        return None
+    key = snapshot(scene)
+    shown = STATE.verdict
+    job = STATE.job
+    if job is not None and not job.thread.is_alive():  # finished: shown only if still current
+        STATE.job = None
+        if job.key == key and not job.cancelled and not job.cancel_event.is_set():
+            STATE.verdict, STATE.solved = job.verdict(), job.key
+            STATE.preview = job.preview if job.error is None else []
+            STATE.results.append(STATE.verdict)
+        job = None
+    if job is not None and job.key != key:  # the planes moved on: latest position wins
+        job.cancel_event.set()  # never waited for: it ends at its next checkpoint, its result dropped
+        STATE.job = job = None
+    settled = key == STATE.seen
+    STATE.seen = key
+    if job is None and settled and key != STATE.solved:
+        message = refusal(scene.wiresculpt.target)
+        if message:
+            STATE.message = message
+            scene.wiresculpt.live = False  # its update stops the timer
+            return None
+        started = _start(scene, key)
+        if isinstance(started, str):
+            STATE.verdict, STATE.solved, STATE.preview = started, key, []
+            STATE.results.append(started)
+        else:
+            STATE.job, STATE.verdict = started, "solving…"
+    elif not settled and key != STATE.solved:
+        STATE.verdict = "solving…"
+    if STATE.verdict != shown:
+        _redraw()
+    return TICK_SECONDS
+
+
+_TICKING = []  # non-empty while tick runs: stop() then leaves the timer to end by returning None
+
+
+def tick():
+    """The timer callback: one _step, its duration recorded."""
+    began = time.perf_counter()
+    _TICKING.append(True)
+    try:
+        return _step()
+    except (AttributeError, ReferenceError):  # no scene or window (closing, loading)
+        stop()
+        return None
+    finally:
+        _TICKING.clear()
+        STATE.durations.append(time.perf_counter() - began)
+        del STATE.durations[:-DURATIONS_KEPT]
+
+
+def start():
+    if not STATE.running:
+        STATE.reset()
+        STATE.running = True
+        STATE.verdict = "solving…"
+        bpy.app.timers.register(tick, first_interval=TICK_SECONDS)
+
+
+def stop():
+    """Stops the timer and cancels the running job (not waited for); the verdict is cleared."""
+    if not _TICKING and bpy.app.timers.is_registered(tick):
+        bpy.app.timers.unregister(tick)
+    if STATE.job is not None:
+        STATE.job.cancel_event.set()
+    durations, drawn = STATE.durations, STATE.preview
+    STATE.reset()
+    STATE.durations = durations  # what the last run's ticks took, for the test
+    if drawn:  # the preview goes from the viewport
+        try:
+            _redraw()
+        except (AttributeError, ReferenceError):  # no window (closing, background)
+            pass
+
+
+def line():
+    """The panel's line, or "" when Live is off."""
+    return f"Live: {STATE.verdict}" if STATE.running else ""
+
+
+def live_changed(settings, context):
+    """The toggle's update (props.LIVE_HOOKS): start, refuse or stop."""
+    if not settings.live:
+        stop()
+        return
+    message = refusal(settings.target)
+    if message:
+        STATE.message = message
+        settings.live = False
+        return
+    STATE.message = ""
+    start()
+
+
+@bpy.app.handlers.persistent
+def _load_pre(*_args):
+    stop()
+
+
+@bpy.app.handlers.persistent
+def _load_post(*_args):
+    scene = bpy.context.scene
+    if scene is not None and scene.wiresculpt.live:  # a file saved with Live on resumes it
+        live_changed(scene.wiresculpt, bpy.context)
+
+
+def register():
+    LIVE_HOOKS.append(live_changed)
+    bpy.app.handlers.load_pre.append(_load_pre)
+    bpy.app.handlers.load_post.append(_load_post)
+
+
+def unregister():
+    stop()
+    for handlers, fn in ((bpy.app.handlers.load_pre, _load_pre), (bpy.app.handlers.load_post, _load_post)):
+        if fn in handlers:
+            handlers.remove(fn)
+    if live_changed in LIVE_HOOKS:
+        LIVE_HOOKS.remove(live_changed)

@@ -1,0 +1,173 @@
+"""Driven by test_live.py in a Blender with a window (under Xvfb): the globe with Live on; a
+timer moves slicing plane "Slice A" in steps (through the centre, off the mesh, back near the
+centre) and records the live verdict once each step has settled, then moves it twice within a
+tick while a solve runs (latest position wins), turns Live off and loads a new file (the timer
+stops). Every tick of the live timer records its duration (operators/live.STATE.durations).
+Prints one line `MODAL {json}` with what it saw, then quits."""
+import json  # noqa: F401
+import math
+import os
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [os.path.join(os.path.dirname(HERE), "addon"), HERE]
+
+import bpy  # noqa: E402
+
+import wiresculpt  # noqa: E402
+
+wiresculpt.register()
+from wiresculpt.blend.mesh import import_mesh  # noqa: E402
+from wiresculpt import pipeline  # noqa: E402
+from wiresculpt.operators import live  # noqa: E402
+from ui_steps import guarded, report, start_watchdog  # noqa: E402
+
+seen = {"verdicts": [], "durations": []}
+# plane A's z (the globe's radius is 0.125): through the mesh, above it, through it again
+STEPS = [0.0, 0.3, 0.02]
+SETTLE_SECONDS = 40.0
+
+
+def setup():
+    for o in list(bpy.data.objects):
+        bpy.data.objects.remove(o)
+    _V, _F, objs = import_mesh(os.path.join(os.path.dirname(HERE), "scripts", "examples", "globe", "globe.obj"))
+    objs[0].scale = (0.125,) * 3
+    bpy.context.view_layer.update()
+    bpy.context.scene.wiresculpt.target = objs[0]
+    for rotation in ((0, 0, 0), (0, math.pi / 2, 0), (math.pi / 2, 0, 0)):
+        bpy.ops.wiresculpt.add_plane()
+        bpy.context.view_layer.objects.active.rotation_euler = rotation
+    bpy.context.view_layer.update()
+    bpy.ops.wiresculpt.slice()
+
+
+def plane():
+    return bpy.context.scene.objects["Slice A"]
+
+
+def settled():
+    """The verdict of the current position is shown (no job, the solved snapshot is the scene's)."""
+    return (live.STATE.job is None and live.STATE.solved is not None
+            and live.STATE.solved == live.snapshot(bpy.context.scene))
+
+
+def data_state():
+    """What a live update must not write: the data-blocks (every live update would be an undo step)."""
+    return sorted(f"{kind}:{block.name}" for kind in ("objects", "curves", "texts", "materials", "meshes")
+                  for block in getattr(bpy.data, kind))
+
+
+def start():
+    seen["data_before"] = data_state()
+    bpy.context.scene.wiresculpt.live = True
+    seen["timer_on"] = bpy.app.timers.is_registered(live.tick)
+    step(0)
+    return None
+
+
+def step(k):
+    plane().location.z = STEPS[k]
+    began = time.monotonic()
+
+    def wait():
+        if not settled():
+            if time.monotonic() - began > SETTLE_SECONDS:
+                raise RuntimeError(f"step {k} did not settle: {live.STATE.verdict!r}")
+            return 0.05
+        seen["verdicts"].append({"z": STEPS[k], "line": live.line(), "seconds": time.monotonic() - began,
+                                 "preview_wires": len(live.STATE.preview), "drawn": live.STATE.drawn})
+        if k + 1 < len(STEPS):
+            step(k + 1)
+        else:
+            bpy.app.timers.register(guarded(seen, latest_wins), first_interval=0.05)
+        return None
+
+    bpy.app.timers.register(guarded(seen, wait), first_interval=0.05)
+
+
+class SlowSolve:
+    """pipeline.solve waiting (polling its cancel) up to HOLD_SECONDS first, so that the second
+    move surely lands while the first position's job runs (the globe solves within a tick)."""
+
+    HOLD_SECONDS = 3.0
+
+    def __init__(self):
+        self.original = pipeline.solve
+        pipeline.solve = self.solve
+
+    def solve(self, design, material, settings, progress=None, cancel=None, **options):
+        deadline = time.monotonic() + self.HOLD_SECONDS
+        while cancel is not None and not cancel() and time.monotonic() < deadline:
+            time.sleep(0.01)
+        return self.original(design, material, settings, progress, cancel, **options)
+
+    def restore(self):
+        pipeline.solve = self.original
+
+
+def latest_wins():
+    """Two moves: the second lands while the first's solve runs; only the last one is shown."""
+    slow = SlowSolve()
+    shown = len(live.STATE.results)
+    plane().location.z = 0.04
+    began = time.monotonic()
+    state = {"moved": False}
+
+    def wait():
+        if not state["moved"]:
+            if live.STATE.job is None:
+                if time.monotonic() - began > SETTLE_SECONDS:
+                    raise RuntimeError("no live job started")
+                return 0.01
+            state["first_job"] = live.STATE.job
+            plane().location.z = 0.3  # off the mesh again, while the job of 0.04 runs
+            state["moved"] = True
+            return 0.05
+        if not settled():
+            if time.monotonic() - began > SETTLE_SECONDS:
+                raise RuntimeError(f"latest position did not settle: {live.STATE.verdict!r}")
+            return 0.05
+        slow.restore()
+        first = state["first_job"]
+        first.thread.join(5.0)
+        seen["first_job_cancelled"] = first.cancel_event.is_set() and first.cancelled
+        seen["latest_results"] = live.STATE.results[shown:]  # the first position's verdict never shown
+        seen["latest_line"] = live.line()
+        seen["latest_z_solved"] = dict(live.STATE.solved[2])["Slice A"][11]  # matrix row 2, column 3
+        bpy.app.timers.register(guarded(seen, turn_off), first_interval=0.05)
+        return None
+
+    bpy.app.timers.register(guarded(seen, wait), first_interval=0.01)
+    return None
+
+
+def turn_off():
+    seen["results"] = list(live.STATE.results)
+    seen["durations"] = list(live.STATE.durations)
+    seen["data_unchanged"] = data_state() == seen.pop("data_before")
+    bpy.context.scene.wiresculpt.live = False
+    seen["off_timer"] = bpy.app.timers.is_registered(live.tick)
+    seen["off_line"] = live.line()
+    seen["off_preview"] = len(live.STATE.preview)
+    bpy.context.scene.wiresculpt.live = True  # on again, then a file is loaded
+    plane().location.z = 0.05
+    bpy.app.timers.register(guarded(seen, load), first_interval=0.25)
+    return None
+
+
+def load():
+    seen["before_load_timer"] = bpy.app.timers.is_registered(live.tick)
+    job = live.STATE.job
+    bpy.ops.wm.read_homefile()
+    seen["load_timer"] = bpy.app.timers.is_registered(live.tick)
+    seen["load_job_cancelled"] = job is None or job.cancel_event.is_set()
+    seen["load_line"] = live.line()
+    report(seen)
+    return None
+
+
+setup()
+bpy.app.timers.register(guarded(seen, start), first_interval=1.0)
+start_watchdog(seen, 200.0)
