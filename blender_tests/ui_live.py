@@ -5,7 +5,6 @@ tick while a solve runs (latest position wins), turns Live off and loads a new f
 stops). Every tick of the live timer records its duration (operators/live.STATE.durations).
 Prints one line `MODAL {json}` with what it saw, then quits."""
 import json  # noqa: F401
-import math
 import os
 import sys
 import time
@@ -18,29 +17,14 @@ import bpy  # noqa: E402
 import wiresculpt  # noqa: E402
 
 wiresculpt.register()
-from wiresculpt.blend.mesh import import_mesh  # noqa: E402
 from wiresculpt import pipeline  # noqa: E402
 from wiresculpt.operators import live  # noqa: E402
-from ui_steps import guarded, report, start_watchdog  # noqa: E402
+from ui_steps import globe_scene as setup, guarded, report, start_watchdog  # noqa: E402
 
 seen = {"verdicts": [], "durations": []}
 # plane A's z (the globe's radius is 0.125): through the mesh, above it, through it again
 STEPS = [0.0, 0.3, 0.02]
 SETTLE_SECONDS = 40.0
-
-
-def setup():
-    for o in list(bpy.data.objects):
-        bpy.data.objects.remove(o)
-    _V, _F, objs = import_mesh(os.path.join(os.path.dirname(HERE), "scripts", "examples", "globe", "globe.obj"))
-    objs[0].scale = (0.125,) * 3
-    bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.target = objs[0]
-    for rotation in ((0, 0, 0), (0, math.pi / 2, 0), (math.pi / 2, 0, 0)):
-        bpy.ops.wiresculpt.add_plane()
-        bpy.context.view_layer.objects.active.rotation_euler = rotation
-    bpy.context.view_layer.update()
-    bpy.ops.wiresculpt.slice()
 
 
 def plane():

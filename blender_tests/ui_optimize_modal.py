@@ -4,7 +4,6 @@ is inside the native layering and inside the native forces, once to the end (and
 finally with the worker stuck in a native step while Blender removes the modal (a new file is
 loaded). Prints one line `MODAL {json}` with what it saw, then quits."""
 import json
-import math
 import os
 import sys
 import threading
@@ -19,10 +18,9 @@ import wiresculpt  # noqa: E402
 
 wiresculpt.register()
 from wiresculpt.blend import results as scene_results  # noqa: E402
-from wiresculpt.blend.mesh import import_mesh  # noqa: E402
 from wiresculpt.ui import overlay  # noqa: E402
 from wiresculpt.operators import optimize  # noqa: E402
-from ui_steps import guarded, report, start_watchdog  # noqa: E402
+from ui_steps import globe_scene as setup, guarded, report, start_watchdog  # noqa: E402
 from wiresculpt.stages import forces as forces_stage  # noqa: E402
 from wiresculpt.stages import layering as layering_stage  # noqa: E402
 
@@ -67,20 +65,6 @@ def results_in_scene():
 def state():
     objects = {o.name: (o.type, tuple(round(x, 9) for x in o.location), o.hide_viewport) for o in bpy.data.objects}
     return json.dumps([objects, {t.name: t.as_string() for t in bpy.data.texts}], sort_keys=True)
-
-
-def setup():
-    for o in list(bpy.data.objects):
-        bpy.data.objects.remove(o)
-    _V, _F, objs = import_mesh(os.path.join(os.path.dirname(HERE), "scripts", "examples", "globe", "globe.obj"))
-    objs[0].scale = (0.125,) * 3
-    bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.target = objs[0]
-    for rotation in ((0, 0, 0), (0, math.pi / 2, 0), (math.pi / 2, 0, 0)):
-        bpy.ops.wiresculpt.add_plane()
-        bpy.context.view_layer.objects.active.rotation_euler = rotation
-    bpy.context.view_layer.update()
-    bpy.ops.wiresculpt.slice()
 
 
 def invoke():

@@ -27,3 +27,25 @@ def start_watchdog(seen, seconds=60.0):
     def watchdog():
         report(seen, error="timed out")
     bpy.app.timers.register(watchdog, first_interval=seconds)
+
+
+def globe_scene():
+    """The bundled globe scaled by 1/8, cut by three slicing planes
+    through its centre (XY, YZ, XZ) and sliced: the scene the modal scripts start from."""
+    import math
+    import os
+
+    from wiresculpt.blend.mesh import import_mesh
+
+    for o in list(bpy.data.objects):
+        bpy.data.objects.remove(o)
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    _V, _F, objs = import_mesh(os.path.join(root, "scripts", "examples", "globe", "globe.obj"))
+    objs[0].scale = (0.125,) * 3
+    bpy.context.view_layer.update()
+    bpy.context.scene.wiresculpt.target = objs[0]
+    for rotation in ((0, 0, 0), (0, math.pi / 2, 0), (math.pi / 2, 0, 0)):
+        bpy.ops.wiresculpt.add_plane()
+        bpy.context.view_layer.objects.active.rotation_euler = rotation
+    bpy.context.view_layer.update()
+    bpy.ops.wiresculpt.slice()
