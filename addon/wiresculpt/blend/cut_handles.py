@@ -48,7 +48,12 @@ def user_cut_points(scene):
 def apply_to_design(scene, design):
     """Gives each closed wire of `design` whose handle was moved a `cut_point` (the forces stage
     snaps it to the target). Returns the names of the wires that got one."""
-    points = user_cut_points(scene)
+    return set_cut_points(design, user_cut_points(scene))
+
+
+def set_cut_points(design, points):
+    """apply_to_design with the moved handles' points ({wire name: (x, y, z)}, user_cut_points)
+    read earlier: no scene is touched, so a worker thread may call it."""
     named = []
     for wire in design["wires"]:
         if wire["closed"] and wire["name"] in points:

@@ -2,6 +2,7 @@
 plane; and the target mesh they cut."""
 import bpy
 
+from ..core.scene import PlaneSpec
 from .objects import scene_collection
 
 HANDLE_KEY = "wiresculpt_handle"  # custom property that marks an object as a slicing handle
@@ -43,6 +44,22 @@ def handle_plane(handle, depsgraph):
         raise ValueError(f"slicing plane {handle.name} has zero scale along its Z axis, "
                          "so it has no normal; give it a non-zero scale")
     return handle.name, tuple(M.translation), tuple(normal.normalized())
+
+
+def ticked_planes(scene, depsgraph):
+    """The slicing planes of the ticked contours, as PlaneSpecs whose contour rule is the ticked
+    indices (in the list's order): what Optimize and Live slice with. ValueError when no contour
+    is ticked or the plane of one is gone."""
+    ticked = [(item.plane, item.index) for item in scene.wiresculpt.contours if item.use]
+    if not ticked:
+        raise ValueError("No contour is ticked: Slice, then tick the contours that become wires")
+    by_name = {h.name: h for h in handles(scene)}
+    rules = {}  # plane name -> its ticked contour indices, in the list's order
+    for plane, index in ticked:
+        if plane not in by_name:
+            raise ValueError(f"slicing plane {plane} of a ticked contour is gone: Slice again")
+        rules.setdefault(plane, []).append(index)
+    return [PlaneSpec(*handle_plane(by_name[name], depsgraph), contours=indices) for name, indices in rules.items()]
 
 
 def add_handle(context, low, high):

@@ -27,9 +27,8 @@ import numpy as np
 from .. import native, pipeline
 from ..blend import cut_handles, mesh
 from ..blend import results as scene_results
-from ..blend.handles import handle_plane, handles, target_problem
+from ..blend.handles import handles, target_problem, ticked_planes
 from ..core.jobs import WorkerJob
-from ..core.scene import PlaneSpec
 from ..props import LIVE_HOOKS, material_of, solver_settings
 
 TICK_SECONDS = 0.1
@@ -131,9 +130,7 @@ class LiveJob(WorkerJob):
     def work(self):
         try:
             design = pipeline.slice_and_pick(self.vertices, self.faces, self.planes, self.material, self.settings)
-            for wire in design["wires"]:  # the user's moved cut handles, as build_design gives them
-                if wire["closed"] and wire["name"] in self.cuts:
-                    wire["cut_point"] = list(self.cuts[wire["name"]])
+            cut_handles.set_cut_points(design, self.cuts)  # the user's moved cut handles, as build_design gives them
             self.design = pipeline.solve(design, self.material, self.settings, cancel=self.cancel_event.is_set,
                                          hook_patterns=LIVE_HOOK_PATTERNS)
             self.preview = preview_segments(self.design)
@@ -157,20 +154,9 @@ def _start(scene, key):
         return "not stable — " + first_words(problem)
     if not native.available():
         return "not stable — solver not loaded"
-    rules = {}
-    for item in ws.contours:
-        if item.use:
-            rules.setdefault(item.plane, []).append(item.index)
-    if not rules:
-        return "not stable — no contour is ticked: Slice and tick contours"
-    by_name = {h.name: h for h in handles(scene)}
     depsgraph = bpy.context.evaluated_depsgraph_get()
     try:
-        missing = [name for name in rules if name not in by_name]
-        if missing:
-            raise ValueError(f"slicing plane {missing[0]} of a ticked contour is gone: Slice again")
-        planes = [PlaneSpec(*handle_plane(by_name[name], depsgraph), contours=indices)
-                  for name, indices in rules.items()]
+        planes = ticked_planes(scene, depsgraph)
     except ValueError as exc:
         return "not stable — " + first_words(str(exc))
     mesh_key = key[:2]

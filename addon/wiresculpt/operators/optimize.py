@@ -20,10 +20,9 @@ import bpy
 from .. import native, pipeline
 from ..blend import cut_handles, mesh
 from ..blend import results as scene_results
-from ..blend.handles import handle_plane, handles, target_problem
+from ..blend.handles import target_problem, ticked_planes
 from ..blend.registration import classes_factory
 from ..core.jobs import WorkerJob
-from ..core.scene import PlaneSpec
 from ..props import material_of, solver_settings
 from .progress import TIMER_SECONDS, WorkerModal
 
@@ -45,18 +44,9 @@ def build_design(context):
         raise ValueError(problem)
     if not native.available():
         raise RuntimeError(native.LOAD_ERROR)
-    ticked = [(item.plane, item.index) for item in ws.contours if item.use]
-    if not ticked:
-        raise ValueError("No contour is ticked: Slice, then tick the contours that become wires")
-    material, settings = material_of(ws), solver_settings(ws)
-    by_name = {h.name: h for h in handles(scene)}
-    rules = {}  # plane name -> its ticked contour indices, in the list's order
-    for plane, index in ticked:
-        if plane not in by_name:
-            raise ValueError(f"slicing plane {plane} of a ticked contour is gone: Slice again")
-        rules.setdefault(plane, []).append(index)
     depsgraph = context.evaluated_depsgraph_get()
-    planes = [PlaneSpec(*handle_plane(by_name[name], depsgraph), contours=indices) for name, indices in rules.items()]
+    planes = ticked_planes(scene, depsgraph)
+    material, settings = material_of(ws), solver_settings(ws)
     V, F = mesh.object_triangles(ws.target, depsgraph)
     try:
         design = pipeline.slice_and_pick(V, F, planes, material, settings)
