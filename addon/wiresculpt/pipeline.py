@@ -402,7 +402,7 @@ def hooks_by_forces(design, material, settings, say, native_progress, checkpoint
     stop_at = start + seconds if deadline is None else deadline
     candidates, total = equal_cost_patterns(design, patterns if design["stable"] else 1, forbidden)
     shared = {}  # the target shape's per-wire solves, shared by the patterns
-    base = _copy_sharing_contours(design)
+    base = design  # only copied from (each pattern solves a copy); replaced by the result at the end
     # The user's cuts (cut handles, settings.cuts) change the forces a little, so patterns within
     # CAPACITY_TIE could trade places when a handle moves and move every other wire's automatic
     # cut with them. The patterns are compared with automatic cuts; the chosen one is then solved

@@ -273,6 +273,7 @@ def _record(mode, before, candidate, searcher, start):
             "changes": candidate["changes"] if candidate else [],
             "candidates": searcher.screened, "full_solves": searcher.full_solves,
             "budget_seconds": searcher.budget, "solves_stopped": searcher.timed_out,
+            "solves_failed": searcher.failed,
             "seconds": time.perf_counter() - start, "score": candidate["score"] if candidate else None,
             "measure": ("cost = sum of |offset| / model size + tilt in radians + 0.05 per contour-rule change; "
                         "score = -cost" if mode == "nearby" else
