@@ -40,11 +40,14 @@ the largest distance of a target shape from its contour (target_max_distance).
 import copy
 import itertools
 import math
+import threading
 import time
 
 import numpy as np
 
 from . import pipeline
+from .core import ordered
+from .core.ordered import InOrder
 from .core.scene import PlaneSpec
 from .stages import layering, slicing
 
@@ -163,6 +166,8 @@ class Searcher:
         self.cache = {}
         self.mesh_info = None  # the slicer's report on the mesh (stages.slicing.mesh), from its first call
         self.screened = self.full_solves = self.timed_out = self.failed = 0
+        self.workers = ordered.WORKERS  # full solves at once (1: the search on one thread)
+        self._counting = threading.Lock()  # solve() runs on the pool's threads
         self.deadline = math.inf  # perf_counter() time at which a full solve is stopped (the budget)
         self.budget = None  # seconds
         self.centre, self.axes, self.size = mesh_frame(vertices, faces)
@@ -227,20 +232,22 @@ class Searcher:
         """The full pipeline on a screened design; the solved design (stable means buildable), or
         None when it fails or runs past the search's deadline (a solve is stopped there, like a
         cancel, so the budget holds however long one solve would take)."""
-        self.full_solves += 1
+        self._count("full_solves")
         try:
             return pipeline.solve(design, self.material, self.settings_for(design),
                                   cancel=lambda: self.cancel() or time.perf_counter() > self.deadline, stock=self.stock)
         except (ValueError, RuntimeError):  # a candidate the solver cannot finish (an infeasible LP): no answer
-            self.failed += 1
+            self._count("failed")
             return None
         except pipeline.Cancelled:
             if self.cancel():
                 raise
-            self.timed_out += 1
+            self._count("timed_out")
             return None
-        except (ValueError, RuntimeError):
-            return None
+
+    def _count(self, name):
+        with self._counting:
+            setattr(self, name, getattr(self, name) + 1)
 
     def coverage(self, design):
         """Share of the mesh's (sampled) vertices within COVERAGE_RADIUS * S of a contour point."""
@@ -306,9 +313,11 @@ def nearby(vertices, faces, planes, material, settings, want=1, budget=BUDGET_SE
         costs = sorted(c["cost"] for c in found)
         return costs[want - 1] if len(costs) >= want else math.inf
 
-    def solve(cost, changes, placements, design):
-        solved = s.solve(design)
-        if solved is None or not solved["stable"]:
+    def take(tag, solved):
+        """A full solve's answer, in the order one thread would have solved them: one that one
+        thread would not have solved (it no longer beats the bar) is dropped."""
+        cost, changes, placements = tag
+        if cost >= bar() or solved is None or not solved["stable"]:
             return
         found.append({"planes": placements, "changes": [t for _, c in changes for t in c.changes], "cost": cost,
                       "score": -cost, "design": solved, "figures": _figures(solved)})
@@ -316,24 +325,28 @@ def nearby(vertices, faces, planes, material, settings, want=1, budget=BUDGET_SE
                               f"(cost {cost:.3f}, {s.screened} screened, {s.full_solves} solved)")
 
     def phase(options):
+        # Full solves run on s.workers threads while the next candidates are screened; their
+        # answers are taken in order (core/ordered.py), so what is found is what one thread finds.
         deferred = []
-        for cost, changes in options:
-            if cost >= bar() or out_of_time():
-                break
-            placements = list(base)
-            for i, c in changes:
-                placements[i] = c
-            ok, design, close = s.screen(placements)
-            if not ok:
-                continue
-            if close:
-                deferred.append((cost, changes, placements, design))
-            else:
-                solve(cost, changes, placements, design)
-        for cost, changes, placements, design in deferred:
-            if cost >= bar() or out_of_time():
-                break
-            solve(cost, changes, placements, design)
+        with InOrder(take, s.workers) as pool:
+            for cost, changes in options:
+                if cost >= bar() or out_of_time():
+                    break
+                placements = list(base)
+                for i, c in changes:
+                    placements[i] = c
+                ok, design, close = s.screen(placements)
+                if not ok:
+                    continue
+                if close:
+                    deferred.append((cost, changes, placements, design))
+                else:
+                    pool.submit((cost, changes, placements), s.solve, design)
+            pool.drain()
+            for cost, changes, placements, design in deferred:
+                if cost >= bar() or out_of_time():
+                    break
+                pool.submit((cost, changes, placements), s.solve, design)
 
     phase([(0.0, ())] + sorted(((c.cost, ((i, c),)) for i, cs in singles.items() for c in cs), key=lambda t: t[0]))
     if len(found) < want and not out_of_time():  # pairs of one-plane changes of two planes
@@ -411,18 +424,23 @@ def auto(vertices, faces, count, material, settings, want=2, budget=3 * BUDGET_S
             break
     screened.sort(key=lambda t: -t[0])
     found = []
-    for cover, counts, axes, rule, placements, design in screened:
-        if len(found) >= want or time.perf_counter() - start > budget:
-            break
-        solved = s.solve(design)
-        if solved is None or not solved["stable"]:
-            continue
+
+    def take(tag, solved):  # in coverage order, as one thread would: past `want` found, dropped
+        cover, counts, axes, rule, placements, _design = tag
+        if len(found) >= want or solved is None or not solved["stable"]:
+            return
         score = cover - FIDELITY_WEIGHT * s.max_deviation(solved) / s.size
         found.append({"planes": placements, "changes": [f"{len(placements)} planes: " + ", ".join(
             f"{n} along {_axis_word(axes[k], k)}" for k, n in enumerate(counts) if n)
             + ("" if rule == "largest" else ", every contour")],
             "cost": 0.0, "score": score, "coverage": cover, "design": solved, "figures": _figures(solved)})
         s.say("plane_search", f"candidate {len(found)}: {found[-1]['changes'][0]} (score {score:.3f})")
+
+    with InOrder(take, s.workers) as pool:
+        for item in screened:
+            if len(found) >= want or time.perf_counter() - start > budget:
+                break
+            pool.submit(item, s.solve, item[-1])
     # a design whose assembly needs two wires placed at once (two_hand_steps) comes after every
     # design that can be built one wire at a time, whatever its score
     found.sort(key=lambda c: (bool(c["design"].get("two_hand_steps")), -c["score"]))
