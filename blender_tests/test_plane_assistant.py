@@ -149,7 +149,7 @@ class FindStablePlanes(Case):
                 self.assertLess(np.abs((np.asarray(lines) - p.origin) @ np.asarray(p.normal)).max(), 1e-6)
                 np.testing.assert_allclose(np.mean(lines, axis=0), p.origin, atol=1e-6)
         log = draw(panel.VIEW3D_PT_wiresculpt_planes, bpy.context)
-        pressed = [kw.get("depress") for name, _a, kw in log if name == "operator" and kw.get("text") == "Preview"]
+        pressed = [kw.get("depress") for name, a, kw in log if name == "operator" and a == ("wiresculpt.preview_planes",)]
         self.assertEqual(pressed, [k == len(candidates) - 1 for k in range(len(candidates))])
         self.assertIn("wiresculpt.preview_planes_clear", [a[0] for name, a, _kw in log if name == "operator" and a])
         # a second click on the shown candidate hides it; Clear hides it too

@@ -104,16 +104,16 @@ def draw_live():
 
 
 def draw_candidate(preview):
-    """The previewed candidate's wires (thicker than Live's) and the outlines of its moved planes."""
+    """The previewed candidate's wires (thicker than Live's) and the outlines of its moved planes,
+    over everything (no depth test: the wires of the scene's own design would hide them)."""
     shader = uniform_colour_shader()
     shader.bind()
-    for width, depth, segments in ((2.5, 'LESS_EQUAL', preview["wires"]), (1.5, 'NONE', preview["planes"])):
+    gpu.state.depth_test_set('NONE')
+    for width, segments in ((3.0, preview["wires"]), (1.5, preview["planes"])):
         gpu.state.line_width_set(width)
-        gpu.state.depth_test_set(depth)
         for colour, lines in segments:
             shader.uniform_float("color", colour)
             batch_for_shader(shader, 'LINES', {"pos": lines}).draw(shader)
-    gpu.state.depth_test_set('NONE')
     gpu.state.line_width_set(1.0)
     plane_search.DRAWN[0] += 1
 

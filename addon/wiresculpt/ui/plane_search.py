@@ -1,6 +1,6 @@
 """The plane assistant's panel (issue 15), under the Wire panel: Find Stable Planes, Suggest
-Planes, and up to three candidates with what changes, their figures, Preview (pressed while shown)
-and Apply."""
+Planes, and up to three candidates with what changes, their figures, Preview (an eye, pressed while
+shown) and Apply."""
 import bpy
 
 from .. import native
@@ -46,7 +46,9 @@ class VIEW3D_PT_wiresculpt_planes(bpy.types.Panel):
             for i, line in enumerate(candidate_lines(candidate)):
                 wrap_labels(box, context, line, icon='CHECKMARK' if i == 0 else 'NONE')
             row = box.row(align=True)
-            row.operator(ops.WIRESCULPT_OT_preview_planes.bl_idname, text="Preview", icon='HIDE_OFF',
+            # the eye alone (its tooltip says what it does): "Preview" beside "Apply candidate k"
+            # would cut both labels in a sidebar of the default width
+            row.operator(ops.WIRESCULPT_OT_preview_planes.bl_idname, text="", icon='HIDE_OFF',
                          depress=shown == k).index = k
             row.operator(ops.WIRESCULPT_OT_apply_planes.bl_idname, text=f"Apply candidate {k + 1}").index = k
         if shown is not None:
