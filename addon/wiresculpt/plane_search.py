@@ -166,7 +166,7 @@ class Searcher:
         self.cache = {}
         self.mesh_info = None  # the slicer's report on the mesh (stages.slicing.mesh), from its first call
         self.screened = self.full_solves = self.timed_out = self.failed = 0
-        self.workers = ordered.WORKERS  # full solves at once (1: the search on one thread)
+        self.workers = ordered.workers()  # full solves at once (1: the search on one thread)
         self._counting = threading.Lock()  # solve() runs on the pool's threads
         self.deadline = math.inf  # perf_counter() time at which a full solve is stopped (the budget)
         self.budget = None  # seconds

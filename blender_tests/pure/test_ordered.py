@@ -2,7 +2,9 @@
 plane assistant relies on to find what one thread finds), errors raised at their turn."""
 import threading
 import unittest
+from unittest import mock
 
+from wiresculpt.core import ordered
 from wiresculpt.core.ordered import InOrder
 
 
@@ -57,6 +59,27 @@ class TakenInOrder(unittest.TestCase):
                 pool.submit(2, lambda: 2)
                 pool.drain()
         self.assertEqual(taken, [0])
+
+
+class Workers(unittest.TestCase):
+    """Two at once only when the load average leaves a core idle."""
+
+    def load(self, cores, load):
+        with mock.patch("os.cpu_count", return_value=cores), mock.patch("os.getloadavg", return_value=(load, 0, 0)):
+            return ordered.workers()
+
+    def test_a_spare_core_gives_two(self):
+        self.assertEqual(self.load(2, 0.3), 2)
+        self.assertEqual(self.load(2, 1.0), 2)
+        self.assertEqual(self.load(8, 5.0), 2)  # never more than WORKERS
+
+    def test_no_spare_core_gives_one(self):
+        self.assertEqual(self.load(2, 1.2), 1)
+        self.assertEqual(self.load(2, 10.0), 1)
+
+    def test_no_load_average_gives_two(self):
+        with mock.patch("os.getloadavg", side_effect=OSError):
+            self.assertEqual(ordered.workers(), 2)
 
 
 if __name__ == "__main__":

@@ -173,15 +173,15 @@ class Nearby(unittest.TestCase):
             self.assertAlmostEqual(c["cost"], cost, delta=1e-9)
 
     def test_two_threads_find_what_one_thread_finds(self):
-        """The full solves run on core/ordered.WORKERS threads; the candidates, their order, changes,
+        """The full solves run on core/ordered.workers() threads; the candidates, their order, changes,
         costs and designs (all but the timings) are those of the search on one thread."""
         def search(workers):
-            saved, ordered.WORKERS = ordered.WORKERS, workers
+            saved, ordered.workers = ordered.workers, lambda most=None: workers  # whatever the load
             try:
                 found, searcher, _start = plane_search.nearby(self.V, self.F, HINGE, PRESETS["steel"],
                                                               settings(plane_search="nearby"), want=3, budget=600.0)
             finally:
-                ordered.WORKERS = saved
+                ordered.workers = saved
             self.assertEqual(searcher.workers, workers)
             return [(c["changes"], c["cost"], [p.as_dict() for p in c["planes"]], c["figures"],
                      untimed(round_trip(c["design"]))) for c in found]

@@ -5,12 +5,28 @@ thread, while the next piece of work already runs.
 Sound for the solver's calls because the native module releases the GIL in its slicing,
 layering, target-shape and forces calls and GLPK (the LPs of layering and forces) keeps its
 environment per thread (Debian 12's libglpk 5.0 is built with _Thread_local:
-native/tests/test_lp.cpp "two threads ..."; docs/method-plane-search.md).
+native/tests/test_lp.cpp "two threads ..."; docs/robustness.md, "GLPK on two threads").
 """
 import collections
+import os
 from concurrent.futures import ThreadPoolExecutor
 
-WORKERS = 2  # this machine's cores; each full solve also runs its target shape on two threads
+WORKERS = 2  # at most; each full solve also runs its target shape on two threads
+
+
+def workers(most=None):
+    """How many pieces of work to run at once: `most` (default WORKERS), but one when the machine
+    has no core to spare (the 1-minute load average leaves less than one of its cores idle). The
+    answers do not depend on it (InOrder takes them in order); only the time does. Measured on the
+    hinged globe (docs/performance.md, plane assistant): at load 10 on 2 cores, two solves at once
+    took 1.6x the time of one (their threads only queue behind the others', and the solves one
+    thread would not have run are extra work)."""
+    most = WORKERS if most is None else most
+    try:
+        idle = (os.cpu_count() or 1) - os.getloadavg()[0]
+    except (AttributeError, OSError):  # no load average on this system
+        return most
+    return most if idle >= 1.0 else 1
 
 
 class InOrder:
