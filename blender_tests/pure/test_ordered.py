@@ -30,12 +30,18 @@ class TakenInOrder(unittest.TestCase):
             self.assertTrue(second_ended.wait(30))
         self.assertEqual(taken, [(1, "first"), (2, "second")])
 
-    def test_one_worker_takes_each_result_before_the_next_submit_returns(self):
-        taken = []
+    def test_one_worker_runs_each_piece_on_the_callers_thread_before_submit_returns(self):
+        taken, threads = [], set()
+
+        def square(k):
+            threads.add(threading.get_ident())
+            return k * k
+
         with InOrder(lambda tag, result: taken.append(result), workers=1) as pool:
             for k in range(5):
-                pool.submit(k, lambda k=k: k * k)
+                pool.submit(k, square, k)
                 self.assertEqual(taken, [j * j for j in range(k + 1)])
+        self.assertEqual(threads, {threading.get_ident()})
 
     def test_two_workers_keep_at_most_two_pending(self):
         taken = []
@@ -62,16 +68,19 @@ class TakenInOrder(unittest.TestCase):
 
 
 class Workers(unittest.TestCase):
-    """Two at once only when the load average leaves a core idle."""
+    """Two at once (when asked for) only when the load average leaves a core idle."""
 
-    def load(self, cores, load):
+    def load(self, cores, load, most=2):
         with mock.patch("os.cpu_count", return_value=cores), mock.patch("os.getloadavg", return_value=(load, 0, 0)):
-            return ordered.workers()
+            return ordered.workers(most)
+
+    def test_the_default_is_workers(self):
+        self.assertEqual(self.load(8, 0.0, None), ordered.WORKERS)
 
     def test_a_spare_core_gives_two(self):
         self.assertEqual(self.load(2, 0.3), 2)
         self.assertEqual(self.load(2, 1.0), 2)
-        self.assertEqual(self.load(8, 5.0), 2)  # never more than WORKERS
+        self.assertEqual(self.load(8, 5.0), 2)  # never more than asked for
 
     def test_no_spare_core_gives_one(self):
         self.assertEqual(self.load(2, 1.2), 1)
@@ -79,7 +88,7 @@ class Workers(unittest.TestCase):
 
     def test_no_load_average_gives_two(self):
         with mock.patch("os.getloadavg", side_effect=OSError):
-            self.assertEqual(ordered.workers(), 2)
+            self.assertEqual(ordered.workers(2), 2)
 
 
 if __name__ == "__main__":

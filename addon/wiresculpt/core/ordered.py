@@ -11,16 +11,18 @@ import collections
 import os
 from concurrent.futures import ThreadPoolExecutor
 
-WORKERS = 2  # at most; each full solve also runs its target shape on two threads
+# One: measured on the hinged globe (docs/performance.md, "Two solves at once"), two full solves
+# at once found the same candidates but cost 1.5-1.9x the CPU time (the solves one thread would
+# not have started are the expensive ones, and each solve already runs its target shape on two
+# threads), so the search took longer at every load this shared machine had (3-10). Set 2 to run
+# them two at once (tests do).
+WORKERS = 1
 
 
 def workers(most=None):
     """How many pieces of work to run at once: `most` (default WORKERS), but one when the machine
     has no core to spare (the 1-minute load average leaves less than one of its cores idle). The
-    answers do not depend on it (InOrder takes them in order); only the time does. Measured on the
-    hinged globe (docs/performance.md, plane assistant): at load 10 on 2 cores, two solves at once
-    took 1.6x the time of one (their threads only queue behind the others', and the solves one
-    thread would not have run are extra work)."""
+    answers do not depend on it (InOrder takes them in order); only the time does."""
     most = WORKERS if most is None else most
     try:
         idle = (os.cpu_count() or 1) - os.getloadavg()[0]
@@ -30,9 +32,10 @@ def workers(most=None):
 
 
 class InOrder:
-    """`submit(tag, fn, *args)` runs fn(*args) on a worker; `take(tag, result)` (given to the
-    constructor) is called on the submitting thread with each result in submission order. At most
-    `workers` pieces of work are in flight: submit waits for (and takes) the oldest beyond that.
+    """`submit(tag, fn, *args)` runs fn(*args) on a worker (with one worker: at once, on the caller's
+    thread); `take(tag, result)` (given to the constructor) is called on the submitting thread with
+    each result in submission order. At most `workers` pieces of work are pending when submit
+    returns: it waits for (and takes) the oldest beyond that.
     An exception raised by a piece of work is raised from submit/drain when its turn comes; the
     work still in flight is then waited for (it should watch the same cancel as the caller).
     Use as a context manager: leaving it drains what is left unless an exception is on its way."""
@@ -41,11 +44,15 @@ class InOrder:
         self.take = take
         self.workers = max(1, int(workers))
         self.pending = collections.deque()
-        self.pool = ThreadPoolExecutor(max_workers=self.workers, thread_name_prefix=name)
+        # one worker: the work runs here, on the caller's thread, as a plain loop would run it
+        self.pool = ThreadPoolExecutor(max_workers=self.workers, thread_name_prefix=name) if self.workers > 1 else None
 
     def submit(self, tag, fn, *args):
+        if self.pool is None:
+            self.take(tag, fn(*args))
+            return
         self.pending.append((tag, self.pool.submit(fn, *args)))
-        while len(self.pending) >= self.workers + 1 or (self.workers == 1 and self.pending):
+        while len(self.pending) >= self.workers + 1:
             self._take_oldest()
 
     def _take_oldest(self):
@@ -67,5 +74,6 @@ class InOrder:
             for _tag, future in self.pending:
                 future.cancel()  # not started yet: never started
             self.pending.clear()
-            self.pool.shutdown(wait=True)
+            if self.pool is not None:
+                self.pool.shutdown(wait=True)
         return False
