@@ -194,6 +194,7 @@ class SuggestPlanes(Case):
         if not native.available():
             self.skipTest(native.LOAD_ERROR)
         ops.RESULT = None
+        ops.PREVIEW = None
         globe_target()
 
     def test_suggest_then_apply_adds_ordinary_planes(self):
@@ -204,7 +205,16 @@ class SuggestPlanes(Case):
         for c in candidates:
             self.assertEqual(len(c["planes"]), 4)
             self.assertEqual(recheck.recheck(json.loads(json.dumps(c["design"]))), [])
+        # the preview of a suggestion outlines every plane it would add, and adds none
+        self.assertEqual(bpy.ops.wiresculpt.preview_planes(index=0), {'FINISHED'})
+        self.assertEqual(handles(bpy.context.scene), [])
+        self.assertEqual(len(ops.PREVIEW["planes"]), 4)
+        for (_colour, lines), p in zip(ops.PREVIEW["planes"], candidates[0]["planes"]):
+            np.testing.assert_allclose(np.mean(lines, axis=0), p.origin, atol=1e-6)
+            self.assertLess(np.abs((np.asarray(lines) - p.origin) @ np.asarray(p.normal)).max(), 1e-6)
+        self.assertEqual(len(ops.PREVIEW["wires"]), len(candidates[0]["design"]["wires"]))
         self.assertEqual(bpy.ops.wiresculpt.apply_planes(index=0), {'FINISHED'})
+        self.assertIsNone(ops.PREVIEW)
         added = handles(bpy.context.scene)
         self.assertEqual(len(added), 4)
         self.assertEqual(len(wire_names()), len(candidates[0]["design"]["wires"]))
