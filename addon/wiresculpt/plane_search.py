@@ -16,17 +16,23 @@ Two searches:
   +-{2, 4, 7, 10, 15, 20} % of S, tilts of 5, 10, 15 deg about two axes each way, the other
   contour rule), then pairs of one-plane changes of two different planes, tried in order of cost.
 - `auto(...)`: planes from the mesh alone: `count` planes in families along the mesh's principal
-  axes (area-weighted), each family spread evenly over the mesh's extent along its axis (one plane
-  of a family goes through the centre: the mesh's symmetry plane when it has one). Candidates are
-  the ways to split `count` over the three axes (at least two families), each with four spreads
-  (SPREADS), in the principal frame and the world's, solved in order of coverage.
+  axes (area-weighted) or the world's, each family spread over the mesh's extent along its axis or
+  over the quantiles of its surface area (family_planes), for every split of `count` over the three
+  axes (balanced first) and every spread of SPREADS; each with the largest contour of every plane,
+  and, when that fails the screen, the contours of the crossing network's largest connected part
+  without hinged wires (Searcher.connected). Screened proposals are verified fewest crossings
+  closer than 2 * min_segment along a wire first (close_gaps), then by coverage; budget
+  auto_budget(count) = AUTO_SECONDS_PER_PLANE * count.
 
 Every candidate is screened cheaply first: slicing (each plane placement sliced once, cached) and
 the layering (stages.layering), whose first step is the hook-relaxed stability check (every
 crossing a ball joint: a mechanism is rejected in about a millisecond) and whose search then
 finds the hooks. Only survivors run the full pipeline (pipeline.solve: target shape, forces, rest
-shape, buildability), and a candidate is returned only when that says stable (which means
-buildable, fab/buildability).
+shape, buildability) with the layering's own hooks (CANDIDATE_HOOK_PATTERNS), and a candidate is
+returned only when that says stable (which means buildable, fab/buildability). The returned
+design then gets the comparison of hook patterns by their forces (Searcher.finish), bounded by
+FINAL_HOOK_SECONDS / FINAL_SECONDS; when that does not end stable in time, the verified design
+is kept.
 
 Score of a returned candidate (documented in docs/formats.md, higher is better):
 
