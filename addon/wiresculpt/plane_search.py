@@ -69,6 +69,7 @@ AUTO_SECONDS_PER_PLANE = 6.0  # auto's search budget: this many seconds per plan
 # stable in time, the verified design (stable and buildable with the layering's hooks) is returned.
 CANDIDATE_HOOK_PATTERNS = 1
 EARLY_SOLVES = 3  # auto verifies as soon as this many screened proposals have no close gap
+SCREEN_SECONDS = 2.0  # a screen's layering longer than this does not pass (a search of many contours)
 FINAL_HOOK_SECONDS = 10.0
 FINAL_SECONDS = 20.0
 
@@ -249,10 +250,12 @@ class Searcher:
             return False, None, None  # refused, or its layering ran past the deadline
 
     def _layer(self, probe, design):
-        """layering.run on `probe`, stopped (native.Cancelled) by a cancel or past the deadline: a
-        layering search can take many seconds on a network of many small contours."""
+        """layering.run on `probe`, stopped (native.Cancelled) by a cancel, past the deadline or
+        after SCREEN_SECONDS: a layering search can take many seconds on a network of many small
+        contours (elephant, N = 6: one took the whole screening time), and a screen is to be cheap."""
+        stop = min(self.deadline, time.perf_counter() + SCREEN_SECONDS)
         layering.run(probe, self.material, self.settings_for(design),
-                     lambda _stage, _fraction: not (self.cancel() or time.perf_counter() > self.deadline))
+                     lambda _stage, _fraction: not (self.cancel() or time.perf_counter() > stop))
 
     def connected(self, placements):
         """The placements with, for each plane, the contours ("all" of them) that belong to the
@@ -613,12 +616,13 @@ def auto(vertices, faces, count, material, settings, want=2, budget=None, progre
         passed += len(batch)
         return batch, False
 
-    more, pool = True, []
+    more, pool, first = True, [], True
     while more and len(found) < want and time.perf_counter() - start < budget:
         # screening up to half the budget at first, later up to half of what is left; verifying the
         # pool (fewest close gaps first) after each round
         now = time.perf_counter()
-        batch, more = screen_some(start + budget / 2 if not s.full_solves else now + (start + budget - now) / 2)
+        batch, more = screen_some(start + budget / 2 if first else now + (start + budget - now) / 2)
+        first = False
         s.deadline = start + budget
         pool = sorted(pool + batch, key=lambda t: t[:2])
         s.say("plane_search", f"{passed} of {s.screened} proposals pass the screen; "
