@@ -4,10 +4,11 @@ planes as given ("off"), then `plane_search: "nearby"`; and for every mesh `plan
 with N planes. Every stable design is re-checked (blender_tests/pure/recheck.py). Prints a
 Markdown table and writes JSON; with --section FILE (docs/performance.md) also writes the table
 between FILE's `<!-- planes:begin -->` and `<!-- planes:end -->`, keeping the section's hand-written
-notes (from `<!-- planes:notes -->` on).
+notes (from `<!-- planes:notes -->` on). --out also records the load average at the start and
+end and the commit; --from-json FILE redoes the table and section from such a file, without a run.
 
     python3.11 scripts/plane_search_corpus.py [--cache build/corpus] [--size 0.5] [--counts 5] [--out FILE]
-                                              [--section FILE] [NAME...]
+                                              [--section FILE] [--from-json FILE] [NAME...]
 """
 import argparse
 import datetime
@@ -67,7 +68,10 @@ def table(rows, counts):
              "|---|---|---|---|" + "---|" * len(counts)]
     for row in rows:
         nb = row["nearby"]
-        change = "; ".join(nb.get("changes") or []) or "kept as given" if nb["stable"] else nb["reason"][-90:]
+        first = nb["reason"].split("; no nearby placement")[0]
+        change = ("; ".join(nb.get("changes") or []) or "kept as given" if nb["stable"] else
+                  f"*{first[:100]}{'…' if len(first) > 100 else ''}*"
+                  + (" (budget reached)" if "budget" in nb["reason"] else ""))
         autos = " | ".join(f"{verdict(row[f'auto{n}'])} ({row[f'auto{n}']['seconds']:.1f}, "
                            f"{row[f'auto{n}'].get('candidates', '-')} / {row[f'auto{n}'].get('full_solves', '-')})"
                            for n in counts)
@@ -76,7 +80,15 @@ def table(rows, counts):
     return lines
 
 
-def section(path, rows, counts, args, load):
+def head_commit():
+    try:
+        return subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
+                              text=True).stdout.strip() or "?"
+    except OSError:
+        return "?"
+
+
+def section(path, rows, counts, args, load, commit):
     """Writes the table and the run's header between the planes markers of `path`, keeping the
     notes after `<!-- planes:notes -->` of the section as it was."""
     with open(path, encoding="utf-8") as f:
@@ -90,11 +102,6 @@ def section(path, rows, counts, args, load):
     unstable = sum(1 for r in rows if not r["off"]["stable"])
     rechecked = sum(1 for r in rows for k in ["nearby"] + [f"auto{n}" for n in counts] if r[k]["stable"])
     failed = sum(1 for r in rows for k in ["nearby"] + [f"auto{n}" for n in counts] if r[k].get("recheck"))
-    try:
-        commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
-                                text=True).stdout.strip()
-    except OSError:
-        commit = "?"
     head = [BEGIN, "## Plane assistant on the real-mesh corpus (issue 15)", "",
             f"`scripts/bench planes --size {args.size} --counts {args.counts} --section docs/performance.md` "
             f"({datetime.date.today().isoformat()}, commit {commit}; `scripts/plane_search_corpus.py`, in-process with "
@@ -121,12 +128,20 @@ def main(argv):
     parser.add_argument("--counts", default="5")
     parser.add_argument("--out", default=None)
     parser.add_argument("--section", default=None, help="write the table into this file's planes section")
+    parser.add_argument("--from-json", default=None, help="no run: the rows of an earlier --out (its load average "
+                                                          "is recorded in it)")
     parser.add_argument("names", nargs="*")
     args = parser.parse_args(argv)
     folder = os.path.join(args.cache, "scenes")
     counts = [int(c) for c in args.counts.split(",") if c.strip()]  # --counts "": nearby only
     rows, load = [], [os.getloadavg()[0]]
-    for name in sorted(os.listdir(folder)):
+    if args.from_json:
+        with open(args.from_json) as f:
+            saved = json.load(f)
+        rows, load, commit = saved["rows"], saved["load"], saved["commit"]
+    else:
+        commit = head_commit()  # the code that ran
+    for name in ([] if args.from_json else sorted(os.listdir(folder))):
         mesh, config, size = name[:-5].rsplit("-", 2)
         if config != "zzxxy5" or size != args.size or (args.names and mesh not in args.names):
             continue
@@ -138,13 +153,14 @@ def main(argv):
             row[f"auto{n}"] = one(V, F, [], scene, plane_search="auto", plane_count=n)
         rows.append(row)
         print(json.dumps(row)[:600], flush=True)
+    if not args.from_json:
+        load.append(os.getloadavg()[0])
     if args.out:
         with open(args.out, "w") as f:
-            json.dump(rows, f, indent=1)
-    load.append(os.getloadavg()[0])
+            json.dump({"rows": rows, "load": load, "commit": commit}, f, indent=1)
     print("\n" + "\n".join(table(rows, counts)))
     if args.section:
-        section(args.section, rows, counts, args, load)
+        section(args.section, rows, counts, args, load, commit)
 
 
 if __name__ == "__main__":
