@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "nlopt_text.hpp"
+#include "target_shape_newton.hpp"
 #include "wiresculpt/error.hpp"
 
 namespace wiresculpt {
@@ -613,6 +614,8 @@ std::array<int, 3> constraint_points(const TargetShapeProblem::Constraint& c, in
 // callback takes the GIL, and polled at every evaluation (20-100 µs each) it serialised the wires
 // that the pipeline solves on two threads. 16 evaluations are at most a few milliseconds.
 constexpr int kProgressEvery = 16;
+// Newton iterations before the SLSQP windows take over (a converging wire needs 15-40).
+constexpr int kNewtonIterations = 100;
 
 double objective(unsigned, const double* x, double* g, void* data) {
   auto* d = static_cast<SolverData*>(data);
@@ -670,6 +673,7 @@ nlopt::algorithm nlopt_algorithm(TargetShapeAlgorithm a) {
     case TargetShapeAlgorithm::auglag_lbfgs: return nlopt::AUGLAG;
     case TargetShapeAlgorithm::ccsaq: return nlopt::LD_CCSAQ;
     case TargetShapeAlgorithm::mma: return nlopt::LD_MMA;
+    case TargetShapeAlgorithm::newton: return nlopt::LD_SLSQP;  // its fallback
   }
   return nlopt::LD_SLSQP;
 }
@@ -866,7 +870,22 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     return moved;
   };
 
-  if (blocks.size() == 1) {
+  // Newton on the whole wire; where it does not converge, the SLSQP windows from the same start.
+  int newton_evaluations = 0;
+  bool newton_done = false;
+  if (o.algorithm == TargetShapeAlgorithm::newton) {
+    const detail::NewtonOutcome nt = detail::newton_target_shape(problem, data.p, data.scale_x, data.scale_f,
+                                                                 o.constraint_tol, kNewtonIterations, progress);
+    newton_evaluations = nt.evaluations;
+    if (nt.converged) {
+      data.p = nt.points;
+      newton_done = true;
+      result.sweeps = 1;
+      result.nlopt_result = "NEWTON_CONVERGED";
+    }
+  }
+  if (newton_done) {
+  } else if (blocks.size() == 1) {
     solve_block(blocks[0]);
     result.sweeps = 1;
   } else if (!blocks.empty()) {
@@ -922,7 +941,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     result.warnings.push_back("wire " + w + ": the target shape stopped at its time budget of " + fmt(o.max_seconds, 4) +
                               " s (max_seconds) before it converged");
   }
-  result.iterations = data.evaluations;
+  result.iterations = data.evaluations + newton_evaluations;
   p = data.p;
 
   // Measure the result.

@@ -600,3 +600,66 @@ TEST_CASE("target shape: a 3 m wire converges within the default evaluation budg
   CHECK(r.feasible);
   for (const auto& s : r.crossings) CHECK(s.status == "ok");
 }
+
+// ---------------------------------------------------------------------------------------------
+// The experimental Newton method (algorithm = newton, not the default; docs/method-target-shape.md,
+// "Issue 17, round 2"): checked against the SLSQP path, an independent solver of the same problem.
+
+namespace {
+Polyline2 ellipse(int n) {
+  Polyline2 contour;
+  for (int k = 0; k < n; ++k) {
+    const double t = 2 * pi * k / n;
+    contour.emplace_back(0.15 * std::cos(t), 0.09 * std::sin(t));
+  }
+  return contour;
+}
+}  // namespace
+
+TEST_CASE("target shape: Newton reaches SLSQP's optimum where SLSQP converges", "[target]") {
+  // The ellipse with four crossings (two kinks inverted; one block) and the 1.3 m wavy loop (five
+  // crossings; SLSQP in windows, Newton on the whole wire).
+  const Polyline2 oval = ellipse(1200);
+  std::vector<TargetCrossing> oval_xs;
+  for (int k = 0; k < 4; ++k) {
+    const int v = k * 1200 / 4 + 37;
+    oval_xs.push_back({v, (k % 2 ? -1.0 : 1.0) * oval[v].normalized(), 2 * pi / 3, true});
+  }
+  const auto [loop, loop_xs] = wavy_loop();
+  for (const auto& [contour, xs] : {std::make_pair(oval, oval_xs), std::make_pair(loop, loop_xs)}) {
+    TargetShapeOptions slsqp, newton;
+    newton.algorithm = TargetShapeAlgorithm::newton;
+    slsqp.sweep_tol = 1e-9;  // windows run until nothing moves by 1 nm
+    const TargetShapeResult a = optimize_target_shape(contour, true, xs, slsqp);
+    const TargetShapeResult b = optimize_target_shape(contour, true, xs, newton);
+    REQUIRE(b.nlopt_result == "NEWTON_CONVERGED");
+    REQUIRE(a.points.size() == b.points.size());
+    CHECK(b.energy == Approx(a.energy).epsilon(1e-6));
+    CHECK(b.energy <= a.energy * (1 + 1e-9));
+    double worst = 0.0;
+    for (std::size_t i = 0; i < a.points.size(); ++i) worst = std::max(worst, (a.points[i] - b.points[i]).norm());
+    CHECK(worst < 1e-4);  // 0.1 mm: the optimum is flat along the wire
+    CHECK(std::abs(a.max_distance - b.max_distance) < 1e-5);
+    CHECK(b.feasible);
+    check_constraints(b, true, xs, newton, 1e-6);
+    for (const auto& s : b.crossings) CHECK(s.status == "ok");
+  }
+}
+
+TEST_CASE("target shape: where Newton cannot converge the wire is solved by the SLSQP windows", "[target]") {
+  // Two crossings whose contact cones ask the one free point between them to be above and below
+  // the wire: no feasible point, so Newton cannot meet its stopping test and the SLSQP path (from the
+  // same start) decides, with the same points and statuses as the SLSQP option.
+  const Polyline2 contour = line(0.3, 301);
+  const std::vector<TargetCrossing> xs{{100, Vec2(0, 1), 2 * pi / 3, true}, {131, Vec2(0, -1), 2 * pi / 3, true}};
+  TargetShapeOptions slsqp, newton;
+  newton.algorithm = TargetShapeAlgorithm::newton;
+  const TargetShapeResult a = optimize_target_shape(contour, false, xs, slsqp);
+  const TargetShapeResult b = optimize_target_shape(contour, false, xs, newton);
+  CHECK(b.nlopt_result == a.nlopt_result);
+  CHECK(b.iterations > a.iterations);  // Newton's evaluations are counted too
+  REQUIRE(a.points.size() == b.points.size());
+  for (std::size_t i = 0; i < a.points.size(); ++i) CHECK(a.points[i] == b.points[i]);
+  for (std::size_t c = 0; c < xs.size(); ++c) CHECK(a.crossings[c].status == b.crossings[c].status);
+  CHECK_FALSE(b.feasible);
+}
