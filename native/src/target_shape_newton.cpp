@@ -2,6 +2,7 @@
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
 
 #include <algorithm>
 #include <cmath>
@@ -225,7 +226,7 @@ Eigen::VectorXd transposed_times(const std::vector<Row>& rows, const Eigen::Vect
 
 NewtonOutcome newton_target_shape(const TargetShapeProblem& problem, const Polyline2& start, double scale_x,
                                   double scale_f, double constraint_tol, int max_iterations,
-                                  const ProgressFn& progress) {
+                                  const ProgressFn& progress, double mu0) {
   NewtonOutcome out;
   out.points = start;
   Wire wire(problem, scale_x, scale_f);
@@ -244,7 +245,7 @@ NewtonOutcome newton_target_shape(const TargetShapeProblem& problem, const Polyl
   // Slacks s = -c where the start is strictly feasible, else small; λ = μ / s.
   // μ0 = 1e-3 (tried 1e-2 to 1e-8 on the duck's wires: none was faster or changed which optimum
   // is found everywhere; docs/method-target-shape.md).
-  double mu = 1e-3;
+  double mu = mu0;
   const double mu_min = 0.1 * constraint_tol, tol = constraint_tol, tau_min = 0.99;
   Eigen::VectorXd s(mc), lambda(mc);
   for (int k = 0; k < mc; ++k) {
@@ -388,6 +389,75 @@ NewtonOutcome newton_target_shape(const TargetShapeProblem& problem, const Polyl
     out.points = p;
   }
   out.points = p;
+  return out;
+}
+
+NewtonOutcome polish_target_shape(const TargetShapeProblem& problem, const Polyline2& start, double scale_x,
+                                  double scale_f, double constraint_tol, int max_iterations,
+                                  const ProgressFn& progress) {
+  NewtonOutcome out;
+  out.points = start;
+  Wire wire(problem, scale_x, scale_f);
+  const int n = wire.variables(), mc = wire.constraints();
+  if (n == 0) {
+    out.converged = true;
+    return out;
+  }
+  Polyline2 p = start;
+  Eigen::VectorXd x = wire.to_x(p), g, c;
+  std::vector<Row> rows;
+  wire.objective(p, &g);
+  wire.constraint_values(p, c, &rows);
+  ++out.evaluations;
+  std::vector<int> active;
+  for (int k = 0; k < mc; ++k)
+    if (c[k] > -1e-4) active.push_back(k);
+  const int na = static_cast<int>(active.size());
+  Eigen::VectorXd lambda = Eigen::VectorXd::Zero(mc);
+  std::vector<Triplet> triplets;
+  Eigen::SparseLU<SparseMatrix> lu;
+  SparseMatrix K(n + na, n + na);
+  for (int it = 0; it < max_iterations; ++it) {
+    report_progress(progress, "target_shape", std::min(1.0, static_cast<double>(it) / max_iterations));
+    out.iterations = it + 1;
+    triplets.clear();
+    wire.lagrangian_hessian(p, lambda, triplets);
+    Eigen::VectorXd rhs(n + na);
+    rhs.head(n) = -g;
+    for (int a = 0; a < na; ++a) {
+      const Row& r = rows[active[a]];
+      for (int j = 0; j < 6; ++j)
+        if (r.var[j] >= 0) {
+          triplets.emplace_back(n + a, r.var[j], r.val[j]);
+          triplets.emplace_back(r.var[j], n + a, r.val[j]);
+        }
+      rhs[n + a] = -c[active[a]];
+    }
+    K.setFromTriplets(triplets.begin(), triplets.end());
+    lu.compute(K);
+    if (lu.info() != Eigen::Success) return out;
+    const Eigen::VectorXd sol = lu.solve(rhs);
+    if (lu.info() != Eigen::Success || !sol.allFinite()) return out;
+    const Eigen::VectorXd dx = sol.head(n);
+    if (dx.lpNorm<Eigen::Infinity>() > 1.0) return out;  // more than l_min: not a polish
+    x += dx;
+    lambda.setZero();
+    for (int a = 0; a < na; ++a) lambda[active[a]] = sol[n + a];
+    wire.to_points(x, p);
+    wire.objective(p, &g);
+    wire.constraint_values(p, c, &rows);
+    ++out.evaluations;
+    const double dual = (g + transposed_times(rows, lambda, n)).lpNorm<Eigen::Infinity>();
+    double primal = 0.0;
+    for (int k : active) primal = std::max(primal, std::abs(c[k]));
+    if (dx.lpNorm<Eigen::Infinity>() <= 1e-9 && dual <= 1e-9 && primal <= constraint_tol) {
+      bool ok = lambda.minCoeff() >= -1e-10;
+      for (int k = 0; k < mc; ++k) ok = ok && c[k] <= constraint_tol;
+      out.converged = ok;
+      if (ok) out.points = p;
+      return out;
+    }
+  }
   return out;
 }
 

@@ -19,8 +19,18 @@ struct NewtonOutcome {
 
 /// Solves the problem from `start` (all points; fixed ones are kept). Variables are p / scale_x,
 /// the objective E / scale_f, as in the SLSQP path. Stops after `max_iterations` Newton
-/// iterations without convergence. Polls `progress` (stage "target_shape") every iteration.
+/// iterations without convergence. Polls `progress` (stage "target_shape") every iteration. `mu0`:
+/// the first barrier parameter (small when `start` is already close to an optimum).
 NewtonOutcome newton_target_shape(const TargetShapeProblem& problem, const Polyline2& start, double scale_x,
+                                  double scale_f, double constraint_tol, int max_iterations,
+                                  const ProgressFn& progress, double mu0 = 1e-3);
+
+/// Newton's method on the KKT conditions of the constraints active at `start` (c_k > -1e-4, taken
+/// as equalities), for a start already near an optimum (SLSQP stopped early): each iteration solves
+/// [W Aᵀ; A 0] [dx; λ] = [-∇f; -c] by sparse LU. Converged only when the step and the KKT residual
+/// vanish (tolerance constraint_tol), every active multiplier is >= 0 and every other constraint
+/// holds: then the point is a KKT point of the inequality problem. Otherwise not converged.
+NewtonOutcome polish_target_shape(const TargetShapeProblem& problem, const Polyline2& start, double scale_x,
                                   double scale_f, double constraint_tol, int max_iterations,
                                   const ProgressFn& progress);
 

@@ -57,6 +57,10 @@ enum class TargetShapeAlgorithm {
   /// where it does not converge (e.g. a kink that cannot be opened) the wire is solved by the
   /// SLSQP windows from the same start. See docs/method-target-shape.md, "Newton".
   newton,
+  /// Experimental: on a wire solved as one block, SLSQP stopped at ftol_rel 1e-6, then Newton's
+  /// method on the KKT conditions of the constraints active there (a polish to the nearby
+  /// optimum); windowed wires as slsqp. Where Newton does not converge, SLSQP from the start.
+  slsqp_newton,
 };
 
 struct TargetShapeOptions {
