@@ -51,9 +51,7 @@ TargetShapeOptions to_options(py::handle d) {
                              {{"slsqp", TargetShapeAlgorithm::slsqp},
                               {"auglag_lbfgs", TargetShapeAlgorithm::auglag_lbfgs},
                               {"ccsaq", TargetShapeAlgorithm::ccsaq},
-                              {"mma", TargetShapeAlgorithm::mma},
-                              {"newton", TargetShapeAlgorithm::newton},
-                              {"slsqp_newton", TargetShapeAlgorithm::slsqp_newton}})});
+                              {"mma", TargetShapeAlgorithm::mma}})});
   return o;
 }
 
@@ -94,7 +92,7 @@ void bind_target_shape(py::module_& m) {
 points: float64 (n, 2), metres; closed: bool; crossings: list of {"vertex": int (index into
 points), "bisector": (x, y) desired h*, "contact_angle": radians (default 2π/3), "active": bool
 (default True)}; options: dict of TargetShapeOptions fields (min_segment, max_bend, vertex_max_bend (radians per point of the result), spacing,
-regularization, friction, algorithm ("slsqp" | "auglag_lbfgs" | "ccsaq" | "mma" | "newton" | "slsqp_newton"), ftol_rel,
+regularization, friction, algorithm ("slsqp" | "auglag_lbfgs" | "ccsaq" | "mma"), ftol_rel,
 xtol_rel, constraint_tol, max_iterations (1..1e7), window (0 or 4..10000), sweep_tol, sweep_ftol ([0, 1)), max_sweeps
 (1..100000), max_seconds (wall-clock budget, (0, 86400], default 120), model_size,
 angle_tolerance, length_tolerance, wire_name); progress: optional callable(stage, fraction) ->

@@ -13,7 +13,6 @@
 #include <vector>
 
 #include "nlopt_text.hpp"
-#include "target_shape_newton.hpp"
 #include "wiresculpt/error.hpp"
 
 namespace wiresculpt {
@@ -614,11 +613,6 @@ std::array<int, 3> constraint_points(const TargetShapeProblem::Constraint& c, in
 // callback takes the GIL, and polled at every evaluation (20-100 µs each) it serialised the wires
 // that the pipeline solves on two threads. 16 evaluations are at most a few milliseconds.
 constexpr int kProgressEvery = 16;
-// Newton iterations before the SLSQP windows take over (a converging wire needs 15-40).
-constexpr int kNewtonIterations = 100;
-// slsqp_newton: the SLSQP energy tolerance before Newton takes over.
-constexpr double kRoughFtol = 1e-6;
-constexpr int kPolishIterations = 20;
 
 double objective(unsigned, const double* x, double* g, void* data) {
   auto* d = static_cast<SolverData*>(data);
@@ -676,8 +670,6 @@ nlopt::algorithm nlopt_algorithm(TargetShapeAlgorithm a) {
     case TargetShapeAlgorithm::auglag_lbfgs: return nlopt::AUGLAG;
     case TargetShapeAlgorithm::ccsaq: return nlopt::LD_CCSAQ;
     case TargetShapeAlgorithm::mma: return nlopt::LD_MMA;
-    case TargetShapeAlgorithm::newton: return nlopt::LD_SLSQP;  // its fallback
-    case TargetShapeAlgorithm::slsqp_newton: return nlopt::LD_SLSQP;
   }
   return nlopt::LD_SLSQP;
 }
@@ -798,7 +790,6 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
   auto out_of_time = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() >= o.max_seconds;
   };
-  double ftol = o.ftol_rel;  // of the blocks' SLSQP solves
   auto solve_block = [&](const Block& b) {
     const unsigned nvar = static_cast<unsigned>(2 * b.points.size());
     data.block = &b;
@@ -815,7 +806,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     opt.set_min_objective(objective, &data);
     if (!b.constraints.empty())
       opt.add_inequality_mconstraint(constraints_fn, &data, std::vector<double>(b.constraints.size(), o.constraint_tol));
-    opt.set_ftol_rel(ftol);
+    opt.set_ftol_rel(o.ftol_rel);
     opt.set_xtol_rel(o.xtol_rel);
     opt.set_maxeval(std::max(1, o.max_iterations - data.evaluations));
     // The wall-clock budget of the whole call (max_seconds), shared by every block.
@@ -875,43 +866,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     return moved;
   };
 
-  // Newton on the whole wire; where it does not converge, the SLSQP windows from the same start.
-  int newton_evaluations = 0;
-  bool newton_done = false;
-  if (o.algorithm == TargetShapeAlgorithm::newton) {
-    const detail::NewtonOutcome nt = detail::newton_target_shape(problem, data.p, data.scale_x, data.scale_f,
-                                                                 o.constraint_tol, kNewtonIterations, progress);
-    newton_evaluations = nt.evaluations;
-    if (nt.converged) {
-      data.p = nt.points;
-      newton_done = true;
-      result.sweeps = 1;
-      result.nlopt_result = "NEWTON_CONVERGED";
-    }
-  }
-  if (o.algorithm == TargetShapeAlgorithm::slsqp_newton && blocks.size() == 1) {
-    const Polyline2 start = data.p;
-    const int evaluations0 = data.evaluations;
-    ftol = std::max(o.ftol_rel, kRoughFtol);
-    solve_block(blocks[0]);
-    ftol = o.ftol_rel;
-    const detail::NewtonOutcome nt = detail::polish_target_shape(problem, data.p, data.scale_x, data.scale_f,
-                                                                 o.constraint_tol, kPolishIterations, progress);
-    newton_evaluations = nt.evaluations + data.evaluations - evaluations0;
-    data.evaluations = evaluations0;
-    worst_result.clear();
-    result.nlopt_result = "none";
-    if (nt.converged) {
-      data.p = nt.points;
-      newton_done = true;
-      result.sweeps = 1;
-      result.nlopt_result = "NEWTON_CONVERGED";
-    } else {
-      data.p = start;
-    }
-  }
-  if (newton_done) {
-  } else if (blocks.size() == 1) {
+  if (blocks.size() == 1) {
     solve_block(blocks[0]);
     result.sweeps = 1;
   } else if (!blocks.empty()) {
@@ -967,7 +922,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     result.warnings.push_back("wire " + w + ": the target shape stopped at its time budget of " + fmt(o.max_seconds, 4) +
                               " s (max_seconds) before it converged");
   }
-  result.iterations = data.evaluations + newton_evaluations;
+  result.iterations = data.evaluations;
   p = data.p;
 
   // Measure the result.

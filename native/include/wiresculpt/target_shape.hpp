@@ -53,14 +53,6 @@ enum class TargetShapeAlgorithm {
   auglag_lbfgs,  ///< NLopt AUGLAG with LD_LBFGS as the local solver
   ccsaq,         ///< NLopt LD_CCSAQ
   mma,           ///< NLopt LD_MMA
-  /// A primal-dual interior-point Newton method on the whole wire (banded Hessian, sparse LDLT);
-  /// where it does not converge (e.g. a kink that cannot be opened) the wire is solved by the
-  /// SLSQP windows from the same start. See docs/method-target-shape.md, "Newton".
-  newton,
-  /// Experimental: on a wire solved as one block, SLSQP stopped at ftol_rel 1e-6, then Newton's
-  /// method on the KKT conditions of the constraints active there (a polish to the nearby
-  /// optimum); windowed wires as slsqp. Where Newton does not converge, SLSQP from the start.
-  slsqp_newton,
 };
 
 struct TargetShapeOptions {
@@ -230,8 +222,6 @@ class TargetShapeProblem {
   const std::vector<Constraint>& constraints() const { return constraints_; }
   const std::vector<TargetCrossingStatus>& statuses() const { return statuses_; }
   double kernel_support() const { return h_; }  ///< metres, h of Eq. 4
-  /// The options as solved (spacing 0 replaced by its default).
-  const TargetShapeOptions& options() const { return options_; }
 
   /// E_d of Eq. 4 (m³); adds dE_d/dp to `grad` when non-null (resized to #points).
   double distance_energy(const Polyline2& p, Polyline2* grad = nullptr) const;
