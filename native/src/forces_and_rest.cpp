@@ -15,6 +15,8 @@ ForcesAndRestResult forces_and_rest(const Network& net, const std::vector<int>& 
                                     const std::vector<int>& requested_cuts, const ForcesAndRestOptions& options,
                                     const ProgressFn& progress) {
   ForcesAndRestResult out;
+  if (!(std::isfinite(options.load_capacity_within) && options.load_capacity_within >= 0))
+    throw InputError("load_capacity_within must be a finite number of radians >= 0 (0: always compute the load capacity)");
   out.cuts = choose_cuts(net, requested_cuts);
   ForceOptions force_options = options.forces;
   LoadCapacityOptions load = options.load;
@@ -91,7 +93,11 @@ ForcesAndRestResult forces_and_rest(const Network& net, const std::vector<int>& 
     out.deflection_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
   }
 
-  if (options.load_capacity) {
+  bool rests_within = true;
+  if (options.load_capacity_within > 0.0)
+    for (const RestShapeResult& rest : out.rests)
+      for (double a : rest.rest_angles) rests_within = rests_within && std::abs(a) <= options.load_capacity_within;
+  if (options.load_capacity && rests_within) {
     const ForceProblem problem(net, hooks, steps, out.cuts, force_options);
     out.load_capacity = load_capacity(net, out.cuts, problem, out.forces.coefficients, load, progress);
     if (out.load_factor) {

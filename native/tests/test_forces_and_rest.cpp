@@ -153,3 +153,53 @@ TEST_CASE("forces_and_rest: the load factor picks the least torque fraction that
   }
   CHECK(tested >= 2);
 }
+
+TEST_CASE("forces_and_rest: load_capacity_within skips the load capacity only beyond it", "[forces][load]") {
+  std::mt19937 rng(47);
+  int tested = 0;
+  fixtures::HookedNetwork last;  // a network the options below are refused on
+  for (int attempt = 0; attempt < 200 && tested < 2; ++attempt) {
+    fixtures::HookedNetwork h;
+    if (!fixtures::random_hooked_sphere(rng, attempt, 24, h)) continue;
+    ForcesAndRestOptions o;
+    o.forces.algorithm = ForceAlgorithm::lp;
+    o.load_capacity = true;
+    std::vector<int> requested(h.net.wires.size(), -1);
+    ForcesAndRestResult all;
+    try {
+      all = forces_and_rest(h.net, h.hooks, h.steps, requested, o);
+    } catch (const SolverError&) {
+      continue;
+    }
+    REQUIRE(all.load_capacity.has_value());
+    double largest = 0.0;  // the largest rest angle, read from the rest shapes
+    for (const RestShapeResult& rest : all.rests)
+      for (double a : rest.rest_angles) largest = std::max(largest, std::abs(a));
+    if (largest <= 0.0) continue;
+    ++tested;
+    last = h;
+    // Every rest angle within the limit: the same load capacity.
+    o.load_capacity_within = largest;
+    const ForcesAndRestResult within = forces_and_rest(h.net, h.hooks, h.steps, requested, o);
+    REQUIRE(within.load_capacity.has_value());
+    REQUIRE(within.load_capacity->directions.size() == all.load_capacity->directions.size());
+    for (std::size_t d = 0; d < all.load_capacity->directions.size(); ++d)
+      CHECK(within.load_capacity->directions[d].multiple == all.load_capacity->directions[d].multiple);
+    // One beyond it: none, and the forces and rest shapes unchanged.
+    o.load_capacity_within = 0.999 * largest;
+    const ForcesAndRestResult beyond = forces_and_rest(h.net, h.hooks, h.steps, requested, o);
+    CHECK_FALSE(beyond.load_capacity.has_value());
+    CHECK(beyond.forces.coefficients == all.forces.coefficients);
+    REQUIRE(beyond.rests.size() == all.rests.size());
+    for (std::size_t w = 0; w < all.rests.size(); ++w) CHECK(beyond.rests[w].rest_angles == all.rests[w].rest_angles);
+  }
+  REQUIRE(tested == 2);
+  const std::vector<int> requested(last.net.wires.size(), -1);
+  ForcesAndRestOptions bad;
+  bad.load_capacity = true;
+  for (double v : {-1.0, std::numeric_limits<double>::quiet_NaN()}) {
+    bad.load_capacity_within = v;
+    CHECK_THROWS_WITH(forces_and_rest(last.net, last.hooks, last.steps, requested, bad),
+                      Catch::Matchers::Contains("load_capacity_within"));
+  }
+}
