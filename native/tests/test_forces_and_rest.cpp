@@ -203,3 +203,54 @@ TEST_CASE("forces_and_rest: load_capacity_within skips the load capacity only be
                       Catch::Matchers::Contains("load_capacity_within"));
   }
 }
+
+TEST_CASE("forces_and_rest: the load capacity after the forces is f times the one at the plastic limit",
+          "[forces][load]") {
+  // With a load factor, forces_and_rest scales the plastic limit's load capacity by the torque
+  // fraction f it chose instead of solving the six LPs again; here they are solved again, at f
+  // with the forces' pre-stress, as load_capacity does for a design without a load factor.
+  std::mt19937 rng(53);
+  int tested = 0;
+  for (int attempt = 0; attempt < 200 && tested < 3; ++attempt) {
+    fixtures::HookedNetwork h;
+    if (!fixtures::random_hooked_sphere(rng, attempt, 24, h)) continue;
+    ForcesAndRestOptions o;
+    o.forces.algorithm = ForceAlgorithm::lp;
+    o.load_capacity = true;
+    std::vector<int> requested(h.net.wires.size(), -1);
+    const std::vector<int> cuts = choose_cuts(h.net, requested);
+    double at_one = 0.0;
+    try {
+      at_one = weakest_multiple(h, cuts, o, 1.0);
+    } catch (const SolverError&) {
+      continue;
+    }
+    if (!std::isfinite(at_one) || at_one < 1e-3) continue;
+    ++tested;
+    INFO("attempt " << attempt);
+    o.load_factor = 0.4 * at_one;  // f about 0.4
+    const ForcesAndRestResult r = forces_and_rest(h.net, h.hooks, h.steps, requested, o);
+    REQUIRE(r.load_capacity.has_value());
+    REQUIRE(r.torque_fraction < 0.9);
+    ForceOptions at_f = o.forces;
+    at_f.torque_fraction = r.torque_fraction;
+    LoadCapacityOptions lo = o.load;
+    lo.torque_bound = o.forces.torque_bound;
+    const ForceProblem problem(h.net, h.hooks, h.steps, r.cuts, at_f);
+    const LoadCapacityResult solved = load_capacity(h.net, r.cuts, problem, r.forces.coefficients, lo);
+    REQUIRE(solved.directions.size() == r.load_capacity->directions.size());
+    for (std::size_t d = 0; d < solved.directions.size(); ++d) {
+      const LoadDirection& a = r.load_capacity->directions[d];
+      const LoadDirection& b = solved.directions[d];
+      INFO("direction " << b.name);
+      CHECK(a.status == b.status);
+      CHECK(a.base == b.base);
+      if (std::isfinite(b.multiple))
+        CHECK(a.multiple == Approx(b.multiple).epsilon(1e-6).margin(1e-9));
+      else
+        CHECK(std::isinf(a.multiple));
+    }
+    CHECK(r.load_capacity->weight == solved.weight);
+  }
+  CHECK(tested == 3);
+}
