@@ -290,7 +290,7 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint,
         within = math.radians(machine_limit) if round_ + 1 < COUPLING_ROUNDS else None
         if "density" in material:  # an earlier solve's must not stand for a skipped one
             design.pop("load_capacity", None)
-        say("forces", forces.run(design, material, settings, native_progress, within))
+        say("forces", forces.run(design, material, settings, native_progress, load_capacity_within=within))
         design["pending_stages"].remove("forces")
         say("rest_shape", forces.rest_summary(design))
         design["pending_stages"].remove("rest_shape")
