@@ -286,7 +286,14 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint,
         if not design["stable"]:  # forces need the hooks of a complete stable assembly
             return design
         checkpoint()
-        say("forces", forces.run(design, material, settings, native_progress))
+        # The load capacity (twelve LPs, most of the stage's time) is only kept from the last round:
+        # a round that may be followed by another skips it when a rest bend is over the limit, the
+        # case in which another round follows (computed below if the rounds stop there anyway).
+        warnings_before = len(design.get("warnings", []))
+        within = math.radians(machine_limit) if round_ + 1 < COUPLING_ROUNDS else None
+        if "density" in material:  # an earlier solve's must not stand for a skipped one
+            design.pop("load_capacity", None)
+        say("forces", forces.run(design, material, settings, native_progress, load_capacity_within=within))
         design["pending_stages"].remove("forces")
         say("rest_shape", forces.rest_summary(design))
         design["pending_stages"].remove("rest_shape")
@@ -303,6 +310,10 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint,
                             f"solving again with {changed} vertex bend limit{'s' if changed != 1 else ''} lowered so "
                             f"that the rest bends stay {COUPLING_MARGIN_DEG:g} deg inside, other bends up to "
                             f"{target_limit:.2f} deg (Sec. 4.3)")
+    if "density" in material and "load_capacity" not in design:  # the last round skipped it
+        del design.get("warnings", [])[warnings_before:]
+        checkpoint()
+        say("forces", forces.run(design, material, settings, native_progress))
     # "Stable" means buildable: the bend program of every wire, with the machine profile in use.
     buildability.apply(design)
     return design
