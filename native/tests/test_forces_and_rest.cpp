@@ -90,10 +90,12 @@ double weakest_multiple(const fixtures::HookedNetwork& h, const std::vector<int>
   for (const LoadDirection& d : lc.directions) m = std::min(m, d.multiple);
   return m;
 }
-}  // namespace
-
-TEST_CASE("forces_and_rest: the load factor picks the least torque fraction that holds it", "[forces][load]") {
-  std::mt19937 rng(43);
+// Calls body(h, requested, cuts, o, at_one) on the first three random hooked spheres (seed `seed`)
+// whose weakest load multiple at the plastic limit, at_one, is finite and at least 1e-3, with
+// LP forces and the load capacity on; returns how many it called it on.
+template <class Body>
+int on_loaded_spheres(unsigned seed, Body body) {
+  std::mt19937 rng(seed);
   int tested = 0;
   for (int attempt = 0; attempt < 200 && tested < 3; ++attempt) {
     fixtures::HookedNetwork h;
@@ -112,6 +114,15 @@ TEST_CASE("forces_and_rest: the load factor picks the least torque fraction that
     if (!std::isfinite(at_one) || at_one < 1e-3) continue;
     ++tested;
     INFO("attempt " << attempt << ", weakest multiple at the plastic limit " << at_one);
+    body(h, requested, cuts, o, at_one);
+  }
+  return tested;
+}
+}  // namespace
+
+TEST_CASE("forces_and_rest: the load factor picks the least torque fraction that holds it", "[forces][load]") {
+  const int tested = on_loaded_spheres(43, [](const fixtures::HookedNetwork& h, const std::vector<int>& requested,
+                                              const std::vector<int>& cuts, ForcesAndRestOptions o, double at_one) {
 
     // Reachable: 40% of what the plastic limit holds.
     o.load_factor = 0.4 * at_one;
@@ -150,7 +161,7 @@ TEST_CASE("forces_and_rest: the load factor picks the least torque fraction that
     // The load factor needs the load capacity (a density).
     o.load_capacity = false;
     CHECK_THROWS_WITH(forces_and_rest(h.net, h.hooks, h.steps, requested, o), Catch::Matchers::Contains("load factor"));
-  }
+  });
   CHECK(tested >= 2);
 }
 
@@ -209,25 +220,8 @@ TEST_CASE("forces_and_rest: the load capacity after the forces is f times the on
   // With a load factor, forces_and_rest scales the plastic limit's load capacity by the torque
   // fraction f it chose instead of solving the six LPs again; here they are solved again, at f
   // with the forces' pre-stress, as load_capacity does for a design without a load factor.
-  std::mt19937 rng(53);
-  int tested = 0;
-  for (int attempt = 0; attempt < 200 && tested < 3; ++attempt) {
-    fixtures::HookedNetwork h;
-    if (!fixtures::random_hooked_sphere(rng, attempt, 24, h)) continue;
-    ForcesAndRestOptions o;
-    o.forces.algorithm = ForceAlgorithm::lp;
-    o.load_capacity = true;
-    std::vector<int> requested(h.net.wires.size(), -1);
-    const std::vector<int> cuts = choose_cuts(h.net, requested);
-    double at_one = 0.0;
-    try {
-      at_one = weakest_multiple(h, cuts, o, 1.0);
-    } catch (const SolverError&) {
-      continue;
-    }
-    if (!std::isfinite(at_one) || at_one < 1e-3) continue;
-    ++tested;
-    INFO("attempt " << attempt);
+  const int tested = on_loaded_spheres(53, [](const fixtures::HookedNetwork& h, const std::vector<int>& requested,
+                                              const std::vector<int>&, ForcesAndRestOptions o, double at_one) {
     o.load_factor = 0.4 * at_one;  // f about 0.4
     const ForcesAndRestResult r = forces_and_rest(h.net, h.hooks, h.steps, requested, o);
     REQUIRE(r.load_capacity.has_value());
@@ -251,6 +245,6 @@ TEST_CASE("forces_and_rest: the load capacity after the forces is f times the on
         CHECK(std::isinf(a.multiple));
     }
     CHECK(r.load_capacity->weight == solved.weight);
-  }
+  });
   CHECK(tested == 3);
 }
