@@ -3,13 +3,16 @@ the promised wire and crossing counts, closed meshes, the longest wire at the re
 the same counts when Blender itself imports the mesh in a batch run. Correctness only: no timing."""
 import json
 import os
+import shutil
+import subprocess
 import tempfile
 import unittest
 
 import numpy as np
 
 import bench_scenes
-from helpers import BATCH, run_blender
+import helpers
+from helpers import BATCH, BLENDER, NO_WINDOW, ROOT, run_blender
 
 
 class BenchScenesTest(unittest.TestCase):
@@ -18,7 +21,7 @@ class BenchScenesTest(unittest.TestCase):
         cls.dir = tempfile.TemporaryDirectory()
         cls.out = cls.dir.name
         try:
-            cls.cases = bench_scenes.generate(cls.out, ["teddy", "sphere-222", "length-0.5m"], say=lambda _line: None)
+            cls.cases = bench_scenes.generate(cls.out, ["teddy", "globe", "sphere-222", "length-0.5m"], say=lambda _line: None)
         except SystemExit as exc:  # the generator's own (P, C) check failed
             cls.dir.cleanup()
             raise AssertionError(str(exc)) from None
@@ -33,13 +36,16 @@ class BenchScenesTest(unittest.TestCase):
     def test_manifest_lists_the_cases_with_their_counts(self):
         with open(os.path.join(self.out, "manifest.json")) as f:
             manifest = json.load(f)["cases"]
-        self.assertEqual([c["name"] for c in manifest], ["teddy", "sphere-222", "length-0.5m"])
+        self.assertEqual([c["name"] for c in manifest], ["teddy", "globe", "sphere-222", "length-0.5m"])
         self.assertEqual((self.case("teddy")["P"], self.case("teddy")["C"]), (4, 10))  # the paper's Teddy
+        # the bundled globe: three great circles, every pair crossing twice
+        self.assertEqual((self.case("globe")["P"], self.case("globe")["C"]), (3, 6))
+        self.assertEqual(self.case("globe")["kind"], "example")
         self.assertEqual((self.case("sphere-222")["P"], self.case("sphere-222")["C"]), (6, 24))
         self.assertEqual((self.case("length-0.5m")["P"], self.case("length-0.5m")["C"]), (4, 10))
 
     def test_counts_measured_by_the_pipeline(self):
-        for name in ("teddy", "sphere-222"):
+        for name in ("teddy", "globe", "sphere-222"):
             case = self.case(name)
             P, C, _lmax = bench_scenes.check(dict(case, scene=os.path.join(self.out, case["scene"])))
             self.assertEqual((P, C), (case["P"], case["C"]), name)
@@ -66,6 +72,36 @@ class BenchScenesTest(unittest.TestCase):
         with open(os.path.join(out, "design.json")) as f:
             design = json.load(f)
         self.assertEqual((len(design["wires"]), len(design["crossings"])), (case["P"], case["C"]))
+
+
+@unittest.skipUnless(shutil.which("xvfb-run"), "xvfb-run is not installed")
+class BenchLiveTest(unittest.TestCase):
+    """scripts/bench_live.py on the globe in a Blender with a window: it records a verdict per move
+    and round trips that contain the live job's own time (no time is asserted)."""
+
+    def test_round_trips_are_recorded(self):
+        if helpers.BPY_MODULE:
+            self.skipTest(NO_WINDOW)
+        with tempfile.TemporaryDirectory() as out:
+            bench_scenes.generate(out, ["globe"], run_check=False, say=lambda _line: None)
+            result_path = os.path.join(out, "live.json")
+            cmd = ["xvfb-run", "-a", "-s", "-screen 0 1280x800x24", BLENDER, "--factory-startup",
+                   "--python-exit-code", "1", "--python", os.path.join(ROOT, "scripts", "bench_live.py"), "--",
+                   os.path.join(out, "manifest.json"), result_path]
+            r = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+            self.assertTrue(os.path.exists(result_path), r.stdout[-3000:] + r.stderr[-3000:])
+            with open(result_path) as f:
+                (record,) = json.load(f)["cases"]
+        self.assertNotIn("error", record)
+        self.assertEqual(record["name"], "globe")
+        self.assertEqual(record["wires_ticked"], 3)
+        self.assertEqual(record["first_verdict"], "Live: stable")
+        self.assertEqual(record["verdicts"], ["Live: stable"] * 5)  # 1 mm moves keep the globe stable
+        self.assertEqual(len(record["round_trips"]), 5)
+        for trip, shown, job in zip(record["round_trips"], record["verdict_set"], record["job_seconds"]):
+            self.assertGreater(job, 0)
+            self.assertLessEqual(job, shown)  # the verdict is shown after its job ran, which began after the move
+            self.assertLessEqual(shown, trip)  # and drawn after it was set
 
 
 if __name__ == "__main__":

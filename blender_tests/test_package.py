@@ -1,8 +1,11 @@
 """The packaged zips: the add-on zip installs into a clean user scripts folder and loads its
-compiled module (the Blender executable); both zips carry their own solver libraries, and a failed
-load says what is wrong; the extension zip passes Blender's own manifest check, installs into a
+compiled module (the Blender executable); both zips carry their own solver libraries and a module
+for each Python the machine has, each of which imports with its own interpreter; a failed load
+says what is wrong; the extension zip passes Blender's own manifest check, installs into a
 temporary extension repository through Blender's extension API, enables and Optimizes the bundled
 globe (Blender 4.2+, e.g. the PyPI bpy)."""
+import glob
+import json
 import os
 import re
 import shutil
@@ -174,8 +177,14 @@ class PackageTest(unittest.TestCase):
             outside = [n for n in entries if n not in bundled and n not in GLIBC]
             self.assertEqual(outside, [], f"{os.path.relpath(path, unpacked)} needs libraries outside the zip")
             self.assertTrue(runpaths and runpaths[0].startswith("$ORIGIN"), f"{path}: run path {runpaths}")
-        module = next(n for n in os.listdir(package_folder) if n.startswith("_wiresculpt"))
-        self.assertEqual(readelf(os.path.join(package_folder, module))[1], ["$ORIGIN/libs"])
+        modules = [n for n in os.listdir(package_folder) if n.startswith("_wiresculpt")]
+        self.assertIn("_wiresculpt.cpython-311-x86_64-linux-gnu.so", modules)  # the default build's
+        for module in modules:
+            entries, runpaths = readelf(os.path.join(package_folder, module))
+            self.assertEqual(runpaths, ["$ORIGIN/libs"], module)
+            solver = [n for n in entries if re.match(r"lib(glpk|nlopt|serialport)", n)]
+            self.assertEqual(len(solver), 3, f"{module} NEEDED: {entries}")
+            self.assertEqual([n for n in solver if n not in bundled], [], f"{module} needs these outside the zip")
         return unpacked, package_folder
 
     def test_zip_carries_its_solver(self):
@@ -209,6 +218,97 @@ class PackageTest(unittest.TestCase):
             self.assert_carries_solver(extension_zip, "")
 
 
+# Run by each Python the zip has a module for, in a subprocess with no LD_LIBRARY_PATH: imports the
+# module from the unpacked add-on folder, strips a G-code text (the rule by hand: ';' to the end of
+# the line and '(...)' are comments, blank lines go) and lists the solver libraries it mapped.
+IMPORT = textwrap.dedent("""
+    import json, os, sys
+    folder = sys.argv[1]
+    sys.path.insert(0, folder)
+    import _wiresculpt as m
+    lines = m.stream_lines("G21 ; millimetres\\n(pin down)\\n\\n  G1 X10 F300 (feed)\\n")
+    with open("/proc/self/maps") as f:
+        mapped = sorted({line.split()[-1] for line in f if "/" in line.split()[-1]})
+    solver = [p for p in mapped if os.path.basename(p).startswith(("libglpk", "libnlopt", "libserialport"))]
+    print(json.dumps({"file": m.__file__, "python": "%d.%d" % sys.version_info[:2], "lines": lines,
+                      "solver": solver}))
+""")
+
+
+def interpreters(version):
+    """The interpreters for Python `version` ("3.10") on this machine: the system's and pyenv's
+    (a clean machine has /usr/bin/python3.11 and maybe no pyenv)."""
+    pyenv = os.environ.get("PYENV_ROOT") or os.path.expanduser("~/.pyenv")
+    found = [f"/usr/bin/python{version}", f"/usr/local/bin/python{version}"] + \
+        sorted(glob.glob(os.path.join(pyenv, "versions", version + ".*", "bin", "python" + version)))
+    return [p for p in found if os.access(p, os.X_OK)]
+
+
+def has_headers(python):
+    """Whether `python` has its development headers (Python.h in its sysconfig include folder)."""
+    code = "import os, sysconfig; print(os.path.isfile(os.path.join(sysconfig.get_paths()['include'], 'Python.h')))"
+    r = subprocess.run([python, "-I", "-c", code], capture_output=True, text=True)
+    return r.stdout.strip() == "True"
+
+
+class ModulePerPythonTest(unittest.TestCase):
+    """The add-on zip has a module for each Python from 3.10 that has its headers on this machine
+    (the system's 3.11 always; pyenv's 3.10, 3.12, 3.13 where they are installed, skipped with a
+    message where not), and each module imports with its own interpreter from the unpacked folder
+    with LD_LIBRARY_PATH cleared, its solver libraries coming from the zip's libs/."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        zip_path, _extension = package(cls.tmp.name)
+        shutil.unpack_archive(zip_path, os.path.join(cls.tmp.name, "unpacked"))
+        cls.folder = os.path.join(cls.tmp.name, "unpacked", "wiresculpt")
+        tags = (re.match(r"_wiresculpt\.cpython-(\d)(\d+)-", n) for n in os.listdir(cls.folder))
+        cls.versions = sorted(f"{t.group(1)}.{t.group(2)}" for t in tags if t)
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def test_a_module_for_every_python_with_headers(self):
+        missing, absent = [], []
+        for version in ("3.10", "3.11", "3.12", "3.13"):
+            pythons = [p for p in interpreters(version) if has_headers(p)]
+            if not pythons:
+                absent.append(version)
+            elif version not in self.versions:
+                missing.append(f"{version} ({pythons[0]})")
+        self.assertNotIn("3.11", absent, "/usr/bin/python3.11 with its headers is always there")
+        self.assertEqual(missing, [], f"the zip has modules for {self.versions} only")
+        if absent:
+            print(f"  no Python {', '.join(absent)} with headers on this machine: not required in the zip")
+
+    def test_each_module_imports_with_its_own_python(self):
+        skipped = []
+        for version in self.versions:
+            pythons = interpreters(version)
+            if not pythons:
+                skipped.append(version)
+                continue
+            with self.subTest(python=pythons[0]):
+                r = subprocess.run([pythons[0], "-I", "-c", IMPORT, self.folder], capture_output=True, text=True,
+                                   env={"PATH": "/usr/bin:/bin"}, timeout=120)
+                self.assertEqual(r.returncode, 0, r.stderr)
+                got = json.loads(r.stdout)
+                self.assertEqual(got["python"], version)
+                self.assertEqual(os.path.dirname(got["file"]), self.folder)
+                self.assertIn(f"cpython-{version.replace('.', '')}-", os.path.basename(got["file"]))
+                self.assertEqual(got["lines"], ["G21", "G1 X10 F300"])
+                names = sorted({re.match(r"lib(glpk|nlopt|serialport)", os.path.basename(p)).group(1)
+                                for p in got["solver"]})
+                self.assertEqual(names, ["glpk", "nlopt", "serialport"], got["solver"])
+                for path in got["solver"]:
+                    self.assertEqual(os.path.dirname(path), os.path.join(self.folder, "libs"))
+        if skipped:
+            print(f"  no interpreter for Python {', '.join(skipped)} on this machine: its module not imported")
+        self.assertGreater(len(self.versions) - len(skipped), 0)
+
+
 class LoadErrorTest(unittest.TestCase):
     """A real failed import, made in a copy of the zip, turned into the sentence the panel shows."""
 
@@ -225,7 +325,10 @@ class LoadErrorTest(unittest.TestCase):
             folder = os.path.join(tmp, "unpacked")
             shutil.unpack_archive(zip_path, folder)
             addon = os.path.join(folder, "wiresculpt")
-            module = next(n for n in os.listdir(addon) if n.startswith("_wiresculpt"))
+            module = "_wiresculpt.cpython-311-x86_64-linux-gnu.so"  # the one Python 3.11 imports
+            for other in os.listdir(addon):
+                if other.startswith("_wiresculpt") and other != module:
+                    os.remove(os.path.join(addon, other))
             self.assertEqual(self.load_error(folder), "")
             # the module's NEEDED entry for GLPK renamed to a library that exists nowhere
             glpk = next(n for n in readelf(os.path.join(addon, module))[0] if n.startswith("libglpk"))
@@ -237,8 +340,9 @@ class LoadErrorTest(unittest.TestCase):
             # the same module named for Python 3.10: Python 3.11 does not import it
             os.rename(os.path.join(addon, module), os.path.join(addon, "_wiresculpt.cpython-310-x86_64-linux-gnu.so"))
             message = self.load_error(folder)
-            self.assertIn("this build is for Python 3.10; this Python uses 3.11", message)
-            self.assertIn("build from source with scripts/package", message)
+            self.assertIn("this zip has the solver for Python 3.10; this Python uses 3.11: install it in a "
+                          "Blender whose Python is 3.10 (Blender 3.4 to 4.0)", message)
+            self.assertIn("build the zip from source with scripts/package", message)
 
 
 class ExtensionTest(unittest.TestCase):

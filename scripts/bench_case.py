@@ -7,7 +7,9 @@ with it), times slicing, then solves the sliced design repeatedly (a fresh copy 
 prints one JSON document on stdout: the design's P, C, longest wire, verdict, and per stage the
 median over the runs of every number the stage records in design["stages"] (stage names are read
 from the design, so new stages appear without changes here), plus the wall time between the
-pipeline's progress calls (which includes the Python glue around the native calls).
+pipeline's progress calls (which includes the Python glue around the native calls). Then the same design solved with the
+layering's own hooks (pipeline.solve(hook_patterns=1), as Live solves; issue 17's whole solve),
+its median wall time as own_hooks_solve_seconds.
 
 Repeats: the first solve decides, so slow cases stay affordable: as many runs as fit in
 --budget seconds (default 12), at least 1 and at most --max-repeats (default 5).
@@ -66,7 +68,7 @@ class TimedModule:
         return timed
 
 
-def solve_once(sliced, scene):
+def solve_once(sliced, scene, hook_patterns=None):
     from wiresculpt import native, pipeline
 
     timed = TimedModule(native.require())
@@ -87,7 +89,7 @@ def solve_once(sliced, scene):
 
     start = time.perf_counter()
     try:
-        solved = pipeline.solve(design, scene.material, scene.settings, progress)
+        solved = pipeline.solve(design, scene.material, scene.settings, progress, hook_patterns=hook_patterns)
     finally:
         native.require = original
     total = time.perf_counter() - start
@@ -123,6 +125,12 @@ def run(scene_path, budget, max_repeats):
     repeats = max(1, min(max_repeats, int(budget / max(total, 1e-6))))
     for _ in range(repeats - 1):
         runs.append(solve_once(sliced, scene))
+
+    # Issue 17's whole solve: layering, target shape, forces and rest shape with the layering's own
+    # hooks (the hook search limited to one pattern, as Live solves), repeated like the runs above.
+    first = solve_once(sliced, scene, hook_patterns=1)
+    own_hooks = [first] + [solve_once(sliced, scene, hook_patterns=1)
+                           for _ in range(max(1, min(max_repeats, int(budget / max(first[2], 1e-6)))) - 1)]
 
     stage_names = list(dict.fromkeys(name for d, _w, _t in runs for name in d["stages"]))
     stages = {}
@@ -171,6 +179,9 @@ def run(scene_path, budget, max_repeats):
         "repeats": len(runs),
         "load_seconds": load_seconds,
         "solve_seconds": statistics.median(t for _d, _w, t in runs),
+        "own_hooks_solve_seconds": statistics.median(t for _d, _w, t in own_hooks),
+        "own_hooks_stable": bool(own_hooks[-1][0]["stable"]),
+        "own_hooks_repeats": len(own_hooks),
         "native_calls": calls,
         "glue_seconds": glue,
         "target_maxeval_wires": sum("MAXEVAL" in r for r in target_results),

@@ -14,6 +14,7 @@ list of cases the bench runs:
   wires from different families crossing twice: C = 2(ab + bc + ca)), C from 10 to 150, fixed size
   0.6 m;
 - `search`: the 5 + 5 + 4 sphere with its planes spread wider, where the layering search explodes;
+- `example`: the bundled globe (scripts/examples/globe, three great circles: P 3, C 6), as it is;
 - `length`: the 1 + 1 + 2 sphere (P 4, C 10, Teddy's counts) scaled so that its longest wire is
   0.5 m to 3 m.
 
@@ -415,6 +416,10 @@ def generate(out, names=None, run_check=True, say=print):
         path = sized(out, name, f"{name}.obj", V, planes, row["l_max_cm"] / 100)
         cases.append({"name": name, "kind": "paper", "scene": path, "P": row["P"], "C": row["C"],
                       "triangles": int(len(F)), "paper": row})
+    if wanted("globe"):
+        path = os.path.join(ROOT, "scripts", "examples", "globe", "scene.json")
+        V, F = read_obj(os.path.join(os.path.dirname(path), "globe.obj"))
+        cases.append({"name": "globe", "kind": "example", "scene": path, "P": 3, "C": 6, "triangles": int(len(F))})
     for a, b, c in CROSSING_FAMILIES:
         name = f"sphere-{a}{b}{c}"
         if not wanted(name):

@@ -32,6 +32,12 @@ BPY_NUMPY=1.26.4
 BPY_SCIPY=1.13.1
 BPY_CACHE=${WIRESCULPT_BPY_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/wiresculpt}
 
+# scripts/package builds the module for every further CPython 3.x on the machine (package_pythons.py)
+# with this pybind11: Debian's 2.10 predates Python 3.12 and 3.13. 2.13.6 is the last 2.x (the API
+# our bindings are written for) and supports Python 3.7 to 3.13; its wheel is the same for every
+# Python (headers and CMake files), so one copy serves them all.
+PACKAGE_PYBIND11=2.13.6
+
 # The sanitizer and fuzz builds (scripts/test, scripts/fuzz).
 FUZZ_PACKAGES=(clang libclang-rt-14-dev)
 
@@ -138,6 +144,21 @@ bpy_python() {
   "$venv/bin/python" -m pip install -q --find-links "$BPY_CACHE/wheels" "${want[@]}" >&2
   echo "${want[*]}" >"$venv/.complete"
   echo "$venv/bin/python"
+}
+
+# Prints the folder holding pybind11Config.cmake of pybind11==$PACKAGE_PYBIND11, pip-installed once
+# into $BPY_CACHE (never into a site-packages: --target); a copy is used only after its install
+# finished.
+package_pybind11() {
+  local dir="$BPY_CACHE/pybind11-$PACKAGE_PYBIND11"
+  if [ ! -f "$dir/.complete" ]; then
+    ensure_packages python3-pip
+    rm -rf "$dir"
+    say "installing pybind11 $PACKAGE_PYBIND11 into $dir"
+    "$PYTHON" -m pip install -q --root-user-action=ignore --no-deps --no-compile --target "$dir" "pybind11==$PACKAGE_PYBIND11" >&2
+    touch "$dir/.complete"
+  fi
+  echo "$dir/pybind11/share/cmake/pybind11"
 }
 
 # Runs a Python file inside headless Blender; extra arguments follow "--".

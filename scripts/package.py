@@ -6,10 +6,16 @@
   `blender --command extension install-file`): blender_manifest.toml and the package's files at
   the top of the zip, as Blender's own `extension build` lays them out.
 
+Both zips carry the module for every Python the machine has (package_pythons.py: each CPython 3.x
+from 3.10 with its development headers; the default build's module, scripts/build with
+/usr/bin/python3.11, plus one build per further Python), so one zip loads in each Blender whose
+Python is among them: Python picks the file whose ABI tag (_wiresculpt.cpython-310-...so) is its
+own.
+
 Both zips carry their own solver: every shared library the module needs (GLPK, NLopt,
 libserialport and what they need in turn: GMP, zlib, SuiteSparse, libltdl, the C++ runtime) is
-copied into libs/ beside the module (wiresculpt/libs/ in the add-on zip, libs/ at the top of the
-extension zip) and every copy, and the module, gets an `$ORIGIN` run path (patchelf), so the only
+copied into libs/ beside the modules (one folder they share) (wiresculpt/libs/ in the add-on zip, libs/ at the top of the
+extension zip) and every copy, and each module, gets an `$ORIGIN` run path (patchelf), so the only
 outside needs left are glibc and the Python that loads the module. The package is refused
 when a NEEDED entry of any bundled file is neither bundled nor part of glibc.
 
@@ -24,6 +30,8 @@ import subprocess
 import sys
 import tempfile
 import zipfile
+
+import package_pythons
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ADDON = os.path.join(ROOT, "addon", "wiresculpt")
@@ -96,8 +104,8 @@ def bundle(module, stage):
 
 def addon_files(modules, stage):
     """(path on disk, path inside the add-on folder) of every file that ships: the Python and TOML
-    files, then each compiled module (a file name in the add-on) with its libraries as bundle()
-    stages them in `stage`."""
+    files, then each compiled module (a path) with its libraries as bundle() stages them in
+    `stage` (one libs/ for all)."""
     files = []
     for folder, dirs, names in os.walk(ADDON):
         dirs[:] = sorted(d for d in dirs if d not in ("__pycache__", LIBS))
@@ -105,9 +113,11 @@ def addon_files(modules, stage):
             if name.endswith((".py", ".toml")):
                 full = os.path.join(folder, name)
                 files.append((full, os.path.relpath(full, ADDON)))
-    for name in sorted(modules):
-        files += [(full, os.path.relpath(full, stage)) for full in bundle(os.path.join(ADDON, name), stage)]
-    return files
+    staged = {}
+    for module in sorted(modules):
+        for full in bundle(module, stage):
+            staged[full] = os.path.relpath(full, stage)  # a library every module needs ships once
+    return files + sorted(staged.items(), key=lambda item: item[1])
 
 
 def write_zip(path, prefix, files):
@@ -119,20 +129,42 @@ def write_zip(path, prefix, files):
     os.replace(tmp, path)
 
 
+def toolchain():
+    """(the default build's Python, CMake, the default build folder, the folder of
+    pybind11Config.cmake for the further Pythons) as scripts/lib.sh names and installs them."""
+    out = subprocess.run(["bash", "-c", 'source "$1"; printf "%s\\n" "$PYTHON" "$CMAKE" "$BUILD_DIR" "$(package_pybind11)"',
+                          "bash", os.path.join(ROOT, "scripts", "lib.sh")],
+                         capture_output=True, text=True)
+    if out.returncode != 0:
+        raise SystemExit("wiresculpt: scripts/lib.sh could not install pybind11 for the package: " + out.stderr)
+    return out.stdout.split("\n")[:4]
+
+
+def modules():
+    """Every compiled module to ship: the default build's (in the add-on folder, for its Python),
+    then one per further Python (package_pythons)."""
+    default = [os.path.join(ADDON, n) for n in os.listdir(ADDON) if n.startswith("_wiresculpt") and n.endswith(".so")]
+    if not default:
+        raise SystemExit("wiresculpt: the compiled module is missing; run scripts/build first")
+    python, cmake, build_dir, pybind11_dir = toolchain()
+    core = os.path.join(build_dir, "native", "libwiresculpt_core.a")
+    tag = re.match(r"_wiresculpt\.cpython-(\d)(\d+)", os.path.basename(default[0]))
+    further = [package_pythons.build(p, v, suffix, cmake, pybind11_dir, core)
+               for p, v, suffix in package_pythons.find(python, f"{tag.group(1)}.{tag.group(2)}")]
+    return default + further
+
+
 def package(out_dir):
     """[the add-on zip, the extension zip]."""
     found = versions()
     if len(set(found.values())) != 1:
         raise SystemExit("wiresculpt: versions disagree: " + ", ".join(f"{k} {v}" for k, v in found.items()))
     version = found["CMakeLists.txt"]
-    modules = [n for n in os.listdir(ADDON) if n.startswith("_wiresculpt") and n.endswith(".so")]
-    if not modules:
-        raise SystemExit("wiresculpt: the compiled module is missing; run scripts/build first")
     os.makedirs(out_dir, exist_ok=True)
     addon_zip = os.path.join(out_dir, f"wiresculpt-{version}-linux-x86_64.zip")
     extension_zip = os.path.join(out_dir, f"wiresculpt-{version}-linux_x64.zip")
     with tempfile.TemporaryDirectory() as stage:
-        files = addon_files(modules, stage)
+        files = addon_files(modules(), stage)
         write_zip(addon_zip, "wiresculpt", files)
         write_zip(extension_zip, "", files)
     return [addon_zip, extension_zip]

@@ -2,13 +2,20 @@
 (system Python with the built module; no Blender): for every `zzxxy5` scene at the given size, the
 planes as given ("off"), then `plane_search: "nearby"`; and for every mesh `plane_search: "auto"`
 with N planes. Every stable design is re-checked (blender_tests/pure/recheck.py). Prints a
-Markdown table and writes JSON.
+Markdown table and writes JSON; with --section FILE (docs/performance.md) also writes the table
+between FILE's `<!-- planes:begin -->` and `<!-- planes:end -->`, keeping the section's hand-written
+notes (from `<!-- planes:notes -->` on). --out also records the load average at the start and
+end and the commit; --from-json FILE redoes the table and section from such a file, without a run.
 
-    python3.11 scripts/plane_search_corpus.py [--cache build/corpus] [--size 0.5] [--counts 5] [--out FILE] [NAME...]
+    python3.11 scripts/plane_search_corpus.py [--cache build/corpus] [--size 0.5] [--counts 5] [--out FILE]
+                                              [--section FILE] [--from-json FILE] [NAME...]
 """
 import argparse
+import datetime
 import json
 import os
+import re
+import subprocess
 import sys
 import time
 
@@ -43,8 +50,75 @@ def one(V, F, planes, scene, **settings):
         out["recheck"] = recheck(json.loads(json.dumps(design)))
     if "plane_search" in design:
         r = design["plane_search"]
-        out.update(changes=r["changes"], candidates=r["candidates"], full_solves=r["full_solves"], score=r["score"])
+        out.update(changes=r["changes"], candidates=r["candidates"], full_solves=r["full_solves"], score=r["score"],
+                   budget=r["budget_seconds"], final_solve=r.get("final_solve"), solves_stopped=r["solves_stopped"])
     return out
+
+
+BEGIN, END, NOTES = "<!-- planes:begin -->", "<!-- planes:end -->", "<!-- planes:notes -->"
+
+
+def table(rows, counts):
+    def verdict(r):
+        if r["stable"]:
+            return "stable" + ("" if not r.get("recheck") else " (re-check FAILS)")
+        return "not stable"
+    lines = ["| mesh | given planes | nearby | nearby s (screened / solved) | " +
+             " | ".join(f"auto N={n} (s, screened / solved)" for n in counts) + " |",
+             "|---|---|---|---|" + "---|" * len(counts)]
+    for row in rows:
+        nb = row["nearby"]
+        first = nb["reason"].split("; no nearby placement")[0]
+        change = ("; ".join(nb.get("changes") or []) or "kept as given" if nb["stable"] else
+                  f"*{first[:100]}{'…' if len(first) > 100 else ''}*"
+                  + (" (budget reached)" if "budget" in nb["reason"] else ""))
+        autos = " | ".join(f"{verdict(row[f'auto{n}'])} ({row[f'auto{n}']['seconds']:.1f}, "
+                           f"{row[f'auto{n}'].get('candidates', '-')} / {row[f'auto{n}'].get('full_solves', '-')})"
+                           for n in counts)
+        lines.append(f"| {row['mesh']} | {verdict(row['off'])} | {verdict(nb)}: {change} | {nb['seconds']:.1f} "
+                     f"({nb.get('candidates', '-')} / {nb.get('full_solves', '-')}) | {autos} |")
+    return lines
+
+
+def head_commit():
+    try:
+        return subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
+                              text=True).stdout.strip() or "?"
+    except OSError:
+        return "?"
+
+
+def section(path, rows, counts, args, load, commit):
+    """Writes the table and the run's header between the planes markers of `path`, keeping the
+    notes after `<!-- planes:notes -->` of the section as it was."""
+    with open(path, encoding="utf-8") as f:
+        text = f.read()
+    old = re.search(re.escape(BEGIN) + r".*?" + re.escape(END), text, re.S)
+    notes = ""
+    if old and NOTES in old.group(0):
+        notes = old.group(0).split(NOTES, 1)[1].rsplit(END, 1)[0].strip("\n")
+    stable = {n: sum(1 for r in rows if r[f"auto{n}"]["stable"]) for n in counts}
+    fixed = sum(1 for r in rows if not r["off"]["stable"] and r["nearby"]["stable"])
+    unstable = sum(1 for r in rows if not r["off"]["stable"])
+    rechecked = sum(1 for r in rows for k in ["nearby"] + [f"auto{n}" for n in counts] if r[k]["stable"])
+    failed = sum(1 for r in rows for k in ["nearby"] + [f"auto{n}" for n in counts] if r[k].get("recheck"))
+    head = [BEGIN, "## Plane assistant on the real-mesh corpus (issue 15)", "",
+            f"`scripts/bench planes --size {args.size} --counts {args.counts} --section docs/performance.md` "
+            f"({datetime.date.today().isoformat()}, commit {commit}; `scripts/plane_search_corpus.py`, in-process with "
+            "the system Python 3.11 and the built module, no Blender): every `zzxxy5` scene of the corpus at "
+            f"{args.size} m, solved with the planes as given, then with `plane_search: \"nearby\"` (budget "
+            f"{plane_search.BUDGET_SECONDS:g} s), and every mesh with `\"auto\"` (budget "
+            f"{plane_search.AUTO_SECONDS_PER_PLANE:g} s per plane, then at most {plane_search.FINAL_SECONDS:g} s "
+            "for the comparison of hook patterns on the returned design). Load average (1 min) of the 2-core "
+            f"machine, shared: {load[0]:.1f} at the start, {load[1]:.1f} at the end. Every stable design is "
+            f"re-checked by `blender_tests/pure/recheck.py`: {rechecked} stable, {failed} refused by it.", "",
+            f"Auto: stable on {', '.join(f'{stable[n]}' for n in counts)} of {len(rows)} meshes for "
+            f"N = {', '.join(str(n) for n in counts)}. Nearby: {fixed} of the {unstable} unstable scenes made "
+            "stable.", ""]
+    body = "\n".join(head + table(rows, counts) + ["", NOTES] + ([notes] if notes else []) + [END])
+    text = text.replace(old.group(0), body) if old else text.rstrip("\n") + "\n\n" + body + "\n"
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(text)
 
 
 def main(argv):
@@ -53,12 +127,21 @@ def main(argv):
     parser.add_argument("--size", default="0.5")
     parser.add_argument("--counts", default="5")
     parser.add_argument("--out", default=None)
+    parser.add_argument("--section", default=None, help="write the table into this file's planes section")
+    parser.add_argument("--from-json", default=None, help="no run: the rows of an earlier --out (its load average "
+                                                          "is recorded in it)")
     parser.add_argument("names", nargs="*")
     args = parser.parse_args(argv)
     folder = os.path.join(args.cache, "scenes")
     counts = [int(c) for c in args.counts.split(",") if c.strip()]  # --counts "": nearby only
-    rows = []
-    for name in sorted(os.listdir(folder)):
+    rows, load = [], [os.getloadavg()[0]]
+    if args.from_json:
+        with open(args.from_json) as f:
+            saved = json.load(f)
+        rows, load, commit = saved["rows"], saved["load"], saved["commit"]
+    else:
+        commit = head_commit()  # the code that ran
+    for name in ([] if args.from_json else sorted(os.listdir(folder))):
         mesh, config, size = name[:-5].rsplit("-", 2)
         if config != "zzxxy5" or size != args.size or (args.names and mesh not in args.names):
             continue
@@ -70,24 +153,14 @@ def main(argv):
             row[f"auto{n}"] = one(V, F, [], scene, plane_search="auto", plane_count=n)
         rows.append(row)
         print(json.dumps(row)[:600], flush=True)
+    if not args.from_json:
+        load.append(os.getloadavg()[0])
     if args.out:
         with open(args.out, "w") as f:
-            json.dump(rows, f, indent=1)
-    print("\n| mesh | given planes | nearby | nearby s (screened / solved) | " +
-          " | ".join(f"auto N={n}" for n in counts) + " |")
-    print("|---|---|---|---|" + "---|" * len(counts))
-
-    def verdict(r):
-        if r["stable"]:
-            return "stable" + ("" if not r.get("recheck") else " (re-check FAILS)")
-        return "not stable"
-    for row in rows:
-        nb = row["nearby"]
-        change = "; ".join(nb.get("changes") or []) if nb["stable"] else nb["reason"][-90:]
-        autos = " | ".join(f"{verdict(row[f'auto{n}'])} ({row[f'auto{n}']['seconds']:.1f} s)"
-                           for n in counts)
-        print(f"| {row['mesh']} | {verdict(row['off'])} | {verdict(nb)}: {change} | {nb['seconds']:.1f} "
-              f"({nb.get('candidates', '-')} / {nb.get('full_solves', '-')}) | {autos} |")
+            json.dump({"rows": rows, "load": load, "commit": commit}, f, indent=1)
+    print("\n" + "\n".join(table(rows, counts)))
+    if args.section:
+        section(args.section, rows, counts, args, load, commit)
 
 
 if __name__ == "__main__":

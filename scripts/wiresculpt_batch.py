@@ -197,7 +197,7 @@ def run(argv):
     from wiresculpt.core.meshcheck import check_output_folder, check_vertices
     from wiresculpt.core.staging import staged
     from wiresculpt.core.scene import load_scene
-    from wiresculpt.core.sizes import STOCK_LENGTH
+    from wiresculpt.core import sizes
     from wiresculpt.blend.mesh import import_mesh
 
     def say(stage, message):
@@ -223,8 +223,7 @@ def run(argv):
     planes = scaled_planes(scene.planes, factor)
     profile = machine_profile(scene, args, say)  # refused before the long work when it is wrong
     model = machine_model(args, say)
-    stock = None if profile is None else (float(profile.get("stock_length", STOCK_LENGTH)),
-                                          profile.get("name") or "the machine profile")
+    stock = None if profile is None else sizes.stock(profile)
     # settings.plane_search "off" is pipeline.run; "nearby"/"auto" return the planes actually used
     design, planes = plane_search.run(V, F, planes, scene.material, scene.settings, say, stock=stock)
     # Everything is written into a hidden folder first and replaces the earlier run's outputs

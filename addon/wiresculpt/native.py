@@ -37,17 +37,31 @@ def host_name():
     return f"Blender {version}" if version else "this Python"
 
 
+# The Blender releases whose own builds embed each Python (a Linux distribution's Blender uses the
+# system's Python instead: Debian 12's Blender 3.4 runs 3.11). 3.11 and 3.13 were checked against
+# the Python tags of PyPI's bpy wheels (cp311 for 4.2.0 to 5.0.1, cp313 for 5.1.0 to 5.3.0); 3.10
+# for 3.1 to 4.0 and 3.11 for 4.1 from Blender's release notes. No Blender release embeds 3.12.
+BLENDERS = {"3.10": "Blender 3.4 to 4.0", "3.11": "Blender 4.1 to 5.0", "3.13": "Blender 5.1 and later"}
+
+
+def _listed(items):
+    """ "a", "a and b", "a, b and c"."""
+    return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
+
+
 def explain_load_error(exc, builds, python=None, host=None):
-    """One sentence saying why the solver did not load and what to do: the Python the zip was
-    built for against the one running, or the shared library the loader could not find."""
+    """One sentence saying why the solver did not load and what to do: the Pythons the zip carries
+    the solver for against the one running (with the Blenders that embed them), or the shared
+    library the loader could not find."""
     python = python or f"{sys.version_info[0]}.{sys.version_info[1]}"
     host = host or host_name()
     text = str(exc)
     if builds and python not in builds:
-        advice = ("use Blender 4.1+" if tuple(map(int, python.split("."))) < (3, 11) else
-                  "use a Blender whose Python is " + " or ".join(builds))
-        return (f"The wiresculpt solver did not load: this build is for Python {' and '.join(builds)}; "
-                f"{host} uses {python}: {advice} or build from source with scripts/package.")
+        blenders = [BLENDERS[b] for b in builds if b in BLENDERS]
+        where = f"a Blender whose Python is {' or '.join(builds)}" + (f" ({', '.join(blenders)})" if blenders else "")
+        return (f"The wiresculpt solver did not load: this zip has the solver for Python {_listed(builds)}; "
+                f"{host} uses {python}: install it in {where}, or build the zip from source with "
+                f"scripts/package on a machine that has Python {python} and its headers.")
     missing = re.search(r"([\w.+-]+\.so[\w.]*): cannot open shared object file", text)
     if missing:
         return (f"The wiresculpt solver did not load: the library {missing.group(1)} is missing. The "

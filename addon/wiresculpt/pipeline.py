@@ -53,14 +53,15 @@ def slice_and_pick(vertices, faces, planes, material, settings, progress=None):
     return design
 
 
-def solve(design, material, settings, progress=None, cancel=None, stock=None, hook_patterns=None):
+def solve(design, material, settings, progress=None, cancel=None, stock=None, hook_patterns=None, hook_seconds=None):
     """Runs every stage after slicing on `design` (its wires' contours set), re-layering while the
     target shape cannot realise a hook (relayer). `progress(stage, message)` is called once per
     finished stage; `cancel()` returning True stops at the next safe point with Cancelled.
     `pending_stages` names the stages that did not run. `stock`: (length in m, profile name) of
     the machine profile in use, for the stock-length warnings said before the long work (None:
     the default profile's). `hook_patterns`: at most this many hook patterns per round in
-    hooks_by_forces (None: HOOK_PATTERNS; 1: the layering's own, as Live does). Past settings.max_solve_seconds (wall
+    hooks_by_forces (None: HOOK_PATTERNS; 1: the layering's own, as Live does); `hook_seconds`: no
+    new pattern after this many seconds (None: HOOK_SECONDS; the plane search's final solve). Past settings.max_solve_seconds (wall
     clock) the solve stops the same way and raises OutOfTime, naming the key and the stage."""
     cancelled = cancel or (lambda: False)
     budget = float(settings.get("max_solve_seconds") or settings_table.SETTINGS["max_solve_seconds"][0])
@@ -96,7 +97,7 @@ def solve(design, material, settings, progress=None, cancel=None, stock=None, ho
         design.setdefault("warnings", []).append(warning)
         say("size", warning)
     try:
-        return relayer(design, material, settings, say, native_progress, checkpoint, hook_patterns)
+        return relayer(design, material, settings, say, native_progress, checkpoint, hook_patterns, hook_seconds)
     except native.Cancelled:
         if not cancelled() and out_of_time():
             raise OutOfTime(budget, at["stage"]) from None
@@ -112,7 +113,7 @@ def _pairs(pairs):
     return [[c, h] for c, h in sorted(pairs)]
 
 
-def relayer(design, material, settings, say, native_progress, checkpoint, hook_patterns=None):
+def relayer(design, material, settings, say, native_progress, checkpoint, hook_patterns=None, hook_seconds=None):
     """Layering, then target shape, forces and rest shape (shape_and_rest); while the result is not
     stable because the target shape could not realise some crossing's hook, forbid those (crossing,
     hook) pairs (target_shape.unrealisable: the failed hook, or both hooks of a crossing too close to
@@ -123,13 +124,14 @@ def relayer(design, material, settings, say, native_progress, checkpoint, hook_p
     `relayer_rounds` re-layerings. Records every round in stages.relayering. Returns the design of
     the last round, or, when the last layering found no stable assembly under the forbidden hooks,
     of the last round that reached the target shape (its shapes and reason show why), saying so.
-    `hook_patterns`: hooks_by_forces' `patterns` bound (None: HOOK_PATTERNS)."""
+    `hook_patterns`: hooks_by_forces' `patterns` bound (None: HOOK_PATTERNS); `hook_seconds`: its
+    time bound over every round (None: HOOK_SECONDS)."""
     extra_rounds = int(layering.knob(settings, "relayer_rounds"))
     # Layering replaces (never edits) each wire's contour, so the copies share the contours.
     pristine = _copy_sharing_contours(design) if extra_rounds else None
     forbidden, rounds, start, shaped = set(), [], time.perf_counter(), None
     same_solves = {}  # target-shape solves by exact input, for every round (target_shape.Memo `same`)
-    hook_deadline = time.monotonic() + HOOK_SECONDS  # one bound for the hook searches of every round
+    hook_deadline = time.monotonic() + (HOOK_SECONDS if hook_seconds is None else hook_seconds)  # one bound for the hook searches of every round
     for round_ in range(extra_rounds + 1):
         began = time.perf_counter()
         checkpoint()
@@ -143,7 +145,8 @@ def relayer(design, material, settings, say, native_progress, checkpoint, hook_p
             # cost that use no forbidden hook; the best forces win among the stable (buildable) ones,
             # and when none is, the layering's own pattern is kept, so the round learns from it.
             attempt = hooks_by_forces(attempt, material, settings, say, native_progress, checkpoint,
-                                      patterns=hook_patterns, forbidden=forbidden, deadline=hook_deadline, same_solves=same_solves)
+                                      patterns=hook_patterns, seconds=hook_seconds, forbidden=forbidden, deadline=hook_deadline,
+                                      same_solves=same_solves)
             shaped = attempt
         learnt = target_shape.unrealisable(attempt) - forbidden
         rounds.append({"forbidden": _pairs(forbidden), "stable": attempt["stable"],
@@ -283,7 +286,14 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint,
         if not design["stable"]:  # forces need the hooks of a complete stable assembly
             return design
         checkpoint()
-        say("forces", forces.run(design, material, settings, native_progress))
+        # The load capacity (twelve LPs, most of the stage's time) is only kept from the last round:
+        # a round that may be followed by another skips it when a rest bend is over the limit, the
+        # case in which another round follows (computed below if the rounds stop there anyway).
+        warnings_before = len(design.get("warnings", []))
+        within = math.radians(machine_limit) if round_ + 1 < COUPLING_ROUNDS else None
+        if "density" in material:  # an earlier solve's must not stand for a skipped one
+            design.pop("load_capacity", None)
+        say("forces", forces.run(design, material, settings, native_progress, load_capacity_within=within))
         design["pending_stages"].remove("forces")
         say("rest_shape", forces.rest_summary(design))
         design["pending_stages"].remove("rest_shape")
@@ -300,6 +310,10 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint,
                             f"solving again with {changed} vertex bend limit{'s' if changed != 1 else ''} lowered so "
                             f"that the rest bends stay {COUPLING_MARGIN_DEG:g} deg inside, other bends up to "
                             f"{target_limit:.2f} deg (Sec. 4.3)")
+    if "density" in material and "load_capacity" not in design:  # the last round skipped it
+        del design.get("warnings", [])[warnings_before:]
+        checkpoint()
+        say("forces", forces.run(design, material, settings, native_progress))
     # "Stable" means buildable: the bend program of every wire, with the machine profile in use.
     buildability.apply(design)
     return design

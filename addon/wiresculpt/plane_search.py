@@ -16,17 +16,23 @@ Two searches:
   +-{2, 4, 7, 10, 15, 20} % of S, tilts of 5, 10, 15 deg about two axes each way, the other
   contour rule), then pairs of one-plane changes of two different planes, tried in order of cost.
 - `auto(...)`: planes from the mesh alone: `count` planes in families along the mesh's principal
-  axes (area-weighted), each family spread evenly over the mesh's extent along its axis (one plane
-  of a family goes through the centre: the mesh's symmetry plane when it has one). Candidates are
-  the ways to split `count` over the three axes (at least two families), each with four spreads
-  (SPREADS), in the principal frame and the world's, solved in order of coverage.
+  axes (area-weighted) or the world's, each family spread over the mesh's extent along its axis or
+  over the quantiles of its surface area (family_planes), for every split of `count` over the three
+  axes (balanced first) and every spread of SPREADS; each with the largest contour of every plane,
+  and, when that fails the screen, the contours of the crossing network's largest connected part
+  without hinged wires (Searcher.connected). Screened proposals are verified fewest crossings
+  closer than 2 * min_segment along a wire first (close_gaps), then by coverage; budget
+  auto_budget(count) = AUTO_SECONDS_PER_PLANE * count.
 
 Every candidate is screened cheaply first: slicing (each plane placement sliced once, cached) and
 the layering (stages.layering), whose first step is the hook-relaxed stability check (every
 crossing a ball joint: a mechanism is rejected in about a millisecond) and whose search then
 finds the hooks. Only survivors run the full pipeline (pipeline.solve: target shape, forces, rest
-shape, buildability), and a candidate is returned only when that says stable (which means
-buildable, fab/buildability).
+shape, buildability) with the layering's own hooks (CANDIDATE_HOOK_PATTERNS), and a candidate is
+returned only when that says stable (which means buildable, fab/buildability). The returned
+design then gets the comparison of hook patterns by their forces (Searcher.finish), bounded by
+FINAL_HOOK_SECONDS / FINAL_SECONDS; when that does not end stable in time, the verified design
+is kept.
 
 Score of a returned candidate (documented in docs/formats.md, higher is better):
 
@@ -40,14 +46,11 @@ the largest distance of a target shape from its contour (target_max_distance).
 import copy
 import itertools
 import math
-import threading
 import time
 
 import numpy as np
 
-from . import pipeline
-from .core import ordered
-from .core.ordered import InOrder
+from . import native, pipeline
 from .core.scene import PlaneSpec
 from .stages import layering, slicing
 
@@ -58,6 +61,17 @@ RULE_COST = 0.05
 COVERAGE_RADIUS = 0.1  # fraction of S
 FIDELITY_WEIGHT = 10.0
 BUDGET_SECONDS = 8.0  # the issue's 10 s for a nearby search on a five-plane scene, with room
+AUTO_SECONDS_PER_PLANE = 6.0  # auto's search budget: this many seconds per plane (24 s for N = 4)
+# Candidates are verified by full solves with the layering's own hooks (pipeline.solve with
+# hook_patterns=1, as Live does: 0.2-4 s on the corpus); the comparison of hook patterns by their
+# forces (issue 16: up to 64 patterns, seconds to a minute) runs once, on the returned design, within
+# FINAL_HOOK_SECONDS (no new pattern after it) and stopped at FINAL_SECONDS; when it does not end
+# stable in time, the verified design (stable and buildable with the layering's hooks) is returned.
+CANDIDATE_HOOK_PATTERNS = 1
+EARLY_SOLVES = 3  # auto verifies as soon as this many screened proposals have no close gap
+SCREEN_SECONDS = 2.0  # a screen's layering longer than this does not pass (a search of many contours)
+FINAL_HOOK_SECONDS = 10.0
+FINAL_SECONDS = 20.0
 
 
 class Placement:
@@ -166,8 +180,7 @@ class Searcher:
         self.cache = {}
         self.mesh_info = None  # the slicer's report on the mesh (stages.slicing.mesh), from its first call
         self.screened = self.full_solves = self.timed_out = self.failed = 0
-        self.workers = ordered.workers()  # full solves at once (1: the search on one thread)
-        self._counting = threading.Lock()  # solve() runs on the pool's threads
+        self.final = None  # what finish() did with the returned design
         self.deadline = math.inf  # perf_counter() time at which a full solve is stopped (the budget)
         self.budget = None  # seconds
         self.centre, self.axes, self.size = mesh_frame(vertices, faces)
@@ -215,39 +228,133 @@ class Searcher:
         """The layering's verdict on the placements (slicing + hook-relaxed check + hook search):
         (passes, the sliced design, whether the layering found crossings too close along a wire for
         the machine); an input the network refuses (planes that coincide) does not pass."""
+        ok, design, probe = self.screen_layered(placements)
+        return ok, design, bool(probe and probe.get("close_crossings"))
+
+    def screen_layered(self, placements):
+        """As screen, with the layered copy of the design instead of the close-crossings flag:
+        (passes, the sliced design, the layered design or None)."""
         if self.cancel():
             raise pipeline.Cancelled()
         self.screened += 1
         try:
             design = self.sliced(placements)
             if design is None or len(design["wires"]) < 2:
-                return False, design, False
+                return False, design, None
             probe = copy.deepcopy(design)
-            layering.run(probe, self.material, self.settings_for(design))
-            return bool(probe["stable"]), design, bool(probe.get("close_crossings"))
-        except (ValueError, RuntimeError):
-            return False, None, False
+            self._layer(probe, design)
+            return bool(probe["stable"]), design, probe
+        except (ValueError, RuntimeError, native.Cancelled):
+            if self.cancel():
+                raise pipeline.Cancelled() from None
+            return False, None, None  # refused, or its layering ran past the deadline
 
-    def solve(self, design):
+    def _layer(self, probe, design):
+        """layering.run on `probe`, stopped (native.Cancelled) by a cancel, past the deadline or
+        after SCREEN_SECONDS: a layering search can take many seconds on a network of many small
+        contours (elephant, N = 6: one took the whole screening time), and a screen is to be cheap."""
+        stop = min(self.deadline, time.perf_counter() + SCREEN_SECONDS)
+        layering.run(probe, self.material, self.settings_for(design),
+                     lambda _stage, _fraction: not (self.cancel() or time.perf_counter() > stop))
+
+    def connected(self, placements):
+        """The placements with, for each plane, the contours ("all" of them) that belong to the
+        largest connected part of the crossing network (the part that crosses the most planes, then
+        has the most crossings) after dropping, again and again, every wire that crosses fewer than
+        two other wires: a contour that crosses no other wire or hangs apart from the rest is left
+        out, and so is one that crosses a single other wire, since two planar wires cross only on
+        their planes' common line, about which it would turn (a hinge). None when no part reaches
+        every plane (a plane would have no wire) or the network refuses the input."""
+        every = [Placement(p.name, p.origin, p.normal, "all") for p in placements]
+        design = self.sliced(every)
+        if design is None or len(design["wires"]) < 2:
+            return None
+        probe = copy.deepcopy(design)
+        try:
+            self._layer(probe, design)
+        except (ValueError, RuntimeError, native.Cancelled):
+            if self.cancel():
+                raise pipeline.Cancelled() from None
+            return None
+        partners = {i: set() for i in range(len(probe["wires"]))}
+        for c in probe["crossings"]:
+            a, b = c["wires"]
+            partners[a].add(b)
+            partners[b].add(a)
+        kept = set(partners)
+        while True:
+            weak = {i for i in kept if len(partners[i] & kept) < 2}
+            if not weak:
+                break
+            kept -= weak
+        crossings = [c for c in probe["crossings"] if set(c["wires"]) <= kept]
+        parent = list(range(len(probe["wires"])))
+
+        def root(i):
+            while parent[i] != i:
+                parent[i] = parent[parent[i]]
+                i = parent[i]
+            return i
+        for c in crossings:
+            a, b = (root(w) for w in c["wires"])
+            parent[a] = b
+        parts = {}
+        for c in crossings:
+            parts.setdefault(root(c["wires"][0]), []).append(c)
+        best, best_key = None, None
+        for r, crossings in parts.items():
+            wires = {i for i in kept if root(i) == r}
+            planes = {probe["wires"][i]["name"].rsplit("/", 1)[0] for i in wires}
+            key = (len(planes), len(crossings))
+            if best_key is None or key > best_key:
+                best, best_key = wires, key
+        if best is None or best_key[0] < len(placements):
+            return None
+        chosen = {}
+        for i in sorted(best):
+            plane, k = probe["wires"][i]["name"].rsplit("/", 1)
+            chosen.setdefault(plane, []).append(int(k))
+        return [Placement(p.name, p.origin, p.normal, sorted(chosen[p.name])) for p in placements]
+
+    def solve(self, design, hook_patterns=CANDIDATE_HOOK_PATTERNS, hook_seconds=None, deadline=None):
         """The full pipeline on a screened design; the solved design (stable means buildable), or
         None when it fails or runs past the search's deadline (a solve is stopped there, like a
-        cancel, so the budget holds however long one solve would take)."""
-        self._count("full_solves")
+        cancel, so the budget holds however long one solve would take). `hook_patterns`: as
+        pipeline.solve's (default: the layering's own hooks, see CANDIDATE_HOOK_PATTERNS);
+        `deadline`: instead of the search's."""
+        self.full_solves += 1
+        stop = self.deadline if deadline is None else deadline
         try:
             return pipeline.solve(design, self.material, self.settings_for(design),
-                                  cancel=lambda: self.cancel() or time.perf_counter() > self.deadline, stock=self.stock)
+                                  cancel=lambda: self.cancel() or time.perf_counter() > stop, stock=self.stock,
+                                  hook_patterns=hook_patterns, hook_seconds=hook_seconds)
         except (ValueError, RuntimeError):  # a candidate the solver cannot finish (an infeasible LP): no answer
-            self._count("failed")
+            self.failed += 1
             return None
         except pipeline.Cancelled:
             if self.cancel():
                 raise
-            self._count("timed_out")
+            self.timed_out += 1
+            return None
+        except (ValueError, RuntimeError):
             return None
 
-    def _count(self, name):
-        with self._counting:
-            setattr(self, name, getattr(self, name) + 1)
+    def finish(self, candidate):
+        """The comparison of hook patterns by their forces (pipeline.solve's default, issue 16) on a
+        candidate verified with the layering's hooks (its "sliced" design, unsolved): its design
+        is replaced when that solve ends stable within FINAL_SECONDS, else kept. Records
+        self.final: {"hook_search": "by forces" or "the layering's hooks", "seconds", "why"}."""
+        began, stopped = time.perf_counter(), self.timed_out
+        solved = self.solve(copy.deepcopy(candidate["sliced"]), hook_patterns=None, hook_seconds=FINAL_HOOK_SECONDS,
+                            deadline=began + FINAL_SECONDS)
+        if solved is not None and solved["stable"]:
+            candidate["design"], candidate["figures"] = solved, _figures(solved)
+            self.final = {"hook_search": "by forces", "seconds": time.perf_counter() - began}
+        else:
+            why = (f"stopped at {FINAL_SECONDS:g} s" if self.timed_out > stopped else
+                   "the solver could not finish it" if solved is None else f"not stable: {solved['reason']}")
+            self.final = {"hook_search": "the layering's hooks", "seconds": time.perf_counter() - began, "why": why}
+        return candidate
 
     def coverage(self, design):
         """Share of the mesh's (sampled) vertices within COVERAGE_RADIUS * S of a contour point."""
@@ -280,7 +387,7 @@ def _record(mode, before, candidate, searcher, start):
             "changes": candidate["changes"] if candidate else [],
             "candidates": searcher.screened, "full_solves": searcher.full_solves,
             "budget_seconds": searcher.budget, "solves_stopped": searcher.timed_out,
-            "solves_failed": searcher.failed,
+            "solves_failed": searcher.failed, "final_solve": searcher.final,
             "seconds": time.perf_counter() - start, "score": candidate["score"] if candidate else None,
             "measure": ("cost = sum of |offset| / model size + tilt in radians + 0.05 per contour-rule change; "
                         "score = -cost" if mode == "nearby" else
@@ -313,40 +420,34 @@ def nearby(vertices, faces, planes, material, settings, want=1, budget=BUDGET_SE
         costs = sorted(c["cost"] for c in found)
         return costs[want - 1] if len(costs) >= want else math.inf
 
-    def take(tag, solved):
-        """A full solve's answer, in the order one thread would have solved them: one that one
-        thread would not have solved (it no longer beats the bar) is dropped."""
-        cost, changes, placements = tag
-        if cost >= bar() or solved is None or not solved["stable"]:
+    def solve(cost, changes, placements, design):
+        solved = s.solve(copy.deepcopy(design))
+        if solved is None or not solved["stable"]:
             return
         found.append({"planes": placements, "changes": [t for _, c in changes for t in c.changes], "cost": cost,
-                      "score": -cost, "design": solved, "figures": _figures(solved)})
+                      "score": -cost, "design": solved, "figures": _figures(solved), "sliced": design})
         s.say("plane_search", f"candidate {len(found)}: {'; '.join(found[-1]['changes']) or 'the planes as given'} "
                               f"(cost {cost:.3f}, {s.screened} screened, {s.full_solves} solved)")
 
     def phase(options):
-        # Full solves run on s.workers threads while the next candidates are screened; their
-        # answers are taken in order (core/ordered.py), so what is found is what one thread finds.
         deferred = []
-        with InOrder(take, s.workers) as pool:
-            for cost, changes in options:
-                if cost >= bar() or out_of_time():
-                    break
-                placements = list(base)
-                for i, c in changes:
-                    placements[i] = c
-                ok, design, close = s.screen(placements)
-                if not ok:
-                    continue
-                if close:
-                    deferred.append((cost, changes, placements, design))
-                else:
-                    pool.submit((cost, changes, placements), s.solve, design)
-            pool.drain()
-            for cost, changes, placements, design in deferred:
-                if cost >= bar() or out_of_time():
-                    break
-                pool.submit((cost, changes, placements), s.solve, design)
+        for cost, changes in options:
+            if cost >= bar() or out_of_time():
+                break
+            placements = list(base)
+            for i, c in changes:
+                placements[i] = c
+            ok, design, close = s.screen(placements)
+            if not ok:
+                continue
+            if close:
+                deferred.append((cost, changes, placements, design))
+            else:
+                solve(cost, changes, placements, design)
+        for cost, changes, placements, design in deferred:
+            if cost >= bar() or out_of_time():
+                break
+            solve(cost, changes, placements, design)
 
     phase([(0.0, ())] + sorted(((c.cost, ((i, c),)) for i, cs in singles.items() for c in cs), key=lambda t: t[0]))
     if len(found) < want and not out_of_time():  # pairs of one-plane changes of two planes
@@ -357,6 +458,8 @@ def nearby(vertices, faces, planes, material, settings, want=1, budget=BUDGET_SE
                     pairs.append((a.cost + b.cost, ((i, a), (j, b))))
         phase(sorted(pairs, key=lambda t: t[0]))
     found.sort(key=lambda c: c["cost"])
+    if found:
+        s.finish(found[0])
     return found[:want], s, start
 
 
@@ -370,13 +473,55 @@ def _family_names(axes):
     return names
 
 
-SPREADS = ((0.2, 0.8), (0.3, 0.7), (0.12, 0.88), (0.38, 0.62))  # a family's first and last plane
+# a family's first and last plane, as fractions of the mesh's extent along its axis: wide first;
+# narrower spreads keep the planes off thin extremities (limbs, where crossings come close together)
+SPREADS = ((0.2, 0.8), (0.3, 0.7), (0.12, 0.88), (0.38, 0.62), (0.25, 0.75), (0.16, 0.84))
 
 
-def family_planes(searcher, counts, contours="largest", spread=SPREADS[0], axes=None):
+def crossing_gaps(design):
+    """The distances along each wire between consecutive crossings (metres), from a layered design
+    (its contours hold the crossing points, crossings[i]["contour_vertices"] their indices)."""
+    at = {}
+    for c in design["crossings"]:
+        for w, v in zip(c["wires"], c["contour_vertices"]):
+            at.setdefault(w, []).append(v)
+    gaps = []
+    for w, vertices in at.items():
+        wire = design["wires"][w]
+        pts = np.asarray(wire["contour"], dtype=float)
+        arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+        total = arc[-1] + (float(np.linalg.norm(pts[-1] - pts[0])) if wire["closed"] else 0.0)
+        s = sorted(arc[v] for v in vertices)
+        gaps += [b - a for a, b in zip(s, s[1:])]
+        if wire["closed"] and len(s) >= 2:
+            gaps.append(total - s[-1] + s[0])
+    return gaps
+
+
+def close_gaps(design, min_segment):
+    """How many crossings follow another along a wire closer than 2 * min_segment: the target
+    shape then has no free bending point between them and mostly cannot realise them (its
+    "too close to their neighbours" verdict), so such candidates are verified last."""
+    return sum(1 for g in crossing_gaps(design) if g < 2.0 * min_segment)
+
+
+def _surface(searcher):
+    """(triangle centroids, areas) of the searcher's mesh, computed once."""
+    if getattr(searcher, "surface", None) is None:
+        V = np.asarray(searcher.V, dtype=float)
+        F = np.asarray(searcher.F, dtype=np.int64)
+        a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+        w = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
+        searcher.surface = ((a + b + c) / 3.0, w if w.sum() > 0 else np.ones(len(F)))
+    return searcher.surface
+
+
+def family_planes(searcher, counts, contours="largest", spread=SPREADS[0], axes=None, by="extent"):
     """Placements for `counts[k]` planes along axis k of `axes` (default: the principal axes),
     spread evenly from `spread[0]` to `spread[1]` of the mesh's extent along it (a family of one
-    goes through the centre)."""
+    goes through the centre); by="area": at those quantiles of the mesh's surface area along the
+    axis instead (a family of one at the median), so that planes gather where the mesh has
+    surface, away from thin extremities (a figure's limbs), where crossings come close together."""
     V = np.asarray(searcher.V, dtype=float)
     axes = searcher.axes if axes is None else axes
     names = _family_names(axes)
@@ -387,9 +532,18 @@ def family_planes(searcher, counts, contours="largest", spread=SPREADS[0], axes=
         axis = axes[k]
         t = (V - searcher.centre) @ axis
         lo, hi = float(t.min()), float(t.max())
+        if by == "area":
+            centroids, areas = _surface(searcher)
+            u = (centroids - searcher.centre) @ axis
+            order = np.argsort(u)
+            share = np.cumsum(areas[order]) / areas.sum()
         for i in range(count):
             f = 0.5 if count == 1 else spread[0] + (spread[1] - spread[0]) * i / (count - 1)
-            origin = searcher.centre + (lo + f * (hi - lo)) * axis
+            if by == "area":
+                at = float(u[order][min(int(np.searchsorted(share, f)), len(order) - 1)])
+            else:
+                at = lo + f * (hi - lo)
+            origin = searcher.centre + at * axis
             out.append(Placement(f"{names[k]}{i}", origin, axis, contours))
     return out
 
@@ -399,51 +553,99 @@ def _axis_word(axis, k):
     return "xyz"[j] if abs(axis[j]) > 0.99 else f"principal axis {k + 1}"
 
 
-def auto(vertices, faces, count, material, settings, want=2, budget=3 * BUDGET_SECONDS, progress=None, cancel=None,
-         stock=None):
-    """Up to `want` stable, buildable plane sets of `count` planes proposed from the mesh alone,
-    best score first (see the module's docstring), and the Searcher. Proposals: every split of
-    `count` over three axes using at least two, every spread of SPREADS, in the principal axes'
-    frame and (when it differs) the world's."""
-    s = Searcher(vertices, faces, material, settings, progress, cancel, stock)
-    start = time.perf_counter()
-    s.deadline, s.budget = start + budget, budget
+def auto_budget(count):
+    """auto's search budget in seconds for `count` planes (the final hook comparison comes on top:
+    at most FINAL_SECONDS)."""
+    return AUTO_SECONDS_PER_PLANE * max(int(count), 1)
+
+
+def splits_of(count):
+    """The ways to split `count` planes over three axes using at least two, balanced first."""
     splits = [c for c in itertools.product(range(count + 1), repeat=3) if sum(c) == count
               and sum(1 for x in c if x) >= 2]
+    return sorted(splits, key=lambda c: (max(c), 0 in c))
+
+
+def auto(vertices, faces, count, material, settings, want=2, budget=None, progress=None, cancel=None,
+         stock=None):
+    """Up to `want` stable, buildable plane sets of `count` planes proposed from the mesh alone,
+    best score first (see the module's docstring), and the Searcher. `budget`: seconds (None:
+    auto_budget(count)). Proposals: every split of `count` over three axes using at least two
+    (balanced first), every spread of SPREADS, in the principal axes' frame and (when it differs)
+    the world's; each with the largest contour of every plane and, when that does not pass the
+    screen, with the contours of the network's largest connected part (Searcher.connected).
+    Screening (up to half the budget) keeps the proposals the layering finds stable; they are
+    verified by full solves with the layering's hooks in order of how many crossings come closer
+    than 2 * min_segment along a wire (fewest first), then coverage; the best found gets the
+    comparison of hook patterns (Searcher.finish)."""
+    s = Searcher(vertices, faces, material, settings, progress, cancel, stock)
+    start = time.perf_counter()
+    budget = auto_budget(count) if budget is None else budget
+    s.deadline, s.budget = start + budget / 2, budget  # screening: up to half the budget
     frames = [s.axes] + ([np.eye(3)] if np.abs(np.abs(s.axes) - np.eye(3)).max() > 1e-6 else [])
-    screened = []
-    for rule in ("largest", "all"):
-        for axes, spread, counts in itertools.product(frames, SPREADS, splits):
-            if time.perf_counter() - start > budget / 2:
-                break
-            placements = family_planes(s, counts, rule, spread, axes)
-            ok, design, _close = s.screen(placements)
+    min_segment = float(settings.get("min_segment") or 0.0)
+    proposals = itertools.product(SPREADS, ("area", "extent"), splits_of(count), frames)
+    seen, found, passed = set(), [], 0
+
+    def screen_some(limit):
+        """Screens proposals until `limit` (perf_counter time) or EARLY_SOLVES of them pass with
+        no close gap; returns the passing ones, and whether proposals remain."""
+        nonlocal passed
+        s.deadline = limit
+        batch, clean = [], 0
+        for spread, by, counts, axes in proposals:
+            placements = family_planes(s, counts, "largest", spread, axes, by)
+            ok, design, probe = s.screen_layered(placements)
+            if not ok:
+                joined = s.connected(placements)
+                if joined is None or all(p.contours == [0] for p in joined):
+                    joined = None
+                else:
+                    key = tuple((p.key(), tuple(p.contours)) for p in joined)
+                    joined = None if key in seen else joined
+                    seen.add(key)
+                if joined is not None:
+                    placements = joined
+                    ok, design, probe = s.screen_layered(placements)
             if ok:
-                screened.append((s.coverage(design), counts, axes, rule, placements, design))
-        if screened:
-            break
-    screened.sort(key=lambda t: -t[0])
-    found = []
+                batch.append((close_gaps(probe, min_segment), -s.coverage(design), counts, axes, placements, design))
+                clean += batch[-1][0] == 0
+            if clean >= EARLY_SOLVES or time.perf_counter() > limit:
+                passed += len(batch)
+                return batch, True
+        passed += len(batch)
+        return batch, False
 
-    def take(tag, solved):  # in coverage order, as one thread would: past `want` found, dropped
-        cover, counts, axes, rule, placements, _design = tag
-        if len(found) >= want or solved is None or not solved["stable"]:
-            return
-        score = cover - FIDELITY_WEIGHT * s.max_deviation(solved) / s.size
-        found.append({"planes": placements, "changes": [f"{len(placements)} planes: " + ", ".join(
-            f"{n} along {_axis_word(axes[k], k)}" for k, n in enumerate(counts) if n)
-            + ("" if rule == "largest" else ", every contour")],
-            "cost": 0.0, "score": score, "coverage": cover, "design": solved, "figures": _figures(solved)})
-        s.say("plane_search", f"candidate {len(found)}: {found[-1]['changes'][0]} (score {score:.3f})")
-
-    with InOrder(take, s.workers) as pool:
-        for item in screened:
-            if len(found) >= want or time.perf_counter() - start > budget:
-                break
-            pool.submit(item, s.solve, item[-1])
+    more, pool, first = True, [], True
+    while more and len(found) < want and time.perf_counter() - start < budget:
+        # screening up to half the budget at first, later up to half of what is left; verifying the
+        # pool (fewest close gaps first) after each round
+        now = time.perf_counter()
+        batch, more = screen_some(start + budget / 2 if first else now + (start + budget - now) / 2)
+        first = False
+        s.deadline = start + budget
+        pool = sorted(pool + batch, key=lambda t: t[:2])
+        s.say("plane_search", f"{passed} of {s.screened} proposals pass the screen; "
+                              f"{sum(1 for t in pool if t[0] == 0)} to verify without crossings closer than "
+                              f"2 x min_segment along a wire")
+        while pool and len(found) < want and time.perf_counter() - start < budget:
+            close, cover, counts, axes, placements, design = pool.pop(0)
+            solved = s.solve(copy.deepcopy(design))
+            if solved is None or not solved["stable"]:
+                continue
+            cover = -cover
+            score = cover - FIDELITY_WEIGHT * s.max_deviation(solved) / s.size
+            rule = "" if all(p.contours == "largest" for p in placements) else ", the connected contours"
+            found.append({"planes": placements, "changes": [f"{len(placements)} planes: " + ", ".join(
+                f"{n} along {_axis_word(axes[k], k)}" for k, n in enumerate(counts) if n) + rule],
+                "cost": 0.0, "score": score, "coverage": cover, "design": solved, "figures": _figures(solved),
+                "sliced": design})
+            s.say("plane_search", f"candidate {len(found)}: {found[-1]['changes'][0]} (score {score:.3f})")
     # a design whose assembly needs two wires placed at once (two_hand_steps) comes after every
     # design that can be built one wire at a time, whatever its score
     found.sort(key=lambda c: (bool(c["design"].get("two_hand_steps")), -c["score"]))
+    if found:
+        s.finish(found[0])
     return found, s, start
 
 

@@ -197,6 +197,78 @@ def eq12(target, torque, l_bar, k_b):
     return 2 * math.atan(t + torque / ((4 * k_b / l_bar) * (1 + t * t)))
 
 
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class LoadCapacityOfTheLastRound(unittest.TestCase):
+    """The coupling rounds skip the load capacity (native load_capacity_within) in a round whose
+    rest bends are over the limit, the rounds that are solved again: the design is the same as
+    with it computed in every round, from one load capacity instead of one per round. On the soft
+    sphere of Coupling, which needs more than one round."""
+
+    def solve(self, deferred, tighten=None):
+        settings = defaults()
+        settings.update(contact_angle_deg=140.0, max_bend_deg=50.0, torque_fraction=1.0, least_out_of_plane=False)
+        V, F = sphere()
+        material = dict(PRESETS["steel"], bending_stiffness=0.1, max_torque=3.0)
+        self.assertIn("density", material)  # the load capacity is computed at all
+        module, run, saved_tighten = native.require(), pipeline.forces.run, pipeline._tighten
+        computed = []
+
+        class Counting:  # which forces_and_rest calls computed a load capacity
+            def __getattr__(_self, name):
+                if name != "forces_and_rest":
+                    return getattr(module, name)
+
+                def call(*args):
+                    r = module.forces_and_rest(*args)
+                    computed.append(r["load_capacity"] is not None)
+                    return r
+                return call
+
+        def every_round(design, material, settings, native_progress=None, load_capacity_within=None):
+            return run(design, material, settings, native_progress)
+
+        saved_require, saved_patterns = native.require, pipeline.HOOK_PATTERNS
+        native.require, pipeline.HOOK_PATTERNS = Counting, 1
+        if not deferred:
+            pipeline.forces.run = every_round
+        if tighten:
+            pipeline._tighten = tighten
+        try:
+            return pipeline.run(V, F, PLANES, material, settings), computed
+        finally:
+            native.require, pipeline.HOOK_PATTERNS = saved_require, saved_patterns
+            pipeline.forces.run, pipeline._tighten = run, saved_tighten
+
+    def assertSameDesign(self, a, b):
+        self.assertEqual(a["load_capacity"], b["load_capacity"])
+        self.assertEqual(a.get("load_factor"), b.get("load_factor"))
+        self.assertEqual(a["warnings"], b["warnings"])
+        self.assertEqual((a["stable"], a.get("reason")), (b["stable"], b.get("reason")))
+        self.assertEqual([c.get("normal_force") for c in a["crossings"]], [c.get("normal_force") for c in b["crossings"]])
+        self.assertEqual([w["rest_angles"] for w in a["wires"]], [w["rest_angles"] for w in b["wires"]])
+
+    def test_one_load_capacity_for_the_same_design(self):
+        deferred, calls = self.solve(True)
+        every, calls_every = self.solve(False)
+        self.assertGreater(deferred["stages"]["target_shape"]["coupling_rounds"], 1)  # the case it is about
+        self.assertEqual(len(calls), len(calls_every))
+        self.assertTrue(all(calls_every))
+        self.assertEqual(calls, [False] * (len(calls) - 1) + [True])
+        self.assertSameDesign(deferred, every)
+
+    def test_rounds_that_stop_over_the_limit_still_get_it(self):
+        # _tighten changing nothing stops the rounds after the first, its rest bends still over the
+        # limit: the load capacity it skipped is computed then, and its warnings are not repeated.
+        def nothing(design, memo, limit, kink):
+            return 0, 0.0
+
+        deferred, calls = self.solve(True, nothing)
+        every, _ = self.solve(False, nothing)
+        self.assertGreater(deferred["stages"]["target_shape"]["rest_excess_deg"], 0.0)
+        self.assertEqual(calls, [False, True])
+        self.assertSameDesign(deferred, every)
+
+
 class CouplingStep(unittest.TestCase):
     """pipeline._tighten on the vertex measured on the corpus (bear, zzxxy5, 0.75 m; wire X1/0,
     target vertex 40): target bend 120.000 deg at the limit, rest 120.089 deg from its torque."""

@@ -12,7 +12,6 @@ import numpy as np
 
 from wiresculpt import native, pipeline, plane_search
 from wiresculpt.core import design as vocabulary
-from wiresculpt.core import ordered
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.scene import PlaneSpec, parse_scene
 from wiresculpt.core.settings import defaults
@@ -171,25 +170,6 @@ class Nearby(unittest.TestCase):
                 shift = abs(float(np.dot(np.subtract(p.origin, q.origin), p.normal))) if tilt < 1e-9 else 0.0
                 cost += shift / 0.25 + tilt + (plane_search.RULE_COST if p.contours != q.contours else 0.0)
             self.assertAlmostEqual(c["cost"], cost, delta=1e-9)
-
-    def test_two_threads_find_what_one_thread_finds(self):
-        """The full solves run on core/ordered.workers() threads; the candidates, their order, changes,
-        costs and designs (all but the timings) are those of the search on one thread."""
-        def search(workers):
-            saved, ordered.workers = ordered.workers, lambda most=None: workers  # whatever the load
-            try:
-                found, searcher, _start = plane_search.nearby(self.V, self.F, HINGE, PRESETS["steel"],
-                                                              settings(plane_search="nearby"), want=3, budget=600.0)
-            finally:
-                ordered.workers = saved
-            self.assertEqual(searcher.workers, workers)
-            return [(c["changes"], c["cost"], [p.as_dict() for p in c["planes"]], c["figures"],
-                     untimed(round_trip(c["design"]))) for c in found]
-
-        one, two = search(1), search(2)
-        self.assertEqual(len(one), 3)
-        self.assertEqual([c[0] for c in two], [c[0] for c in one])
-        self.assertEqual(two, one)
 
     def test_stable_planes_are_kept(self):
         design, used = plane_search.run(self.V, self.F, BASE, PRESETS["steel"], settings(plane_search="nearby"))

@@ -135,6 +135,7 @@ py::dict forces_and_rest_py(const py::object& wire_list, const py::object& cross
               {field::number("torque_fraction", o.forces.torque_fraction), field::number("max_bend", o.rest.max_bend),
                field::number("assembly_weight", o.forces.assembly_weight), field::number("gravity", o.load.gravity),
                field::number("load_factor", o.load_factor), field::number("tie_tolerance", o.forces.tie_tolerance),
+               field::number("load_capacity_within", o.load_capacity_within),
                field::boolean("least_out_of_plane", o.forces.least_out_of_plane), field::number("deflection_limit", o.deflection_limit),
                field::integer("max_iterations", o.forces.max_iterations),
                field::choice("torque_bound", o.forces.torque_bound,
@@ -231,7 +232,8 @@ whose load capacity holds this multiple of the weight in all six directions, cap
 a density; forces_and_rest.hpp), "max_bend" rad (2pi/3), "assembly_weight" (0.05),
 "algorithm" ("lp_then_slsqp" | "lp" | "slsqp"), "gravity" m/s^2 (9.81), "max_iterations",
 "torque_bound" ("3d": |t_v| <= t_max, default | "in_plane": its plane-normal part only),
-"least_out_of_plane" (True) and "tie_tolerance" (relative loss of G_stb allowed for it; forces.hpp)}.
+"least_out_of_plane" (True), "tie_tolerance" (relative loss of G_stb allowed for it; forces.hpp) and
+"load_capacity_within" (rad, 0: off; > 0: no load capacity, None, when a rest angle is beyond it)}.
 progress(stage, fraction) -> False cancels (raises Cancelled).
 Returns the design document's own keys (docs/formats.md), for the forces stage to copy:
 {"crossings": [{"force": [3] N on wires[0] by wires[1], "normal_force": N, "out_of_plane":

@@ -15,9 +15,12 @@ ForcesAndRestResult forces_and_rest(const Network& net, const std::vector<int>& 
                                     const std::vector<int>& requested_cuts, const ForcesAndRestOptions& options,
                                     const ProgressFn& progress) {
   ForcesAndRestResult out;
+  if (!(std::isfinite(options.load_capacity_within) && options.load_capacity_within >= 0))
+    throw InputError("load_capacity_within must be a finite number of radians >= 0 (0: always compute the load capacity)");
   out.cuts = choose_cuts(net, requested_cuts);
   ForceOptions force_options = options.forces;
   LoadCapacityOptions load = options.load;
+  std::optional<LoadCapacityResult> at_plastic_limit;  // with a load factor
   load.torque_bound = options.forces.torque_bound;  // the same bound as the forces
   if (options.load_factor != 0.0) {
     if (!std::isfinite(options.load_factor) || options.load_factor < 0)
@@ -48,6 +51,7 @@ ForcesAndRestResult forces_and_rest(const Network& net, const std::vector<int>& 
     }
     force_options.torque_fraction = f;
     out.load_factor = lf;
+    at_plastic_limit = at_one;
   }
   out.torque_fraction = force_options.torque_fraction;
   out.forces = optimize_forces(net, hooks, steps, out.cuts, force_options, progress);
@@ -91,9 +95,31 @@ ForcesAndRestResult forces_and_rest(const Network& net, const std::vector<int>& 
     out.deflection_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();
   }
 
-  if (options.load_capacity) {
+  bool rests_within = true;
+  if (options.load_capacity_within > 0.0)
+    for (const RestShapeResult& rest : out.rests)
+      for (double a : rest.rest_angles) rests_within = rests_within && std::abs(a) <= options.load_capacity_within;
+  if (options.load_capacity && rests_within && at_plastic_limit) {
+    // The load capacity's LP does not depend on the pre-stress (a0 + δ >= 0 with δ free: only
+    // x = a0 + δ enters, and a0 shifts the row bounds with it) and is homogeneous in (x, λ, t_max),
+    // so at torque fraction f it is f times the one at the plastic limit, direction by direction
+    // (load_capacity.hpp; test "the load capacity after the forces is f times the one at the
+    // plastic limit" against the LPs solved at f with the forces' pre-stress).
+    const auto t1 = std::chrono::steady_clock::now();
+    const double f = force_options.torque_fraction;
+    out.load_capacity = *at_plastic_limit;
+    for (LoadDirection& d : out.load_capacity->directions) {
+      d.multiple *= f;  // +inf stays +inf (f > 0)
+      d.coefficients *= f;
+      d.lp_iterations = 0;
+      d.lp_rounds = 0;
+    }
+    out.load_capacity->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  } else if (options.load_capacity && rests_within) {
     const ForceProblem problem(net, hooks, steps, out.cuts, force_options);
     out.load_capacity = load_capacity(net, out.cuts, problem, out.forces.coefficients, load, progress);
+  }
+  if (out.load_capacity) {
     if (out.load_factor) {
       out.load_factor->reached = std::numeric_limits<double>::infinity();
       for (const LoadDirection& d : out.load_capacity->directions)

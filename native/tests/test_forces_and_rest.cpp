@@ -90,10 +90,12 @@ double weakest_multiple(const fixtures::HookedNetwork& h, const std::vector<int>
   for (const LoadDirection& d : lc.directions) m = std::min(m, d.multiple);
   return m;
 }
-}  // namespace
-
-TEST_CASE("forces_and_rest: the load factor picks the least torque fraction that holds it", "[forces][load]") {
-  std::mt19937 rng(43);
+// Calls body(h, requested, cuts, o, at_one) on the first three random hooked spheres (seed `seed`)
+// whose weakest load multiple at the plastic limit, at_one, is finite and at least 1e-3, with
+// LP forces and the load capacity on; returns how many it called it on.
+template <class Body>
+int on_loaded_spheres(unsigned seed, Body body) {
+  std::mt19937 rng(seed);
   int tested = 0;
   for (int attempt = 0; attempt < 200 && tested < 3; ++attempt) {
     fixtures::HookedNetwork h;
@@ -112,6 +114,15 @@ TEST_CASE("forces_and_rest: the load factor picks the least torque fraction that
     if (!std::isfinite(at_one) || at_one < 1e-3) continue;
     ++tested;
     INFO("attempt " << attempt << ", weakest multiple at the plastic limit " << at_one);
+    body(h, requested, cuts, o, at_one);
+  }
+  return tested;
+}
+}  // namespace
+
+TEST_CASE("forces_and_rest: the load factor picks the least torque fraction that holds it", "[forces][load]") {
+  const int tested = on_loaded_spheres(43, [](const fixtures::HookedNetwork& h, const std::vector<int>& requested,
+                                              const std::vector<int>& cuts, ForcesAndRestOptions o, double at_one) {
 
     // Reachable: 40% of what the plastic limit holds.
     o.load_factor = 0.4 * at_one;
@@ -150,6 +161,90 @@ TEST_CASE("forces_and_rest: the load factor picks the least torque fraction that
     // The load factor needs the load capacity (a density).
     o.load_capacity = false;
     CHECK_THROWS_WITH(forces_and_rest(h.net, h.hooks, h.steps, requested, o), Catch::Matchers::Contains("load factor"));
-  }
+  });
   CHECK(tested >= 2);
+}
+
+TEST_CASE("forces_and_rest: load_capacity_within skips the load capacity only beyond it", "[forces][load]") {
+  std::mt19937 rng(47);
+  int tested = 0;
+  fixtures::HookedNetwork last;  // a network the options below are refused on
+  for (int attempt = 0; attempt < 200 && tested < 2; ++attempt) {
+    fixtures::HookedNetwork h;
+    if (!fixtures::random_hooked_sphere(rng, attempt, 24, h)) continue;
+    ForcesAndRestOptions o;
+    o.forces.algorithm = ForceAlgorithm::lp;
+    o.load_capacity = true;
+    std::vector<int> requested(h.net.wires.size(), -1);
+    ForcesAndRestResult all;
+    try {
+      all = forces_and_rest(h.net, h.hooks, h.steps, requested, o);
+    } catch (const SolverError&) {
+      continue;
+    }
+    REQUIRE(all.load_capacity.has_value());
+    double largest = 0.0;  // the largest rest angle, read from the rest shapes
+    for (const RestShapeResult& rest : all.rests)
+      for (double a : rest.rest_angles) largest = std::max(largest, std::abs(a));
+    if (largest <= 0.0) continue;
+    ++tested;
+    last = h;
+    // Every rest angle within the limit: the same load capacity.
+    o.load_capacity_within = largest;
+    const ForcesAndRestResult within = forces_and_rest(h.net, h.hooks, h.steps, requested, o);
+    REQUIRE(within.load_capacity.has_value());
+    REQUIRE(within.load_capacity->directions.size() == all.load_capacity->directions.size());
+    for (std::size_t d = 0; d < all.load_capacity->directions.size(); ++d)
+      CHECK(within.load_capacity->directions[d].multiple == all.load_capacity->directions[d].multiple);
+    // One beyond it: none, and the forces and rest shapes unchanged.
+    o.load_capacity_within = 0.999 * largest;
+    const ForcesAndRestResult beyond = forces_and_rest(h.net, h.hooks, h.steps, requested, o);
+    CHECK_FALSE(beyond.load_capacity.has_value());
+    CHECK(beyond.forces.coefficients == all.forces.coefficients);
+    REQUIRE(beyond.rests.size() == all.rests.size());
+    for (std::size_t w = 0; w < all.rests.size(); ++w) CHECK(beyond.rests[w].rest_angles == all.rests[w].rest_angles);
+  }
+  REQUIRE(tested == 2);
+  const std::vector<int> requested(last.net.wires.size(), -1);
+  ForcesAndRestOptions bad;
+  bad.load_capacity = true;
+  for (double v : {-1.0, std::numeric_limits<double>::quiet_NaN()}) {
+    bad.load_capacity_within = v;
+    CHECK_THROWS_WITH(forces_and_rest(last.net, last.hooks, last.steps, requested, bad),
+                      Catch::Matchers::Contains("load_capacity_within"));
+  }
+}
+
+TEST_CASE("forces_and_rest: the load capacity after the forces is f times the one at the plastic limit",
+          "[forces][load]") {
+  // With a load factor, forces_and_rest scales the plastic limit's load capacity by the torque
+  // fraction f it chose instead of solving the six LPs again; here they are solved again, at f
+  // with the forces' pre-stress, as load_capacity does for a design without a load factor.
+  const int tested = on_loaded_spheres(53, [](const fixtures::HookedNetwork& h, const std::vector<int>& requested,
+                                              const std::vector<int>&, ForcesAndRestOptions o, double at_one) {
+    o.load_factor = 0.4 * at_one;  // f about 0.4
+    const ForcesAndRestResult r = forces_and_rest(h.net, h.hooks, h.steps, requested, o);
+    REQUIRE(r.load_capacity.has_value());
+    REQUIRE(r.torque_fraction < 0.9);
+    ForceOptions at_f = o.forces;
+    at_f.torque_fraction = r.torque_fraction;
+    LoadCapacityOptions lo = o.load;
+    lo.torque_bound = o.forces.torque_bound;
+    const ForceProblem problem(h.net, h.hooks, h.steps, r.cuts, at_f);
+    const LoadCapacityResult solved = load_capacity(h.net, r.cuts, problem, r.forces.coefficients, lo);
+    REQUIRE(solved.directions.size() == r.load_capacity->directions.size());
+    for (std::size_t d = 0; d < solved.directions.size(); ++d) {
+      const LoadDirection& a = r.load_capacity->directions[d];
+      const LoadDirection& b = solved.directions[d];
+      INFO("direction " << b.name);
+      CHECK(a.status == b.status);
+      CHECK(a.base == b.base);
+      if (std::isfinite(b.multiple))
+        CHECK(a.multiple == Approx(b.multiple).epsilon(1e-6).margin(1e-9));
+      else
+        CHECK(std::isinf(a.multiple));
+    }
+    CHECK(r.load_capacity->weight == solved.weight);
+  });
+  CHECK(tested == 3);
 }

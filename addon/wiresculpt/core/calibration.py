@@ -23,7 +23,7 @@ import zlib
 import numpy as np
 
 from .. import native
-from . import materials
+from . import materials, sizes
 from .files import write_atomic
 
 CANTILEVER_COLUMNS = ("load_g", "state", "s_m", "deflection_m")
@@ -383,7 +383,7 @@ def validate_profile(profile, where="machine profile"):
     key, a wrong type, a value out of range), prefixed with `where`."""
     if not isinstance(profile, dict):
         raise ValueError(f"{where}: expected a JSON object")
-    stock = profile.get("stock_length", 1.0)
+    stock = profile.get("stock_length", sizes.STOCK_LENGTH)
     if isinstance(stock, bool) or not isinstance(stock, (int, float)) or not 0 < stock < 100:
         raise ValueError(f"{where}: stock_length must be a length in metres between 0 and 100, got {stock!r}")
     closed_overlap(profile, where)

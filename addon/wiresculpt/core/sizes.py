@@ -6,6 +6,14 @@ STOCK_LENGTH = 1.0   # m: the default machine profile's straight wire stock (pro
 LARGEST_MODEL = 1.5  # m: beyond this a sculpture of stiff planar wires sags and is hard to build
 
 
+def stock(profile):
+    """(m, name): a machine profile's stock length (key stock_length, STOCK_LENGTH when absent) and
+    the name its warnings use; the default profile's for None."""
+    if profile is None:
+        return STOCK_LENGTH, "the default machine profile"
+    return float(profile.get("stock_length", STOCK_LENGTH)), profile.get("name") or "the machine profile"
+
+
 def wire_length(wire):
     """m: the wire's own `length`, else the length of its target (or contour) polyline, closed
     when the wire is closed."""

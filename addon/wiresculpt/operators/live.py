@@ -1,9 +1,10 @@
 """Live: while a slicing plane (or the target) moves, re-slice and re-solve in the background and
 show the verdict (docs/user-guide.md, Live).
 
-A bpy.app.timers callback (tick, every TICK_SECONDS) compares a snapshot of the slicing planes'
+A bpy.app.timers callback (tick, every TICK_SECONDS while nothing changes, every
+ACTIVE_TICK_SECONDS while planes move or a job runs) compares a snapshot of the slicing planes'
 and the target's matrix_world (and the ticked contours) with the last one it saw. A snapshot that
-stayed the same for one tick and differs from the one solved (or being solved) starts a LiveJob on
+stayed the same for SETTLE_SECONDS and differs from the one solved (or being solved) starts a LiveJob on
 a worker thread: slice_and_pick then pipeline.solve with the hook search limited to the
 layering's own pattern (hook_patterns=1) and the user's relayer_rounds. Latest position wins: a
 running job whose snapshot is no longer current is cancelled (its cancel event; it is never waited
@@ -31,7 +32,9 @@ from ..blend.handles import handles, target_problem, ticked_planes
 from ..core.jobs import WorkerJob
 from ..props import LIVE_HOOKS, material_of, solver_settings
 
-TICK_SECONDS = 0.1
+TICK_SECONDS = 0.1  # while nothing changes
+ACTIVE_TICK_SECONDS = 0.02  # while a plane moves or a job runs: the verdict is seen sooner
+SETTLE_SECONDS = 0.05  # a position unchanged this long is solved (a drag's every frame is not)
 MAX_TRIANGLES = 200_000  # Live is refused on larger targets (re-slicing alone would lag)
 LIVE_HOOK_PATTERNS = 1  # the layering's own hook pattern only: Optimize may pick other hooks
 REASON_WORDS = 8  # words of the reason the panel shows
@@ -46,6 +49,7 @@ class LiveState:
     def reset(self):
         self.running = False  # the timer is registered
         self.seen = None  # the snapshot of the previous tick
+        self.seen_since = 0.0  # time.monotonic() when `seen` was first seen
         self.solved = None  # the snapshot of the shown verdict
         self.job = None  # the LiveJob of the current snapshot, while it runs
         self.verdict = ""  # "stable", "not stable — …", "solving…" (the panel adds "Live: ")
@@ -54,6 +58,9 @@ class LiveState:
         self.mesh = None  # (V, F) world coordinates
         self.durations = []  # seconds of each tick (the test reads them)
         self.results = []  # the verdicts shown, in order
+        self.shown_at = None  # time.monotonic() when the latest verdict was set (the bench reads it)
+        self.drawn_at = None  # time.monotonic() of the overlay's latest draw of the preview
+        self.job_seconds = None  # the shown verdict's LiveJob wall time (the bench reads it)
         self.drawn = 0  # overlay draws of the preview (the test reads it)
 
 
@@ -126,8 +133,10 @@ class LiveJob(WorkerJob):
         self.cancelled = False
         self.design = None
         self.preview = []
+        self.seconds = None  # the work's wall time (slicing, solve, preview), when it ended
 
     def work(self):
+        began = time.monotonic()
         try:
             design = pipeline.slice_and_pick(self.vertices, self.faces, self.planes, self.material, self.settings)
             cut_handles.set_cut_points(design, self.cuts)  # the user's moved cut handles, as build_design gives them
@@ -136,6 +145,8 @@ class LiveJob(WorkerJob):
             self.preview = preview_segments(self.design)
         except pipeline.Cancelled:
             self.cancelled = True
+        finally:
+            self.seconds = time.monotonic() - began
 
     def verdict(self):
         if self.error is not None:
@@ -190,12 +201,15 @@ def _step():
             STATE.verdict, STATE.solved = job.verdict(), job.key
             STATE.preview = job.preview if job.error is None else []
             STATE.results.append(STATE.verdict)
+            STATE.shown_at, STATE.job_seconds = time.monotonic(), job.seconds
         job = None
     if job is not None and job.key != key:  # the planes moved on: latest position wins
         job.cancel_event.set()  # never waited for: it ends at its next checkpoint, its result dropped
         STATE.job = job = None
-    settled = key == STATE.seen
-    STATE.seen = key
+    now = time.monotonic()
+    if key != STATE.seen:
+        STATE.seen, STATE.seen_since = key, now
+    settled = now - STATE.seen_since >= SETTLE_SECONDS
     if job is None and settled and key != STATE.solved:
         message = refusal(scene.wiresculpt.target)
         if message:
@@ -206,13 +220,14 @@ def _step():
         if isinstance(started, str):
             STATE.verdict, STATE.solved, STATE.preview = started, key, []
             STATE.results.append(started)
+            STATE.shown_at = time.monotonic()
         else:
             STATE.job, STATE.verdict = started, "solving…"
     elif not settled and key != STATE.solved:
         STATE.verdict = "solving…"
     if STATE.verdict != shown:
         _redraw()
-    return TICK_SECONDS
+    return ACTIVE_TICK_SECONDS if STATE.job is not None or key != STATE.solved else TICK_SECONDS
 
 
 _TICKING = []  # non-empty while tick runs: stop() then leaves the timer to end by returning None

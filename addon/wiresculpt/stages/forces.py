@@ -85,9 +85,11 @@ def _inputs(design):
     return wires, crossings
 
 
-def run(design, material, settings, native_progress=None):
+def run(design, material, settings, native_progress=None, load_capacity_within=None):
     """Computes forces, rest shapes and load capacity into `design`. Returns the forces stage's
-    progress line; rest_summary(design) gives the rest-shape stage's."""
+    progress line; rest_summary(design) gives the rest-shape stage's. `load_capacity_within`
+    (radians): when a rest angle is beyond it, no load capacity (the pipeline's coupling rounds
+    that will be solved again; native forces_and_rest.hpp)."""
     wires, crossings = _inputs(design)
     mat = {k: material[k] for k in ("bending_stiffness", "max_torque", "friction", "wire_diameter", "density",
                                     "shear_modulus") if k in material}
@@ -99,6 +101,8 @@ def run(design, material, settings, native_progress=None):
                "torque_bound": settings.get("torque_bound", "3d"),
                # within 3% of the optimal G_stb, the least out-of-plane force (docs/method-forces.md §12)
                "least_out_of_plane": settings.get("least_out_of_plane", True)}
+    if load_capacity_within is not None:
+        options["load_capacity_within"] = load_capacity_within
     steps = [list(s) for s in design.get("assembly_steps", [])]
     r = native.forces_and_rest(wires, crossings, steps, mat, options, native_progress)
 

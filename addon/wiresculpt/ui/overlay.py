@@ -10,6 +10,8 @@ whisker at the target vertex where it deflects most, along its plane normal, DEF
 the deflection long (so 1 mm shows as 1 cm), red when over the limit (DEFLECTION_LIMIT, the
 solver's default 2 mm), else blue.
 """
+import time
+
 import bpy
 import gpu
 import numpy as np
@@ -101,6 +103,7 @@ def draw_live():
     gpu.state.depth_test_set('NONE')
     gpu.state.line_width_set(1.0)
     live.STATE.drawn += 1
+    live.STATE.drawn_at = time.monotonic()
 
 
 def draw_candidate(preview):

@@ -42,6 +42,12 @@ struct ForcesAndRestOptions {
   LoadCapacityOptions load;
   /// Compute the load capacity (it needs the material's density). Default false.
   bool load_capacity = false;
+  /// Radians; > 0: the load capacity after the forces (and the load factor's `reached`) is only
+  /// computed when every rest angle is within this (|rest angle| <= it); otherwise `load_capacity`
+  /// stays empty. The pipeline's coupling rounds (Sec. 4.3) solve again when a rest bend is over
+  /// the machine's limit and keep only the last round's result, so they skip these six LPs in the
+  /// rounds that are followed by another. 0: always computed. Default 0.
+  double load_capacity_within = 0.0;
   /// > 0: choose forces.torque_fraction by the load factor (file comment; needs load_capacity,
   /// else InputError); 0: use forces.torque_fraction as given. Multiples of the weight. Default 0.
   double load_factor = 0.0;
