@@ -53,6 +53,13 @@ def placements():
     return {h.name: handle_plane(h, depsgraph)[1:] for h in handles(bpy.context.scene)}
 
 
+def scene_state():
+    """Every object's type, matrix and visibility, every text, and the contour ticks."""
+    objects = {o.name: (o.type, [list(r) for r in o.matrix_world], o.hide_viewport) for o in bpy.data.objects}
+    ticks = [(i.plane, i.index, i.use) for i in bpy.context.scene.wiresculpt.contours]
+    return json.dumps([objects, {t.name: t.as_string() for t in bpy.data.texts}, ticks], sort_keys=True)
+
+
 def wire_names():
     return sorted(o.name for o in bpy.context.scene.objects if scene_results.WIRE_KEY in o)
 
@@ -63,6 +70,7 @@ class FindStablePlanes(Case):
         if not native.available():
             self.skipTest(native.LOAD_ERROR)
         ops.RESULT = None
+        ops.PREVIEW = None
         hinge_scene()
 
     def test_the_scene_is_a_hinge(self):
@@ -107,6 +115,62 @@ class FindStablePlanes(Case):
         self.assertEqual(bpy.ops.wiresculpt.optimize(), {'FINISHED'})
         self.assertTrue(json.loads(bpy.data.texts[scene_results.DESIGN_TEXT].as_string())["stable"])
 
+    def test_preview_on_click_shows_the_candidate_and_changes_nothing(self):
+        _V, _F, given, _material, _settings = ops.gather(bpy.context)  # the planes the search starts from
+        given = {p.name: p for p in given}
+        self.assertEqual(bpy.ops.wiresculpt.find_planes(), {'FINISHED'})
+        candidates = ops.RESULT["candidates"]
+        self.assertGreaterEqual(len(candidates), 2)
+        self.assertIsNone(ops.PREVIEW)
+        before = scene_state()
+        for k, c in enumerate(candidates):
+            self.assertEqual(bpy.ops.wiresculpt.preview_planes(index=k), {'FINISHED'})
+            self.assertEqual(scene_state(), before)  # no scene data written
+            self.assertEqual(ops.PREVIEW["index"], k)
+            # the overlay holds each design wire's polyline (its target), as segments, in the design's order
+            design = json.loads(json.dumps(c["design"]))
+            self.assertEqual(len(ops.PREVIEW["wires"]), len(design["wires"]))
+            for (_colour, lines), w in zip(ops.PREVIEW["wires"], design["wires"]):
+                points = w["target"]
+                pairs = [(points[i], points[i + 1]) for i in range(len(points) - 1)]
+                if w["closed"]:
+                    pairs.append((points[-1], points[0]))
+                expected = [p for pair in pairs for p in pair]
+                self.assertEqual(np.shape(lines), (len(expected), 3), w["name"])
+                np.testing.assert_allclose(lines, expected, atol=1e-6, err_msg=w["name"])
+            # and an outline in the plane of each plane the candidate changes, centred on it
+            changed = [p for p in c["planes"] if p.contours != given[p.name].contours
+                       or np.linalg.norm(np.subtract(p.normal, given[p.name].normal)) > 1e-9
+                       or abs(np.dot(np.subtract(p.origin, given[p.name].origin), p.normal)) > 1e-9]
+            self.assertTrue(changed, c["changes"])
+            self.assertEqual(len(ops.PREVIEW["planes"]), len(changed))
+            for (_colour, lines), p in zip(ops.PREVIEW["planes"], changed):
+                self.assertEqual(np.shape(lines), (8, 3))
+                self.assertLess(np.abs((np.asarray(lines) - p.origin) @ np.asarray(p.normal)).max(), 1e-6)
+                np.testing.assert_allclose(np.mean(lines, axis=0), p.origin, atol=1e-6)
+        log = draw(panel.VIEW3D_PT_wiresculpt_planes, bpy.context)
+        pressed = [kw.get("depress") for name, a, kw in log if name == "operator" and a == ("wiresculpt.preview_planes",)]
+        self.assertEqual(pressed, [k == len(candidates) - 1 for k in range(len(candidates))])
+        self.assertIn("wiresculpt.preview_planes_clear", [a[0] for name, a, _kw in log if name == "operator" and a])
+        # a second click on the shown candidate hides it; Clear hides it too
+        self.assertEqual(bpy.ops.wiresculpt.preview_planes(index=len(candidates) - 1), {'FINISHED'})
+        self.assertIsNone(ops.PREVIEW)
+        self.assertEqual(bpy.ops.wiresculpt.preview_planes(index=0), {'FINISHED'})
+        self.assertEqual(bpy.ops.wiresculpt.preview_planes_clear(), {'FINISHED'})
+        self.assertIsNone(ops.PREVIEW)
+        self.assertEqual(scene_state(), before)
+        # Apply ends the preview: the candidate is the scene's own then
+        self.assertEqual(bpy.ops.wiresculpt.preview_planes(index=1), {'FINISHED'})
+        self.assertEqual(bpy.ops.wiresculpt.apply_planes(index=1), {'FINISHED'})
+        self.assertIsNone(ops.PREVIEW)
+        self.assertNotEqual(scene_state(), before)
+
+    def test_a_preview_of_no_candidate_is_refused(self):
+        self.assertFalse(ops.WIRESCULPT_OT_preview_planes.poll(bpy.context))
+        with self.assertRaises(ValueError):
+            ops.preview_candidate(bpy.context, 0)
+        self.assertIsNone(ops.PREVIEW)
+
     def test_a_cancelled_search_leaves_the_scene_and_the_candidates(self):
         before = placements()
         objects = sorted(bpy.data.objects.keys())
@@ -130,6 +194,7 @@ class SuggestPlanes(Case):
         if not native.available():
             self.skipTest(native.LOAD_ERROR)
         ops.RESULT = None
+        ops.PREVIEW = None
         globe_target()
 
     def test_suggest_then_apply_adds_ordinary_planes(self):
@@ -140,7 +205,16 @@ class SuggestPlanes(Case):
         for c in candidates:
             self.assertEqual(len(c["planes"]), 4)
             self.assertEqual(recheck.recheck(json.loads(json.dumps(c["design"]))), [])
+        # the preview of a suggestion outlines every plane it would add, and adds none
+        self.assertEqual(bpy.ops.wiresculpt.preview_planes(index=0), {'FINISHED'})
+        self.assertEqual(handles(bpy.context.scene), [])
+        self.assertEqual(len(ops.PREVIEW["planes"]), 4)
+        for (_colour, lines), p in zip(ops.PREVIEW["planes"], candidates[0]["planes"]):
+            np.testing.assert_allclose(np.mean(lines, axis=0), p.origin, atol=1e-6)
+            self.assertLess(np.abs((np.asarray(lines) - p.origin) @ np.asarray(p.normal)).max(), 1e-6)
+        self.assertEqual(len(ops.PREVIEW["wires"]), len(candidates[0]["design"]["wires"]))
         self.assertEqual(bpy.ops.wiresculpt.apply_planes(index=0), {'FINISHED'})
+        self.assertIsNone(ops.PREVIEW)
         added = handles(bpy.context.scene)
         self.assertEqual(len(added), 4)
         self.assertEqual(len(wire_names()), len(candidates[0]["design"]["wires"]))

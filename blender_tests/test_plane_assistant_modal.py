@@ -1,6 +1,7 @@
 """Find Stable Planes from the UI (modal operator, worker thread, timer) in a Blender with a
 window, under Xvfb: cancel mid-search leaves the scene as it was, a finished search changes
-nothing either, and Apply is one undo step."""
+nothing either, Preview draws a candidate with no undo step, and Apply is one undo step that ends
+the preview."""
 import os
 import shutil
 import unittest
@@ -36,6 +37,17 @@ class ModalFindPlanes(unittest.TestCase):
         self.assertEqual(self.seen["apply"], ["FINISHED"])
         self.assertTrue(self.seen["apply_changed"])
         self.assertTrue(self.seen["undo_restores"])
+        self.assertTrue(self.seen["apply_clears_preview"])
+
+    def test_preview_is_drawn_and_no_undo_step(self):
+        self.assertEqual(self.seen["preview"], ["FINISHED"])
+        self.assertEqual(self.seen["preview_index"], 0)
+        self.assertEqual(self.seen["preview_wires"], self.seen["design_wires"])
+        self.assertTrue(self.seen["preview_changes_nothing"])
+        self.assertTrue(self.seen["preview_no_data"])
+        self.assertGreater(self.seen["drawn_after"], self.seen["drawn_before"])  # the overlay drew it
+        self.assertTrue(self.seen["undo_took_the_marker"])  # the click pushed no undo step
+        self.assertTrue(self.seen["preview_kept_by_undo"])
 
 
 if __name__ == "__main__":

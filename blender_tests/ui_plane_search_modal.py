@@ -1,6 +1,7 @@
 """Driven by test_plane_assistant_modal.py in a Blender with a window (under Xvfb): Find Stable
 Planes as the panel runs it (INVOKE: worker thread, modal timer) on the hinged globe
-(test_plane_assistant.py), cancelled mid-search, then to the end, then Apply and one Undo. Prints
+(test_plane_assistant.py), cancelled mid-search, then to the end, then a candidate previewed (no
+undo step, drawn), then Apply and one Undo. Prints
 one line `MODAL {json}` with what it saw, then quits."""
 import json
 import math
@@ -91,9 +92,38 @@ def check_full():
         return 0.2
     seen["candidates"] = len(ops.RESULT["candidates"]) if ops.RESULT else 0
     seen["search_unchanged"] = state() == seen["before_full"]
+    # A marker step the preview must not hide: the target moved 1 m and pushed as an undo step.
+    # If clicking Preview pushed a step, the Undo below would undo that step and leave the target
+    # moved; with no step, it undoes the move.
+    target = bpy.context.scene.wiresculpt.target
+    target.location.x += 1.0
+    with override():
+        bpy.ops.ed.undo_push(message="marker: target moved")
+        marked = state()
+        # undo=True: as a click on the panel's button runs it (an operator with UNDO pushes a step)
+        seen["preview"] = sorted(bpy.ops.wiresculpt.preview_planes('INVOKE_DEFAULT', True, index=0))
+    seen["preview_index"] = ops.PREVIEW["index"] if ops.PREVIEW else None
+    seen["preview_wires"] = len(ops.PREVIEW["wires"]) if ops.PREVIEW else 0
+    seen["design_wires"] = len(ops.RESULT["candidates"][0]["design"]["wires"])
+    seen["drawn_before"] = ops.DRAWN[0]
+    seen["preview_changes_nothing"] = state() == marked
+    seen["moved_state"] = marked
+    bpy.app.timers.register(guarded(seen, check_preview_drawn), first_interval=0.5)
+    return None
+
+
+def check_preview_drawn():
+    seen["drawn_after"] = ops.DRAWN[0]  # the viewport redrew with the preview since the click
+    seen["preview_no_data"] = state() == seen.pop("moved_state")
+    with override():
+        bpy.ops.ed.undo()
+    target = bpy.context.scene.wiresculpt.target
+    seen["undo_took_the_marker"] = abs(target.location.x) < 1e-9 and state() == seen["before_full"]
+    seen["preview_kept_by_undo"] = ops.PREVIEW is not None
     with override():
         bpy.ops.ed.undo_push(message="before Apply")
-        seen["apply"] = sorted(bpy.ops.wiresculpt.apply_planes('EXEC_DEFAULT', index=0))
+        seen["apply"] = sorted(bpy.ops.wiresculpt.apply_planes('EXEC_DEFAULT', True, index=0))
+    seen["apply_clears_preview"] = ops.PREVIEW is None
     seen["apply_changed"] = state() != seen["before_full"]
     with override():
         bpy.ops.ed.undo()  # one step takes the applied planes and design away

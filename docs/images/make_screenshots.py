@@ -14,10 +14,11 @@ temporary folder, so the machine preview's violet ghosts show how far an uncompe
 would miss.
 
 With SHOTS=planes (screen "-screen 0 1600x2050x24") it makes the plane assistant's loop,
-docs/images/panel-planes-1-not-stable.png, -2-candidates.png and -3-applied.png, each cropped to the
+docs/images/panel-planes-1-not-stable.png, -2-candidates.png, -2b-preview.png and -3-applied.png, each cropped to the
 sidebar and a strip of the viewport: the globe with five slicing planes of which "Slice E"
 (x = 0.8 R) crosses only the plane y = 0, on one line (the hinged scene of
 blender_tests/test_plane_assistant.py), optimized (not stable); Find Stable Planes (run inline);
+Preview of candidate 1 (its wires and moved plane drawn over the scene, which is unchanged);
 Apply candidate 1 (the moved plane selected, the stable verdict in the panel).
 """
 import math
@@ -110,6 +111,13 @@ def find_planes():
         assert bpy.ops.wiresculpt.find_planes() == {'FINISHED'}
 
 
+def preview_first():
+    from wiresculpt.operators import plane_search as search
+    with win_override():
+        assert bpy.ops.wiresculpt.preview_planes(index=0) == {'FINISHED'}
+    print("PREVIEW", search.RESULT["candidates"][0]["changes"])
+
+
 def apply_first():
     from wiresculpt.operators import plane_search as search
     def placement(o):  # origin and normal
@@ -133,6 +141,7 @@ if FABRICATION:
 elif PLANES:
     shots = [("panel-planes-1-not-stable.png", 0, None, (VIEW, 1230)),
              ("panel-planes-2-candidates.png", 0, find_planes, (VIEW, 1850)),
+             ("panel-planes-2b-preview.png", 0, preview_first, (VIEW, 1850)),
              ("panel-planes-3-applied.png", 0, apply_first, (VIEW, 1590))]  # to the Stability panel's end
 else:
     shots = [("panel.png", 0, None, None), ("panel-step1.png", 1, None, None)]

@@ -3,18 +3,25 @@ worker thread under a modal like Optimize's (progress, Esc cancels, the scene un
 user applies a candidate), and Apply: the candidate's planes become the slicing handles' placement
 (Find) or new slicing handles (Suggest), with the candidate's design as the result, in one undo
 step. In background mode (tests, scripts) the search runs inline.
+
+Preview: clicking a candidate's Preview shows its wires and the planes it moves (or adds) as a
+viewport overlay (ui/overlay.py draws PREVIEW), like Live's: module state only, no scene data and
+no undo step. It lasts until Apply, a click on the same Preview (or another candidate's), Clear,
+a new search or loading a file. The segments are made on the worker with the candidates
+(candidate["preview"]), so a click only points at them.
 """
 import copy
 import threading
 import time
 
 import bpy
+import numpy as np
 from mathutils import Matrix, Vector
 
 from .. import native, pipeline, plane_search
 from ..blend import mesh
 from ..blend import results as scene_results
-from ..blend.handles import add_handle, handle_plane, handles, target_problem
+from ..blend.handles import PLANE_MARGIN, add_handle, handle_plane, handles, target_problem
 from ..blend.registration import classes_factory
 from ..core.jobs import WorkerJob
 from ..core.scene import PlaneSpec
@@ -24,8 +31,12 @@ from .progress import WorkerModal
 
 MAX_CANDIDATES = 3
 UI_BUDGET_SECONDS = 60.0  # the panel's search may take longer than the batch's: Esc stops it
+PLANE_COLOUR = (1.0, 0.85, 0.2, 1.0)  # the outline of a plane the previewed candidate moves or adds
 # What the panel shows: {"scene", "mode", "candidates": [...], "message"} of the last search, or None.
 RESULT = None
+# The previewed candidate: {"scene", "index", "wires": [(RGBA, (2k, 3) float32)], "planes": [...]}, or None.
+PREVIEW = None
+DRAWN = [0]  # overlay draws of a preview (the tests read it)
 
 
 def gather(context, need_planes=True):
@@ -59,6 +70,38 @@ def describe(candidate):
             f"closure gap {f['closure_gap'] * 1000:.1f} mm")
 
 
+def polyline_segments(points, closed):
+    """(2k, 3) float32 end points of the segments of a polyline (closed: the last back to the first)."""
+    points = np.asarray(points, dtype=np.float32).reshape(-1, 3)
+    if len(points) < 2:
+        return np.empty((0, 3), dtype=np.float32)
+    ends = np.concatenate([points[1:], points[:1]]) if closed else points[1:]
+    return np.stack([points[:len(ends)], ends], axis=1).reshape(-1, 3)
+
+
+def plane_outline(origin, normal, half):
+    """(8, 3) float32 segment end points of the square of side 2 * half centred at `origin` in the
+    plane with unit `normal`."""
+    n = np.asarray(normal, dtype=float)
+    n = n / np.linalg.norm(n)
+    u = np.cross(n, [0.0, 0.0, 1.0] if abs(n[2]) < 0.9 else [1.0, 0.0, 0.0])
+    u /= np.linalg.norm(u)
+    v = np.cross(n, u)
+    corners = [np.asarray(origin, dtype=float) + half * (a * u + b * v) for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+    return polyline_segments(corners, True)
+
+
+def candidate_preview(candidate, mode, size):
+    """What the overlay draws for a candidate: each design wire's shape (its target polyline, the
+    contour where there is none; blend/results.wire_points) in the wire's colour, and the outline of
+    every plane it moves (nearby) or adds (auto), PLANE_MARGIN times the model's `size` across."""
+    wires = [(scene_results.wire_colour(w["id"]), polyline_segments(scene_results.wire_points(w), w["closed"]))
+             for w in candidate["design"]["wires"]]
+    planes = [(PLANE_COLOUR, plane_outline(p.origin, p.normal, 0.5 * PLANE_MARGIN * size))
+              for p in candidate["planes"] if mode == "auto" or p.changes]
+    return {"wires": wires, "planes": planes}
+
+
 class SearchJob(WorkerJob):
     name = "wiresculpt plane search"
 
@@ -88,6 +131,10 @@ class SearchJob(WorkerJob):
                     progress=self._progress, cancel=self.cancel_event.is_set)
         except pipeline.Cancelled:
             self.cancelled = True
+            return
+        size = float(np.max(np.ptp(np.asarray(self.V, dtype=float), axis=0)))
+        for candidate in self.found:
+            candidate["preview"] = candidate_preview(candidate, self.mode, size)
 
     def stop(self, timeout=optimize.JOIN_SECONDS):
         self.cancel_event.set()
@@ -110,6 +157,7 @@ def running():
 
 def _store(job):
     global RESULT
+    clear_preview()
     RESULT = {"scene": job.scene_name, "mode": job.mode, "candidates": job.found,
               "message": (f"{len(job.found)} stable candidate{'s' if len(job.found) != 1 else ''} "
                           f"({job.searched.screened} screened, {job.searched.full_solves} solved, "
@@ -267,7 +315,49 @@ def apply_candidate(context, index):
     for item in scene.wiresculpt.contours:
         item.use = f"{item.plane}/{item.index}" in picked
     scene_results.write_results(scene, design)
+    clear_preview()  # the candidate is now the scene's own
     return candidate
+
+
+def _redraw():
+    wm = bpy.context.window_manager
+    for window in (wm.windows if wm else []):
+        for area in (window.screen.areas if window.screen else []):
+            if area.type == 'VIEW_3D':
+                area.tag_redraw()
+
+
+def clear_preview():
+    """No candidate previewed any more (the overlay stops drawing it)."""
+    global PREVIEW
+    if PREVIEW is not None:
+        PREVIEW = None
+        try:
+            _redraw()
+        except (AttributeError, ReferenceError):  # no window (closing, loading)
+            pass
+
+
+def preview_candidate(context, index):
+    """Previews candidate `index` of the last search (or stops previewing it when it is the one
+    shown); True when a candidate is previewed after. ValueError when there is no such candidate."""
+    global PREVIEW
+    if RESULT is None or RESULT["scene"] != context.scene.name or not 0 <= index < len(RESULT["candidates"]):
+        raise ValueError("no such candidate: run Find Stable Planes or Suggest Planes first")
+    if previewed(context) == index:
+        clear_preview()
+        return False
+    shown = RESULT["candidates"][index]["preview"]
+    PREVIEW = {"scene": context.scene.name, "index": index, "wires": shown["wires"], "planes": shown["planes"]}
+    _redraw()
+    return True
+
+
+def previewed(context):
+    """The index of the candidate previewed in this scene, or None."""
+    if PREVIEW is None or context.scene is None or PREVIEW["scene"] != context.scene.name:
+        return None
+    return PREVIEW["index"]
 
 
 class WIRESCULPT_OT_apply_planes(bpy.types.Operator):
@@ -293,6 +383,41 @@ class WIRESCULPT_OT_apply_planes(bpy.types.Operator):
         return {'FINISHED'}
 
 
+class WIRESCULPT_OT_preview_planes(bpy.types.Operator):
+    """Show this candidate's wires and the planes it moves in the viewport, without changing the
+    scene (click again to hide it)"""
+    bl_idname = "wiresculpt.preview_planes"
+    bl_label = "Preview"
+    bl_options = {'INTERNAL'}  # no UNDO: a preview is no scene change and no undo step
+
+    index: bpy.props.IntProperty(default=0, min=0)
+
+    @classmethod
+    def poll(cls, context):
+        return RESULT is not None and bool(RESULT["candidates"])
+
+    def execute(self, context):
+        try:
+            preview_candidate(context, self.index)
+        except ValueError as exc:
+            self.report({'ERROR'}, f"Cannot preview: {exc}")
+            return {'CANCELLED'}
+        return {'FINISHED'}
+
+
+class WIRESCULPT_OT_preview_planes_clear(bpy.types.Operator):
+    """Hide the previewed candidate"""
+    bl_idname = "wiresculpt.preview_planes_clear"
+    bl_label = "Clear Preview"
+    bl_options = {'INTERNAL'}
+
+    def execute(self, context):
+        if PREVIEW is None:
+            return {'CANCELLED'}
+        clear_preview()
+        return {'FINISHED'}
+
+
 class WIRESCULPT_OT_find_planes_cancel(bpy.types.Operator):
     """Stop the running plane search; the scene stays as it was"""
     bl_idname = "wiresculpt.find_planes_cancel"
@@ -308,5 +433,23 @@ class WIRESCULPT_OT_find_planes_cancel(bpy.types.Operator):
         return {'FINISHED'}
 
 
-register, unregister = classes_factory((WIRESCULPT_OT_find_planes, WIRESCULPT_OT_suggest_planes,
-                                        WIRESCULPT_OT_apply_planes, WIRESCULPT_OT_find_planes_cancel))
+_register, _unregister = classes_factory((WIRESCULPT_OT_find_planes, WIRESCULPT_OT_suggest_planes,
+                                          WIRESCULPT_OT_apply_planes, WIRESCULPT_OT_preview_planes,
+                                          WIRESCULPT_OT_preview_planes_clear, WIRESCULPT_OT_find_planes_cancel))
+
+
+@bpy.app.handlers.persistent
+def _load_pre(*_args):
+    clear_preview()
+
+
+def register():
+    _register()
+    bpy.app.handlers.load_pre.append(_load_pre)
+
+
+def unregister():
+    if _load_pre in bpy.app.handlers.load_pre:
+        bpy.app.handlers.load_pre.remove(_load_pre)
+    clear_preview()
+    _unregister()

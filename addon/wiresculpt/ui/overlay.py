@@ -1,4 +1,6 @@
-"""Viewport overlay: Live's preview wires (operators/live.STATE.preview) while Live is on; the contact force at every crossing as an arrow (gpu module, no bgl), and
+"""Viewport overlay: Live's preview wires (operators/live.STATE.preview) while Live is on; the
+plane assistant's previewed candidate (operators/plane_search.PREVIEW: its wires, and the outlines
+of the planes it moves or adds); the contact force at every crossing as an arrow (gpu module, no bgl), and
 each wire's predicted out-of-plane deflection as a whisker.
 
 Drawn only when the stored design has `force` per crossing and scene.wiresculpt.show_forces is
@@ -17,6 +19,7 @@ from gpu_extras.batch import batch_for_shader
 
 from ..blend import compat, results
 from ..operators import live
+from ..operators import plane_search
 
 ARROW_SHARE = 0.2
 HEAD_SHARE = 0.25  # arrow head length as a share of the arrow
@@ -103,9 +106,27 @@ def draw_live():
     live.STATE.drawn_at = time.monotonic()
 
 
+def draw_candidate(preview):
+    """The previewed candidate's wires (thicker than Live's) and the outlines of its moved planes,
+    over everything (no depth test: the wires of the scene's own design would hide them)."""
+    shader = uniform_colour_shader()
+    shader.bind()
+    gpu.state.depth_test_set('NONE')
+    for width, segments in ((3.0, preview["wires"]), (1.5, preview["planes"])):
+        gpu.state.line_width_set(width)
+        for colour, lines in segments:
+            shader.uniform_float("color", colour)
+            batch_for_shader(shader, 'LINES', {"pos": lines}).draw(shader)
+    gpu.state.line_width_set(1.0)
+    plane_search.DRAWN[0] += 1
+
+
 def draw():
     if live.STATE.running and live.STATE.preview:
         draw_live()
+    preview = plane_search.PREVIEW
+    if preview is not None and plane_search.previewed(bpy.context) is not None:
+        draw_candidate(preview)
     scene = bpy.context.scene
     if scene is None or not scene.wiresculpt.show_forces:
         return

@@ -1,5 +1,6 @@
 """The plane assistant's panel (issue 15), under the Wire panel: Find Stable Planes, Suggest
-Planes, and up to three candidates with what changes, their figures and Apply."""
+Planes, and up to three candidates with what changes, their figures, Preview (an eye, pressed while
+shown) and Apply."""
 import bpy
 
 from .. import native
@@ -39,11 +40,19 @@ class VIEW3D_PT_wiresculpt_planes(bpy.types.Panel):
         if result is None or result["scene"] != context.scene.name:
             return
         wrap_labels(layout, context, result["message"], icon='INFO')
+        shown = ops.previewed(context)
         for k, candidate in enumerate(result["candidates"]):
             box = layout.box()
             for i, line in enumerate(candidate_lines(candidate)):
                 wrap_labels(box, context, line, icon='CHECKMARK' if i == 0 else 'NONE')
-            box.operator(ops.WIRESCULPT_OT_apply_planes.bl_idname, text=f"Apply candidate {k + 1}").index = k
+            row = box.row(align=True)
+            # the eye alone (its tooltip says what it does): "Preview" beside "Apply candidate k"
+            # would cut both labels in a sidebar of the default width
+            row.operator(ops.WIRESCULPT_OT_preview_planes.bl_idname, text="", icon='HIDE_OFF',
+                         depress=shown == k).index = k
+            row.operator(ops.WIRESCULPT_OT_apply_planes.bl_idname, text=f"Apply candidate {k + 1}").index = k
+        if shown is not None:
+            layout.operator(ops.WIRESCULPT_OT_preview_planes_clear.bl_idname, icon='X')
 
 
 register, unregister = classes_factory((VIEW3D_PT_wiresculpt_planes,))
