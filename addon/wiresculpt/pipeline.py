@@ -17,6 +17,7 @@ from .stages import forces, layering, slicing, target_shape
 ALL_STAGES = ["layering", "target_shape", "forces", "rest_shape"]
 COUPLING_ROUNDS = 4  # target shape <-> rest shape iterations (Sec. 4.3)
 COUPLING_MARGIN_DEG = 0.5
+ANGLE_SLACK = 1e-12  # rad: the bend program's kAngleSlack (native/src/fab/bend_program.cpp)
 # Hooks by their forces (hooks_by_forces, docs/method-forces.md §12): a crossing's two hooks cost
 # the same in Eq. 2 when within HOOK_TIE; load capacities (at the plastic limit) within CAPACITY_TIE
 # of the best are equal, and the paper's out-of-plane measure decides among them; the search
@@ -181,10 +182,18 @@ def apply_cuts(design, cuts):
         names[name]["cut_override"] = index
 
 
+def _over(angle, limit_deg):
+    """Radians by which a rest bend is beyond the machine's limit, counting one within the bend
+    program's own slack (ANGLE_SLACK) as at the limit: a bend that rounding puts 1e-16 rad over
+    120 deg is made, and chasing it cost the Airplane two coupling rounds."""
+    over = abs(angle) - math.radians(limit_deg)
+    return over if over > ANGLE_SLACK else 0.0
+
+
 def _largest_over_bend(design, limit_deg):
     """The largest rest bend beyond the machine's limit (degrees over it), 0 when none. Taken from
-    the rest angles with no tolerance: the bend program refuses anything over the limit."""
-    return max((math.degrees(abs(a)) - limit_deg for w in design["wires"] for a in w.get("rest_angles", [])),
+    the rest angles with the bend program's slack only: it refuses anything further over."""
+    return max((math.degrees(_over(a, limit_deg)) for w in design["wires"] for a in w.get("rest_angles", [])),
                default=0.0)
 
 
@@ -225,7 +234,7 @@ def _tighten(design, memo, machine_limit_deg, floor_deg):
     for w in design["wires"]:
         m = len(w["target"])
         for position, (rest, target) in enumerate(zip(w["rest_angles"], w["target_angles"])):
-            if abs(rest) <= math.radians(machine_limit_deg):
+            if not _over(rest, machine_limit_deg):
                 continue
             vertex = (w["cut"] + position) % m if w["closed"] else position
             limit = target_limit_for(target, rest, wanted)
