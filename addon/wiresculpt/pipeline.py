@@ -299,7 +299,9 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint,
         # a round that may be followed by another skips it when a rest bend is over the limit, the
         # case in which another round follows (computed below if the rounds stop there anyway).
         warnings_before = len(design.get("warnings", []))
-        within = math.radians(machine_limit) if round_ + 1 < COUPLING_ROUNDS else None
+        # with the bend program's slack, as _largest_over_bend: a round that ends the coupling within
+        # it keeps its load capacity instead of solving the forces a second time below
+        within = math.radians(machine_limit) + ANGLE_SLACK if round_ + 1 < COUPLING_ROUNDS else None
         if "density" in material:  # an earlier solve's must not stand for a skipped one
             design.pop("load_capacity", None)
         say("forces", forces.run(design, material, settings, native_progress, load_capacity_within=within))
