@@ -181,6 +181,7 @@ class Searcher:
         self.mesh_info = None  # the slicer's report on the mesh (stages.slicing.mesh), from its first call
         self.screened = self.full_solves = self.timed_out = self.failed = 0
         self.final = None  # what finish() did with the returned design
+        self.surface = None  # (triangle centroids, areas) of the mesh, made by _surface when first needed
         self.deadline = math.inf  # perf_counter() time at which a full solve is stopped (the budget)
         self.budget = None  # seconds
         self.centre, self.axes, self.size = mesh_frame(vertices, faces)
@@ -335,8 +336,6 @@ class Searcher:
             if self.cancel():
                 raise
             self.timed_out += 1
-            return None
-        except (ValueError, RuntimeError):
             return None
 
     def finish(self, candidate):
@@ -507,7 +506,7 @@ def close_gaps(design, min_segment):
 
 def _surface(searcher):
     """(triangle centroids, areas) of the searcher's mesh, computed once."""
-    if getattr(searcher, "surface", None) is None:
+    if searcher.surface is None:
         V = np.asarray(searcher.V, dtype=float)
         F = np.asarray(searcher.F, dtype=np.int64)
         a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
