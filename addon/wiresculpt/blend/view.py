@@ -1,5 +1,6 @@
 """How a saved .blend opens (issue 21): every 3D view framed on the sculpture, its sidebar open on
-the Wire tab, the first wire selected and active.
+the Wire tab, the first wire selected and active; and redraw_3d_views, which the operators use to
+show what changed in module state (Live's verdict, a previewed candidate, a dropped result).
 
 Blender keeps each 3D view's camera (SpaceView3D.region_3d: view_location, view_distance,
 view_rotation) and whether its sidebar shows (show_region_ui) in the screens it saves, so setting
@@ -41,6 +42,16 @@ def bounds(objects):
     lo = Vector(tuple(min(c[i] for c in corners) for i in range(3)))
     hi = Vector(tuple(max(c[i] for c in corners) for i in range(3)))
     return (lo + hi) / 2, max(hi - lo)
+
+
+def redraw_3d_views():
+    """Asks every 3D view of every window to redraw (a verdict, an overlay or a result changed
+    outside an operator's own area)."""
+    wm = bpy.context.window_manager
+    for window in (wm.windows if wm else []):
+        for area in (window.screen.areas if window.screen else []):
+            if area.type == 'VIEW_3D':
+                area.tag_redraw()
 
 
 def view3d_spaces():

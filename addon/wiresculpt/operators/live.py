@@ -29,6 +29,7 @@ from .. import native, pipeline
 from ..blend import cut_handles, mesh
 from ..blend import results as scene_results
 from ..blend.handles import handles, target_problem, ticked_planes
+from ..blend.view import redraw_3d_views
 from ..core.jobs import WorkerJob
 from ..props import LIVE_HOOKS, material_of, solver_settings
 
@@ -180,13 +181,6 @@ def _start(scene, key):
     return job
 
 
-def _redraw():
-    for window in bpy.context.window_manager.windows:
-        for area in (window.screen.areas if window.screen else []):
-            if area.type == 'VIEW_3D':
-                area.tag_redraw()
-
-
 def _step():
     scene = bpy.context.scene
     if scene is None or not scene.wiresculpt.live:
@@ -226,7 +220,7 @@ def _step():
     elif not settled and key != STATE.solved:
         STATE.verdict = "solving…"
     if STATE.verdict != shown:
-        _redraw()
+        redraw_3d_views()
     return ACTIVE_TICK_SECONDS if STATE.job is not None or key != STATE.solved else TICK_SECONDS
 
 
@@ -267,7 +261,7 @@ def stop():
     STATE.durations = durations  # what the last run's ticks took, for the test
     if drawn:  # the preview goes from the viewport
         try:
-            _redraw()
+            redraw_3d_views()
         except (AttributeError, ReferenceError):  # no window (closing, background)
             pass
 

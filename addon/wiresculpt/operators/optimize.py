@@ -21,6 +21,7 @@ from .. import native, pipeline
 from ..blend import cut_handles, mesh
 from ..blend import results as scene_results
 from ..blend.handles import target_problem, ticked_planes
+from ..blend.view import redraw_3d_views
 from ..blend.registration import classes_factory
 from ..core.jobs import WorkerJob
 from ..props import material_of, solver_settings
@@ -133,13 +134,6 @@ def running():
     return JOB is not None
 
 
-def _redraw_3d_views():
-    for window in bpy.context.window_manager.windows:
-        for area in (window.screen.areas if window.screen else []):
-            if area.type == 'VIEW_3D':
-                area.tag_redraw()
-
-
 def _wait_for_worker(job):
     """A timer after the modal is gone: polls the cancelled job until its worker ends, then
     drops it (its result is never written)."""
@@ -149,7 +143,7 @@ def _wait_for_worker(job):
     if JOB is job:
         JOB = None
     try:
-        _redraw_3d_views()
+        redraw_3d_views()
     except (AttributeError, ReferenceError):  # no window (closing, background)
         pass
     return None

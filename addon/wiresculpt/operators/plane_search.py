@@ -23,6 +23,7 @@ from ..blend import mesh
 from ..blend import results as scene_results
 from ..blend.handles import PLANE_MARGIN, add_handle, handle_plane, handles, target_problem
 from ..blend.registration import classes_factory
+from ..blend.view import redraw_3d_views
 from ..core.jobs import WorkerJob
 from ..core.scene import PlaneSpec
 from ..props import material_of, solver_settings
@@ -319,21 +320,13 @@ def apply_candidate(context, index):
     return candidate
 
 
-def _redraw():
-    wm = bpy.context.window_manager
-    for window in (wm.windows if wm else []):
-        for area in (window.screen.areas if window.screen else []):
-            if area.type == 'VIEW_3D':
-                area.tag_redraw()
-
-
 def clear_preview():
     """No candidate previewed any more (the overlay stops drawing it)."""
     global PREVIEW
     if PREVIEW is not None:
         PREVIEW = None
         try:
-            _redraw()
+            redraw_3d_views()
         except (AttributeError, ReferenceError):  # no window (closing, loading)
             pass
 
@@ -349,7 +342,7 @@ def preview_candidate(context, index):
         return False
     shown = RESULT["candidates"][index]["preview"]
     PREVIEW = {"scene": context.scene.name, "index": index, "wires": shown["wires"], "planes": shown["planes"]}
-    _redraw()
+    redraw_3d_views()
     return True
 
 
