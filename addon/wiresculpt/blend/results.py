@@ -75,6 +75,16 @@ def stored_design():
 
 # --- geometry ---------------------------------------------------------------------------------
 
+def polyline_segments(points, closed):
+    """(2k, 3) float32 end points of the segments of a polyline (closed: the last back to the
+    first), as the overlays draw lines."""
+    points = np.asarray(points, dtype=np.float32).reshape(-1, 3)
+    if len(points) < 2:
+        return np.empty((0, 3), dtype=np.float32)
+    ends = np.concatenate([points[1:], points[:1]]) if closed else points[1:]
+    return np.stack([points[:len(ends)], ends], axis=1).reshape(-1, 3)
+
+
 def wire_points(wire):
     """The wire's shape to show: the optimized target, or the contour when it was not computed."""
     return np.asarray(wire.get("target") or wire["contour"], dtype=np.float64)

@@ -110,13 +110,10 @@ def preview_segments(design):
     applied), in the wire's colour: what the overlay draws."""
     out = []
     for wire_id, points in scene_results.wire_shapes(design).items():
-        points = np.asarray(points, dtype=np.float32)
         if len(points) < 2:
             continue
         wire = next(w for w in design["wires"] if w["id"] == wire_id)
-        ends = np.concatenate([points[1:], points[:1]]) if wire["closed"] else points[1:]
-        starts = points[:len(ends)]
-        out.append((scene_results.wire_colour(wire_id), np.stack([starts, ends], axis=1).reshape(-1, 3)))
+        out.append((scene_results.wire_colour(wire_id), scene_results.polyline_segments(points, wire["closed"])))
     return out
 
 

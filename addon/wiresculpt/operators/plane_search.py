@@ -71,15 +71,6 @@ def describe(candidate):
             f"closure gap {f['closure_gap'] * 1000:.1f} mm")
 
 
-def polyline_segments(points, closed):
-    """(2k, 3) float32 end points of the segments of a polyline (closed: the last back to the first)."""
-    points = np.asarray(points, dtype=np.float32).reshape(-1, 3)
-    if len(points) < 2:
-        return np.empty((0, 3), dtype=np.float32)
-    ends = np.concatenate([points[1:], points[:1]]) if closed else points[1:]
-    return np.stack([points[:len(ends)], ends], axis=1).reshape(-1, 3)
-
-
 def plane_outline(origin, normal, half):
     """(8, 3) float32 segment end points of the square of side 2 * half centred at `origin` in the
     plane with unit `normal`."""
@@ -89,14 +80,15 @@ def plane_outline(origin, normal, half):
     u /= np.linalg.norm(u)
     v = np.cross(n, u)
     corners = [np.asarray(origin, dtype=float) + half * (a * u + b * v) for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
-    return polyline_segments(corners, True)
+    return scene_results.polyline_segments(corners, True)
 
 
 def candidate_preview(candidate, mode, size):
     """What the overlay draws for a candidate: each design wire's shape (its target polyline, the
     contour where there is none; blend/results.wire_points) in the wire's colour, and the outline of
     every plane it moves (nearby) or adds (auto), PLANE_MARGIN times the model's `size` across."""
-    wires = [(scene_results.wire_colour(w["id"]), polyline_segments(scene_results.wire_points(w), w["closed"]))
+    wires = [(scene_results.wire_colour(w["id"]), scene_results.polyline_segments(scene_results.wire_points(w),
+                                                                                   w["closed"]))
              for w in candidate["design"]["wires"]]
     planes = [(PLANE_COLOUR, plane_outline(p.origin, p.normal, 0.5 * PLANE_MARGIN * size))
               for p in candidate["planes"] if mode == "auto" or p.changes]
