@@ -50,8 +50,9 @@ import time
 
 import numpy as np
 
-from . import native, pipeline
+from . import native, pipeline, plane_faults
 from .core.scene import PlaneSpec
+from .plane_faults import Tally, close_gaps, crossing_gaps  # noqa: F401 (the search's names for them)
 from .stages import layering, slicing
 
 MODES = ("off", "nearby", "auto")
@@ -72,6 +73,7 @@ EARLY_SOLVES = 3  # auto verifies as soon as this many screened proposals have n
 SCREEN_SECONDS = 2.0  # a screen's layering longer than this does not pass (a search of many contours)
 FINAL_HOOK_SECONDS = 10.0
 FINAL_SECONDS = 20.0
+PAIR_SINGLES = 25  # the two-plane changes pair each plane's this many cheapest one-plane changes (all 25)
 
 
 class Placement:
@@ -181,6 +183,9 @@ class Searcher:
         self.mesh_info = None  # the slicer's report on the mesh (stages.slicing.mesh), from its first call
         self.screened = self.full_solves = self.timed_out = self.failed = 0
         self.final = None  # what finish() did with the returned design
+        self.fault = None  # why the last screen did not pass (plane_faults), None when it passed
+        self.empty = None  # the plane of the last sliced() that found no contour
+        self.tally = None  # the nearby search's account of its candidates (plane_faults.Tally)
         self.surface = None  # (triangle centroids, areas) of the mesh, made by _surface when first needed
         self.deadline = math.inf  # perf_counter() time at which a full solve is stopped (the budget)
         self.budget = None  # seconds
@@ -214,6 +219,7 @@ class Searcher:
         for p in placements:
             found = self._contours(p)
             if not found:
+                self.empty = p.name
                 return None  # a change that removes a plane's wire is no answer
             contours += len(found)
             for k in rules.pick(found, p.contours, p.name):
@@ -238,16 +244,22 @@ class Searcher:
         if self.cancel():
             raise pipeline.Cancelled()
         self.screened += 1
+        self.fault = None
         try:
             design = self.sliced(placements)
             if design is None or len(design["wires"]) < 2:
+                self.fault = ("misses", (), (self.empty,)) if design is None else ("few", (), ())
                 return False, design, None
             probe = copy.deepcopy(design)
             self._layer(probe, design)
+            if not probe["stable"]:
+                self.fault = plane_faults.structural_fault(probe) or ("mechanism", (), ("the layering's verdict",))
             return bool(probe["stable"]), design, probe
-        except (ValueError, RuntimeError, native.Cancelled):
+        except (ValueError, RuntimeError, native.Cancelled) as exc:
             if self.cancel():
                 raise pipeline.Cancelled() from None
+            self.fault = (("slow", (), ()) if isinstance(exc, native.Cancelled) else
+                          ("refused", (), (str(exc).split(";", 1)[0][:120],)))
             return False, None, None  # refused, or its layering ran past the deadline
 
     def _layer(self, probe, design):
@@ -407,8 +419,12 @@ def nearby(vertices, faces, planes, material, settings, want=1, budget=BUDGET_SE
     s = Searcher(vertices, faces, material, settings, progress, cancel, stock)
     start = time.perf_counter()
     s.deadline, s.budget = start + budget, budget
+    min_segment = float(settings.get("min_segment") or 0.0)
     base = [Placement(p.name, p.origin, _unit(p.normal), p.contours) for p in planes]
     singles = {i: single_changes(p, s.centre, s.size) for i, p in enumerate(planes)}
+    pairs = [(a.cost + b.cost, ((i, a), (j, b))) for i, j in itertools.combinations(sorted(singles), 2)
+             for a in singles[i][:PAIR_SINGLES] for b in singles[j][:PAIR_SINGLES]]
+    tally = s.tally = Tally(base, singles, len(pairs))
     found = []
 
     def out_of_time():
@@ -419,10 +435,16 @@ def nearby(vertices, faces, planes, material, settings, want=1, budget=BUDGET_SE
         costs = sorted(c["cost"] for c in found)
         return costs[want - 1] if len(costs) >= want else math.inf
 
-    def solve(cost, changes, placements, design):
+    def solve(cost, changes, placements, design, probe):
+        family, stopped = tally.family_of(changes), s.timed_out
+        tally.solved(family)
         solved = s.solve(copy.deepcopy(design))
         if solved is None or not solved["stable"]:
+            fault = ((("stopped" if s.timed_out > stopped else "failed"), (), ()) if solved is None
+                     else plane_faults.verdict_fault(probe, solved, min_segment))
+            tally.fault(family, fault, changes)
             return
+        tally.fault(family, ("stable", (), ()), changes)
         found.append({"planes": placements, "changes": [t for _, c in changes for t in c.changes], "cost": cost,
                       "score": -cost, "design": solved, "figures": _figures(solved), "sliced": design})
         s.say("plane_search", f"candidate {len(found)}: {'; '.join(found[-1]['changes']) or 'the planes as given'} "
@@ -436,26 +458,29 @@ def nearby(vertices, faces, planes, material, settings, want=1, budget=BUDGET_SE
             placements = list(base)
             for i, c in changes:
                 placements[i] = c
-            ok, design, close = s.screen(placements)
+            ok, design, probe = s.screen_layered(placements)
+            tally.screened(tally.family_of(changes))
             if not ok:
+                tally.fault(tally.family_of(changes), s.fault, changes)
                 continue
-            if close:
-                deferred.append((cost, changes, placements, design))
+            if probe.get("close_crossings"):
+                deferred.append((cost, changes, placements, design, probe))
             else:
-                solve(cost, changes, placements, design)
-        for cost, changes, placements, design in deferred:
+                solve(cost, changes, placements, design, probe)
+        for k, (cost, changes, placements, design, probe) in enumerate(deferred):
             if cost >= bar() or out_of_time():
+                for _cost, later, _placements, _design, left in deferred[k:]:
+                    gap = plane_faults.closest_gap(left)
+                    tally.fault(tally.family_of(later), ("near", (gap[1],), gap[2]) if gap else ("unsolved", (), ()),
+                                later)
                 break
-            solve(cost, changes, placements, design)
+            solve(cost, changes, placements, design, probe)
 
     phase([(0.0, ())] + sorted(((c.cost, ((i, c),)) for i, cs in singles.items() for c in cs), key=lambda t: t[0]))
     if len(found) < want and not out_of_time():  # pairs of one-plane changes of two planes
-        pairs = []
-        for i, j in itertools.combinations(sorted(singles), 2):
-            for a in singles[i][:12]:
-                for b in singles[j][:12]:
-                    pairs.append((a.cost + b.cost, ((i, a), (j, b))))
-        phase(sorted(pairs, key=lambda t: t[0]))
+        phase(tally.pair_order(pairs))
+    tally.seconds = time.perf_counter() - start
+    tally.out_of_time = out_of_time()
     found.sort(key=lambda c: c["cost"])
     if found:
         s.finish(found[0])
@@ -475,33 +500,6 @@ def _family_names(axes):
 # a family's first and last plane, as fractions of the mesh's extent along its axis: wide first;
 # narrower spreads keep the planes off thin extremities (limbs, where crossings come close together)
 SPREADS = ((0.2, 0.8), (0.3, 0.7), (0.12, 0.88), (0.38, 0.62), (0.25, 0.75), (0.16, 0.84))
-
-
-def crossing_gaps(design):
-    """The distances along each wire between consecutive crossings (metres), from a layered design
-    (its contours hold the crossing points, crossings[i]["contour_vertices"] their indices)."""
-    at = {}
-    for c in design["crossings"]:
-        for w, v in zip(c["wires"], c["contour_vertices"]):
-            at.setdefault(w, []).append(v)
-    gaps = []
-    for w, vertices in at.items():
-        wire = design["wires"][w]
-        pts = np.asarray(wire["contour"], dtype=float)
-        arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
-        total = arc[-1] + (float(np.linalg.norm(pts[-1] - pts[0])) if wire["closed"] else 0.0)
-        s = sorted(arc[v] for v in vertices)
-        gaps += [b - a for a, b in zip(s, s[1:])]
-        if wire["closed"] and len(s) >= 2:
-            gaps.append(total - s[-1] + s[0])
-    return gaps
-
-
-def close_gaps(design, min_segment):
-    """How many crossings follow another along a wire closer than 2 * min_segment: the target
-    shape then has no free bending point between them and mostly cannot realise them (its
-    "too close to their neighbours" verdict), so such candidates are verified last."""
-    return sum(1 for g in crossing_gaps(design) if g < 2.0 * min_segment)
 
 
 def _surface(searcher):
@@ -670,11 +668,9 @@ def run(vertices, faces, planes, material, settings, progress=None, cancel=None,
         else:
             design = pipeline.run(vertices, faces, planes, material, settings, progress, cancel, stock)
             best = None
-            design["reason"] += (f"; no nearby placement ({s.screened} tried: offsets up to "
-                                 f"{OFFSETS[-1] * 100:g} % of the model size, tilts up to {TILTS_DEG[-1]:g} deg, "
-                                 f"contour rules, one or two planes at a time) gives a stable design"
-                                 + (f" within the search's {s.budget:g} s budget" if time.perf_counter() - start > s.budget
-                                    else ""))
+            if not design["stable"]:
+                design["reason"] = (f"{nearby_reason(s)}. The planes as given: {design['reason']}"
+                                    if design["reason"] else nearby_reason(s))
         design["plane_search"] = _record("nearby", planes, best, s, start)
         used = [p.spec() for p in best["planes"]] if best else list(planes)
         say("plane_search", _summary(design["plane_search"]))
@@ -699,6 +695,14 @@ def run(vertices, faces, planes, material, settings, progress=None, cancel=None,
         say("plane_search", _summary(design["plane_search"]))
         return design, used
     raise ValueError(f'settings.plane_search must be one of {", ".join(MODES)}, got {mode!r}')
+
+
+def nearby_reason(searcher):
+    """Why the nearby search `searcher` ran found no stable placement (plane_faults.Tally.report):
+    what it searched, how far the budget let it, its candidates counted by fault, what to change."""
+    s = searcher
+    return s.tally.report(OFFSETS[-1] * s.size * 1000.0, s.size * 1000.0, TILTS_DEG[-1], s.budget,
+                          float(s.settings.get("min_segment") or 0.0))
 
 
 def _summary(record):
