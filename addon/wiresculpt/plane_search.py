@@ -14,7 +14,12 @@ Two searches:
   with S the model size (largest side of the mesh's bounding box): 5 % of the model's size costs
   as much as a tilt of 0.05 rad (2.9 deg). Candidates are one-plane changes (offsets
   +-{2, 4, 7, 10, 15, 20} % of S, tilts of 5, 10, 15 deg about two axes each way, the other
-  contour rule), then pairs of one-plane changes of two different planes, tried in order of cost.
+  contour rule: 25 per plane), tried in order of cost, then pairs of one-plane changes of two
+  different planes (25 x 25 per pair of planes), those whose two changes, each screened alone,
+  together free every wire at fault in the given planes first (plane_faults.Tally.pair_order), each
+  group by cost. When none gives a stable design, the search's reason (nearby_reason) says what it
+  searched, whether the budget cut it short and how much was left, its candidates counted by fault
+  in each family (plane_faults), and what to change.
 - `auto(...)`: planes from the mesh alone: `count` planes in families along the mesh's principal
   axes (area-weighted) or the world's, each family spread over the mesh's extent along its axis or
   over the quantiles of its surface area (family_planes), for every split of `count` over the three
@@ -411,11 +416,14 @@ def nearby(vertices, faces, planes, material, settings, want=1, budget=BUDGET_SE
     """Up to `want` stable, buildable candidates near `planes`, cheapest change first:
     [{"planes": [Placement], "changes": [sentence], "cost", "score", "design", "figures"}], the
     Searcher (its counts) and the start time. The given planes themselves are candidate 0 (cost 0).
-    Order: one-plane changes, then pairs; within each, by cost, except that a screened candidate
+    Order: one-plane changes by cost, then pairs (plane_faults.Tally.pair_order: those that the
+    single changes' faults point at first, then by cost); within each, except that a screened candidate
     whose layering reports crossings closer along a wire than the machine's minimum segment
     (`close_crossings`: the full pipeline mostly fails on them, at a second each) is solved only
     after the others, and only while it is cheaper than the `want`-th found, so that the answer is
-    still the cheapest the budget allows."""
+    still the cheapest one-plane change the budget allows (a pair: the cheapest of its group, the
+    search stopping at the first pair that costs more than the `want`-th found). When none is found,
+    the Searcher's tally (plane_faults.Tally) holds the account nearby_reason words."""
     s = Searcher(vertices, faces, material, settings, progress, cancel, stock)
     start = time.perf_counter()
     s.deadline, s.budget = start + budget, budget
