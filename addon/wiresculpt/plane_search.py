@@ -571,6 +571,62 @@ def splits_of(count):
     return sorted(splits, key=lambda c: (max(c), 0 in c))
 
 
+GROW_BASES = 3  # grow: the (count - 1)-plane proposals extended, fewest close crossings first
+GROW_QUANTILES = tuple(round(0.05 * k, 2) for k in range(1, 20))  # where grow adds a plane: 5 %, 10 %, ... 95 %
+
+
+def area_quantile_plane(searcher, axis, q, name):
+    """The plane normal to `axis` through the point at which a share `q` of the mesh's surface area
+    lies below it along `axis`."""
+    centroids, areas = _surface(searcher)
+    u = (centroids - searcher.centre) @ axis
+    order = np.argsort(u)
+    share = np.cumsum(areas[order]) / areas.sum()
+    at = float(u[order][min(int(np.searchsorted(share, q)), len(order) - 1)])
+    return Placement(name, searcher.centre + at * np.asarray(axis, dtype=float), axis, "largest")
+
+
+def grow(s, count, frames, min_segment, until):
+    """Proposals of `count` planes grown from proposals of count - 1 (a designer adds a plane to a
+    set that holds): the (count - 1)-plane family proposals (largest contours) screened for up to a
+    quarter of the time left before `until`, the GROW_BASES that pass with the fewest crossings
+    closer than 2 * min_segment along a wire (then the largest closest gap) each extended by one
+    plane along each of its three axes at every area quantile of GROW_QUANTILES (area_quantile_plane)
+    and screened, up to half the time left. Returns the extended sets that pass the screen as auto's
+    pool entries, fewest close gaps first, then the largest closest gap. The families' evenly spread
+    planes often put crossings closer than 2 * min_segment along some wire (man, N = 6: every
+    proposal), and planes at uneven places, which no spread gives, keep them apart."""
+    began = time.perf_counter()
+    s.deadline = began + (until - began) / 4
+    bases = []
+    for spread, by, counts, axes in itertools.product(SPREADS, ("area", "extent"), splits_of(count - 1), frames):
+        if time.perf_counter() > s.deadline:
+            break
+        placements = family_planes(s, counts, "largest", spread, axes, by)
+        ok, _design, probe = s.screen_layered(placements)
+        if ok:
+            gap = plane_faults.closest_gap(probe)
+            bases.append((close_gaps(probe, min_segment), -(gap[0] if gap else math.inf), counts, axes, placements))
+    bases.sort(key=lambda b: b[:2])
+    s.deadline = began + (until - began) / 2
+    out = []
+    for _close, _gap, counts, axes, placements in bases[:GROW_BASES]:
+        names = _family_names(axes)
+        for k in range(3):
+            for q in GROW_QUANTILES:
+                if time.perf_counter() > s.deadline:
+                    return sorted(out, key=lambda t: t[:2])
+                added = area_quantile_plane(s, axes[k], q, f"{names[k]}{counts[k]}")
+                ok, design, probe = s.screen_layered(placements + [added])
+                if ok:
+                    gap = plane_faults.closest_gap(probe)
+                    out.append((close_gaps(probe, min_segment), -(gap[0] if gap else math.inf),
+                                tuple(c + (j == k) for j, c in enumerate(counts)), axes, placements + [added],
+                                design, f" (grown: the last along {_axis_word(axes[k], k)} at {q:.0%} of the "
+                                        "surface area)"))
+    return sorted(out, key=lambda t: t[:2])
+
+
 def auto(vertices, faces, count, material, settings, want=2, budget=None, progress=None, cancel=None,
          stock=None):
     """Up to `want` stable, buildable plane sets of `count` planes proposed from the mesh alone,
@@ -592,9 +648,10 @@ def auto(vertices, faces, count, material, settings, want=2, budget=None, progre
     proposals = itertools.product(SPREADS, ("area", "extent"), splits_of(count), frames)
     seen, found, passed = set(), [], 0
 
-    def screen_some(limit):
+    def screen_some(limit, soft=math.inf):
         """Screens proposals until `limit` (perf_counter time) or EARLY_SOLVES of them pass with
-        no close gap; returns the passing ones, and whether proposals remain."""
+        no close gap, or until `soft` when none has passed without one by then; returns the passing
+        ones, and whether proposals remain."""
         nonlocal passed
         s.deadline = limit
         batch, clean = [], 0
@@ -613,28 +670,36 @@ def auto(vertices, faces, count, material, settings, want=2, budget=None, progre
                     placements = joined
                     ok, design, probe = s.screen_layered(placements)
             if ok:
-                batch.append((close_gaps(probe, min_segment), -s.coverage(design), counts, axes, placements, design))
+                batch.append((close_gaps(probe, min_segment), -s.coverage(design), counts, axes, placements, design, ""))
                 clean += batch[-1][0] == 0
-            if clean >= EARLY_SOLVES or time.perf_counter() > limit:
+            if clean >= EARLY_SOLVES or time.perf_counter() > limit or (not clean and time.perf_counter() > soft):
                 passed += len(batch)
                 return batch, True
         passed += len(batch)
         return batch, False
 
-    more, pool, first = True, [], True
+    more, pool, first, grown = True, [], True, None
     while more and len(found) < want and time.perf_counter() - start < budget:
-        # screening up to half the budget at first, later up to half of what is left; verifying the
-        # pool (fewest close gaps first) after each round
+        # screening up to half the budget at first (a quarter when no proposal passes without close
+        # crossings by then: grow follows), later up to half of what is left; verifying the pool
+        # (fewest close gaps first) after each round
         now = time.perf_counter()
-        batch, more = screen_some(start + budget / 2 if first else now + (start + budget - now) / 2)
+        batch, more = (screen_some(start + budget / 2, start + budget / 4) if first else
+                       screen_some(now + (start + budget - now) / 2))
         first = False
         s.deadline = start + budget
         pool = sorted(pool + batch, key=lambda t: t[:2])
         s.say("plane_search", f"{passed} of {s.screened} proposals pass the screen; "
                               f"{sum(1 for t in pool if t[0] == 0)} to verify without crossings closer than "
                               f"2 x min_segment along a wire")
+        if not grown and count >= 3 and not any(t[0] == 0 for t in pool):
+            # no proposal keeps its crossings apart: grow sets from count - 1 planes (grow), verified first
+            grown = grow(s, count, frames, min_segment, start + budget)
+            s.deadline = start + budget
+            pool = grown + pool
+            s.say("plane_search", f"{len(grown)} sets grown from {count - 1} planes pass the screen")
         while pool and len(found) < want and time.perf_counter() - start < budget:
-            close, cover, counts, axes, placements, design = pool.pop(0)
+            close, cover, counts, axes, placements, design, extra = pool.pop(0)
             solved = s.solve(copy.deepcopy(design))
             if solved is None or not solved["stable"]:
                 continue
@@ -642,7 +707,7 @@ def auto(vertices, faces, count, material, settings, want=2, budget=None, progre
             score = cover - FIDELITY_WEIGHT * s.max_deviation(solved) / s.size
             rule = "" if all(p.contours == "largest" for p in placements) else ", the connected contours"
             found.append({"planes": placements, "changes": [f"{len(placements)} planes: " + ", ".join(
-                f"{n} along {_axis_word(axes[k], k)}" for k, n in enumerate(counts) if n) + rule],
+                f"{n} along {_axis_word(axes[k], k)}" for k, n in enumerate(counts) if n) + rule + extra],
                 "cost": 0.0, "score": score, "coverage": cover, "design": solved, "figures": _figures(solved),
                 "sliced": design})
             s.say("plane_search", f"candidate {len(found)}: {found[-1]['changes'][0]} (score {score:.3f})")
