@@ -27,7 +27,10 @@ Two searches:
   and, when that fails the screen, the contours of the crossing network's largest connected part
   without hinged wires (Searcher.connected). Screened proposals are verified fewest crossings
   closer than 2 * min_segment along a wire first (close_gaps), then by coverage; budget
-  auto_budget(count) = AUTO_SECONDS_PER_PLANE * count.
+  auto_budget(count) = AUTO_SECONDS_PER_PLANE * count. When no proposal of the first screening
+  round keeps its crossings 2 * min_segment apart, sets grown from count - 1 planes (grow: a
+  family proposal plus one plane at an area quantile along one of its axes) are screened and
+  verified first.
 
 Every candidate is screened cheaply first: slicing (each plane placement sliced once, cached) and
 the layering (stages.layering), whose first step is the hook-relaxed stability check (every
@@ -692,14 +695,13 @@ def auto(vertices, faces, count, material, settings, want=2, budget=None, progre
         s.say("plane_search", f"{passed} of {s.screened} proposals pass the screen; "
                               f"{sum(1 for t in pool if t[0] == 0)} to verify without crossings closer than "
                               f"2 x min_segment along a wire")
-        if not grown and count >= 3 and not any(t[0] == 0 for t in pool):
-            # no proposal keeps its crossings apart: grow sets from count - 1 planes (grow), verified first
+        if grown is None and count >= 3 and not any(t[0] == 0 for t in pool):
+            # no proposal keeps its crossings apart: sets grown from count - 1 planes, verified first
             grown = grow(s, count, frames, min_segment, start + budget)
             s.deadline = start + budget
-            pool = grown + pool
             s.say("plane_search", f"{len(grown)} sets grown from {count - 1} planes pass the screen")
-        while pool and len(found) < want and time.perf_counter() - start < budget:
-            close, cover, counts, axes, placements, design, extra = pool.pop(0)
+        while (grown or pool) and len(found) < want and time.perf_counter() - start < budget:
+            close, cover, counts, axes, placements, design, extra = (grown or pool).pop(0)
             solved = s.solve(copy.deepcopy(design))
             if solved is None or not solved["stable"]:
                 continue
