@@ -217,7 +217,8 @@ class NoNearbyPlacement(Case):
         self.assertEqual(len(before), 3)
         a, c, b = sorted(before, key=lambda n: -before[n][0][2])  # z = 0.5 R, x = 0 (at z = 0), z = -0.5 R
         first, second = sorted((a, b))
-        self.assertIn(f"wire {first}/0 on wire {c}/0, wire {second}/0 on wire {c}/0", result["message"])
+        self.assertIn(f"(wire {first}/0 on wire {c}/0 in 1875, wire {second}/0 on wire {c}/0 in 1875)",
+                      result["message"])
         self.assertIn(f"move or tilt planes {first} and {second} towards each other", result["message"])
         log = draw(panel.VIEW3D_PT_wiresculpt_planes, bpy.context)
         shown = " ".join(kw.get("text", "") for _name, _a, kw in log)

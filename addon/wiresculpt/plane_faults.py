@@ -255,7 +255,7 @@ def summary(faults, min_segment=None, shown=4):
     parts = []
     for kind, n in ranked[:shown]:
         items = sorted(named.get(kind, {}).items(), key=lambda kv: (-kv[1], kv[0]))
-        detail = ", ".join(f"{item} in {k}" if k != n else item for item, k in items[:3])
+        detail = ", ".join(item if len(items) == 1 else f"{item} in {k}" for item, k in items[:3])
         more = f", {len(items) - 3} more" if len(items) > 3 else ""
         parts.append(f"{n} {KIND_WORDS[kind].format(**words)}" + (f" ({detail}{more})" if detail else ""))
     rest = sum(n for _kind, n in ranked[shown:])

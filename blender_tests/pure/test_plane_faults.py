@@ -145,7 +145,7 @@ class NoNearbyPlacement(unittest.TestCase):
         self.assertIn(f"and two at a time (1875 pairs); {CANDIDATES} placements screened, 0 fully solved", reason)
         self.assertIn(f"Every one of the {CANDIDATES} candidates was screened", reason)
         self.assertIn("two-plane changes (1875 of 1875 screened): 1875 hinge", reason)
-        self.assertIn("(wire A/0 on wire C/0, wire B/0 on wire C/0)", reason)
+        self.assertIn("(wire A/0 on wire C/0 in 1875, wire B/0 on wire C/0 in 1875)", reason)
         self.assertIn("add a plane whose wire crosses wire A/0 away from its line with wire C/0", reason)
         self.assertIn("move or tilt planes A and B towards each other until their wires cross", reason)
         self.assertNotIn("budget", reason)
