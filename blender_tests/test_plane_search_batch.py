@@ -84,8 +84,8 @@ class PlaneSearchBatch(unittest.TestCase):
         self.assertIsNone(d["plane_search"]["score"])
         # the reason is the search's (what it searched, why each family failed, what to change), then the
         # given planes'; it names wires A/0 and B/0, hinged on T/0
-        self.assertTrue(d["reason"].startswith("no nearby placement gives a stable design. Searched: planes A, B, T "),
-                        d["reason"])
+        self.assertTrue(d["reason"].startswith(
+            "no nearby placement gives a stable design. Searched: planes A, B, T "), d["reason"])
         self.assertIn("Why: the planes as given: 1 hinge", d["reason"])
         self.assertIn("wire A/0 on wire T/0", d["reason"])
         self.assertIn("wire B/0 on wire T/0", d["reason"])

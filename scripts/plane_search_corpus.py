@@ -64,7 +64,8 @@ def nearby_cell(reason):
     planes as given first) by its first 100 characters."""
     if not reason.startswith("no nearby placement"):
         first = reason.split("; no nearby placement")[0]
-        return f"*{first[:100]}{'…' if len(first) > 100 else ''}*" + (" (budget reached)" if "budget" in reason else "")
+        return (f"*{first[:100]}{'…' if len(first) > 100 else ''}*"
+                + (" (budget reached)" if "budget" in reason else ""))
     cut = re.search(r"budget ended the search after (\d+) of (\d+) candidates", reason)
     every = re.search(r"Every one of the (\d+) candidates was screened", reason)
     todo = re.search(r"To change: (.*?)(?:\. The planes as given: |$)", reason, re.S)

@@ -58,9 +58,10 @@ import time
 
 import numpy as np
 
-from . import native, pipeline, plane_faults
+from . import native, pipeline
+from .core import plane_faults
+from .core.plane_faults import Tally, close_gaps, crossing_gaps  # noqa: F401 (the search's names for them)
 from .core.scene import PlaneSpec
-from .plane_faults import Tally, close_gaps, crossing_gaps  # noqa: F401 (the search's names for them)
 from .stages import layering, slicing
 
 MODES = ("off", "nearby", "auto")
@@ -673,7 +674,8 @@ def auto(vertices, faces, count, material, settings, want=2, budget=None, progre
                     placements = joined
                     ok, design, probe = s.screen_layered(placements)
             if ok:
-                batch.append((close_gaps(probe, min_segment), -s.coverage(design), counts, axes, placements, design, ""))
+                batch.append((close_gaps(probe, min_segment), -s.coverage(design), counts, axes, placements, design,
+                              ""))
                 clean += batch[-1][0] == 0
             if clean >= EARLY_SOLVES or time.perf_counter() > limit or (not clean and time.perf_counter() > soft):
                 passed += len(batch)

@@ -19,7 +19,8 @@ import math
 import re
 import unittest
 
-from wiresculpt import native, pipeline, plane_faults, plane_search
+from wiresculpt import native, pipeline, plane_search
+from wiresculpt.core import plane_faults
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.scene import PlaneSpec
 from wiresculpt.core.settings import defaults

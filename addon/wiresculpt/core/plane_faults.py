@@ -29,9 +29,10 @@ KINDS = ("misses", "few", "refused", "slow", "alone", "apart", "hinge", "mechani
 
 
 def wire_gaps(design):
-    """[(gap in metres, wire index, crossing id before, crossing id after)] along each wire between
-    consecutive crossings (crossings by their index in design["crossings"]), from a layered design (its contours hold the crossing points and
-    crossings[i]["contour_vertices"] their indices); a closed wire's last gap runs over its end."""
+    """[(gap in metres, wire index, crossing before, crossing after)] along each wire between
+    consecutive crossings (crossings by their index in design["crossings"]), from a layered design
+    (its contours hold the crossing points and crossings[i]["contour_vertices"] their indices); a
+    closed wire's last gap runs over its end."""
     at = {}
     for k, c in enumerate(design["crossings"]):
         for w, v in zip(c["wires"], c["contour_vertices"]):
