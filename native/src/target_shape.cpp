@@ -715,11 +715,22 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
   TargetShapeResult result;
   Polyline2 p = problem.initial();
   const int m = static_cast<int>(p.size());
+  const bool warm = !o.start.empty();
+  if (warm) {  // a previous result of this problem: its free points (the crossings stay the contour's)
+    if (o.start.size() != p.size())
+      throw InputError("target shape of wire " + w + ": start has " + std::to_string(o.start.size()) +
+                       " points, but this contour with these crossings and spacing has " + std::to_string(m));
+    for (int i = 0; i < m; ++i) {
+      if (!o.start[i].allFinite())
+        throw InputError("target shape of wire " + w + ": start point " + std::to_string(i) + " is not finite");
+      if (!problem.fixed()[i]) p[i] = o.start[i];
+    }
+  }
 
-  // Start: each free neighbour of an active crossing that lies outside the contact cone is turned
+  // Start (cold): each free neighbour of an active crossing that lies outside the contact cone is turned
   // about the crossing point onto the cone (keeping its distance and its side of h*), so that
   // the kinks start open the right way. The regulariser still measures from initial().
-  for (std::size_t c = 0; c < crossings.size(); ++c) {
+  for (std::size_t c = 0; c < crossings.size() && !warm; ++c) {
     const TargetCrossingStatus& s = problem.statuses_[c];
     if (!problem.crossings_[c].active || !s.realised) continue;
     const Vec2 h = problem.crossings_[c].bisector;

@@ -600,3 +600,65 @@ TEST_CASE("target shape: a 3 m wire converges within the default evaluation budg
   CHECK(r.feasible);
   for (const auto& s : r.crossings) CHECK(s.status == "ok");
 }
+
+TEST_CASE("target shape: a warm start from the looser limit's optimum reaches the cold solve's optimum", "[target]") {
+  // The coupling (Sec. 4.3) lowers one vertex's bend limit and solves again. Started from the
+  // previous optimum (`start`), the solve must end where a cold start ends: the same distances to
+  // the contour (0.1 mm, issue 17's tolerance), the same crossings realised, every constraint
+  // held, and with fewer evaluations (what the start is for). One windowed loop with crossings
+  // (2 m, ten crossings) and one one-block wire with a crossing.
+  const auto two_metres = long_loop(0.3, 10);
+  const auto wavy = wavy_loop();
+  for (const auto* c : {&two_metres, &wavy}) {
+    const auto& [contour, xs] = *c;
+    TargetShapeOptions o;
+    o.sweep_ftol = 1e-3;
+    const TargetShapeResult loose = optimize_target_shape(contour, true, xs, o);
+    const int m = static_cast<int>(loose.points.size());
+    auto bend = [&](const Polyline2& p, int i) {
+      return angle_between(p[i] - p[(i + m - 1) % m], p[(i + 1) % m] - p[i]);
+    };
+    std::vector<char> fixed(static_cast<std::size_t>(m), 0);
+    for (int v : loose.crossing_vertices) fixed[static_cast<std::size_t>(v)] = 1;
+    int sharpest = -1;  // the sharpest bend at a point whose neighbours are both free
+    for (int i = 0; i < m; ++i)
+      if (!fixed[i] && !fixed[(i + 1) % m] && !fixed[(i + m - 1) % m] &&
+          (sharpest < 0 || bend(loose.points, i) > bend(loose.points, sharpest)))
+        sharpest = i;
+    REQUIRE(sharpest >= 0);
+    const double limit = 0.5 * bend(loose.points, sharpest);
+    REQUIRE(limit > 2.0 * pi / 180.0);
+    o.vertex_max_bend.assign(static_cast<std::size_t>(m), 0.0);
+    o.vertex_max_bend[static_cast<std::size_t>(sharpest)] = limit;
+    const TargetShapeResult cold = optimize_target_shape(contour, true, xs, o);
+    o.start = loose.points;
+    const TargetShapeResult warm = optimize_target_shape(contour, true, xs, o);
+    INFO(contour.size() << " contour points, " << m << " target points; evaluations cold " << cold.iterations
+                        << ", warm " << warm.iterations);
+    REQUIRE(warm.points.size() == cold.points.size());
+    CHECK(bend(warm.points, sharpest) <= limit + 1e-6);
+    CHECK(std::abs(warm.max_distance - cold.max_distance) < 1e-4);
+    CHECK(std::abs(warm.rms_distance - cold.rms_distance) < 1e-4);
+    CHECK(warm.feasible == cold.feasible);
+    for (std::size_t k = 0; k < xs.size(); ++k) {
+      CHECK(warm.crossings[k].status == cold.crossings[k].status);
+      CHECK(warm.crossings[k].realised == cold.crossings[k].realised);
+    }
+    for (int v : warm.crossing_vertices) CHECK((warm.points[v] - cold.points[v]).norm() == 0.0);  // the contour's own
+    check_constraints(warm, true, xs, o, 1e-6);
+    CHECK(warm.iterations < cold.iterations);
+  }
+}
+
+TEST_CASE("target shape: a start of the wrong size or not finite is refused, naming the wire", "[target]") {
+  const auto [contour, xs] = wavy_loop();
+  TargetShapeOptions o;
+  o.wire_name = "W";
+  const TargetShapeResult r = optimize_target_shape(contour, true, xs, o);
+  o.start = r.points;
+  o.start.pop_back();
+  CHECK_THROWS_WITH(optimize_target_shape(contour, true, xs, o), Contains("wire W") && Contains("start has"));
+  o.start = r.points;
+  o.start[1].x() = std::nan("");
+  CHECK_THROWS_WITH(optimize_target_shape(contour, true, xs, o), Contains("wire W") && Contains("start point 1"));
+}

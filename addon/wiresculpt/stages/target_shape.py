@@ -90,6 +90,10 @@ def prepare_wire(design, wire, settings, size, memo=None):
     contour = to_2d(wire["contour"], origin, u, v)
     key = Memo.key(contour, wire["closed"], specs, options) if memo is not None else None
     result = memo.reusable(key, options["max_bend"]) if memo is not None else None
+    if result is None and memo is not None:  # a coupling round: start from the looser limit's optimum
+        start = memo.start(contour, wire["closed"], specs, options)
+        if start is not None:
+            options = {**options, "start": start}
     return {"contour": contour, "closed": wire["closed"], "specs": specs, "options": options, "refs": refs,
             "frame": (origin, u, v), "key": key, "result": result}
 
@@ -106,6 +110,7 @@ def finish_wire(job, result, memo=None):
     """Remembers a new solve in the memo; (result, refs, frame) as solve_wire returns them."""
     if memo is not None and job["result"] is None:
         memo.remember(job["key"], job["options"]["max_bend"], result)
+        memo.remember_start(job["contour"], job["closed"], job["specs"], job["options"], result)
     return result, job["refs"], job["frame"]
 
 
@@ -136,6 +141,12 @@ class Memo:
       realised under the old limit and whose bends all lie within the new one is still a local
       optimum of the tighter problem (the same point, feasible, in a smaller feasible set): it is
       reused for the same contour, crossings and options. Only the other wires are solved again.
+    - `starts`: the optimum of each wire problem whatever its bend limits (max_bend and
+      vertex_max_bend left out of the key), when it converged with every active crossing realised.
+      A wire solved again because its limits went down starts from it (the native `start`
+      option: the same problem, a warm start) instead of from the resampled contour: most of its
+      points are already where the tighter problem wants them (docs/method-target-shape.md,
+      "Coupling rounds").
     """
 
     CONVERGED = ("NLOPT_SUCCESS", "NLOPT_FTOL_REACHED", "NLOPT_XTOL_REACHED", "none")  # "none": nothing free
@@ -148,15 +159,27 @@ class Memo:
         self.nulled = []
         self.vertex_limits = {}
         self.solves = {}  # key -> (max_bend, result)
+        self.starts = {}  # key without the bend limits -> points of a converged solve
         self.same = {} if same is None else same
         self.reused = 0
 
     @staticmethod
-    def key(contour, closed, specs, options):
-        """Everything the solve depends on except the bend limit."""
+    def key(contour, closed, specs, options, ignore=("max_bend",)):
+        """Everything the solve depends on except the bend limit (the options named in `ignore`;
+        a start is never part of it)."""
         spec_key = tuple((s["vertex"], s["bisector"], s["contact_angle"], s["active"]) for s in specs)
-        other = tuple(sorted((k, v) for k, v in options.items() if k != "max_bend"))
+        other = tuple(sorted((k, v) for k, v in options.items() if k not in ignore and k != "start"))
         return (np.ascontiguousarray(contour, dtype=np.float64).tobytes(), bool(closed), spec_key, other)
+
+    LIMITS = ("max_bend", "vertex_max_bend")
+
+    def start(self, contour, closed, specs, options):
+        """The points of this wire problem's optimum under other bend limits, or None."""
+        return self.starts.get(self.key(contour, closed, specs, options, self.LIMITS))
+
+    def remember_start(self, contour, closed, specs, options, result):
+        if result["nlopt_result"] in self.CONVERGED and all(s["status"] in ("ok", "inactive") for s in result["crossings"]):
+            self.starts[self.key(contour, closed, specs, options, self.LIMITS)] = result["points"]
 
     def reusable(self, key, max_bend):
         """The remembered result for `key` if it is an optimum that the limit `max_bend` (radians)

@@ -68,6 +68,14 @@ struct TargetShapeOptions {
   /// the forces bend the rest shape beyond the machine. Entries <= 0 or past the end: max_bend.
   /// Default empty.
   std::vector<double> vertex_max_bend;
+  /// Metres, in the wire's plane frame: points to start the solve from instead of the resampled
+  /// contour with its kinks turned open, one per point of the result (the same count as a solve
+  /// of this contour with these crossings and spacing returns; else InputError). The crossing
+  /// points are always the contour's own; the regulariser still measures from the resampling, so
+  /// the problem is the same and only the start changes. The coupling with the rest shape passes
+  /// the previous round's result when it lowers a vertex's bend limit (warm start; see
+  /// docs/method-target-shape.md). Default empty (cold start).
+  Polyline2 start;
   /// Metres. Arc-length spacing of the initial resampling between consecutive crossings; 0 means
   /// 1.5 × min_segment. 0, or from min_segment/10 to 10 m (should not be below min_segment). A
   /// wire longer than 250000 × spacing (10^6 target points) is refused. Default 0.
