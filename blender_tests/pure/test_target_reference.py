@@ -133,6 +133,39 @@ class AgainstConvergedSweeps(unittest.TestCase):
         self.assertIn("Arms/0", warm_starts)  # the Teddy's coupled wire
 
 
+    def test_windows_from_29_points_reach_the_one_block_optimum(self):
+        # Wires of 29 to 32 points are solved in windows (ONE_BLOCK_POINTS), no longer as one block
+        # (the solver's default, 4 x window): the same distances (0.1 mm), hooks, nulled crossings
+        # and verdict on every stand-in, and at least one such wire (the Teddy's Arms/0) so that
+        # the comparison compares something.
+        self.assertEqual(target_shape.ONE_BLOCK_POINTS, 28)
+        real, sizes = native.optimize_target_shape, []
+
+        def one_block(points, closed, crossings, options=None, progress=None):
+            result = real(points, closed, crossings, {**options, "one_block_points": -1}, progress)
+            sizes.append(len(result["points"]))
+            return result
+
+        for name in ["globe"] + STAND_INS:
+            with self.subTest(name):
+                scene, design = self.layered(name)
+                windows = copy.deepcopy(design)
+                target_shape.run(windows, scene.material, scene.settings)
+                block = copy.deepcopy(design)
+                with mock.patch.object(target_shape.native, "optimize_target_shape", one_block):
+                    target_shape.run(block, scene.material, scene.settings)
+                for ww, wb in zip(windows["wires"], block["wires"]):
+                    self.assertAlmostEqual(ww["target_max_distance"], wb["target_max_distance"], delta=1e-4,
+                                           msg=ww["name"])
+                    self.assertAlmostEqual(ww["target_rms_distance"], wb["target_rms_distance"], delta=1e-4,
+                                           msg=ww["name"])
+                self.assertEqual([c["hook"] for c in windows["crossings"]], [c["hook"] for c in block["crossings"]])
+                self.assertEqual(sorted(n["crossing"] for n in windows["stages"]["target_shape"]["nulled_crossings"]),
+                                 sorted(n["crossing"] for n in block["stages"]["target_shape"]["nulled_crossings"]))
+                self.assertEqual(windows.get("stable"), block.get("stable"))
+        self.assertTrue([m for m in sizes if 28 < m <= 32])
+
+
 class Threads(unittest.TestCase):
     """solve_all keeps the order of its jobs and hands back the memo's results untouched."""
 

@@ -38,6 +38,7 @@ TargetShapeOptions to_options(py::handle d) {
                field::number("friction", o.friction), field::number("ftol_rel", o.ftol_rel),
                field::number("xtol_rel", o.xtol_rel), field::number("constraint_tol", o.constraint_tol),
                field::integer("max_iterations", o.max_iterations), field::integer("window", o.window),
+               field::integer("one_block_points", o.one_block_points),
                field::number("sweep_tol", o.sweep_tol), field::number("sweep_ftol", o.sweep_ftol),
                field::integer("max_sweeps", o.max_sweeps),
                field::number("max_seconds", o.max_seconds),

@@ -76,6 +76,8 @@ void validate(const Polyline2& contour, bool closed, const std::vector<TargetCro
     bad("max_iterations must be from 1 to " + std::to_string(kMaxIterations));
   if (o.window < 0 || o.window > kMaxWindow || (o.window > 0 && o.window < 4))
     bad("window must be 0 (one block) or from 4 to " + std::to_string(kMaxWindow) + " points");
+  if (o.one_block_points < -1 || o.one_block_points > kMaxWindow)
+    bad("one_block_points must be -1 (4 x window) or from 0 to " + std::to_string(kMaxWindow) + " points");
   if (o.max_sweeps <= 0 || o.max_sweeps > kMaxSweeps) bad("max_sweeps must be from 1 to " + std::to_string(kMaxSweeps));
   if (!(o.max_seconds > 0.0 && o.max_seconds <= kMaxSeconds))
     bad("max_seconds must be more than 0 and at most " + std::to_string(static_cast<int>(kMaxSeconds)) + " seconds");
@@ -755,7 +757,8 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
   // docs/method-target-shape.md).
   std::vector<Block> blocks;
   const int window = o.window;
-  if (window <= 0 || static_cast<long long>(m) <= 4LL * window) {  // small wires: one block is as cheap
+  const long long one_block = o.one_block_points < 0 ? 4LL * window : o.one_block_points;
+  if (window <= 0 || static_cast<long long>(m) <= one_block) {  // small wires: one block is as cheap
     std::vector<int> all(m);
     for (int i = 0; i < m; ++i) all[i] = i;
     blocks.push_back(make_block(problem, all));

@@ -662,3 +662,28 @@ TEST_CASE("target shape: a start of the wrong size or not finite is refused, nam
   o.start[1].x() = std::nan("");
   CHECK_THROWS_WITH(optimize_target_shape(contour, true, xs, o), Contains("wire W") && Contains("start point 1"));
 }
+
+TEST_CASE("target shape: one_block_points decides between one block and windows", "[target]") {
+  // The wavy loop's result (65 points) with windows of 20: at the default (4 x window = 80) one
+  // block; with one_block_points below its size, windows (more than one sweep). Both end at the
+  // same distances (0.1 mm) with the same crossings.
+  const auto [contour, xs] = wavy_loop();
+  TargetShapeOptions o;
+  o.sweep_ftol = 1e-3;
+  o.window = 20;
+  const TargetShapeResult block = optimize_target_shape(contour, true, xs, o);
+  const int m = static_cast<int>(block.points.size());
+  REQUIRE(m > 20);
+  REQUIRE(m <= 4 * o.window);
+  CHECK(block.sweeps == 1);
+  o.one_block_points = 20;
+  const TargetShapeResult windows = optimize_target_shape(contour, true, xs, o);
+  CHECK(windows.sweeps > 1);
+  CHECK(std::abs(windows.max_distance - block.max_distance) < 1e-4);
+  CHECK(std::abs(windows.rms_distance - block.rms_distance) < 1e-4);
+  for (std::size_t k = 0; k < xs.size(); ++k) CHECK(windows.crossings[k].status == block.crossings[k].status);
+  o.one_block_points = m;  // at most this many points: one block again
+  CHECK(optimize_target_shape(contour, true, xs, o).sweeps == 1);
+  o.one_block_points = -2;
+  CHECK_THROWS_WITH(optimize_target_shape(contour, true, xs, o), Contains("one_block_points"));
+}

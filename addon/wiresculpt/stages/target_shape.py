@@ -45,6 +45,14 @@ MAX_ROUNDS = 4  # solve, null what cannot be realised, solve again (each round n
 # only creep points along the wire (TargetShapeOptions::sweep_ftol; docs/method-target-shape.md,
 # issue 17: the same distances to the contour and crossings, 3-6x fewer evaluations on long wires).
 SWEEP_FTOL = 1e-3
+# Wires of up to this many target points are one NLopt block, longer ones are solved in windows
+# (TargetShapeOptions::one_block_points; the solver's own default is 4 x window = 32). SLSQP's
+# dense subproblem costs about n^3: a 32-point block took 560 us an evaluation against 20 us for
+# an 8-point window, and the Teddy's 32-point Arms/0 0.05 s against 0.005 s in windows, at the same
+# distances and crossings. At 28 every stand-in and real-mesh scene keeps its distances (0.1 mm),
+# crossings and verdict; at 24 or 16 some (the Chair's 26-point backrest) reach other optima
+# (docs/method-target-shape.md, issue 17).
+ONE_BLOCK_POINTS = 28
 # Wires are independent problems: up to this many are solved at once, each on its own thread (the
 # native call releases the GIL; each result depends only on its own wire, so the order is kept).
 MAX_THREADS = 2
@@ -83,7 +91,8 @@ def prepare_wire(design, wire, settings, size, memo=None):
         refs.append((c, k))
     options = {"min_segment": settings["min_segment"], "max_bend": math.radians(settings["max_bend_deg"]),
                "friction": 0.0, "model_size": size, "wire_name": wire["name"],
-               "angle_tolerance": REALISED_ANGLE, "length_tolerance": REALISED_LENGTH, "sweep_ftol": SWEEP_FTOL}
+               "angle_tolerance": REALISED_ANGLE, "length_tolerance": REALISED_LENGTH, "sweep_ftol": SWEEP_FTOL,
+               "one_block_points": ONE_BLOCK_POINTS}
     limits = memo.vertex_limits.get(wire["name"]) if memo is not None else None
     if limits:  # the coupling's own limits at some points (pipeline._tighten), radians by target index
         options["vertex_max_bend"] = tuple(limits.get(i, 0.0) for i in range(max(limits) + 1))

@@ -107,6 +107,9 @@ struct TargetShapeOptions {
   /// sweep_tol (multiplicative Schwarz / block coordinate descent). Dense SLSQP costs O(n³) per
   /// iteration, so windows make long wires fast; see docs/method-target-shape.md. Default 8.
   int window = 8;
+  /// Points: a wire of at most this many points is solved as one block even with windows; -1
+  /// means 4 × window. From -1 to 10000. Default -1.
+  int one_block_points = -1;
   /// Metres. A window is solved again when a point its energy terms read moved by more than this
   /// since its last solve. Default 1e-7 (0.1 µm, a hundredth of the 10 µm to which a realised
   /// segment is checked): at 1 nm the sweeps chase SLSQP's own stopping noise (the optimum is
