@@ -889,6 +889,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     const double move_tol = o.sweep_tol;
     std::vector<char> dirty(blocks.size(), 1);
     double last_energy = std::numeric_limits<double>::infinity();  // E after the previous sweep
+    double last_violation = std::numeric_limits<double>::infinity();  // and its largest violation
     std::vector<std::vector<int>> watchers(m);  // point -> blocks whose terms read it
     for (std::size_t k = 0; k < blocks.size(); ++k)
       for (int t : blocks[k].terms)
@@ -918,16 +919,21 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
         result.nlopt_result = "NLOPT_MAXEVAL_REACHED";
         break;
       }
-      // Stop once a whole sweep, with every constraint met, lowered the wire's energy by no more
-      // than sweep_ftol of it: what is left is creep along the wire (see sweep_ftol).
+      // Stop once a whole sweep lowered the wire's energy by no more than sweep_ftol of it, with
+      // every constraint met or with its largest violation not lowered by more than that fraction
+      // either: what is left is creep along the wire (see sweep_ftol).
       if (o.sweep_ftol > 0.0) {
         const double energy = problem.energy(data.p);
         double violation = 0.0;
         for (std::size_t k = 0; k < problem.constraints().size(); ++k)
           violation = std::max(violation, problem.constraint(k, data.p));
         const bool small = last_energy - energy <= o.sweep_ftol * std::abs(energy);
+        // An infeasible wire whose sweep lowered neither its energy nor its largest violation is
+        // stuck there: the kink it cannot open stays as far from its cone.
+        const bool stuck = violation >= (1.0 - o.sweep_ftol) * last_violation;
         last_energy = energy;
-        if (small && violation <= o.constraint_tol) break;
+        last_violation = violation;
+        if (small && (violation <= o.constraint_tol || stuck)) break;
       }
     }
   }

@@ -687,3 +687,49 @@ TEST_CASE("target shape: one_block_points decides between one block and windows"
   o.one_block_points = -2;
   CHECK_THROWS_WITH(optimize_target_shape(contour, true, xs, o), Contains("one_block_points"));
 }
+
+TEST_CASE("target shape: sweep_ftol also stops the sweeps of a wire stuck on a kink it cannot open", "[target]") {
+  // The hairpin of "a kink whose neighbour breaks the bend limit is not realised" with 0.5 m tails,
+  // so that the wire is solved in windows: the kink at A cannot be made, the wire stays
+  // infeasible and the energy stop of sweep_ftol alone never fires. Sweeps run to 1 nm creep on
+  // to the 200-sweep cap (115,000 evaluations), lowering the violation a little each time; the
+  // stuck stop ends after a few with the same verdict per crossing, which is what the caller
+  // uses (it nulls the crossing and solves the wire again without it). The shape of a wire
+  // stuck infeasible is no optimum, so its distances are not compared.
+  Polyline2 contour;
+  auto run = [&](Vec2 a, Vec2 b) {
+    const int n = static_cast<int>(std::lround((b - a).norm() / 0.001));
+    for (int k = 1; k <= n; ++k) contour.push_back(a + (b - a) * (static_cast<double>(k) / n));
+  };
+  const Vec2 d2(std::cos(140.0 * pi / 180.0), std::sin(140.0 * pi / 180.0));
+  const Vec2 corner(0.018, 0.0), b = corner + 0.021 * d2;
+  contour.push_back({-0.5, 0.0});
+  run({-0.5, 0.0}, {0.0, 0.0});
+  const int a_vertex = static_cast<int>(contour.size()) - 1;
+  run({0.0, 0.0}, corner);
+  run(corner, b);
+  const int b_vertex = static_cast<int>(contour.size()) - 1;
+  run(b, b + 0.5 * d2);
+  TargetShapeOptions reference, fast;
+  for (TargetShapeOptions* o : {&reference, &fast}) {
+    o->friction = 0.0;
+    o->angle_tolerance = 0.1 * pi / 180.0;
+    o->length_tolerance = 1e-5;
+  }
+  reference.sweep_tol = 1e-9;
+  reference.max_iterations = 1'000'000;
+  fast.sweep_ftol = 1e-3;
+  const std::vector<TargetCrossing> xs{{a_vertex, Vec2(0, 1), 2 * pi / 3, true}, {b_vertex, Vec2(0, 1), 2 * pi / 3, false}};
+  const TargetShapeResult a = optimize_target_shape(contour, false, xs, fast);
+  const TargetShapeResult r = optimize_target_shape(contour, false, xs, reference);
+  INFO(a.sweeps << " / " << r.sweeps << " sweeps, " << a.iterations << " / " << r.iterations << " evaluations, "
+                << a.points.size() << " points");
+  REQUIRE(a.points.size() > 32);  // windows
+  REQUIRE(r.crossings[0].status == "infeasible");
+  REQUIRE_FALSE(r.feasible);
+  CHECK_FALSE(a.feasible);
+  CHECK(a.sweeps <= 10);
+  CHECK(10 * a.iterations < r.iterations);
+  for (std::size_t k = 0; k < xs.size(); ++k) CHECK(a.crossings[k].status == r.crossings[k].status);
+  CHECK(a.max_angle_violation > fast.angle_tolerance);
+}

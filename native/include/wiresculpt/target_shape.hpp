@@ -116,9 +116,11 @@ struct TargetShapeOptions {
   /// flat along the wire) for 10-20 times as many evaluations without changing the energy's
   /// first 7 digits; see docs/method-target-shape.md.
   double sweep_tol = 1e-7;
-  /// Relative energy decrease per sweep, in [0, 1). With windows, the sweeps also stop once every
-  /// constraint holds (to constraint_tol) and a whole sweep lowered the wire's energy E by no more
-  /// than sweep_ftol × E. The optimum is flat along the wire, and sweeps after the first few mostly
+  /// Relative energy decrease per sweep, in [0, 1). With windows, the sweeps also stop once a
+  /// whole sweep lowered the wire's energy E by no more than sweep_ftol × E and either every
+  /// constraint holds (to constraint_tol) or the largest violation went down by no more than
+  /// sweep_ftol of it (a kink that cannot be opened stays as far from its cone sweep after sweep;
+  /// such a wire's crossing is reported, and further sweeps only creep). The optimum is flat along the wire, and sweeps after the first few mostly
   /// move points along it (millimetres on a 3 m wire, each sweep a little) without changing their
   /// distance to the contour; see docs/method-target-shape.md. 0: off, the sweeps run until no
   /// window moves a point by more than sweep_tol. Default 0; the pipeline uses 1e-3.
