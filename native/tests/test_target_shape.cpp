@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <tuple>
 #include <utility>
 
 #include "wiresculpt/error.hpp"
@@ -491,12 +492,12 @@ TEST_CASE("target shape: a per-point bend limit holds at that point, the others 
   CHECK_THROWS_WITH(optimize_target_shape(contour, true, {}, o), Contains("vertex_max_bend[0]"));
 }
 
-TEST_CASE("target shape: a kink whose neighbour breaks the bend limit is not realised", "[target]") {
-  // A hairpin right after an active crossing A at the origin (kink opening towards +y): the wire
-  // runs along +x for 18 mm, turns back by 140° and meets a fixed (null) crossing B 21 mm later.
-  // Between them there is one free point, and with the kink's cone, 15 mm segments and B fixed,
-  // the solver meets the cone at the cost of a bend over 120° at that point: the kink cannot be
-  // made, so A is reported, not passed on as realised beside an unbendable wire.
+namespace {
+
+// A hairpin right after crossing A at the origin: the wire comes along +x from -tail, runs 18 mm
+// past A, turns back by 140° and meets crossing B 21 mm later, then runs on for `tail` metres;
+// contour points every 1 mm. Returns the contour and the vertices of A and B.
+std::tuple<Polyline2, int, int> hairpin(double tail) {
   Polyline2 contour;
   auto run = [&](Vec2 a, Vec2 b) {
     const int n = static_cast<int>(std::lround((b - a).norm() / 0.001));
@@ -504,13 +505,28 @@ TEST_CASE("target shape: a kink whose neighbour breaks the bend limit is not rea
   };
   const Vec2 d2(std::cos(140.0 * pi / 180.0), std::sin(140.0 * pi / 180.0));
   const Vec2 corner(0.018, 0.0), b = corner + 0.021 * d2;
-  contour.push_back({-0.06, 0.0});
-  run({-0.06, 0.0}, {0.0, 0.0});
+  contour.push_back({-tail, 0.0});
+  run({-tail, 0.0}, {0.0, 0.0});
+  const int a_vertex = static_cast<int>(contour.size()) - 1;
   run({0.0, 0.0}, corner);
   run(corner, b);
-  run(b, b + 0.06 * d2);
-  REQUIRE((contour[60] - Vec2(0, 0)).norm() < 1e-12);
-  REQUIRE((contour[99] - b).norm() < 1e-12);
+  const int b_vertex = static_cast<int>(contour.size()) - 1;
+  run(b, b + tail * d2);
+  return {contour, a_vertex, b_vertex};
+}
+
+}  // namespace
+
+TEST_CASE("target shape: a kink whose neighbour breaks the bend limit is not realised", "[target]") {
+  // A hairpin right after an active crossing A at the origin (kink opening towards +y): the wire
+  // runs along +x for 18 mm, turns back by 140° and meets a fixed (null) crossing B 21 mm later.
+  // Between them there is one free point, and with the kink's cone, 15 mm segments and B fixed,
+  // the solver meets the cone at the cost of a bend over 120° at that point: the kink cannot be
+  // made, so A is reported, not passed on as realised beside an unbendable wire.
+  const auto [contour, a_vertex, b_vertex] = hairpin(0.06);
+  REQUIRE(a_vertex == 60);
+  REQUIRE(b_vertex == 99);
+  REQUIRE(contour[60].norm() < 1e-12);
   TargetShapeOptions o;
   o.friction = 0.0;
   o.angle_tolerance = 0.1 * pi / 180.0;
@@ -696,20 +712,7 @@ TEST_CASE("target shape: sweep_ftol also stops the sweeps of a wire stuck on a k
   // stuck stop ends after a few with the same verdict per crossing, which is what the caller
   // uses (it nulls the crossing and solves the wire again without it). The shape of a wire
   // stuck infeasible is no optimum, so its distances are not compared.
-  Polyline2 contour;
-  auto run = [&](Vec2 a, Vec2 b) {
-    const int n = static_cast<int>(std::lround((b - a).norm() / 0.001));
-    for (int k = 1; k <= n; ++k) contour.push_back(a + (b - a) * (static_cast<double>(k) / n));
-  };
-  const Vec2 d2(std::cos(140.0 * pi / 180.0), std::sin(140.0 * pi / 180.0));
-  const Vec2 corner(0.018, 0.0), b = corner + 0.021 * d2;
-  contour.push_back({-0.5, 0.0});
-  run({-0.5, 0.0}, {0.0, 0.0});
-  const int a_vertex = static_cast<int>(contour.size()) - 1;
-  run({0.0, 0.0}, corner);
-  run(corner, b);
-  const int b_vertex = static_cast<int>(contour.size()) - 1;
-  run(b, b + 0.5 * d2);
+  const auto [contour, a_vertex, b_vertex] = hairpin(0.5);
   TargetShapeOptions reference, fast;
   for (TargetShapeOptions* o : {&reference, &fast}) {
     o->friction = 0.0;
