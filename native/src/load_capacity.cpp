@@ -159,14 +159,16 @@ LoadCapacityResult load_capacity(const Network& net, const std::vector<int>& cut
       blocks.c.segment<3>(b) = T3a0.segment<3>(3 * torque_row[i]);
     }
     std::set<std::pair<int, int>> added;
-    detail::LpSolution sol = detail::solve_lp_with_torque_rows(lp, blocks, polytope, t_max, added, &ld.lp_rounds);
+    detail::LpSolution sol = detail::solve_lp_with_torque_rows(lp, blocks, polytope, t_max, added, &ld.lp_rounds,
+                                                                     options.lp_warm_start);
     ld.lp_iterations = sol.iterations;
     if (sol.status == detail::LpSolution::unbounded) {
       // Cap λ: an optimum well below the cap is the problem's (rows not yet added had left λ
       // free); one at the cap means that nothing but the cones limits the load.
       const double cap = 1e8;
       lp.col_hi[K] = cap;
-      const detail::LpSolution capped = detail::solve_lp_with_torque_rows(lp, blocks, polytope, t_max, added, &ld.lp_rounds);
+      const detail::LpSolution capped = detail::solve_lp_with_torque_rows(lp, blocks, polytope, t_max, added, &ld.lp_rounds,
+                                                                     options.lp_warm_start);
       ld.lp_iterations += capped.iterations;
       if (capped.status == detail::LpSolution::optimal && capped.x[K] < 0.5 * cap) sol = capped;
     }

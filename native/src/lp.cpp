@@ -18,6 +18,8 @@ namespace {
 // factorisation fail, so a problem holding one is refused before GLPK sees it
 // (docs/robustness.md).
 constexpr double kLargest = 1e100, kSmallest = 1e-100;
+// Entries below this fraction of their column's largest are rounding noise (solve_lp).
+constexpr double kNoise = 1e-13;
 
 int bound_type(double lo, double hi) {
   const bool l = std::isfinite(lo), h = std::isfinite(hi);
@@ -27,25 +29,117 @@ int bound_type(double lo, double hi) {
   return GLP_FR;
 }
 
-// Everything GLPK needs, as plain arrays, and what it answers: the body below runs inside
-// run_guarded (only trivially destructible locals, nothing that throws).
-struct OneShot {
-  int rows, cols, entries;
-  int dir;
-  const int* row_type;
-  const double *row_lo, *row_hi;
+double finite_or_zero(double v) { return std::isfinite(v) ? v : 0.0; }
+
+// The first number GLPK cannot take among the triplets from `first_tri`, the objective and column
+// bounds (when `columns`) and the row bounds from `first_row`, as a sentence; empty when all are
+// fine. solve_lp checks the whole problem; the cutting-plane rounds only the rows they add.
+std::string out_of_range(const LinearProgram& in, std::size_t first_tri, std::size_t first_row, bool columns) {
+  auto bad = [](double v, bool nonzero_entry) {
+    if (!std::isfinite(v)) return true;
+    const double a = std::abs(v);
+    return a > kLargest || (nonzero_entry && a < kSmallest);
+  };
+  auto say = [](const std::string& what, double v) {
+    std::ostringstream s;
+    s << what << " is " << v << ", outside the range the LP solver handles (magnitudes 1e-100 to 1e100)";
+    return s.str();
+  };
+  for (std::size_t t = first_tri; t < in.tri_val.size(); ++t)
+    if (in.tri_val[t] != 0.0 && bad(in.tri_val[t], true))
+      return say("a coefficient (row " + std::to_string(in.tri_row[t]) + ", column " + std::to_string(in.tri_col[t]) + ")",
+                 in.tri_val[t]);
+  if (columns)
+    for (std::size_t j = 0; j < in.obj.size(); ++j)
+      if (bad(in.obj[j], false)) return say("objective coefficient " + std::to_string(j), in.obj[j]);
+  auto bound_bad = [&](double v) { return std::isnan(v) || (std::isfinite(v) && bad(v, false)); };
+  for (std::size_t r = first_row; r < in.row_lo.size(); ++r)
+    if (bound_bad(in.row_lo[r]) || bound_bad(in.row_hi[r]))
+      return say("a bound of row " + std::to_string(r), bound_bad(in.row_lo[r]) ? in.row_lo[r] : in.row_hi[r]);
+  if (columns)
+    for (std::size_t j = 0; j < in.col_lo.size(); ++j)
+      if (bound_bad(in.col_lo[j]) || bound_bad(in.col_hi[j]))
+        return say("a bound of column " + std::to_string(j), bound_bad(in.col_lo[j]) ? in.col_lo[j] : in.col_hi[j]);
+  return {};
+}
+
+// The rows [first_row, R) of a problem as GLPK takes them: the triplets from `first_tri` that are
+// not rounding noise (|a| > kNoise × the largest |a| of their column, `col_max`), 1-based and
+// sorted by row (row r's entries are ind/val[start[r - first_row] .. start[r - first_row + 1]),
+// slot 0 unused as GLPK wants), and each row's type and finite bounds. A row left empty is free
+// when its bounds admit 0 up to rounding; `infeasible` is set when one does not.
+struct GlpkRows {
+  std::vector<int> row, col;  // 1-based, in triplet order (glp_load_matrix)
+  std::vector<double> val;
+  std::vector<int> type;
+  std::vector<double> lo, hi;
+  bool infeasible = false;
+};
+
+GlpkRows glpk_rows(const LinearProgram& in, std::size_t first_tri, std::size_t first_row,
+                   const std::vector<double>& col_max, std::vector<double>* col_min_kept) {
+  const std::size_t R = in.row_lo.size();
+  GlpkRows g;
+  g.row.push_back(0);
+  g.col.push_back(0);
+  g.val.push_back(0.0);
+  std::vector<char> used(R - first_row, 0);
+  for (std::size_t t = first_tri; t < in.tri_val.size(); ++t) {
+    const double a = std::abs(in.tri_val[t]);
+    if (!(a > kNoise * col_max[in.tri_col[t]])) continue;
+    g.row.push_back(in.tri_row[t] + 1);
+    g.col.push_back(in.tri_col[t] + 1);
+    g.val.push_back(in.tri_val[t]);
+    used[in.tri_row[t] - first_row] = 1;
+    double& m = (*col_min_kept)[in.tri_col[t]];
+    m = std::min(m, a);
+  }
+  for (std::size_t r = first_row; r < R; ++r) {
+    const bool u = used[r - first_row];
+    if (!u && (in.row_lo[r] > 1e-9 * (1.0 + std::abs(in.row_lo[r])) ||
+               in.row_hi[r] < -1e-9 * (1.0 + std::abs(in.row_hi[r]))))
+      g.infeasible = true;
+    g.type.push_back(u ? bound_type(in.row_lo[r], in.row_hi[r]) : GLP_FR);
+    g.lo.push_back(finite_or_zero(in.row_lo[r]));
+    g.hi.push_back(finite_or_zero(in.row_hi[r]));
+  }
+  return g;
+}
+
+// What a guarded GLPK body is given and answers. Bodies run inside run_guarded: only trivially
+// destructible locals, nothing that throws.
+struct GlpkCall {
+  glp_prob* p;
+  // build: the whole problem
+  int dir, cols;
   const int* col_type;
   const double *col_lo, *col_hi, *obj;
+  // build: all rows; add: the new rows
+  int rows, entries;
+  const int* row_type;
+  const double *row_lo, *row_hi;
   const int *ia, *ja;
   const double* ar;
+  // answers
   double* x;  // cols entries
   int ret, status, iterations;
   double objective;
 };
 
-void one_shot_body(void* c) {
-  OneShot& q = *static_cast<OneShot*>(c);
+void read_answer(GlpkCall& q) {
+  q.status = glp_get_status(q.p);
+  if (q.ret == 0 && q.status == GLP_OPT) {
+    for (int j = 0; j < q.cols; ++j) q.x[j] = glp_get_col_prim(q.p, j + 1);
+    q.objective = glp_get_obj_val(q.p);
+  }
+}
+
+// A new problem holding everything, scaled, solved with presolve (and without it when the
+// presolved solve stopped with an error). Leaves the problem alive in q.p.
+void build_body(void* c) {
+  GlpkCall& q = *static_cast<GlpkCall*>(c);
   glp_prob* lp = glp_create_prob();
+  q.p = lp;
   glp_set_obj_dir(lp, q.dir);
   if (q.rows > 0) glp_add_rows(lp, q.rows);
   if (q.cols > 0) glp_add_cols(lp, q.cols);
@@ -67,104 +161,51 @@ void one_shot_body(void* c) {
     ret = glp_simplex(lp, &parm);
   }
   q.ret = ret;
-  q.status = glp_get_status(lp);
-  if (ret == 0 && q.status == GLP_OPT) {
-    for (int j = 0; j < q.cols; ++j) q.x[j] = glp_get_col_prim(lp, j + 1);
-    q.objective = glp_get_obj_val(lp);
-  }
   q.iterations = glp_get_it_cnt(lp);
-  glp_delete_prob(lp);
+  read_answer(q);
 }
 
-// The first number of the problem GLPK cannot take, as a sentence; empty when all are fine.
-std::string out_of_range(const LinearProgram& in) {
-  auto bad = [](double v, bool nonzero_entry) {
-    if (!std::isfinite(v)) return true;
-    const double a = std::abs(v);
-    return a > kLargest || (nonzero_entry && a < kSmallest);
-  };
-  auto say = [](const std::string& what, double v) {
-    std::ostringstream s;
-    s << what << " is " << v << ", outside the range the LP solver handles (magnitudes 1e-100 to 1e100)";
-    return s.str();
-  };
-  for (std::size_t t = 0; t < in.tri_val.size(); ++t)
-    if (in.tri_val[t] != 0.0 && bad(in.tri_val[t], true))
-      return say("a coefficient (row " + std::to_string(in.tri_row[t]) + ", column " + std::to_string(in.tri_col[t]) + ")",
-                 in.tri_val[t]);
-  for (std::size_t j = 0; j < in.obj.size(); ++j)
-    if (bad(in.obj[j], false)) return say("objective coefficient " + std::to_string(j), in.obj[j]);
-  auto bound_bad = [&](double v) { return std::isnan(v) || (std::isfinite(v) && bad(v, false)); };
-  for (std::size_t r = 0; r < in.row_lo.size(); ++r)
-    if (bound_bad(in.row_lo[r]) || bound_bad(in.row_hi[r]))
-      return say("a bound of row " + std::to_string(r), bound_bad(in.row_lo[r]) ? in.row_lo[r] : in.row_hi[r]);
-  for (std::size_t j = 0; j < in.col_lo.size(); ++j)
-    if (bound_bad(in.col_lo[j]) || bound_bad(in.col_hi[j]))
-      return say("a bound of column " + std::to_string(j), bound_bad(in.col_lo[j]) ? in.col_lo[j] : in.col_hi[j]);
-  return {};
+// Adds q.rows rows (their entries sorted by row, q.ia 1-based row numbers of the whole problem)
+// with their auxiliary variables basic, scales them, and re-solves from the last basis with the
+// dual simplex (the old optimal basis stays dual feasible; only the new rows' bounds are violated).
+void add_rows_body(void* c) {
+  GlpkCall& q = *static_cast<GlpkCall*>(c);
+  glp_prob* lp = q.p;
+  const int before = glp_get_it_cnt(lp);
+  const int first = glp_add_rows(lp, q.rows);  // new rows are basic (GLP_BS)
+  int t = 1;
+  for (int r = 0; r < q.rows; ++r) {
+    const int i = first + r;
+    glp_set_row_bnds(lp, i, q.row_type[r], q.row_lo[r], q.row_hi[r]);
+    const int start = t;
+    double largest = 0.0;
+    while (t <= q.entries && q.ia[t] == i) {
+      largest = std::max(largest, std::abs(q.ar[t]) * glp_get_sjj(lp, q.ja[t]));
+      ++t;
+    }
+    if (t > start) {
+      glp_set_mat_row(lp, i, t - start, q.ja + start - 1, q.ar + start - 1);
+      // The row's scale factor as GLPK's equilibration would make it: its largest scaled entry 1,
+      // rounded to a power of 2 (no rounding error in the scaling).
+      int e = 0;
+      std::frexp(1.0 / largest, &e);
+      glp_set_rii(lp, i, std::ldexp(1.0, e - 1));
+    }
+  }
+  glp_smcp parm;
+  glp_init_smcp(&parm);
+  parm.msg_lev = GLP_MSG_OFF;
+  parm.presolve = GLP_OFF;
+  parm.meth = GLP_DUALP;
+  q.ret = glp_simplex(lp, &parm);
+  q.iterations = glp_get_it_cnt(lp) - before;
+  read_answer(q);
 }
 
-}  // namespace
+void delete_body(void* c) { glp_delete_prob(static_cast<glp_prob*>(c)); }
 
-LpSolution solve_lp(const LinearProgram& in) {
+LpSolution interpret(const GlpkCall& q, std::vector<double>& x) {
   LpSolution out;
-  const int K = static_cast<int>(in.obj.size());
-  const int R = static_cast<int>(in.row_lo.size());
-  if (in.col_lo.size() != in.obj.size() || in.col_hi.size() != in.obj.size() || in.row_hi.size() != in.row_lo.size() ||
-      in.tri_row.size() != in.tri_val.size() || in.tri_col.size() != in.tri_val.size()) {
-    out.reason = "the LP's arrays differ in size";
-    return out;
-  }
-  for (std::size_t t = 0; t < in.tri_val.size(); ++t)
-    if (in.tri_row[t] < 0 || in.tri_row[t] >= R || in.tri_col[t] < 0 || in.tri_col[t] >= K) {
-      out.reason = "a coefficient names row " + std::to_string(in.tri_row[t]) + ", column " +
-                   std::to_string(in.tri_col[t]) + ", outside the LP";
-      return out;
-    }
-  out.reason = out_of_range(in);
-  if (!out.reason.empty()) return out;
-  // Entries below 1e-13 of their column's largest are rounding noise of cross products (a
-  // structural zero computed as 1e-19 would otherwise pin a variable); rows left empty become
-  // free when their bounds admit 0 up to rounding, else the LP is infeasible.
-  std::vector<double> col_max(K, 0.0);
-  for (std::size_t t = 0; t < in.tri_val.size(); ++t)
-    col_max[in.tri_col[t]] = std::max(col_max[in.tri_col[t]], std::abs(in.tri_val[t]));
-  std::vector<int> ia{0}, ja{0};
-  std::vector<double> ar{0.0};
-  std::vector<char> row_used(R, 0);
-  for (std::size_t t = 0; t < in.tri_val.size(); ++t) {
-    if (!(std::abs(in.tri_val[t]) > 1e-13 * col_max[in.tri_col[t]])) continue;
-    ia.push_back(in.tri_row[t] + 1);
-    ja.push_back(in.tri_col[t] + 1);
-    ar.push_back(in.tri_val[t]);
-    row_used[in.tri_row[t]] = 1;
-  }
-  for (int r = 0; r < R; ++r)
-    if (!row_used[r] && (in.row_lo[r] > 1e-9 * (1.0 + std::abs(in.row_lo[r])) ||
-                         in.row_hi[r] < -1e-9 * (1.0 + std::abs(in.row_hi[r])))) {
-      out.status = LpSolution::infeasible;
-      return out;
-    }
-  auto finite_or_zero = [](double v) { return std::isfinite(v) ? v : 0.0; };
-  std::vector<int> row_type(R), col_type(K);
-  std::vector<double> row_lo(R), row_hi(R), col_lo(K), col_hi(K), x(K, 0.0);
-  for (int r = 0; r < R; ++r) {
-    row_type[r] = row_used[r] ? bound_type(in.row_lo[r], in.row_hi[r]) : GLP_FR;
-    row_lo[r] = finite_or_zero(in.row_lo[r]);
-    row_hi[r] = finite_or_zero(in.row_hi[r]);
-  }
-  for (int j = 0; j < K; ++j) {
-    col_type[j] = bound_type(in.col_lo[j], in.col_hi[j]);
-    col_lo[j] = finite_or_zero(in.col_lo[j]);
-    col_hi[j] = finite_or_zero(in.col_hi[j]);
-  }
-  OneShot q{R, K, static_cast<int>(ar.size()) - 1, in.maximise ? GLP_MAX : GLP_MIN, row_type.data(), row_lo.data(),
-            row_hi.data(), col_type.data(), col_lo.data(), col_hi.data(), in.obj.data(), ia.data(), ja.data(),
-            ar.data(), x.data(), 0, 0, 0, 0.0};
-  if (!run_guarded(one_shot_body, &q)) {  // GLPK's environment (and the problem) is gone
-    out.reason = "GLPK stopped with an internal error";
-    return out;
-  }
   out.iterations = q.iterations;
   if (q.ret == 0 || q.ret == GLP_ENOPFS || q.ret == GLP_ENODFS) {
     if (q.ret == GLP_ENOPFS || q.status == GLP_NOFEAS) out.status = LpSolution::infeasible;
@@ -180,16 +221,169 @@ LpSolution solve_lp(const LinearProgram& in) {
   return out;
 }
 
+// A GLPK problem kept alive between solves on one thread: build() makes it from a whole
+// LinearProgram (cold, presolve on), add_rows() passes it the rows appended to that program since
+// and re-solves from the last basis (warm). Every GLPK call runs guarded; after a GLPK internal
+// error the problem is gone with the environment and held() is false.
+class HeldLp {
+ public:
+  HeldLp() = default;
+  HeldLp(const HeldLp&) = delete;
+  HeldLp& operator=(const HeldLp&) = delete;
+  ~HeldLp() { release(); }
+
+  bool held() const { return p_ && generation_ == glpk_generation(); }
+
+  LpSolution build(const LinearProgram& in) {
+    release();
+    LpSolution out;
+    const int K = static_cast<int>(in.obj.size());
+    const int R = static_cast<int>(in.row_lo.size());
+    if (in.col_lo.size() != in.obj.size() || in.col_hi.size() != in.obj.size() || in.row_hi.size() != in.row_lo.size() ||
+        in.tri_row.size() != in.tri_val.size() || in.tri_col.size() != in.tri_val.size()) {
+      out.reason = "the LP's arrays differ in size";
+      return out;
+    }
+    for (std::size_t t = 0; t < in.tri_val.size(); ++t)
+      if (in.tri_row[t] < 0 || in.tri_row[t] >= R || in.tri_col[t] < 0 || in.tri_col[t] >= K) {
+        out.reason = "a coefficient names row " + std::to_string(in.tri_row[t]) + ", column " +
+                     std::to_string(in.tri_col[t]) + ", outside the LP";
+        return out;
+      }
+    out.reason = out_of_range(in, 0, 0, true);
+    if (!out.reason.empty()) return out;
+    // Entries below 1e-13 of their column's largest are rounding noise of cross products (a
+    // structural zero computed as 1e-19 would otherwise pin a variable); rows left empty become
+    // free when their bounds admit 0 up to rounding, else the LP is infeasible.
+    col_max_.assign(K, 0.0);
+    col_min_kept_.assign(K, std::numeric_limits<double>::infinity());
+    for (std::size_t t = 0; t < in.tri_val.size(); ++t)
+      col_max_[in.tri_col[t]] = std::max(col_max_[in.tri_col[t]], std::abs(in.tri_val[t]));
+    const GlpkRows g = glpk_rows(in, 0, 0, col_max_, &col_min_kept_);
+    if (g.infeasible) {
+      out.status = LpSolution::infeasible;
+      return out;
+    }
+    std::vector<int> col_type(K);
+    std::vector<double> col_lo(K), col_hi(K), x(K, 0.0);
+    for (int j = 0; j < K; ++j) {
+      col_type[j] = bound_type(in.col_lo[j], in.col_hi[j]);
+      col_lo[j] = finite_or_zero(in.col_lo[j]);
+      col_hi[j] = finite_or_zero(in.col_hi[j]);
+    }
+    GlpkCall q{nullptr, in.maximise ? GLP_MAX : GLP_MIN, K, col_type.data(), col_lo.data(), col_hi.data(),
+               in.obj.data(), R, static_cast<int>(g.val.size()) - 1, g.type.data(), g.lo.data(), g.hi.data(),
+               g.row.data(), g.col.data(), g.val.data(), x.data(), 0, 0, 0, 0.0};
+    const unsigned generation = glpk_generation();
+    if (!run_guarded(build_body, &q)) {  // GLPK's environment (and the problem) is gone
+      out.reason = "GLPK stopped with an internal error";
+      return out;
+    }
+    p_ = q.p;
+    generation_ = generation;
+    rows_ = in.row_lo.size();
+    tris_ = in.tri_val.size();
+    cols_ = in.obj.size();
+    return interpret(q, x);
+  }
+
+  /// The rows of `in` after those GLPK holds, re-solved from the last basis. Requires held() and
+  /// `in` to be the program last built or added to, grown by rows only (columns, objective and
+  /// the rows held unchanged; every new triplet in a new row). Returns `failed` when that does not
+  /// hold or when a kept entry would now be dropped as noise (a new row raised its column's
+  /// largest entry): a rebuild answers then.
+  LpSolution add_rows(const LinearProgram& in) {
+    LpSolution out;
+    out.reason = "the rows cannot be added to the problem GLPK holds";
+    const std::size_t R = in.row_lo.size(), T = in.tri_val.size();
+    if (!held() || in.obj.size() != cols_ || in.col_lo.size() != cols_ || in.col_hi.size() != cols_ ||
+        in.row_hi.size() != R || R < rows_ || T < tris_ || in.tri_row.size() != T || in.tri_col.size() != T)
+      return out;
+    for (std::size_t t = tris_; t < T; ++t)
+      if (in.tri_row[t] < static_cast<int>(rows_) || in.tri_row[t] >= static_cast<int>(R) || in.tri_col[t] < 0 ||
+          in.tri_col[t] >= static_cast<int>(cols_) || (t > tris_ && in.tri_row[t] < in.tri_row[t - 1]))
+        return out;
+    std::string bad = out_of_range(in, tris_, rows_, false);
+    if (!bad.empty()) {
+      out.reason = std::move(bad);
+      return out;
+    }
+    std::vector<double> col_max = col_max_;
+    for (std::size_t t = tris_; t < T; ++t)
+      col_max[in.tri_col[t]] = std::max(col_max[in.tri_col[t]], std::abs(in.tri_val[t]));
+    for (std::size_t j = 0; j < cols_; ++j)
+      if (!(col_min_kept_[j] > kNoise * col_max[j])) return out;  // an entry held would be noise now
+    std::vector<double> col_min_kept = col_min_kept_;
+    const GlpkRows g = glpk_rows(in, tris_, rows_, col_max, &col_min_kept);
+    if (g.infeasible) {
+      out.reason.clear();
+      out.status = LpSolution::infeasible;
+      return out;
+    }
+    std::vector<double> x(cols_, 0.0);
+    GlpkCall q{p_, 0, static_cast<int>(cols_), nullptr, nullptr, nullptr, nullptr, static_cast<int>(R - rows_),
+               static_cast<int>(g.val.size()) - 1, g.type.data(), g.lo.data(), g.hi.data(), g.row.data(), g.col.data(),
+               g.val.data(), x.data(), 0, 0, 0, 0.0};
+    if (!run_guarded(add_rows_body, &q)) {
+      p_ = nullptr;
+      out.reason = "GLPK stopped with an internal error";
+      return out;
+    }
+    col_max_ = std::move(col_max);
+    col_min_kept_ = std::move(col_min_kept);
+    rows_ = R;
+    tris_ = T;
+    return interpret(q, x);
+  }
+
+ private:
+  void release() {
+    if (held()) run_guarded(delete_body, p_);
+    p_ = nullptr;
+  }
+
+  glp_prob* p_ = nullptr;
+  unsigned generation_ = 0;  // GLPK's environment when `p_` was made (glpk_guard.hpp)
+  std::size_t rows_ = 0, tris_ = 0, cols_ = 0;  // how much of the LinearProgram GLPK holds
+  std::vector<double> col_max_, col_min_kept_;   // per column: largest entry, smallest entry kept
+};
+
+}  // namespace
+
+LpSolution solve_lp(const LinearProgram& in) {
+  HeldLp held;
+  LpSolution out = held.build(in);
+  out.builds = 1;
+  return out;
+}
+
 
 LpSolution solve_lp_with_torque_rows(LinearProgram& lp, const TorqueBlocks& blocks, const TorquePolytope& polytope,
-                                     double t_max, std::set<std::pair<int, int>>& added, int* rounds) {
+                                     double t_max, std::set<std::pair<int, int>>& added, int* rounds,
+                                     bool warm_start) {
   const Eigen::Index V = blocks.A.rows() / 3, cols = blocks.A.cols();
-  int iterations = 0;
+  int iterations = 0, builds = 0, warm = 0;
+  HeldLp held;
   for (;;) {
-    LpSolution sol = solve_lp(lp);
+    LpSolution sol;
+    if (warm_start && held.held()) {
+      sol = held.add_rows(lp);
+      if (sol.status == LpSolution::optimal) {
+        ++warm;
+      } else {  // whatever stopped the warm solve, the rebuilt problem answers (never a worse answer)
+        iterations += sol.iterations;
+        sol = held.build(lp);
+        ++builds;
+      }
+    } else {
+      sol = held.build(lp);
+      ++builds;
+    }
     if (rounds) ++*rounds;
     iterations += sol.iterations;
     sol.iterations = iterations;
+    sol.builds = builds;
+    sol.warm_solves = warm;
     if (sol.status != LpSolution::optimal) return sol;
     const Eigen::Map<const Eigen::VectorXd> x(sol.x.data(), cols);
     const Eigen::VectorXd t = blocks.A * x + blocks.c;

@@ -6,8 +6,10 @@
 // and docs/method-layering.md (stability); GLPK's failure modes: docs/robustness.md.
 //
 // Two shapes of problem:
-//   LinearProgram / solve_lp      one LP, built and solved once (presolve on): forces, torque
-//                                 rows, in-plane balance, load capacity.
+//   LinearProgram / solve_lp      one LP, built and solved once (presolve on): in-plane balance;
+//                                 solve_lp_with_torque_rows keeps it in GLPK across its rounds and
+//                                 re-solves from the last basis after adding rows (dual simplex):
+//                                 forces, torque rows, load capacity.
 //   EqualityLp                    min c·x subject to A x = b, x >= 0, kept alive between solves
 //                                 so that a new right-hand side b restarts from the last basis
 //                                 (dual simplex): the stability checks of Eq. 1, which solve one
@@ -37,6 +39,12 @@ struct LpSolution {
   std::vector<double> x;
   double objective = 0.0;
   int iterations = 0;
+  /// GLPK problems built from scratch (presolve on) for this answer: 1 for solve_lp; for
+  /// solve_lp_with_torque_rows 1 when every later round was warm-started.
+  int builds = 0;
+  /// solve_lp_with_torque_rows: rounds re-solved from the previous round's basis (rows added,
+  /// dual simplex) and kept (a warm solve that stops short of an optimum is redone by a build).
+  int warm_solves = 0;
   /// When `failed`: why, as a clause ("a coefficient (row 3, column 1) is 1e-300, outside the
   /// range the LP solver handles (magnitudes 1e-100 to 1e100)", "GLPK stopped with an internal
   /// error"); empty otherwise.
@@ -64,8 +72,17 @@ struct TorqueBlocks {
 /// set). `added` holds the (block, row) pairs already in `lp`; `rounds` counts the solves.
 /// Returns the last solution (when not optimal, GLPK's status with the rows so far), with the
 /// simplex iterations of every solve.
+///
+/// `warm_start` (default): the first round builds the GLPK problem as solve_lp does (the same
+/// input checks, presolve on); each later round adds only the new rows to it (checked and their
+/// noise dropped as solve_lp would, their auxiliary variables basic) and re-solves from the
+/// previous optimal basis with the dual simplex, which that basis stays feasible for. A warm solve
+/// that does not end optimal, or rows that would change which held entries are noise, fall back
+/// to a build of the whole `lp` (presolve on), so the answer is never worse than a rebuild's.
+/// false: every round builds from scratch (the behaviour before; tests compare the two).
 LpSolution solve_lp_with_torque_rows(LinearProgram& lp, const TorqueBlocks& blocks, const TorquePolytope& polytope,
-                                     double t_max, std::set<std::pair<int, int>>& added, int* rounds);
+                                     double t_max, std::set<std::pair<int, int>>& added, int* rounds,
+                                     bool warm_start = true);
 
 /// min c·x subject to A x = b, x >= 0 (A rows × cols, given as triplets with 0-based indices),
 /// kept in GLPK between solves: solve(b) changes only the rows whose b changed and restarts the

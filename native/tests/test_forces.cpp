@@ -494,6 +494,41 @@ TEST_CASE("forces: on random networks every 3D torque stays within t_max", "[for
   CHECK(tested >= 10);
 }
 
+TEST_CASE("forces: warm-started cutting planes reach the rebuilt LP optima on random networks", "[forces][torque][warm]") {
+  // The force LP and the least-out-of-plane LP after it, each a cutting-plane loop over the 3D
+  // polytope's rows: re-solving the problem GLPK holds from its last basis must give the optimum
+  // that rebuilding every round gives (G_stb relative 1e-7), with every 3D torque within t_max.
+  std::mt19937 rng(41);
+  int tested = 0;
+  for (int attempt = 0; attempt < 300 && tested < 10; ++attempt) {
+    fixtures::HookedNetwork h;
+    if (!fixtures::random_hooked_sphere(rng, attempt, 32, h)) continue;
+    ForceOptions o;
+    o.torque_fraction = attempt % 2 ? 1.0 : 0.4;
+    o.algorithm = ForceAlgorithm::lp;
+    o.least_out_of_plane = attempt % 3 != 0;
+    const auto cuts = choose_cuts(h.net);
+    ForceResult warm, cold;
+    ForceOptions rebuilt = o;
+    rebuilt.lp_warm_start = false;
+    try {
+      cold = optimize_forces(h.net, h.hooks, h.steps, cuts, rebuilt);
+    } catch (const SolverError&) {
+      CHECK_THROWS_AS(optimize_forces(h.net, h.hooks, h.steps, cuts, o), SolverError);
+      continue;
+    }
+    warm = optimize_forces(h.net, h.hooks, h.steps, cuts, o);
+    ++tested;
+    INFO("attempt " << attempt);
+    CHECK(warm.g_stb == Approx(cold.g_stb).epsilon(1e-7).margin(1e-12));
+    for (int w = 0; w < static_cast<int>(h.net.wires.size()); ++w)
+      CHECK(fixtures::max_torque_3d(h.net.wires[w], cuts[w], wire_loads(h.net, h.hooks, warm.forces, w)) <=
+            warm.t_max * (1 + 1e-7));
+    CHECK(warm.equilibrium_residual < 1e-9);
+  }
+  CHECK(tested >= 8);
+}
+
 TEST_CASE("forces: out-of-plane shares are per wire, in that wire's own plane", "[forces][share]") {
   // Two wires in perpendicular planes (normals z and x) crossing at the origin on their common
   // line d = z × x = y. Only the planes and the crossing matter for the shares.

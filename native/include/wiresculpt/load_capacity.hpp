@@ -40,6 +40,9 @@ struct LoadCapacityOptions {
   double tie_tolerance = 1e-6;
   /// Which torque is bounded by t_max: full_3d (default, |t_v|) or in_plane (n·t_v only).
   TorqueBound torque_bound = TorqueBound::full_3d;
+  /// As ForceOptions::lp_warm_start: false rebuilds GLPK's problem in every cutting-plane round
+  /// (for tests). Default true.
+  bool lp_warm_start = true;
 };
 
 struct LoadDirection {
