@@ -110,16 +110,19 @@ GlpkRows glpk_rows(const LinearProgram& in, std::size_t first_tri, std::size_t f
 // destructible locals, nothing that throws.
 struct GlpkCall {
   glp_prob* p;
-  // build: the whole problem
-  int dir, cols;
+  int dir, cols;  // the direction and every column's count
+  // build: every column; extend: the new columns only
   const int* col_type;
-  const double *col_lo, *col_hi, *obj;
-  // build: all rows; add: the new rows
+  const double *col_lo, *col_hi;
+  const double* obj;  // every column
+  int set_objective;  // extend: the objective or direction changed, or columns were added
+  // build: every row; extend: the new rows
   int rows, entries;
   const int* row_type;
   const double *row_lo, *row_hi;
   const int *ia, *ja;
   const double* ar;
+  int new_cols;  // extend
   // answers
   double* x;  // cols entries
   int ret, status, iterations;
@@ -165,14 +168,25 @@ void build_body(void* c) {
   read_answer(q);
 }
 
-// Adds q.rows rows (their entries sorted by row, q.ia 1-based row numbers of the whole problem)
-// with their auxiliary variables basic, scales them, and re-solves from the last basis with the
-// dual simplex (the old optimal basis stays dual feasible; only the new rows' bounds are violated).
-void add_rows_body(void* c) {
+// Adds q.new_cols columns and q.rows rows (their entries sorted by row, q.ia 1-based row numbers
+// of the whole problem) with the new rows' auxiliary variables basic and the new columns
+// non-basic, scales the new rows, sets the objective when it changed, and re-solves from the last
+// basis: with the dual simplex when only rows were added (the old optimal basis stays dual
+// feasible; only the new rows' bounds are violated), else with the primal simplex (the old rows
+// are still satisfied; the new objective is not yet optimal).
+void extend_body(void* c) {
   GlpkCall& q = *static_cast<GlpkCall*>(c);
   glp_prob* lp = q.p;
   const int before = glp_get_it_cnt(lp);
-  const int first = glp_add_rows(lp, q.rows);  // new rows are basic (GLP_BS)
+  if (q.new_cols > 0) {
+    const int first = glp_add_cols(lp, q.new_cols);
+    for (int j = 0; j < q.new_cols; ++j) glp_set_col_bnds(lp, first + j, q.col_type[j], q.col_lo[j], q.col_hi[j]);
+  }
+  if (q.set_objective) {
+    glp_set_obj_dir(lp, q.dir);
+    for (int j = 0; j < q.cols; ++j) glp_set_obj_coef(lp, j + 1, q.obj[j]);
+  }
+  const int first = q.rows > 0 ? glp_add_rows(lp, q.rows) : 0;  // new rows are basic (GLP_BS)
   int t = 1;
   for (int r = 0; r < q.rows; ++r) {
     const int i = first + r;
@@ -196,7 +210,7 @@ void add_rows_body(void* c) {
   glp_init_smcp(&parm);
   parm.msg_lev = GLP_MSG_OFF;
   parm.presolve = GLP_OFF;
-  parm.meth = GLP_DUALP;
+  parm.meth = q.set_objective ? GLP_PRIMAL : GLP_DUALP;
   q.ret = glp_simplex(lp, &parm);
   q.iterations = glp_get_it_cnt(lp) - before;
   read_answer(q);
@@ -221,153 +235,167 @@ LpSolution interpret(const GlpkCall& q, std::vector<double>& x) {
   return out;
 }
 
-// A GLPK problem kept alive between solves on one thread: build() makes it from a whole
-// LinearProgram (cold, presolve on), add_rows() passes it the rows appended to that program since
-// and re-solves from the last basis (warm). Every GLPK call runs guarded; after a GLPK internal
-// error the problem is gone with the environment and held() is false.
-class HeldLp {
- public:
-  HeldLp() = default;
-  HeldLp(const HeldLp&) = delete;
-  HeldLp& operator=(const HeldLp&) = delete;
-  ~HeldLp() { release(); }
-
-  bool held() const { return p_ && generation_ == glpk_generation(); }
-
-  LpSolution build(const LinearProgram& in) {
-    release();
-    LpSolution out;
-    const int K = static_cast<int>(in.obj.size());
-    const int R = static_cast<int>(in.row_lo.size());
-    if (in.col_lo.size() != in.obj.size() || in.col_hi.size() != in.obj.size() || in.row_hi.size() != in.row_lo.size() ||
-        in.tri_row.size() != in.tri_val.size() || in.tri_col.size() != in.tri_val.size()) {
-      out.reason = "the LP's arrays differ in size";
-      return out;
-    }
-    for (std::size_t t = 0; t < in.tri_val.size(); ++t)
-      if (in.tri_row[t] < 0 || in.tri_row[t] >= R || in.tri_col[t] < 0 || in.tri_col[t] >= K) {
-        out.reason = "a coefficient names row " + std::to_string(in.tri_row[t]) + ", column " +
-                     std::to_string(in.tri_col[t]) + ", outside the LP";
-        return out;
-      }
-    out.reason = out_of_range(in, 0, 0, true);
-    if (!out.reason.empty()) return out;
-    // Entries below 1e-13 of their column's largest are rounding noise of cross products (a
-    // structural zero computed as 1e-19 would otherwise pin a variable); rows left empty become
-    // free when their bounds admit 0 up to rounding, else the LP is infeasible.
-    col_max_.assign(K, 0.0);
-    col_min_kept_.assign(K, std::numeric_limits<double>::infinity());
-    for (std::size_t t = 0; t < in.tri_val.size(); ++t)
-      col_max_[in.tri_col[t]] = std::max(col_max_[in.tri_col[t]], std::abs(in.tri_val[t]));
-    const GlpkRows g = glpk_rows(in, 0, 0, col_max_, &col_min_kept_);
-    if (g.infeasible) {
-      out.status = LpSolution::infeasible;
-      return out;
-    }
-    std::vector<int> col_type(K);
-    std::vector<double> col_lo(K), col_hi(K), x(K, 0.0);
-    for (int j = 0; j < K; ++j) {
-      col_type[j] = bound_type(in.col_lo[j], in.col_hi[j]);
-      col_lo[j] = finite_or_zero(in.col_lo[j]);
-      col_hi[j] = finite_or_zero(in.col_hi[j]);
-    }
-    GlpkCall q{nullptr, in.maximise ? GLP_MAX : GLP_MIN, K, col_type.data(), col_lo.data(), col_hi.data(),
-               in.obj.data(), R, static_cast<int>(g.val.size()) - 1, g.type.data(), g.lo.data(), g.hi.data(),
-               g.row.data(), g.col.data(), g.val.data(), x.data(), 0, 0, 0, 0.0};
-    const unsigned generation = glpk_generation();
-    if (!run_guarded(build_body, &q)) {  // GLPK's environment (and the problem) is gone
-      out.reason = "GLPK stopped with an internal error";
-      return out;
-    }
-    p_ = q.p;
-    generation_ = generation;
-    rows_ = in.row_lo.size();
-    tris_ = in.tri_val.size();
-    cols_ = in.obj.size();
-    return interpret(q, x);
-  }
-
-  /// The rows of `in` after those GLPK holds, re-solved from the last basis. Requires held() and
-  /// `in` to be the program last built or added to, grown by rows only (columns, objective and
-  /// the rows held unchanged; every new triplet in a new row). Returns `failed` when that does not
-  /// hold or when a kept entry would now be dropped as noise (a new row raised its column's
-  /// largest entry): a rebuild answers then.
-  LpSolution add_rows(const LinearProgram& in) {
-    LpSolution out;
-    out.reason = "the rows cannot be added to the problem GLPK holds";
-    const std::size_t R = in.row_lo.size(), T = in.tri_val.size();
-    if (!held() || in.obj.size() != cols_ || in.col_lo.size() != cols_ || in.col_hi.size() != cols_ ||
-        in.row_hi.size() != R || R < rows_ || T < tris_ || in.tri_row.size() != T || in.tri_col.size() != T)
-      return out;
-    for (std::size_t t = tris_; t < T; ++t)
-      if (in.tri_row[t] < static_cast<int>(rows_) || in.tri_row[t] >= static_cast<int>(R) || in.tri_col[t] < 0 ||
-          in.tri_col[t] >= static_cast<int>(cols_) || (t > tris_ && in.tri_row[t] < in.tri_row[t - 1]))
-        return out;
-    std::string bad = out_of_range(in, tris_, rows_, false);
-    if (!bad.empty()) {
-      out.reason = std::move(bad);
-      return out;
-    }
-    std::vector<double> col_max = col_max_;
-    for (std::size_t t = tris_; t < T; ++t)
-      col_max[in.tri_col[t]] = std::max(col_max[in.tri_col[t]], std::abs(in.tri_val[t]));
-    for (std::size_t j = 0; j < cols_; ++j)
-      if (!(col_min_kept_[j] > kNoise * col_max[j])) return out;  // an entry held would be noise now
-    std::vector<double> col_min_kept = col_min_kept_;
-    const GlpkRows g = glpk_rows(in, tris_, rows_, col_max, &col_min_kept);
-    if (g.infeasible) {
-      out.reason.clear();
-      out.status = LpSolution::infeasible;
-      return out;
-    }
-    std::vector<double> x(cols_, 0.0);
-    GlpkCall q{p_, 0, static_cast<int>(cols_), nullptr, nullptr, nullptr, nullptr, static_cast<int>(R - rows_),
-               static_cast<int>(g.val.size()) - 1, g.type.data(), g.lo.data(), g.hi.data(), g.row.data(), g.col.data(),
-               g.val.data(), x.data(), 0, 0, 0, 0.0};
-    if (!run_guarded(add_rows_body, &q)) {
-      p_ = nullptr;
-      out.reason = "GLPK stopped with an internal error";
-      return out;
-    }
-    col_max_ = std::move(col_max);
-    col_min_kept_ = std::move(col_min_kept);
-    rows_ = R;
-    tris_ = T;
-    return interpret(q, x);
-  }
-
- private:
-  void release() {
-    if (held()) run_guarded(delete_body, p_);
-    p_ = nullptr;
-  }
-
-  glp_prob* p_ = nullptr;
-  unsigned generation_ = 0;  // GLPK's environment when `p_` was made (glpk_guard.hpp)
-  std::size_t rows_ = 0, tris_ = 0, cols_ = 0;  // how much of the LinearProgram GLPK holds
-  std::vector<double> col_max_, col_min_kept_;   // per column: largest entry, smallest entry kept
-};
-
 }  // namespace
 
-LpSolution solve_lp(const LinearProgram& in) {
-  HeldLp held;
-  LpSolution out = held.build(in);
+struct HeldLp::State {
+  glp_prob* p = nullptr;
+  unsigned generation = 0;  // GLPK's environment when `p` was made (glpk_guard.hpp)
+  // What of the LinearProgram GLPK holds: rows, triplets, and the columns' bounds and objective.
+  std::size_t rows = 0, tris = 0;
+  bool maximise = true;
+  std::vector<double> obj, col_lo, col_hi;
+  std::vector<double> col_max, col_min_kept;  // per column: largest entry, smallest entry kept
+  bool alive() const { return p && generation == glpk_generation(); }
+  void release() {
+    if (alive()) run_guarded(delete_body, p);
+    p = nullptr;
+  }
+};
+
+HeldLp::HeldLp() : s_(std::make_unique<State>()) {}
+HeldLp::~HeldLp() { s_->release(); }
+bool HeldLp::held() const { return s_->alive(); }
+
+LpSolution HeldLp::build(const LinearProgram& in) {
+  State& s = *s_;
+  s.release();
+  LpSolution out;
   out.builds = 1;
-  return out;
+  const int K = static_cast<int>(in.obj.size());
+  const int R = static_cast<int>(in.row_lo.size());
+  if (in.col_lo.size() != in.obj.size() || in.col_hi.size() != in.obj.size() || in.row_hi.size() != in.row_lo.size() ||
+      in.tri_row.size() != in.tri_val.size() || in.tri_col.size() != in.tri_val.size()) {
+    out.reason = "the LP's arrays differ in size";
+    return out;
+  }
+  for (std::size_t t = 0; t < in.tri_val.size(); ++t)
+    if (in.tri_row[t] < 0 || in.tri_row[t] >= R || in.tri_col[t] < 0 || in.tri_col[t] >= K) {
+      out.reason = "a coefficient names row " + std::to_string(in.tri_row[t]) + ", column " +
+                   std::to_string(in.tri_col[t]) + ", outside the LP";
+      return out;
+    }
+  out.reason = out_of_range(in, 0, 0, true);
+  if (!out.reason.empty()) return out;
+  // Entries below 1e-13 of their column's largest are rounding noise of cross products (a
+  // structural zero computed as 1e-19 would otherwise pin a variable); rows left empty become
+  // free when their bounds admit 0 up to rounding, else the LP is infeasible.
+  std::vector<double> col_max(K, 0.0), col_min_kept(K, std::numeric_limits<double>::infinity());
+  for (std::size_t t = 0; t < in.tri_val.size(); ++t)
+    col_max[in.tri_col[t]] = std::max(col_max[in.tri_col[t]], std::abs(in.tri_val[t]));
+  const GlpkRows g = glpk_rows(in, 0, 0, col_max, &col_min_kept);
+  if (g.infeasible) {
+    out.status = LpSolution::infeasible;
+    return out;
+  }
+  std::vector<int> col_type(K);
+  std::vector<double> col_lo(K), col_hi(K), x(K, 0.0);
+  for (int j = 0; j < K; ++j) {
+    col_type[j] = bound_type(in.col_lo[j], in.col_hi[j]);
+    col_lo[j] = finite_or_zero(in.col_lo[j]);
+    col_hi[j] = finite_or_zero(in.col_hi[j]);
+  }
+  GlpkCall q{nullptr, in.maximise ? GLP_MAX : GLP_MIN, K, col_type.data(), col_lo.data(), col_hi.data(),
+             in.obj.data(), 0, R, static_cast<int>(g.val.size()) - 1, g.type.data(), g.lo.data(), g.hi.data(),
+             g.row.data(), g.col.data(), g.val.data(), 0, x.data(), 0, 0, 0, 0.0};
+  const unsigned generation = glpk_generation();
+  if (!run_guarded(build_body, &q)) {  // GLPK's environment (and the problem) is gone
+    out.reason = "GLPK stopped with an internal error";
+    return out;
+  }
+  s.p = q.p;
+  s.generation = generation;
+  s.rows = in.row_lo.size();
+  s.tris = in.tri_val.size();
+  s.maximise = in.maximise;
+  s.obj = in.obj;
+  s.col_lo = in.col_lo;
+  s.col_hi = in.col_hi;
+  s.col_max = std::move(col_max);
+  s.col_min_kept = std::move(col_min_kept);
+  LpSolution sol = interpret(q, x);
+  sol.builds = 1;
+  return sol;
+}
+
+LpSolution HeldLp::extend(const LinearProgram& in) {
+  State& s = *s_;
+  LpSolution out;
+  out.reason = "the LP is not the one GLPK holds grown by rows and columns";
+  const std::size_t R = in.row_lo.size(), T = in.tri_val.size(), K = in.obj.size(), K0 = s.obj.size();
+  if (!s.alive() || K < K0 || in.col_lo.size() != K || in.col_hi.size() != K || in.row_hi.size() != R || R < s.rows ||
+      T < s.tris || in.tri_row.size() != T || in.tri_col.size() != T)
+    return out;
+  for (std::size_t j = 0; j < K0; ++j)
+    if (in.col_lo[j] != s.col_lo[j] || in.col_hi[j] != s.col_hi[j]) return out;
+  for (std::size_t t = s.tris; t < T; ++t)
+    if (in.tri_row[t] < static_cast<int>(s.rows) || in.tri_row[t] >= static_cast<int>(R) || in.tri_col[t] < 0 ||
+        in.tri_col[t] >= static_cast<int>(K) || (t > s.tris && in.tri_row[t] < in.tri_row[t - 1]))
+      return out;
+  std::string bad = out_of_range(in, s.tris, s.rows, true);
+  if (!bad.empty()) {
+    out.reason = std::move(bad);
+    return out;
+  }
+  std::vector<double> col_max = s.col_max;
+  col_max.resize(K, 0.0);
+  for (std::size_t t = s.tris; t < T; ++t)
+    col_max[in.tri_col[t]] = std::max(col_max[in.tri_col[t]], std::abs(in.tri_val[t]));
+  for (std::size_t j = 0; j < K0; ++j)
+    if (!(s.col_min_kept[j] > kNoise * col_max[j])) return out;  // an entry held would be noise now
+  std::vector<double> col_min_kept = s.col_min_kept;
+  col_min_kept.resize(K, std::numeric_limits<double>::infinity());
+  const GlpkRows g = glpk_rows(in, s.tris, s.rows, col_max, &col_min_kept);
+  if (g.infeasible) {
+    out.reason.clear();
+    out.status = LpSolution::infeasible;
+    return out;
+  }
+  // New columns, and the objective where it changed (the least-out-of-plane LP after the force LP).
+  const int new_cols = static_cast<int>(K - K0);
+  std::vector<int> col_type(new_cols);
+  std::vector<double> col_lo(new_cols), col_hi(new_cols);
+  for (int j = 0; j < new_cols; ++j) {
+    col_type[j] = bound_type(in.col_lo[K0 + j], in.col_hi[K0 + j]);
+    col_lo[j] = finite_or_zero(in.col_lo[K0 + j]);
+    col_hi[j] = finite_or_zero(in.col_hi[K0 + j]);
+  }
+  const bool same_objective = in.maximise == s.maximise && new_cols == 0 && in.obj == s.obj;
+  std::vector<double> x(K, 0.0);
+  GlpkCall q{s.p, in.maximise ? GLP_MAX : GLP_MIN, static_cast<int>(K), col_type.data(), col_lo.data(),
+             col_hi.data(), in.obj.data(), same_objective ? 0 : 1, static_cast<int>(R - s.rows),
+             static_cast<int>(g.val.size()) - 1, g.type.data(), g.lo.data(), g.hi.data(), g.row.data(),
+             g.col.data(), g.val.data(), new_cols, x.data(), 0, 0, 0, 0.0};
+  if (!run_guarded(extend_body, &q)) {
+    s.p = nullptr;
+    out.reason = "GLPK stopped with an internal error";
+    return out;
+  }
+  s.rows = R;
+  s.tris = T;
+  s.maximise = in.maximise;
+  s.obj = in.obj;
+  s.col_lo = in.col_lo;
+  s.col_hi = in.col_hi;
+  s.col_max = std::move(col_max);
+  s.col_min_kept = std::move(col_min_kept);
+  return interpret(q, x);
 }
 
 
+LpSolution solve_lp(const LinearProgram& in) { return HeldLp().build(in); }
+
+
 LpSolution solve_lp_with_torque_rows(LinearProgram& lp, const TorqueBlocks& blocks, const TorquePolytope& polytope,
-                                     double t_max, std::set<std::pair<int, int>>& added, int* rounds,
-                                     bool warm_start) {
+                                     double t_max, std::set<std::pair<int, int>>& added, int* rounds, bool warm_start,
+                                     HeldLp* keep) {
   const Eigen::Index V = blocks.A.rows() / 3, cols = blocks.A.cols();
   int iterations = 0, builds = 0, warm = 0;
-  HeldLp held;
+  HeldLp own;
+  HeldLp& held = keep ? *keep : own;
   for (;;) {
     LpSolution sol;
     if (warm_start && held.held()) {
-      sol = held.add_rows(lp);
+      sol = held.extend(lp);
       if (sol.status == LpSolution::optimal) {
         ++warm;
       } else {  // whatever stopped the warm solve, the rebuilt problem answers (never a worse answer)

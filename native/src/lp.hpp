@@ -58,6 +58,31 @@ struct LpSolution {
 /// dropped as rounding noise.
 LpSolution solve_lp(const LinearProgram& lp);
 
+/// A GLPK problem kept alive between solves on the calling thread (every GLPK call guarded, as
+/// solve_lp's). build() makes it from a whole LinearProgram, exactly as solve_lp solves it
+/// (checks, noise drop, presolve on). extend() takes the same program grown by rows and columns
+/// only (the held rows and the held columns' bounds unchanged, each new triplet in a new row, rows
+/// in order; the objective and its direction may change) and re-solves from the last basis, the new
+/// rows' auxiliary variables basic: the dual simplex when only rows were added, else the primal
+/// simplex. It applies solve_lp's checks and noise rule to what is new and returns `failed`,
+/// leaving the held problem as it was, when the program is not such a growth of the held one or a
+/// held entry would now count as noise (a rebuild answers then). After a GLPK internal error
+/// nothing is held. solve_lp_with_torque_rows uses one, and passes it on when given.
+class HeldLp {
+ public:
+  HeldLp();
+  ~HeldLp();
+  HeldLp(const HeldLp&) = delete;
+  HeldLp& operator=(const HeldLp&) = delete;
+  bool held() const;
+  LpSolution build(const LinearProgram& lp);
+  LpSolution extend(const LinearProgram& lp);
+
+ private:
+  struct State;
+  std::unique_ptr<State> s_;
+};
+
 /// Torques linear in an LP's columns x: block v (rows 3v..3v+2) is t_v = A_v x + c_v, its
 /// components along the wire's n, u, v.
 struct TorqueBlocks {
@@ -74,15 +99,18 @@ struct TorqueBlocks {
 /// simplex iterations of every solve.
 ///
 /// `warm_start` (default): the first round builds the GLPK problem as solve_lp does (the same
-/// input checks, presolve on); each later round adds only the new rows to it (checked and their
+/// input checks, presolve on; or extends `keep`'s); each later round adds only the new rows to it (checked and their
 /// noise dropped as solve_lp would, their auxiliary variables basic) and re-solves from the
 /// previous optimal basis with the dual simplex, which that basis stays feasible for. A warm solve
 /// that does not end optimal, or rows that would change which held entries are noise, fall back
 /// to a build of the whole `lp` (presolve on), so the answer is never worse than a rebuild's.
 /// false: every round builds from scratch (the behaviour before; tests compare the two).
+/// `keep` (optional): the held problem to start from and to leave the last one in, so that a
+/// later loop over a grown `lp` starts from this one's optimal basis (the forces' least-out-of-
+/// plane LP, which adds rows, columns and a new objective to the force LP).
 LpSolution solve_lp_with_torque_rows(LinearProgram& lp, const TorqueBlocks& blocks, const TorquePolytope& polytope,
                                      double t_max, std::set<std::pair<int, int>>& added, int* rounds,
-                                     bool warm_start = true);
+                                     bool warm_start = true, HeldLp* keep = nullptr);
 
 /// min c·x subject to A x = b, x >= 0 (A rows × cols, given as triplets with 0-based indices),
 /// kept in GLPK between solves: solve(b) changes only the rows whose b changed and restarts the

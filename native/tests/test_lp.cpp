@@ -14,6 +14,7 @@
 #include <random>
 #include <set>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include "glpk_guard.hpp"  // native/src: private to the core
@@ -442,4 +443,64 @@ TEST_CASE("lp: rows a round adds are checked as solve_lp checks them", "[lp][war
   CHECK(fine.builds == 1);
   CHECK(fine.warm_solves == 1);
   CHECK(fine.x[0] == Approx(2.0).epsilon(1e-12));
+}
+
+TEST_CASE("lp: a second loop over the program grown by rows, a column and a new objective starts from the first's basis",
+          "[lp][warm]") {
+  // First the textbook LP through cuts (as above): (3, 1), 11. Then, as the forces' least-out-of-
+  // plane LP does, the same rows plus a column s >= 0, the rows 3x + 2y >= 10 and s - x >= -2,
+  // and the objective minimise s + y. By hand: s = max(0, x - 2), y >= (10 - 3x) / 2 (inside
+  // x + 3y <= 6 only for x > 2.4), so s + y = 3 - x/2, least at x = 3: (3, 0.5, 1), objective 1.5.
+  LinearProgram lp;
+  lp.obj = {3.0, 2.0};
+  lp.col_lo = {0.0, 0.0};
+  lp.col_hi = {3.0, 10.0};
+  TorqueBlocks blocks;
+  blocks.A = Eigen::MatrixXd::Zero(6, 2);
+  blocks.A.row(0) << 1.0, 1.0;
+  blocks.A.row(3) << 4.0 / 6.0, 3.0 * 4.0 / 6.0;
+  blocks.c = Eigen::VectorXd::Zero(6);
+  const auto& slab = wiresculpt::torque_polytope(wiresculpt::TorqueBound::in_plane);
+  std::set<std::pair<int, int>> added;
+  HeldLp held;
+  const LpSolution first = solve_lp_with_torque_rows(lp, blocks, slab, 4.0, added, nullptr, true, &held);
+  REQUIRE(first.status == LpSolution::optimal);
+  CHECK(first.objective == Approx(11.0).epsilon(1e-12));
+  REQUIRE(held.held());
+  LinearProgram tie = lp;
+  tie.maximise = false;
+  tie.obj = {0.0, 1.0, 1.0};
+  tie.col_lo.push_back(0.0);
+  tie.col_hi.push_back(kInf);
+  const int r = static_cast<int>(tie.row_lo.size());
+  for (auto [row, col, val] : {std::tuple{r, 0, 3.0}, std::tuple{r, 1, 2.0}, std::tuple{r + 1, 0, -1.0}, std::tuple{r + 1, 2, 1.0}}) {
+    tie.tri_row.push_back(row);
+    tie.tri_col.push_back(col);
+    tie.tri_val.push_back(val);
+  }
+  tie.row_lo.insert(tie.row_lo.end(), {10.0, -2.0});
+  tie.row_hi.insert(tie.row_hi.end(), {kInf, kInf});
+  TorqueBlocks padded{Eigen::MatrixXd::Zero(6, 3), blocks.c};
+  padded.A.leftCols(2) = blocks.A;
+  int rounds = 0;
+  const LinearProgram tie_before = tie;
+  const LpSolution second = solve_lp_with_torque_rows(tie, padded, slab, 4.0, added, &rounds, true, &held);
+  REQUIRE(second.status == LpSolution::optimal);
+  CHECK(second.objective == Approx(1.5).epsilon(1e-12));
+  CHECK(second.x[0] == Approx(3.0).epsilon(1e-12));
+  CHECK(second.x[1] == Approx(0.5).epsilon(1e-12));
+  CHECK(second.x[2] == Approx(1.0).epsilon(1e-12));
+  CHECK(second.builds == 0);  // extended the held problem, did not rebuild
+  CHECK(second.warm_solves == rounds);
+  const LpSolution rebuilt = solve_lp(tie_before);
+  REQUIRE(rebuilt.status == LpSolution::optimal);
+  CHECK(rebuilt.objective == Approx(1.5).epsilon(1e-12));
+  // A program whose held columns' bounds changed is no growth of the held one: it is rebuilt.
+  LinearProgram capped = tie_before;
+  capped.col_hi[1] = 5.0;
+  std::set<std::pair<int, int>> none;
+  const LpSolution again = solve_lp_with_torque_rows(capped, padded, slab, 4.0, none, nullptr, true, &held);
+  REQUIRE(again.status == LpSolution::optimal);
+  CHECK(again.builds == 1);
+  CHECK(again.objective == Approx(1.5).epsilon(1e-12));
 }
