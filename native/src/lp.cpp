@@ -382,6 +382,8 @@ LpSolution HeldLp::extend(const LinearProgram& in) {
 }
 
 
+void free_thread_glpk() { free_glpk_environment(); }
+
 LpSolution solve_lp(const LinearProgram& in) { return HeldLp().build(in); }
 
 

@@ -112,6 +112,11 @@ LpSolution solve_lp_with_torque_rows(LinearProgram& lp, const TorqueBlocks& bloc
                                      double t_max, std::set<std::pair<int, int>>& added, int* rounds,
                                      bool warm_start = true, HeldLp* keep = nullptr);
 
+/// Frees the calling thread's GLPK environment (GLPK keeps one per thread and does not free it
+/// when the thread ends, ~5 kB each): a thread started to solve LPs calls this last. Problems
+/// still held on the thread are gone after it (EqualityLp::solve then says internal_error).
+void free_thread_glpk();
+
 /// min c·x subject to A x = b, x >= 0 (A rows × cols, given as triplets with 0-based indices),
 /// kept in GLPK between solves: solve(b) changes only the rows whose b changed and restarts the
 /// dual simplex from the last basis (with c >= 0 every basis stays dual feasible when b changes).
