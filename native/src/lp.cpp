@@ -64,9 +64,9 @@ std::string out_of_range(const LinearProgram& in, std::size_t first_tri, std::si
 }
 
 // The rows [first_row, R) of a problem as GLPK takes them: the triplets from `first_tri` that are
-// not rounding noise (|a| > kNoise × the largest |a| of their column, `col_max`), 1-based and
-// sorted by row (row r's entries are ind/val[start[r - first_row] .. start[r - first_row + 1]),
-// slot 0 unused as GLPK wants), and each row's type and finite bounds. A row left empty is free
+// not rounding noise (|a| > kNoise × the largest |a| of their column, `col_max`), 1-based, in the
+// triplets' order (slot 0 unused, as GLPK wants), with the smallest kept |a| of each column
+// lowered into `col_min_kept`; and each row's type and finite bounds. A row left empty is free
 // when its bounds admit 0 up to rounding; `infeasible` is set when one does not.
 struct GlpkRows {
   std::vector<int> row, col;  // 1-based, in triplet order (glp_load_matrix)
