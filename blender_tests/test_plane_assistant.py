@@ -188,6 +188,45 @@ class FindStablePlanes(Case):
         self.assertFalse(ops.WIRESCULPT_OT_apply_planes.poll(bpy.context))
 
 
+class NoNearbyPlacement(Case):
+    """The globe with handles at z = 0.5 R, z = -0.5 R and x = 0: the two z circles cross only the
+    x = 0 circle, each at two points on one line (a hinge), and no nearby change of one or two planes
+    makes them cross each other (blender_tests/pure/test_plane_faults.py says why, by hand)."""
+
+    def setUp(self):
+        super().setUp()
+        if not native.available():
+            self.skipTest(native.LOAD_ERROR)
+        ops.RESULT = None
+        ops.PREVIEW = None
+        globe_target()
+        for rotation, location in (((0, 0, 0), (0, 0, 0.5 * R)), ((0, 0, 0), (0, 0, -0.5 * R)),
+                                   ((0, math.pi / 2, 0), (0, 0, 0))):
+            add_handle(rotation, location)
+        bpy.context.view_layer.update()
+        assert bpy.ops.wiresculpt.slice() == {'FINISHED'}
+
+    def test_the_panel_says_why_no_nearby_placement_exists(self):
+        before = placements()
+        self.assertEqual(bpy.ops.wiresculpt.find_planes(), {'FINISHED'})
+        self.assertEqual(placements(), before)
+        result = ops.RESULT
+        self.assertEqual(result["candidates"], [])
+        self.assertTrue(result["message"].startswith("No stable placement found: no nearby placement gives a "
+                                                     "stable design. Searched: planes "), result["message"])
+        self.assertEqual(len(before), 3)
+        a, c, b = sorted(before, key=lambda n: -before[n][0][2])  # z = 0.5 R, x = 0 (at z = 0), z = -0.5 R
+        first, second = sorted((a, b))
+        self.assertIn(f"(wire {first}/0 on wire {c}/0 in 1875, wire {second}/0 on wire {c}/0 in 1875)",
+                      result["message"])
+        self.assertIn(f"move or tilt planes {first} and {second} towards each other", result["message"])
+        log = draw(panel.VIEW3D_PT_wiresculpt_planes, bpy.context)
+        shown = " ".join(kw.get("text", "") for _name, _a, kw in log)
+        self.assertIn("No stable placement found: no nearby placement gives a stable design.", shown)
+        self.assertIn("towards each other", shown)
+        self.assertFalse(any(kw.get("text", "").startswith("Apply candidate") for _name, _a, kw in log))
+
+
 class SuggestPlanes(Case):
     def setUp(self):
         super().setUp()

@@ -82,7 +82,15 @@ class PlaneSearchBatch(unittest.TestCase):
         self.assertFalse(d["stable"])
         self.assertEqual(d["plane_search"]["planes_after"], [])
         self.assertIsNone(d["plane_search"]["score"])
-        self.assertIn("no nearby placement", d["reason"])
+        # the reason is the search's (what it searched, why each family failed, what to change), then the
+        # given planes'; it names wires A/0 and B/0, hinged on T/0
+        self.assertTrue(d["reason"].startswith(
+            "no nearby placement gives a stable design. Searched: planes A, B, T "), d["reason"])
+        self.assertIn("Why: the planes as given: 1 hinge", d["reason"])
+        self.assertIn("wire A/0 on wire T/0", d["reason"])
+        self.assertIn("wire B/0 on wire T/0", d["reason"])
+        self.assertIn("To change: ", d["reason"])
+        self.assertIn(". The planes as given: ", d["reason"])
 
     def test_auto_with_no_planes(self):
         r, d = self.run_scene([], plane_search="auto", plane_count=4)

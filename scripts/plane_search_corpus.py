@@ -58,6 +58,23 @@ def one(V, F, planes, scene, **settings):
 BEGIN, END, NOTES = "<!-- planes:begin -->", "<!-- planes:end -->", "<!-- planes:notes -->"
 
 
+def nearby_cell(reason):
+    """An unstable nearby row's cell: whether the budget ended the search (after N of M candidates)
+    and the reason's advice (its "To change: ..."), cut at 160 characters; an older reason (the
+    planes as given first) by its first 100 characters."""
+    if not reason.startswith("no nearby placement"):
+        first = reason.split("; no nearby placement")[0]
+        return (f"*{first[:100]}{'…' if len(first) > 100 else ''}*"
+                + (" (budget reached)" if "budget" in reason else ""))
+    cut = re.search(r"budget ended the search after (\d+) of (\d+) candidates", reason)
+    every = re.search(r"Every one of the (\d+) candidates was screened", reason)
+    todo = re.search(r"To change: (.*?)(?:\. The planes as given: |$)", reason, re.S)
+    todo = todo.group(1) if todo else ""
+    head = (f"budget ended after {cut.group(1)} of {cut.group(2)} candidates" if cut else
+            f"all {every.group(1)} candidates screened" if every else "")
+    return f"{head}; *{todo[:160]}{'…' if len(todo) > 160 else ''}*"
+
+
 def table(rows, counts):
     def verdict(r):
         if r["stable"]:
@@ -68,10 +85,7 @@ def table(rows, counts):
              "|---|---|---|---|" + "---|" * len(counts)]
     for row in rows:
         nb = row["nearby"]
-        first = nb["reason"].split("; no nearby placement")[0]
-        change = ("; ".join(nb.get("changes") or []) or "kept as given" if nb["stable"] else
-                  f"*{first[:100]}{'…' if len(first) > 100 else ''}*"
-                  + (" (budget reached)" if "budget" in nb["reason"] else ""))
+        change = ("; ".join(nb.get("changes") or []) or "kept as given" if nb["stable"] else nearby_cell(nb["reason"]))
         autos = " | ".join(f"{verdict(row[f'auto{n}'])} ({row[f'auto{n}']['seconds']:.1f}, "
                            f"{row[f'auto{n}'].get('candidates', '-')} / {row[f'auto{n}'].get('full_solves', '-')})"
                            for n in counts)

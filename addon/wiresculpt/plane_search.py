@@ -14,7 +14,12 @@ Two searches:
   with S the model size (largest side of the mesh's bounding box): 5 % of the model's size costs
   as much as a tilt of 0.05 rad (2.9 deg). Candidates are one-plane changes (offsets
   +-{2, 4, 7, 10, 15, 20} % of S, tilts of 5, 10, 15 deg about two axes each way, the other
-  contour rule), then pairs of one-plane changes of two different planes, tried in order of cost.
+  contour rule: 25 per plane), tried in order of cost, then pairs of one-plane changes of two
+  different planes (25 x 25 per pair of planes), those whose two changes, each screened alone,
+  together free every wire at fault in the given planes first (plane_faults.Tally.pair_order), each
+  group by cost. When none gives a stable design, the search's reason (nearby_reason) says what it
+  searched, whether the budget cut it short and how much was left, its candidates counted by fault
+  in each family (plane_faults), and what to change.
 - `auto(...)`: planes from the mesh alone: `count` planes in families along the mesh's principal
   axes (area-weighted) or the world's, each family spread over the mesh's extent along its axis or
   over the quantiles of its surface area (family_planes), for every split of `count` over the three
@@ -22,7 +27,10 @@ Two searches:
   and, when that fails the screen, the contours of the crossing network's largest connected part
   without hinged wires (Searcher.connected). Screened proposals are verified fewest crossings
   closer than 2 * min_segment along a wire first (close_gaps), then by coverage; budget
-  auto_budget(count) = AUTO_SECONDS_PER_PLANE * count.
+  auto_budget(count) = AUTO_SECONDS_PER_PLANE * count. When no proposal of the first screening
+  round keeps its crossings 2 * min_segment apart, sets grown from count - 1 planes (grow: a
+  family proposal plus one plane at an area quantile along one of its axes) are screened and
+  verified first.
 
 Every candidate is screened cheaply first: slicing (each plane placement sliced once, cached) and
 the layering (stages.layering), whose first step is the hook-relaxed stability check (every
@@ -51,6 +59,8 @@ import time
 import numpy as np
 
 from . import native, pipeline
+from .core import plane_faults
+from .core.plane_faults import Tally, close_gaps, crossing_gaps  # noqa: F401 (the search's names for them)
 from .core.scene import PlaneSpec
 from .stages import layering, slicing
 
@@ -72,6 +82,7 @@ EARLY_SOLVES = 3  # auto verifies as soon as this many screened proposals have n
 SCREEN_SECONDS = 2.0  # a screen's layering longer than this does not pass (a search of many contours)
 FINAL_HOOK_SECONDS = 10.0
 FINAL_SECONDS = 20.0
+PAIR_SINGLES = 25  # the two-plane changes pair each plane's this many cheapest one-plane changes (all 25)
 
 
 class Placement:
@@ -181,6 +192,9 @@ class Searcher:
         self.mesh_info = None  # the slicer's report on the mesh (stages.slicing.mesh), from its first call
         self.screened = self.full_solves = self.timed_out = self.failed = 0
         self.final = None  # what finish() did with the returned design
+        self.fault = None  # why the last screen did not pass (plane_faults), None when it passed
+        self.empty = None  # the plane of the last sliced() that found no contour
+        self.tally = None  # the nearby search's account of its candidates (plane_faults.Tally)
         self.surface = None  # (triangle centroids, areas) of the mesh, made by _surface when first needed
         self.deadline = math.inf  # perf_counter() time at which a full solve is stopped (the budget)
         self.budget = None  # seconds
@@ -214,6 +228,7 @@ class Searcher:
         for p in placements:
             found = self._contours(p)
             if not found:
+                self.empty = p.name
                 return None  # a change that removes a plane's wire is no answer
             contours += len(found)
             for k in rules.pick(found, p.contours, p.name):
@@ -238,16 +253,22 @@ class Searcher:
         if self.cancel():
             raise pipeline.Cancelled()
         self.screened += 1
+        self.fault = None
         try:
             design = self.sliced(placements)
             if design is None or len(design["wires"]) < 2:
+                self.fault = ("misses", (), (self.empty,)) if design is None else ("few", (), ())
                 return False, design, None
             probe = copy.deepcopy(design)
             self._layer(probe, design)
+            if not probe["stable"]:
+                self.fault = plane_faults.structural_fault(probe) or ("mechanism", (), ("the layering's verdict",))
             return bool(probe["stable"]), design, probe
-        except (ValueError, RuntimeError, native.Cancelled):
+        except (ValueError, RuntimeError, native.Cancelled) as exc:
             if self.cancel():
                 raise pipeline.Cancelled() from None
+            self.fault = (("slow", (), ()) if isinstance(exc, native.Cancelled) else
+                          ("refused", (), (str(exc).split(";", 1)[0][:120],)))
             return False, None, None  # refused, or its layering ran past the deadline
 
     def _layer(self, probe, design):
@@ -399,16 +420,23 @@ def nearby(vertices, faces, planes, material, settings, want=1, budget=BUDGET_SE
     """Up to `want` stable, buildable candidates near `planes`, cheapest change first:
     [{"planes": [Placement], "changes": [sentence], "cost", "score", "design", "figures"}], the
     Searcher (its counts) and the start time. The given planes themselves are candidate 0 (cost 0).
-    Order: one-plane changes, then pairs; within each, by cost, except that a screened candidate
+    Order: one-plane changes by cost, then pairs (plane_faults.Tally.pair_order: those that the
+    single changes' faults point at first, then by cost); within each, except that a screened candidate
     whose layering reports crossings closer along a wire than the machine's minimum segment
     (`close_crossings`: the full pipeline mostly fails on them, at a second each) is solved only
     after the others, and only while it is cheaper than the `want`-th found, so that the answer is
-    still the cheapest the budget allows."""
+    still the cheapest one-plane change the budget allows (a pair: the cheapest of its group, the
+    search stopping at the first pair that costs more than the `want`-th found). When none is found,
+    the Searcher's tally (plane_faults.Tally) holds the account nearby_reason words."""
     s = Searcher(vertices, faces, material, settings, progress, cancel, stock)
     start = time.perf_counter()
     s.deadline, s.budget = start + budget, budget
+    min_segment = float(settings.get("min_segment") or 0.0)
     base = [Placement(p.name, p.origin, _unit(p.normal), p.contours) for p in planes]
     singles = {i: single_changes(p, s.centre, s.size) for i, p in enumerate(planes)}
+    pairs = [(a.cost + b.cost, ((i, a), (j, b))) for i, j in itertools.combinations(sorted(singles), 2)
+             for a in singles[i][:PAIR_SINGLES] for b in singles[j][:PAIR_SINGLES]]
+    tally = s.tally = Tally(base, singles, len(pairs))
     found = []
 
     def out_of_time():
@@ -419,10 +447,16 @@ def nearby(vertices, faces, planes, material, settings, want=1, budget=BUDGET_SE
         costs = sorted(c["cost"] for c in found)
         return costs[want - 1] if len(costs) >= want else math.inf
 
-    def solve(cost, changes, placements, design):
+    def solve(cost, changes, placements, design, probe):
+        family, stopped = tally.family_of(changes), s.timed_out
+        tally.solved(family)
         solved = s.solve(copy.deepcopy(design))
         if solved is None or not solved["stable"]:
+            fault = ((("stopped" if s.timed_out > stopped else "failed"), (), ()) if solved is None
+                     else plane_faults.verdict_fault(probe, solved, min_segment))
+            tally.fault(family, fault, changes)
             return
+        tally.fault(family, ("stable", (), ()), changes)
         found.append({"planes": placements, "changes": [t for _, c in changes for t in c.changes], "cost": cost,
                       "score": -cost, "design": solved, "figures": _figures(solved), "sliced": design})
         s.say("plane_search", f"candidate {len(found)}: {'; '.join(found[-1]['changes']) or 'the planes as given'} "
@@ -436,26 +470,29 @@ def nearby(vertices, faces, planes, material, settings, want=1, budget=BUDGET_SE
             placements = list(base)
             for i, c in changes:
                 placements[i] = c
-            ok, design, close = s.screen(placements)
+            ok, design, probe = s.screen_layered(placements)
+            tally.screened(tally.family_of(changes))
             if not ok:
+                tally.fault(tally.family_of(changes), s.fault, changes)
                 continue
-            if close:
-                deferred.append((cost, changes, placements, design))
+            if probe.get("close_crossings"):
+                deferred.append((cost, changes, placements, design, probe))
             else:
-                solve(cost, changes, placements, design)
-        for cost, changes, placements, design in deferred:
+                solve(cost, changes, placements, design, probe)
+        for k, (cost, changes, placements, design, probe) in enumerate(deferred):
             if cost >= bar() or out_of_time():
+                for _cost, later, _placements, _design, left in deferred[k:]:
+                    gap = plane_faults.closest_gap(left)
+                    tally.fault(tally.family_of(later), ("near", (gap[1],), gap[2]) if gap else ("unsolved", (), ()),
+                                later)
                 break
-            solve(cost, changes, placements, design)
+            solve(cost, changes, placements, design, probe)
 
     phase([(0.0, ())] + sorted(((c.cost, ((i, c),)) for i, cs in singles.items() for c in cs), key=lambda t: t[0]))
     if len(found) < want and not out_of_time():  # pairs of one-plane changes of two planes
-        pairs = []
-        for i, j in itertools.combinations(sorted(singles), 2):
-            for a in singles[i][:12]:
-                for b in singles[j][:12]:
-                    pairs.append((a.cost + b.cost, ((i, a), (j, b))))
-        phase(sorted(pairs, key=lambda t: t[0]))
+        phase(tally.pair_order(pairs))
+    tally.seconds = time.perf_counter() - start
+    tally.out_of_time = out_of_time()
     found.sort(key=lambda c: c["cost"])
     if found:
         s.finish(found[0])
@@ -475,33 +512,6 @@ def _family_names(axes):
 # a family's first and last plane, as fractions of the mesh's extent along its axis: wide first;
 # narrower spreads keep the planes off thin extremities (limbs, where crossings come close together)
 SPREADS = ((0.2, 0.8), (0.3, 0.7), (0.12, 0.88), (0.38, 0.62), (0.25, 0.75), (0.16, 0.84))
-
-
-def crossing_gaps(design):
-    """The distances along each wire between consecutive crossings (metres), from a layered design
-    (its contours hold the crossing points, crossings[i]["contour_vertices"] their indices)."""
-    at = {}
-    for c in design["crossings"]:
-        for w, v in zip(c["wires"], c["contour_vertices"]):
-            at.setdefault(w, []).append(v)
-    gaps = []
-    for w, vertices in at.items():
-        wire = design["wires"][w]
-        pts = np.asarray(wire["contour"], dtype=float)
-        arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
-        total = arc[-1] + (float(np.linalg.norm(pts[-1] - pts[0])) if wire["closed"] else 0.0)
-        s = sorted(arc[v] for v in vertices)
-        gaps += [b - a for a, b in zip(s, s[1:])]
-        if wire["closed"] and len(s) >= 2:
-            gaps.append(total - s[-1] + s[0])
-    return gaps
-
-
-def close_gaps(design, min_segment):
-    """How many crossings follow another along a wire closer than 2 * min_segment: the target
-    shape then has no free bending point between them and mostly cannot realise them (its
-    "too close to their neighbours" verdict), so such candidates are verified last."""
-    return sum(1 for g in crossing_gaps(design) if g < 2.0 * min_segment)
 
 
 def _surface(searcher):
@@ -565,6 +575,62 @@ def splits_of(count):
     return sorted(splits, key=lambda c: (max(c), 0 in c))
 
 
+GROW_BASES = 3  # grow: the (count - 1)-plane proposals extended, fewest close crossings first
+GROW_QUANTILES = tuple(round(0.05 * k, 2) for k in range(1, 20))  # where grow adds a plane: 5 %, 10 %, ... 95 %
+
+
+def area_quantile_plane(searcher, axis, q, name):
+    """The plane normal to `axis` through the point at which a share `q` of the mesh's surface area
+    lies below it along `axis`."""
+    centroids, areas = _surface(searcher)
+    u = (centroids - searcher.centre) @ axis
+    order = np.argsort(u)
+    share = np.cumsum(areas[order]) / areas.sum()
+    at = float(u[order][min(int(np.searchsorted(share, q)), len(order) - 1)])
+    return Placement(name, searcher.centre + at * np.asarray(axis, dtype=float), axis, "largest")
+
+
+def grow(s, count, frames, min_segment, until):
+    """Proposals of `count` planes grown from proposals of count - 1 (a designer adds a plane to a
+    set that holds): the (count - 1)-plane family proposals (largest contours) screened for up to a
+    quarter of the time left before `until`, the GROW_BASES that pass with the fewest crossings
+    closer than 2 * min_segment along a wire (then the largest closest gap) each extended by one
+    plane along each of its three axes at every area quantile of GROW_QUANTILES (area_quantile_plane)
+    and screened, up to half the time left. Returns the extended sets that pass the screen as auto's
+    pool entries, fewest close gaps first, then the largest closest gap. The families' evenly spread
+    planes often put crossings closer than 2 * min_segment along some wire (man, N = 6: every
+    proposal), and planes at uneven places, which no spread gives, keep them apart."""
+    began = time.perf_counter()
+    s.deadline = began + (until - began) / 4
+    bases = []
+    for spread, by, counts, axes in itertools.product(SPREADS, ("area", "extent"), splits_of(count - 1), frames):
+        if time.perf_counter() > s.deadline:
+            break
+        placements = family_planes(s, counts, "largest", spread, axes, by)
+        ok, _design, probe = s.screen_layered(placements)
+        if ok:
+            gap = plane_faults.closest_gap(probe)
+            bases.append((close_gaps(probe, min_segment), -(gap[0] if gap else math.inf), counts, axes, placements))
+    bases.sort(key=lambda b: b[:2])
+    s.deadline = began + (until - began) / 2
+    out = []
+    for _close, _gap, counts, axes, placements in bases[:GROW_BASES]:
+        names = _family_names(axes)
+        for k in range(3):
+            for q in GROW_QUANTILES:
+                if time.perf_counter() > s.deadline:
+                    return sorted(out, key=lambda t: t[:2])
+                added = area_quantile_plane(s, axes[k], q, f"{names[k]}{counts[k]}")
+                ok, design, probe = s.screen_layered(placements + [added])
+                if ok:
+                    gap = plane_faults.closest_gap(probe)
+                    out.append((close_gaps(probe, min_segment), -(gap[0] if gap else math.inf),
+                                tuple(c + (j == k) for j, c in enumerate(counts)), axes, placements + [added],
+                                design, f" (grown: the last along {_axis_word(axes[k], k)} at {q:.0%} of the "
+                                        "surface area)"))
+    return sorted(out, key=lambda t: t[:2])
+
+
 def auto(vertices, faces, count, material, settings, want=2, budget=None, progress=None, cancel=None,
          stock=None):
     """Up to `want` stable, buildable plane sets of `count` planes proposed from the mesh alone,
@@ -586,9 +652,10 @@ def auto(vertices, faces, count, material, settings, want=2, budget=None, progre
     proposals = itertools.product(SPREADS, ("area", "extent"), splits_of(count), frames)
     seen, found, passed = set(), [], 0
 
-    def screen_some(limit):
+    def screen_some(limit, soft=math.inf):
         """Screens proposals until `limit` (perf_counter time) or EARLY_SOLVES of them pass with
-        no close gap; returns the passing ones, and whether proposals remain."""
+        no close gap, or until `soft` when none has passed without one by then; returns the passing
+        ones, and whether proposals remain."""
         nonlocal passed
         s.deadline = limit
         batch, clean = [], 0
@@ -607,28 +674,36 @@ def auto(vertices, faces, count, material, settings, want=2, budget=None, progre
                     placements = joined
                     ok, design, probe = s.screen_layered(placements)
             if ok:
-                batch.append((close_gaps(probe, min_segment), -s.coverage(design), counts, axes, placements, design))
+                batch.append((close_gaps(probe, min_segment), -s.coverage(design), counts, axes, placements, design,
+                              ""))
                 clean += batch[-1][0] == 0
-            if clean >= EARLY_SOLVES or time.perf_counter() > limit:
+            if clean >= EARLY_SOLVES or time.perf_counter() > limit or (not clean and time.perf_counter() > soft):
                 passed += len(batch)
                 return batch, True
         passed += len(batch)
         return batch, False
 
-    more, pool, first = True, [], True
+    more, pool, first, grown = True, [], True, None
     while more and len(found) < want and time.perf_counter() - start < budget:
-        # screening up to half the budget at first, later up to half of what is left; verifying the
-        # pool (fewest close gaps first) after each round
+        # screening up to half the budget at first (a quarter when no proposal passes without close
+        # crossings by then: grow follows), later up to half of what is left; verifying the pool
+        # (fewest close gaps first) after each round
         now = time.perf_counter()
-        batch, more = screen_some(start + budget / 2 if first else now + (start + budget - now) / 2)
+        batch, more = (screen_some(start + budget / 2, start + budget / 4) if first else
+                       screen_some(now + (start + budget - now) / 2))
         first = False
         s.deadline = start + budget
         pool = sorted(pool + batch, key=lambda t: t[:2])
         s.say("plane_search", f"{passed} of {s.screened} proposals pass the screen; "
                               f"{sum(1 for t in pool if t[0] == 0)} to verify without crossings closer than "
                               f"2 x min_segment along a wire")
-        while pool and len(found) < want and time.perf_counter() - start < budget:
-            close, cover, counts, axes, placements, design = pool.pop(0)
+        if grown is None and count >= 3 and not any(t[0] == 0 for t in pool):
+            # no proposal keeps its crossings apart: sets grown from count - 1 planes, verified first
+            grown = grow(s, count, frames, min_segment, start + budget)
+            s.deadline = start + budget
+            s.say("plane_search", f"{len(grown)} sets grown from {count - 1} planes pass the screen")
+        while (grown or pool) and len(found) < want and time.perf_counter() - start < budget:
+            close, cover, counts, axes, placements, design, extra = (grown or pool).pop(0)
             solved = s.solve(copy.deepcopy(design))
             if solved is None or not solved["stable"]:
                 continue
@@ -636,7 +711,7 @@ def auto(vertices, faces, count, material, settings, want=2, budget=None, progre
             score = cover - FIDELITY_WEIGHT * s.max_deviation(solved) / s.size
             rule = "" if all(p.contours == "largest" for p in placements) else ", the connected contours"
             found.append({"planes": placements, "changes": [f"{len(placements)} planes: " + ", ".join(
-                f"{n} along {_axis_word(axes[k], k)}" for k, n in enumerate(counts) if n) + rule],
+                f"{n} along {_axis_word(axes[k], k)}" for k, n in enumerate(counts) if n) + rule + extra],
                 "cost": 0.0, "score": score, "coverage": cover, "design": solved, "figures": _figures(solved),
                 "sliced": design})
             s.say("plane_search", f"candidate {len(found)}: {found[-1]['changes'][0]} (score {score:.3f})")
@@ -670,11 +745,9 @@ def run(vertices, faces, planes, material, settings, progress=None, cancel=None,
         else:
             design = pipeline.run(vertices, faces, planes, material, settings, progress, cancel, stock)
             best = None
-            design["reason"] += (f"; no nearby placement ({s.screened} tried: offsets up to "
-                                 f"{OFFSETS[-1] * 100:g} % of the model size, tilts up to {TILTS_DEG[-1]:g} deg, "
-                                 f"contour rules, one or two planes at a time) gives a stable design"
-                                 + (f" within the search's {s.budget:g} s budget" if time.perf_counter() - start > s.budget
-                                    else ""))
+            if not design["stable"]:
+                design["reason"] = (f"{nearby_reason(s)}. The planes as given: {design['reason']}"
+                                    if design["reason"] else nearby_reason(s))
         design["plane_search"] = _record("nearby", planes, best, s, start)
         used = [p.spec() for p in best["planes"]] if best else list(planes)
         say("plane_search", _summary(design["plane_search"]))
@@ -699,6 +772,14 @@ def run(vertices, faces, planes, material, settings, progress=None, cancel=None,
         say("plane_search", _summary(design["plane_search"]))
         return design, used
     raise ValueError(f'settings.plane_search must be one of {", ".join(MODES)}, got {mode!r}')
+
+
+def nearby_reason(searcher):
+    """Why the nearby search `searcher` ran found no stable placement (plane_faults.Tally.report):
+    what it searched, how far the budget let it, its candidates counted by fault, what to change."""
+    s = searcher
+    return s.tally.report(OFFSETS[-1] * s.size * 1000.0, s.size * 1000.0, TILTS_DEG[-1], s.budget,
+                          float(s.settings.get("min_segment") or 0.0))
 
 
 def _summary(record):

@@ -16,6 +16,7 @@ are known by hand:
   that comparison is stopped."""
 import copy
 import math
+import time
 import unittest
 
 import numpy as np
@@ -140,6 +141,46 @@ class Connected(unittest.TestCase):
         self.assertIsNone(s.connected(BASE + [place("W", (0.8, 0, 0), (1, 0, 0))]))
         kept = s.connected(BASE)
         self.assertEqual([p.contours for p in kept], [[0]] * 4)
+
+
+class AreaQuantiles(unittest.TestCase):
+    def test_a_sphere_by_archimedes(self):
+        # Archimedes' hat-box theorem: a sphere's area between heights -R and h is 2 pi R (h + R),
+        # a share (h + R) / (2 R) of its 4 pi R^2, so the plane below which a share q lies is at
+        # h = R (2 q - 1), whatever the axis (a fine sphere: ring height pi R / 96)
+        V, F = sphere(R, segments=96, rings=96)
+        s = plane_search.Searcher(V, F, PRESETS["steel"], settings())
+        for axis in (np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])):
+            for q in (0.05, 0.25, 0.5, 0.75, 0.9):
+                p = plane_search.area_quantile_plane(s, axis, q, "Q")
+                self.assertEqual(p.normal, tuple(axis))
+                self.assertAlmostEqual(float(np.dot(p.origin, axis)), R * (2 * q - 1), delta=0.04 * R)
+
+
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class Grow(unittest.TestCase):
+    def test_sets_grown_from_one_plane_fewer(self):
+        V, F = sphere(R)
+        s = plane_search.Searcher(V, F, PRESETS["steel"], settings())
+        grown = plane_search.grow(s, 4, [np.eye(3)], 0.015, time.perf_counter() + 600.0)
+        self.assertTrue(grown)
+        keys = [g[:2] for g in grown]
+        self.assertEqual(keys, sorted(keys))  # fewest close gaps first, then the largest closest gap
+        bases = {tuple(p.key() for p in plane_search.family_planes(s, counts, "largest", spread, np.eye(3), by))
+                 for spread in plane_search.SPREADS for by in ("area", "extent")
+                 for counts in plane_search.splits_of(3)}
+        self.assertLessEqual(len({tuple(p.key() for p in g[4][:3]) for g in grown}), plane_search.GROW_BASES)
+        for close, gap, counts, axes, placements, design, words in grown:
+            self.assertEqual(len(placements), 4)
+            self.assertEqual(sum(counts), 4)
+            self.assertIn(tuple(p.key() for p in placements[:3]), bases)  # a 3-plane proposal ...
+            added = placements[3]  # ... and a plane normal to a world axis at an area quantile
+            k = int(np.argmax(np.abs(added.normal)))
+            self.assertEqual(added.normal, tuple(np.eye(3)[k]))
+            q = (float(np.dot(added.origin, added.normal)) / R + 1) / 2  # Archimedes, as above
+            self.assertLess(min(abs(q - g) for g in plane_search.GROW_QUANTILES), 0.05)
+            self.assertIn("grown", words)
+            self.assertEqual(close, plane_search.close_gaps(s.screen_layered(placements)[2], 0.015))
 
 
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)

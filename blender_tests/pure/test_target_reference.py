@@ -95,6 +95,77 @@ class AgainstConvergedSweeps(unittest.TestCase):
         self.assertEqual(len(keys), len(set(keys)))
 
 
+    def test_coupling_warm_start_reaches_the_cold_optimum(self):
+        # A coupling round (Sec. 4.3) that lowers a vertex's bend limit starts that wire from the
+        # previous round's optimum (Memo.start). Solved with and without it, every stand-in must end
+        # with the same distances per wire (0.1 mm), hooks, nulled crossings, coupling rounds and
+        # verdict; and the start must actually be used somewhere (the Teddy's and the Airplane's
+        # couplings lower vertex limits).
+        from wiresculpt import pipeline
+
+        real, warm_starts = native.optimize_target_shape, []
+
+        def counted(points, closed, crossings, options=None, progress=None):
+            if "start" in options:
+                warm_starts.append(options["wire_name"])
+            return real(points, closed, crossings, options, progress)
+
+        for name in ["globe"] + STAND_INS[:-1]:
+            with self.subTest(name):
+                scene, _V, _F, _planes, design = bench_scenes.load_and_slice(self.scenes[name])
+                with mock.patch.object(target_shape.native, "optimize_target_shape", counted):
+                    warm = pipeline.solve(copy.deepcopy(design), scene.material, scene.settings, hook_patterns=1)
+                with mock.patch.object(target_shape.Memo, "start", lambda *_args: None):
+                    cold = pipeline.solve(copy.deepcopy(design), scene.material, scene.settings, hook_patterns=1)
+                for ww, wc in zip(warm["wires"], cold["wires"]):
+                    self.assertAlmostEqual(ww["target_max_distance"], wc["target_max_distance"], delta=1e-4,
+                                           msg=ww["name"])
+                    self.assertAlmostEqual(ww["target_rms_distance"], wc["target_rms_distance"], delta=1e-4,
+                                           msg=ww["name"])
+                    self.assertEqual(len(ww["target"]), len(wc["target"]), ww["name"])
+                stage_w, stage_c = warm["stages"]["target_shape"], cold["stages"]["target_shape"]
+                self.assertEqual([c["hook"] for c in warm["crossings"]], [c["hook"] for c in cold["crossings"]])
+                self.assertEqual(sorted(n["crossing"] for n in stage_w["nulled_crossings"]),
+                                 sorted(n["crossing"] for n in stage_c["nulled_crossings"]))
+                self.assertEqual(stage_w["coupling_rounds"], stage_c["coupling_rounds"])
+                self.assertEqual(warm["stable"], cold["stable"])
+                self.assertEqual(warm.get("reason"), cold.get("reason"))
+        self.assertIn("Arms/0", warm_starts)  # the Teddy's coupled wire
+
+
+    def test_windows_from_29_points_reach_the_one_block_optimum(self):
+        # Wires of 29 to 32 points are solved in windows (ONE_BLOCK_POINTS), no longer as one block
+        # (the solver's default, 4 x window): the same distances (0.1 mm), hooks, nulled crossings
+        # and verdict on every stand-in, and at least one such wire (the Teddy's Arms/0) so that
+        # the comparison compares something.
+        self.assertEqual(target_shape.ONE_BLOCK_POINTS, 28)
+        real, sizes = native.optimize_target_shape, []
+
+        def one_block(points, closed, crossings, options=None, progress=None):
+            result = real(points, closed, crossings, {**options, "one_block_points": -1}, progress)
+            sizes.append(len(result["points"]))
+            return result
+
+        for name in ["globe"] + STAND_INS:
+            with self.subTest(name):
+                scene, design = self.layered(name)
+                windows = copy.deepcopy(design)
+                target_shape.run(windows, scene.material, scene.settings)
+                block = copy.deepcopy(design)
+                with mock.patch.object(target_shape.native, "optimize_target_shape", one_block):
+                    target_shape.run(block, scene.material, scene.settings)
+                for ww, wb in zip(windows["wires"], block["wires"]):
+                    self.assertAlmostEqual(ww["target_max_distance"], wb["target_max_distance"], delta=1e-4,
+                                           msg=ww["name"])
+                    self.assertAlmostEqual(ww["target_rms_distance"], wb["target_rms_distance"], delta=1e-4,
+                                           msg=ww["name"])
+                self.assertEqual([c["hook"] for c in windows["crossings"]], [c["hook"] for c in block["crossings"]])
+                self.assertEqual(sorted(n["crossing"] for n in windows["stages"]["target_shape"]["nulled_crossings"]),
+                                 sorted(n["crossing"] for n in block["stages"]["target_shape"]["nulled_crossings"]))
+                self.assertEqual(windows.get("stable"), block.get("stable"))
+        self.assertTrue([m for m in sizes if 28 < m <= 32])
+
+
 class Threads(unittest.TestCase):
     """solve_all keeps the order of its jobs and hands back the memo's results untouched."""
 

@@ -38,11 +38,13 @@ TargetShapeOptions to_options(py::handle d) {
                field::number("friction", o.friction), field::number("ftol_rel", o.ftol_rel),
                field::number("xtol_rel", o.xtol_rel), field::number("constraint_tol", o.constraint_tol),
                field::integer("max_iterations", o.max_iterations), field::integer("window", o.window),
+               field::integer("one_block_points", o.one_block_points),
                field::number("sweep_tol", o.sweep_tol), field::number("sweep_ftol", o.sweep_ftol),
                field::integer("max_sweeps", o.max_sweeps),
                field::number("max_seconds", o.max_seconds),
                field::number("model_size", o.model_size), field::number("angle_tolerance", o.angle_tolerance),
                field::number("length_tolerance", o.length_tolerance), field::text("wire_name", o.wire_name),
+               {"start", [&](py::handle v, const std::string& at) { o.start = to_points<2>(v, at); }},
                {"vertex_max_bend",
                 [&](py::handle v, const std::string& at) {
                   each_item(v, at, [&](py::handle x, const std::string& i) { o.vertex_max_bend.push_back(to_number(x, i)); });
@@ -91,7 +93,8 @@ void bind_target_shape(py::module_& m) {
 
 points: float64 (n, 2), metres; closed: bool; crossings: list of {"vertex": int (index into
 points), "bisector": (x, y) desired h*, "contact_angle": radians (default 2π/3), "active": bool
-(default True)}; options: dict of TargetShapeOptions fields (min_segment, max_bend, vertex_max_bend (radians per point of the result), spacing,
+(default True)}; options: dict of TargetShapeOptions fields (min_segment, max_bend, vertex_max_bend (radians per point of the result), start ((m, 2)
+points of a previous result to start from), spacing,
 regularization, friction, algorithm ("slsqp" | "auglag_lbfgs" | "ccsaq" | "mma"), ftol_rel,
 xtol_rel, constraint_tol, max_iterations (1..1e7), window (0 or 4..10000), sweep_tol, sweep_ftol ([0, 1)), max_sweeps
 (1..100000), max_seconds (wall-clock budget, (0, 86400], default 120), model_size,

@@ -76,6 +76,8 @@ void validate(const Polyline2& contour, bool closed, const std::vector<TargetCro
     bad("max_iterations must be from 1 to " + std::to_string(kMaxIterations));
   if (o.window < 0 || o.window > kMaxWindow || (o.window > 0 && o.window < 4))
     bad("window must be 0 (one block) or from 4 to " + std::to_string(kMaxWindow) + " points");
+  if (o.one_block_points < -1 || o.one_block_points > kMaxWindow)
+    bad("one_block_points must be -1 (4 x window) or from 0 to " + std::to_string(kMaxWindow) + " points");
   if (o.max_sweeps <= 0 || o.max_sweeps > kMaxSweeps) bad("max_sweeps must be from 1 to " + std::to_string(kMaxSweeps));
   if (!(o.max_seconds > 0.0 && o.max_seconds <= kMaxSeconds))
     bad("max_seconds must be more than 0 and at most " + std::to_string(static_cast<int>(kMaxSeconds)) + " seconds");
@@ -715,11 +717,22 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
   TargetShapeResult result;
   Polyline2 p = problem.initial();
   const int m = static_cast<int>(p.size());
+  const bool warm = !o.start.empty();
+  if (warm) {  // a previous result of this problem: its free points (the crossings stay the contour's)
+    if (o.start.size() != p.size())
+      throw InputError("target shape of wire " + w + ": start has " + std::to_string(o.start.size()) +
+                       " points, but this contour with these crossings and spacing has " + std::to_string(m));
+    for (int i = 0; i < m; ++i) {
+      if (!o.start[i].allFinite())
+        throw InputError("target shape of wire " + w + ": start point " + std::to_string(i) + " is not finite");
+      if (!problem.fixed()[i]) p[i] = o.start[i];
+    }
+  }
 
-  // Start: each free neighbour of an active crossing that lies outside the contact cone is turned
+  // Start (cold): each free neighbour of an active crossing that lies outside the contact cone is turned
   // about the crossing point onto the cone (keeping its distance and its side of h*), so that
   // the kinks start open the right way. The regulariser still measures from initial().
-  for (std::size_t c = 0; c < crossings.size(); ++c) {
+  for (std::size_t c = 0; c < crossings.size() && !warm; ++c) {
     const TargetCrossingStatus& s = problem.statuses_[c];
     if (!problem.crossings_[c].active || !s.realised) continue;
     const Vec2 h = problem.crossings_[c].bisector;
@@ -744,7 +757,8 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
   // docs/method-target-shape.md).
   std::vector<Block> blocks;
   const int window = o.window;
-  if (window <= 0 || static_cast<long long>(m) <= 4LL * window) {  // small wires: one block is as cheap
+  const long long one_block = o.one_block_points < 0 ? 4LL * window : o.one_block_points;
+  if (window <= 0 || static_cast<long long>(m) <= one_block) {  // small wires: one block is as cheap
     std::vector<int> all(m);
     for (int i = 0; i < m; ++i) all[i] = i;
     blocks.push_back(make_block(problem, all));
@@ -875,6 +889,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     const double move_tol = o.sweep_tol;
     std::vector<char> dirty(blocks.size(), 1);
     double last_energy = std::numeric_limits<double>::infinity();  // E after the previous sweep
+    double last_violation = std::numeric_limits<double>::infinity();  // and its largest violation
     std::vector<std::vector<int>> watchers(m);  // point -> blocks whose terms read it
     for (std::size_t k = 0; k < blocks.size(); ++k)
       for (int t : blocks[k].terms)
@@ -904,16 +919,21 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
         result.nlopt_result = "NLOPT_MAXEVAL_REACHED";
         break;
       }
-      // Stop once a whole sweep, with every constraint met, lowered the wire's energy by no more
-      // than sweep_ftol of it: what is left is creep along the wire (see sweep_ftol).
+      // Stop once a whole sweep lowered the wire's energy by no more than sweep_ftol of it, with
+      // every constraint met or with its largest violation not lowered by more than that fraction
+      // either: what is left is creep along the wire (see sweep_ftol).
       if (o.sweep_ftol > 0.0) {
         const double energy = problem.energy(data.p);
         double violation = 0.0;
         for (std::size_t k = 0; k < problem.constraints().size(); ++k)
           violation = std::max(violation, problem.constraint(k, data.p));
         const bool small = last_energy - energy <= o.sweep_ftol * std::abs(energy);
+        // An infeasible wire whose sweep lowered neither its energy nor its largest violation is
+        // stuck there: the kink it cannot open stays as far from its cone.
+        const bool stuck = violation >= (1.0 - o.sweep_ftol) * last_violation;
         last_energy = energy;
-        if (small && violation <= o.constraint_tol) break;
+        last_violation = violation;
+        if (small && (violation <= o.constraint_tol || stuck)) break;
       }
     }
   }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <tuple>
 #include <utility>
 
 #include "wiresculpt/error.hpp"
@@ -491,12 +492,12 @@ TEST_CASE("target shape: a per-point bend limit holds at that point, the others 
   CHECK_THROWS_WITH(optimize_target_shape(contour, true, {}, o), Contains("vertex_max_bend[0]"));
 }
 
-TEST_CASE("target shape: a kink whose neighbour breaks the bend limit is not realised", "[target]") {
-  // A hairpin right after an active crossing A at the origin (kink opening towards +y): the wire
-  // runs along +x for 18 mm, turns back by 140° and meets a fixed (null) crossing B 21 mm later.
-  // Between them there is one free point, and with the kink's cone, 15 mm segments and B fixed,
-  // the solver meets the cone at the cost of a bend over 120° at that point: the kink cannot be
-  // made, so A is reported, not passed on as realised beside an unbendable wire.
+namespace {
+
+// A hairpin right after crossing A at the origin: the wire comes along +x from -tail, runs 18 mm
+// past A, turns back by 140° and meets crossing B 21 mm later, then runs on for `tail` metres;
+// contour points every 1 mm. Returns the contour and the vertices of A and B.
+std::tuple<Polyline2, int, int> hairpin(double tail) {
   Polyline2 contour;
   auto run = [&](Vec2 a, Vec2 b) {
     const int n = static_cast<int>(std::lround((b - a).norm() / 0.001));
@@ -504,13 +505,28 @@ TEST_CASE("target shape: a kink whose neighbour breaks the bend limit is not rea
   };
   const Vec2 d2(std::cos(140.0 * pi / 180.0), std::sin(140.0 * pi / 180.0));
   const Vec2 corner(0.018, 0.0), b = corner + 0.021 * d2;
-  contour.push_back({-0.06, 0.0});
-  run({-0.06, 0.0}, {0.0, 0.0});
+  contour.push_back({-tail, 0.0});
+  run({-tail, 0.0}, {0.0, 0.0});
+  const int a_vertex = static_cast<int>(contour.size()) - 1;
   run({0.0, 0.0}, corner);
   run(corner, b);
-  run(b, b + 0.06 * d2);
-  REQUIRE((contour[60] - Vec2(0, 0)).norm() < 1e-12);
-  REQUIRE((contour[99] - b).norm() < 1e-12);
+  const int b_vertex = static_cast<int>(contour.size()) - 1;
+  run(b, b + tail * d2);
+  return {contour, a_vertex, b_vertex};
+}
+
+}  // namespace
+
+TEST_CASE("target shape: a kink whose neighbour breaks the bend limit is not realised", "[target]") {
+  // A hairpin right after an active crossing A at the origin (kink opening towards +y): the wire
+  // runs along +x for 18 mm, turns back by 140° and meets a fixed (null) crossing B 21 mm later.
+  // Between them there is one free point, and with the kink's cone, 15 mm segments and B fixed,
+  // the solver meets the cone at the cost of a bend over 120° at that point: the kink cannot be
+  // made, so A is reported, not passed on as realised beside an unbendable wire.
+  const auto [contour, a_vertex, b_vertex] = hairpin(0.06);
+  REQUIRE(a_vertex == 60);
+  REQUIRE(b_vertex == 99);
+  REQUIRE(contour[60].norm() < 1e-12);
   TargetShapeOptions o;
   o.friction = 0.0;
   o.angle_tolerance = 0.1 * pi / 180.0;
@@ -599,4 +615,124 @@ TEST_CASE("target shape: a 3 m wire converges within the default evaluation budg
   CHECK(r.iterations < o.max_iterations);
   CHECK(r.feasible);
   for (const auto& s : r.crossings) CHECK(s.status == "ok");
+}
+
+TEST_CASE("target shape: a warm start from the looser limit's optimum reaches the cold solve's optimum", "[target]") {
+  // The coupling (Sec. 4.3) lowers one vertex's bend limit and solves again. Started from the
+  // previous optimum (`start`), the solve must end where a cold start ends: the same distances to
+  // the contour (0.1 mm, issue 17's tolerance), the same crossings realised, every constraint
+  // held, and with fewer evaluations (what the start is for). One windowed loop with crossings
+  // (2 m, ten crossings) and one one-block wire with a crossing.
+  const auto two_metres = long_loop(0.3, 10);
+  const auto wavy = wavy_loop();
+  for (const auto* c : {&two_metres, &wavy}) {
+    const auto& [contour, xs] = *c;
+    TargetShapeOptions o;
+    o.sweep_ftol = 1e-3;
+    const TargetShapeResult loose = optimize_target_shape(contour, true, xs, o);
+    const int m = static_cast<int>(loose.points.size());
+    auto bend = [&](const Polyline2& p, int i) {
+      return angle_between(p[i] - p[(i + m - 1) % m], p[(i + 1) % m] - p[i]);
+    };
+    std::vector<char> fixed(static_cast<std::size_t>(m), 0);
+    for (int v : loose.crossing_vertices) fixed[static_cast<std::size_t>(v)] = 1;
+    int sharpest = -1;  // the sharpest bend at a point whose neighbours are both free
+    for (int i = 0; i < m; ++i)
+      if (!fixed[i] && !fixed[(i + 1) % m] && !fixed[(i + m - 1) % m] &&
+          (sharpest < 0 || bend(loose.points, i) > bend(loose.points, sharpest)))
+        sharpest = i;
+    REQUIRE(sharpest >= 0);
+    const double limit = 0.5 * bend(loose.points, sharpest);
+    REQUIRE(limit > 2.0 * pi / 180.0);
+    o.vertex_max_bend.assign(static_cast<std::size_t>(m), 0.0);
+    o.vertex_max_bend[static_cast<std::size_t>(sharpest)] = limit;
+    const TargetShapeResult cold = optimize_target_shape(contour, true, xs, o);
+    o.start = loose.points;
+    const TargetShapeResult warm = optimize_target_shape(contour, true, xs, o);
+    INFO(contour.size() << " contour points, " << m << " target points; evaluations cold " << cold.iterations
+                        << ", warm " << warm.iterations);
+    REQUIRE(warm.points.size() == cold.points.size());
+    CHECK(bend(warm.points, sharpest) <= limit + 1e-6);
+    CHECK(std::abs(warm.max_distance - cold.max_distance) < 1e-4);
+    CHECK(std::abs(warm.rms_distance - cold.rms_distance) < 1e-4);
+    CHECK(warm.feasible == cold.feasible);
+    for (std::size_t k = 0; k < xs.size(); ++k) {
+      CHECK(warm.crossings[k].status == cold.crossings[k].status);
+      CHECK(warm.crossings[k].realised == cold.crossings[k].realised);
+    }
+    for (int v : warm.crossing_vertices) CHECK((warm.points[v] - cold.points[v]).norm() == 0.0);  // the contour's own
+    check_constraints(warm, true, xs, o, 1e-6);
+    CHECK(warm.iterations < cold.iterations);
+  }
+}
+
+TEST_CASE("target shape: a start of the wrong size or not finite is refused, naming the wire", "[target]") {
+  const auto [contour, xs] = wavy_loop();
+  TargetShapeOptions o;
+  o.wire_name = "W";
+  const TargetShapeResult r = optimize_target_shape(contour, true, xs, o);
+  o.start = r.points;
+  o.start.pop_back();
+  CHECK_THROWS_WITH(optimize_target_shape(contour, true, xs, o), Contains("wire W") && Contains("start has"));
+  o.start = r.points;
+  o.start[1].x() = std::nan("");
+  CHECK_THROWS_WITH(optimize_target_shape(contour, true, xs, o), Contains("wire W") && Contains("start point 1"));
+}
+
+TEST_CASE("target shape: one_block_points decides between one block and windows", "[target]") {
+  // The wavy loop's result (65 points) with windows of 20: at the default (4 x window = 80) one
+  // block; with one_block_points below its size, windows (more than one sweep). Both end at the
+  // same distances (0.1 mm) with the same crossings.
+  const auto [contour, xs] = wavy_loop();
+  TargetShapeOptions o;
+  o.sweep_ftol = 1e-3;
+  o.window = 20;
+  const TargetShapeResult block = optimize_target_shape(contour, true, xs, o);
+  const int m = static_cast<int>(block.points.size());
+  REQUIRE(m > 20);
+  REQUIRE(m <= 4 * o.window);
+  CHECK(block.sweeps == 1);
+  o.one_block_points = 20;
+  const TargetShapeResult windows = optimize_target_shape(contour, true, xs, o);
+  CHECK(windows.sweeps > 1);
+  CHECK(std::abs(windows.max_distance - block.max_distance) < 1e-4);
+  CHECK(std::abs(windows.rms_distance - block.rms_distance) < 1e-4);
+  for (std::size_t k = 0; k < xs.size(); ++k) CHECK(windows.crossings[k].status == block.crossings[k].status);
+  o.one_block_points = m;  // at most this many points: one block again
+  CHECK(optimize_target_shape(contour, true, xs, o).sweeps == 1);
+  o.one_block_points = -2;
+  CHECK_THROWS_WITH(optimize_target_shape(contour, true, xs, o), Contains("one_block_points"));
+}
+
+TEST_CASE("target shape: sweep_ftol also stops the sweeps of a wire stuck on a kink it cannot open", "[target]") {
+  // The hairpin of "a kink whose neighbour breaks the bend limit is not realised" with 0.5 m tails,
+  // so that the wire is solved in windows: the kink at A cannot be made, the wire stays
+  // infeasible and the energy stop of sweep_ftol alone never fires. Sweeps run to 1 nm creep on
+  // to the 200-sweep cap (115,000 evaluations), lowering the violation a little each time; the
+  // stuck stop ends after a few with the same verdict per crossing, which is what the caller
+  // uses (it nulls the crossing and solves the wire again without it). The shape of a wire
+  // stuck infeasible is no optimum, so its distances are not compared.
+  const auto [contour, a_vertex, b_vertex] = hairpin(0.5);
+  TargetShapeOptions reference, fast;
+  for (TargetShapeOptions* o : {&reference, &fast}) {
+    o->friction = 0.0;
+    o->angle_tolerance = 0.1 * pi / 180.0;
+    o->length_tolerance = 1e-5;
+  }
+  reference.sweep_tol = 1e-9;
+  reference.max_iterations = 1'000'000;
+  fast.sweep_ftol = 1e-3;
+  const std::vector<TargetCrossing> xs{{a_vertex, Vec2(0, 1), 2 * pi / 3, true}, {b_vertex, Vec2(0, 1), 2 * pi / 3, false}};
+  const TargetShapeResult a = optimize_target_shape(contour, false, xs, fast);
+  const TargetShapeResult r = optimize_target_shape(contour, false, xs, reference);
+  INFO(a.sweeps << " / " << r.sweeps << " sweeps, " << a.iterations << " / " << r.iterations << " evaluations, "
+                << a.points.size() << " points");
+  REQUIRE(a.points.size() > 32);  // windows
+  REQUIRE(r.crossings[0].status == "infeasible");
+  REQUIRE_FALSE(r.feasible);
+  CHECK_FALSE(a.feasible);
+  CHECK(a.sweeps <= 10);
+  CHECK(10 * a.iterations < r.iterations);
+  for (std::size_t k = 0; k < xs.size(); ++k) CHECK(a.crossings[k].status == r.crossings[k].status);
+  CHECK(a.max_angle_violation > fast.angle_tolerance);
 }

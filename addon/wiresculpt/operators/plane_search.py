@@ -155,6 +155,8 @@ def _store(job):
               "message": (f"{len(job.found)} stable candidate{'s' if len(job.found) != 1 else ''} "
                           f"({job.searched.screened} screened, {job.searched.full_solves} solved, "
                           f"{time.perf_counter() - job.started:.1f} s)" if job.found else
+                          f"No stable placement found: {plane_search.nearby_reason(job.searched)}"
+                          if job.mode == "nearby" else
                           f"No stable placement found ({job.searched.screened} screened, "
                           f"{job.searched.full_solves} solved)")}
     return RESULT

@@ -45,6 +45,14 @@ MAX_ROUNDS = 4  # solve, null what cannot be realised, solve again (each round n
 # only creep points along the wire (TargetShapeOptions::sweep_ftol; docs/method-target-shape.md,
 # issue 17: the same distances to the contour and crossings, 3-6x fewer evaluations on long wires).
 SWEEP_FTOL = 1e-3
+# Wires of up to this many target points are one NLopt block, longer ones are solved in windows
+# (TargetShapeOptions::one_block_points; the solver's own default is 4 x window = 32). SLSQP's
+# dense subproblem costs about n^3: a 32-point block took 560 us an evaluation against 20 us for
+# an 8-point window, and the Teddy's 32-point Arms/0 0.05 s against 0.005 s in windows, at the same
+# distances and crossings. At 28 every stand-in and real-mesh scene keeps its distances (0.1 mm),
+# crossings and verdict; at 24 or 16 some (the Chair's 26-point backrest) reach other optima
+# (docs/method-target-shape.md, issue 17).
+ONE_BLOCK_POINTS = 28
 # Wires are independent problems: up to this many are solved at once, each on its own thread (the
 # native call releases the GIL; each result depends only on its own wire, so the order is kept).
 MAX_THREADS = 2
@@ -83,13 +91,18 @@ def prepare_wire(design, wire, settings, size, memo=None):
         refs.append((c, k))
     options = {"min_segment": settings["min_segment"], "max_bend": math.radians(settings["max_bend_deg"]),
                "friction": 0.0, "model_size": size, "wire_name": wire["name"],
-               "angle_tolerance": REALISED_ANGLE, "length_tolerance": REALISED_LENGTH, "sweep_ftol": SWEEP_FTOL}
+               "angle_tolerance": REALISED_ANGLE, "length_tolerance": REALISED_LENGTH, "sweep_ftol": SWEEP_FTOL,
+               "one_block_points": ONE_BLOCK_POINTS}
     limits = memo.vertex_limits.get(wire["name"]) if memo is not None else None
     if limits:  # the coupling's own limits at some points (pipeline._tighten), radians by target index
         options["vertex_max_bend"] = tuple(limits.get(i, 0.0) for i in range(max(limits) + 1))
     contour = to_2d(wire["contour"], origin, u, v)
     key = Memo.key(contour, wire["closed"], specs, options) if memo is not None else None
     result = memo.reusable(key, options["max_bend"]) if memo is not None else None
+    if result is None and memo is not None:  # a coupling round: start from the looser limit's optimum
+        start = memo.start(contour, wire["closed"], specs, options)
+        if start is not None:
+            options = {**options, "start": start}
     return {"contour": contour, "closed": wire["closed"], "specs": specs, "options": options, "refs": refs,
             "frame": (origin, u, v), "key": key, "result": result}
 
@@ -106,6 +119,7 @@ def finish_wire(job, result, memo=None):
     """Remembers a new solve in the memo; (result, refs, frame) as solve_wire returns them."""
     if memo is not None and job["result"] is None:
         memo.remember(job["key"], job["options"]["max_bend"], result)
+        memo.remember_start(job["contour"], job["closed"], job["specs"], job["options"], result)
     return result, job["refs"], job["frame"]
 
 
@@ -136,6 +150,12 @@ class Memo:
       realised under the old limit and whose bends all lie within the new one is still a local
       optimum of the tighter problem (the same point, feasible, in a smaller feasible set): it is
       reused for the same contour, crossings and options. Only the other wires are solved again.
+    - `starts`: the optimum of each wire problem whatever its bend limits (max_bend and
+      vertex_max_bend left out of the key), when it converged with every active crossing realised.
+      A wire solved again because its limits went down starts from it (the native `start`
+      option: the same problem, a warm start) instead of from the resampled contour: most of its
+      points are already where the tighter problem wants them (docs/method-target-shape.md,
+      "Coupling rounds").
     """
 
     CONVERGED = ("NLOPT_SUCCESS", "NLOPT_FTOL_REACHED", "NLOPT_XTOL_REACHED", "none")  # "none": nothing free
@@ -148,15 +168,27 @@ class Memo:
         self.nulled = []
         self.vertex_limits = {}
         self.solves = {}  # key -> (max_bend, result)
+        self.starts = {}  # key without the bend limits -> points of a converged solve
         self.same = {} if same is None else same
         self.reused = 0
 
     @staticmethod
-    def key(contour, closed, specs, options):
-        """Everything the solve depends on except the bend limit."""
+    def key(contour, closed, specs, options, ignore=("max_bend",)):
+        """Everything the solve depends on except the bend limit (the options named in `ignore`;
+        a start is never part of it)."""
         spec_key = tuple((s["vertex"], s["bisector"], s["contact_angle"], s["active"]) for s in specs)
-        other = tuple(sorted((k, v) for k, v in options.items() if k != "max_bend"))
+        other = tuple(sorted((k, v) for k, v in options.items() if k not in ignore and k != "start"))
         return (np.ascontiguousarray(contour, dtype=np.float64).tobytes(), bool(closed), spec_key, other)
+
+    LIMITS = ("max_bend", "vertex_max_bend")
+
+    def start(self, contour, closed, specs, options):
+        """The points of this wire problem's optimum under other bend limits, or None."""
+        return self.starts.get(self.key(contour, closed, specs, options, self.LIMITS))
+
+    def remember_start(self, contour, closed, specs, options, result):
+        if result["nlopt_result"] in self.CONVERGED and all(s["status"] in ("ok", "inactive") for s in result["crossings"]):
+            self.starts[self.key(contour, closed, specs, options, self.LIMITS)] = result["points"]
 
     def reusable(self, key, max_bend):
         """The remembered result for `key` if it is an optimum that the limit `max_bend` (radians)

@@ -68,6 +68,14 @@ struct TargetShapeOptions {
   /// the forces bend the rest shape beyond the machine. Entries <= 0 or past the end: max_bend.
   /// Default empty.
   std::vector<double> vertex_max_bend;
+  /// Metres, in the wire's plane frame: points to start the solve from instead of the resampled
+  /// contour with its kinks turned open, one per point of the result (the same count as a solve
+  /// of this contour with these crossings and spacing returns; else InputError). The crossing
+  /// points are always the contour's own; the regulariser still measures from the resampling, so
+  /// the problem is the same and only the start changes. The coupling with the rest shape passes
+  /// the previous round's result when it lowers a vertex's bend limit (warm start; see
+  /// docs/method-target-shape.md). Default empty (cold start).
+  Polyline2 start;
   /// Metres. Arc-length spacing of the initial resampling between consecutive crossings; 0 means
   /// 1.5 × min_segment. 0, or from min_segment/10 to 10 m (should not be below min_segment). A
   /// wire longer than 250000 × spacing (10^6 target points) is refused. Default 0.
@@ -99,15 +107,20 @@ struct TargetShapeOptions {
   /// sweep_tol (multiplicative Schwarz / block coordinate descent). Dense SLSQP costs O(n³) per
   /// iteration, so windows make long wires fast; see docs/method-target-shape.md. Default 8.
   int window = 8;
+  /// Points: a wire of at most this many points is solved as one block even with windows; -1
+  /// means 4 × window. From -1 to 10000. Default -1.
+  int one_block_points = -1;
   /// Metres. A window is solved again when a point its energy terms read moved by more than this
   /// since its last solve. Default 1e-7 (0.1 µm, a hundredth of the 10 µm to which a realised
   /// segment is checked): at 1 nm the sweeps chase SLSQP's own stopping noise (the optimum is
   /// flat along the wire) for 10-20 times as many evaluations without changing the energy's
   /// first 7 digits; see docs/method-target-shape.md.
   double sweep_tol = 1e-7;
-  /// Relative energy decrease per sweep, in [0, 1). With windows, the sweeps also stop once every
-  /// constraint holds (to constraint_tol) and a whole sweep lowered the wire's energy E by no more
-  /// than sweep_ftol × E. The optimum is flat along the wire, and sweeps after the first few mostly
+  /// Relative energy decrease per sweep, in [0, 1). With windows, the sweeps also stop once a
+  /// whole sweep lowered the wire's energy E by no more than sweep_ftol × E and either every
+  /// constraint holds (to constraint_tol) or the largest violation went down by no more than
+  /// sweep_ftol of it (a kink that cannot be opened stays as far from its cone sweep after sweep;
+  /// such a wire's crossing is reported, and further sweeps only creep). The optimum is flat along the wire, and sweeps after the first few mostly
   /// move points along it (millimetres on a 3 m wire, each sweep a little) without changing their
   /// distance to the contour; see docs/method-target-shape.md. 0: off, the sweeps run until no
   /// window moves a point by more than sweep_tol. Default 0; the pipeline uses 1e-3.

@@ -1,0 +1,180 @@
+"""Why no nearby placement exists (plane_faults.py, plane_search.nearby's account; issue 15: "with
+nearby, every scene ends stable or says why no nearby placement exists"), on scenes whose answers
+are known by hand:
+
+- hand-made crossing networks: a wire crossing nothing ("alone"), two groups with no crossing
+  between them ("apart"), a wire with its two crossings on the common line of two planes
+  ("hinge"), the closest two crossings along a wire;
+- a sphere (radius R) cut by A: z = 0.5 R, B: z = -0.5 R and C: x = 0. A and B cross only C, each
+  at two points on one line (a hinge each), and no nearby change makes A and B cross: their planes
+  stay within 15 + 15 deg of parallel, and the nearest the two can come inside the sphere is where a
+  15 deg tilt meets an offset or another tilt, at |x| or |y - x| >= R / (2 tan 15 deg) = 1.87 R >
+  sqrt2 R, outside it. C still crosses A and B whatever one or two changes do (A's circle at
+  z = 0.9 R has radius 0.436 R > 0.4 R, C's largest offset). So every candidate fails with the same
+  fault, a hinge of A/0 and of B/0 on C/0, and the search screens all of its candidates: the given
+  planes, 25 one-plane changes of each plane (6 offsets and 3 tilts about 2 axes, each both ways,
+  and the other contour rule) and 25 x 25 two-plane changes of each of the 3 pairs of planes:
+  1 + 3 x 25 + 3 x 625 = 1951."""
+import math
+import re
+import unittest
+
+from wiresculpt import native, pipeline, plane_search
+from wiresculpt.core import plane_faults
+from wiresculpt.core.materials import PRESETS
+from wiresculpt.core.scene import PlaneSpec
+from wiresculpt.core.settings import defaults
+
+from helpers import sphere
+
+R = 0.125
+CANDIDATES = 1 + 3 * 25 + 3 * 25 * 25
+HINGES = ("hinge", ("A/0", "B/0"), ("C/0", "C/0"))
+
+
+def settings(**kw):
+    s = defaults()
+    s["cuts"] = {}
+    s.update(kw)
+    return s
+
+
+def P(name, origin, normal):
+    return PlaneSpec(name, tuple(R * c for c in origin), normal)
+
+
+PARALLEL = [P("A", (0, 0, 0.5), (0, 0, 1)), P("B", (0, 0, -0.5), (0, 0, 1)), P("C", (0, 0, 0), (1, 0, 0))]
+
+
+def network(names, crossings):
+    """A layered design by hand: wires by name (a straight two-point contour each, unused here),
+    crossings as (wire a, wire b, point)."""
+    return {"wires": [{"name": n, "contour": [[0, 0, 0], [1, 0, 0]], "closed": False} for n in names],
+            "crossings": [{"id": k, "wires": [a, b], "point": list(p), "contour_vertices": [0, 0]}
+                          for k, (a, b, p) in enumerate(crossings)],
+            "reason": "not stable"}
+
+
+class Structural(unittest.TestCase):
+    # four wires as the planes z = 0 (Z/0), x = 0 (X/0), y = 0 (Y/0) and z = 1 (W/0) of a unit sphere
+    # would cut them: Z, X and Y cross each other at 6 points, not on one line for any wire
+    SIX = [(0, 1, (0, 1, 0)), (0, 1, (0, -1, 0)), (0, 2, (1, 0, 0)), (0, 2, (-1, 0, 0)),
+           (1, 2, (0, 0, 1)), (1, 2, (0, 0, -1))]
+
+    def test_a_wire_crossing_nothing_is_alone(self):
+        d = network(["Z/0", "X/0", "Y/0", "W/0"], self.SIX)
+        self.assertEqual(plane_faults.structural_fault(d), ("alone", ("W/0",), ()))
+
+    def test_two_groups_are_apart(self):
+        # W and V cross each other twice, and nothing else: the smaller part is named
+        d = network(["Z/0", "X/0", "Y/0", "W/0", "V/0"],
+                    self.SIX + [(3, 4, (5, 0, 0)), (3, 4, (5, 1, 1))])
+        self.assertEqual(plane_faults.structural_fault(d), ("apart", ("V/0", "W/0"), ()))
+
+    def test_a_wire_crossing_one_other_twice_hinges(self):
+        # W crosses X alone, at (0, 0.5, 0.8) and (0, -0.5, 0.8): on the line x = 0, z = 0.8
+        d = network(["Z/0", "X/0", "Y/0", "W/0"],
+                    self.SIX + [(3, 1, (0, 0.5, 0.8)), (3, 1, (0, -0.5, 0.8))])
+        self.assertEqual(plane_faults.structural_fault(d), ("hinge", ("W/0",), ("X/0",)))
+        # a third crossing off that line (W crossing Y at (0.3, 0, 0.8)) holds it
+        d = network(["Z/0", "X/0", "Y/0", "W/0"],
+                    self.SIX + [(3, 1, (0, 0.5, 0.8)), (3, 1, (0, -0.5, 0.8)), (3, 2, (0.3, 0, 0.8))])
+        self.assertEqual(plane_faults.structural_fault(d), ("mechanism", (), ("not stable",)))
+
+    def test_words_name_the_wire_and_the_counts_add_up(self):
+        faults = {("hinge", ("W/0",), ("X/0",)): 41, ("hinge", ("V/0",), ("X/0+Y/0",)): 2,
+                  ("alone", ("W/0",), ()): 12, ("misses", (), ("W",)): 1, ("few", (), ()): 1}
+        text = plane_faults.summary(faults, 0.015, shown=2)
+        self.assertTrue(text.startswith("43 hinge"), text)
+        self.assertIn("wire W/0 on wire X/0 in 41", text)
+        self.assertIn("wire V/0 on wire X/0 and wire Y/0 in 2", text)
+        self.assertIn("12 leave a wire crossing no other wire (wire W/0)", text)
+        self.assertIn("2 for 2 other reasons (misses, few)", text)  # 43 + 12 + 2 = 57 = the counts' sum
+        self.assertIn("add a plane whose wire crosses wire W/0 away from its line with wire X/0",
+                      plane_faults.advice([("hinge", ("W/0",), ("X/0",))]))
+
+
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class Closest(unittest.TestCase):
+    def test_two_planes_close_together_are_named(self):
+        # the sphere cut by y = 0, z = 0 and x = +-d: XA's and XB's crossings on the Y and Z circles
+        # are 2 R asin(d / R) = 10 mm apart for d = 5 mm, the closest gaps of the network
+        s = plane_search.Searcher(*sphere(R), PRESETS["steel"], settings())
+        d = 0.005
+        planes = [plane_search.Placement("Y", (0, 0, 0), (0, 1, 0), "largest"),
+                  plane_search.Placement("Z", (0, 0, 0), (0, 0, 1), "largest"),
+                  plane_search.Placement("XA", (d, 0, 0), (1, 0, 0), "largest"),
+                  plane_search.Placement("XB", (-d, 0, 0), (1, 0, 0), "largest")]
+        _ok, _design, probe = s.screen_layered(planes)
+        gap, wire, others = plane_faults.closest_gap(probe)
+        self.assertAlmostEqual(gap, 2 * R * math.asin(d / R), delta=0.02 * gap)
+        self.assertIn(wire, ("Y/0", "Z/0"))
+        self.assertEqual(sorted(others), ["XA/0", "XB/0"])
+        # a full solve that says so is counted as "close" on that wire, and the advice moves XA and XB apart
+        solved = {"reason": "the target shape cannot realise crossings 1 and 2, too close to their neighbours along "
+                            f"the wires for a free bending point between them (the closest: wire '{wire}': ...)"}
+        fault = plane_faults.verdict_fault(probe, solved, 0.015)
+        self.assertEqual(fault[:2], ("close", (wire,)))
+        advice = plane_faults.advice([fault], 0.015)
+        self.assertEqual(len(advice), 1)
+        self.assertRegex(advice[0], rf"move planes X[AB] and X[AB] apart, so that their crossings along wire {wire} "
+                                    r"are at least 30 mm apart")
+
+
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class NoNearbyPlacement(unittest.TestCase):
+    def setUp(self):
+        self.V, self.F = sphere(R)
+
+    def test_every_candidate_is_counted_and_the_reason_names_the_hinges(self):
+        found, s, _start = plane_search.nearby(self.V, self.F, PARALLEL, PRESETS["steel"], settings(), budget=600.0)
+        self.assertEqual(found, [])
+        self.assertEqual(s.screened, CANDIDATES)
+        self.assertEqual(s.full_solves, 0)  # nothing passed the screen
+        tally = s.tally
+        self.assertEqual(tally.totals(), {HINGES: CANDIDATES})
+        for name, family in tally.families.items():
+            self.assertEqual(sum(family["faults"].values()), family["screened"], name)
+            self.assertEqual(family["screened"], family["total"], name)
+        self.assertEqual([tally.families[k]["total"] for k in ("given", "A", "B", "C", "pairs")],
+                         [1, 25, 25, 25, 3 * 25 * 25])
+        reason = plane_search.nearby_reason(s)
+        self.assertTrue(reason.startswith("no nearby placement gives a stable design. Searched: planes A, B, C "
+                                          "one at a time (75 changes: offsets up to 50 mm (20 % of the model's "
+                                          "250 mm)"), reason)
+        self.assertIn("tilts up to 15 deg", reason)
+        self.assertIn(f"and two at a time (1875 pairs); {CANDIDATES} placements screened, 0 fully solved", reason)
+        self.assertIn(f"Every one of the {CANDIDATES} candidates was screened", reason)
+        self.assertIn("two-plane changes (1875 of 1875 screened): 1875 hinge", reason)
+        self.assertIn("(wire A/0 on wire C/0 in 1875, wire B/0 on wire C/0 in 1875)", reason)
+        self.assertIn("add a plane whose wire crosses wire A/0 away from its line with wire C/0", reason)
+        self.assertIn("move or tilt planes A and B towards each other until their wires cross", reason)
+        self.assertNotIn("budget", reason)
+
+    def test_a_search_cut_short_says_how_much_was_left(self):
+        found, s, _start = plane_search.nearby(self.V, self.F, PARALLEL, PRESETS["steel"], settings(), budget=0.0)
+        self.assertEqual((found, s.screened), ([], 0))
+        reason = plane_search.nearby_reason(s)
+        self.assertIn(f"The 0 s budget ended the search after 0 of {CANDIDATES} candidates: {CANDIDATES} left "
+                      "(the planes as given, 75 one-plane and 1875 two-plane changes)", reason)
+        self.assertIn("give the search more time", reason)
+
+    def test_the_reason_reaches_the_design(self):
+        design, used = plane_search.run(self.V, self.F, PARALLEL, PRESETS["steel"], settings(plane_search="nearby"))
+        given = pipeline.run(self.V, self.F, PARALLEL, PRESETS["steel"], settings())
+        self.assertFalse(design["stable"])
+        self.assertEqual(used, PARALLEL)
+        self.assertTrue(design["reason"].startswith("no nearby placement gives a stable design. Searched: "))
+        self.assertTrue(design["reason"].endswith(f". The planes as given: {given['reason']}"))
+        self.assertIn("wire A/0 on wire C/0", design["reason"])
+        # the record keeps the keys it had (FORMATS.md's and the extra ones before this change), no new one
+        self.assertEqual(set(design["plane_search"]), {
+            "mode", "planes_before", "planes_after", "changes", "candidates", "full_solves", "budget_seconds",
+            "solves_stopped", "solves_failed", "final_solve", "seconds", "score", "measure"})
+        self.assertEqual(design["plane_search"]["planes_after"], [])
+        screened = int(re.search(r"; (\d+) placements screened", design["reason"]).group(1))
+        self.assertEqual(design["plane_search"]["candidates"], screened)
+
+
+if __name__ == "__main__":
+    unittest.main()
