@@ -34,7 +34,7 @@ class Coupling(unittest.TestCase):
         saved, module = pipeline.COUPLING_ROUNDS, native.require()
         pipeline.COUPLING_ROUNDS = rounds
         saved_patterns, pipeline.HOOK_PATTERNS = pipeline.HOOK_PATTERNS, 1  # one hook pattern: count its solves
-        self.calls = 0
+        self.calls = self.starts = 0
 
         class Counting:  # counts the native target-shape solves of every round
             def __getattr__(_self, name):
@@ -43,6 +43,7 @@ class Coupling(unittest.TestCase):
 
                 def solve(*args):
                     self.calls += 1
+                    self.starts += "start" in args[3]
                     return module.optimize_target_shape(*args)
                 return solve
         saved_require = native.require
@@ -74,6 +75,9 @@ class Coupling(unittest.TestCase):
         self.assertEqual(stage["rest_excess_deg"], 0.0)
         # The stage's counts add every coupling round, as its time does.
         self.assertEqual(stage["wire_solves"], self.calls)
+        # Only the global limit went down (no vertex limit, below): every wire starts cold, as the
+        # warm start is only for lowered vertex limits (target_shape.Memo.starts).
+        self.assertEqual(self.starts, 0)
         self.assertGreater(stage["wire_solves"], len(coupled["wires"]))
         # The one bend over the limit (about 1 deg) is a hooked kink already at its least bend, so
         # no vertex limit can take it back (vertex_limits 0; before the bend program's slack was

@@ -150,12 +150,15 @@ class Memo:
       realised under the old limit and whose bends all lie within the new one is still a local
       optimum of the tighter problem (the same point, feasible, in a smaller feasible set): it is
       reused for the same contour, crossings and options. Only the other wires are solved again.
-    - `starts`: the optimum of each wire problem whatever its bend limits (max_bend and
-      vertex_max_bend left out of the key), when it converged with every active crossing realised.
-      A wire solved again because its limits went down starts from it (the native `start`
-      option: the same problem, a warm start) instead of from the resampled contour: most of its
-      points are already where the tighter problem wants them (docs/method-target-shape.md,
-      "Coupling rounds").
+    - `starts`: the optimum of each wire problem whatever its per-vertex bend limits
+      (vertex_max_bend left out of the key), when it converged with every active crossing
+      realised. A wire solved again because the coupling lowered the limit of some of its
+      vertices starts from it (the native `start` option: the same problem, a warm start) instead
+      of from the resampled contour: most of its points are already where the tighter problem
+      wants them. Not when the global limit (max_bend) went down: every bend of the wire is then
+      constrained anew, and started from the old optimum the coupling's soft-sphere case
+      (test_pipeline.Coupling) reached an optimum whose hooked kink stayed over the machine's
+      limit (docs/method-target-shape.md, "Coupling rounds").
     """
 
     CONVERGED = ("NLOPT_SUCCESS", "NLOPT_FTOL_REACHED", "NLOPT_XTOL_REACHED", "none")  # "none": nothing free
@@ -180,10 +183,11 @@ class Memo:
         other = tuple(sorted((k, v) for k, v in options.items() if k not in ignore and k != "start"))
         return (np.ascontiguousarray(contour, dtype=np.float64).tobytes(), bool(closed), spec_key, other)
 
-    LIMITS = ("max_bend", "vertex_max_bend")
+    LIMITS = ("vertex_max_bend",)
 
     def start(self, contour, closed, specs, options):
-        """The points of this wire problem's optimum under other bend limits, or None."""
+        """The points of this wire problem's optimum under other per-vertex bend limits (the same
+        max_bend), or None."""
         return self.starts.get(self.key(contour, closed, specs, options, self.LIMITS))
 
     def remember_start(self, contour, closed, specs, options, result):
