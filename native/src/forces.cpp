@@ -391,8 +391,12 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
     // The other rows of the bound's polytope join as solutions violate them.
     const detail::TorqueBlocks blocks{problem.torque_frame_rows(), Eigen::VectorXd::Zero(problem.torque_frame_rows().rows())};
     std::set<std::pair<int, int>> added;
+    // The problem GLPK holds, passed from loop to loop: the least-out-of-plane LP below starts from
+    // the force LP's optimal basis.
+    detail::HeldLp held;
     detail::LpSolution sol =
-        detail::solve_lp_with_torque_rows(lp, blocks, problem.polytope(), problem.t_max(), added, &r.lp_rounds);
+        detail::solve_lp_with_torque_rows(lp, blocks, problem.polytope(), problem.t_max(), added, &r.lp_rounds,
+                                          options.lp_warm_start, &held);
     r.lp_iterations = sol.iterations;
     if (sol.status == detail::LpSolution::unbounded) {
       // Bound every coefficient: when the optimum then keeps away from the cap, it is the
@@ -402,7 +406,8 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
       lp.col_hi.assign(K, cap);
       report_progress(progress, "forces", 0.25);  // between the two LPs
       const detail::LpSolution capped =
-          detail::solve_lp_with_torque_rows(lp, blocks, problem.polytope(), problem.t_max(), added, &r.lp_rounds);
+          detail::solve_lp_with_torque_rows(lp, blocks, problem.polytope(), problem.t_max(), added, &r.lp_rounds,
+                                          options.lp_warm_start, &held);
       r.lp_iterations += capped.iterations;
       std::string names;
       if (capped.status == detail::LpSolution::optimal)
@@ -461,7 +466,8 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
       padded.A.leftCols(K) = blocks.A;
       std::set<std::pair<int, int>> tie_added = added;
       const detail::LpSolution tied =
-          detail::solve_lp_with_torque_rows(tie, padded, problem.polytope(), problem.t_max(), tie_added, &r.lp_rounds);
+          detail::solve_lp_with_torque_rows(tie, padded, problem.polytope(), problem.t_max(), tie_added, &r.lp_rounds,
+                                          options.lp_warm_start, &held);
       r.lp_iterations += tied.iterations;
       if (tied.status == detail::LpSolution::optimal)
         for (int j = 0; j < K; ++j) a(j) = std::max(0.0, tied.x[j]);

@@ -23,6 +23,11 @@ int swallow_output(void*, const char*) { return 1; }
 
 unsigned glpk_generation() { return t_generation; }
 
+void free_glpk_environment() {
+  glp_free_env();
+  ++t_generation;
+}
+
 void configure_glpk() {
   if (t_configured == t_generation) return;
   glp_term_out(GLP_OFF);

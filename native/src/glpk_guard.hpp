@@ -20,6 +20,10 @@ namespace wiresculpt::detail {
 /// Increases each time GLPK's environment was freed after an internal error on this thread.
 unsigned glpk_generation();
 
+/// Frees this thread's GLPK environment (every problem object in it; glpk_generation() increases).
+/// GLPK does not free it when a thread ends: a thread that solved LPs calls this before it ends.
+void free_glpk_environment();
+
 /// Turns GLPK's terminal output off for the current environment (the core never prints).
 void configure_glpk();
 

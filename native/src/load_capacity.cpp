@@ -1,6 +1,12 @@
 #include "wiresculpt/load_capacity.hpp"
 
+#include <atomic>
+#include <cstdlib>
 #include <chrono>
+#include <exception>
+#include <optional>
+#include <system_error>
+#include <thread>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -25,6 +31,7 @@ LoadCapacityResult load_capacity(const Network& net, const std::vector<int>& cut
   if (!positive(options.gravity)) throw InputError("gravity must be a finite number of m/s^2 > 0");
   if (!std::isfinite(options.tie_tolerance) || options.tie_tolerance < 0)
     throw InputError("tie_tolerance must be a finite number of metres >= 0");
+  if (options.threads < 1 || options.threads > 2) throw InputError("load capacity: threads must be 1 or 2");
   const int K = problem.columns();
   if (a0.size() != K)
     throw InputError("load capacity: expected " + std::to_string(K) + " pre-stress coefficients, got " +
@@ -75,9 +82,9 @@ LoadCapacityResult load_capacity(const Network& net, const std::vector<int>& cut
     if (row != T.rows()) throw InputError("load capacity: the cuts differ from those of the force problem");
   }
 
-  const char* names[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
-  for (int dir = 0; dir < 6; ++dir) {
-    report_progress(progress, "load_capacity", dir / 6.0);
+  // One direction's LP; reads only what is above (shared, unchanged), so two threads can run it.
+  auto solve_direction = [&](int dir) {
+    static const char* const names[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
     LoadDirection ld;
     ld.name = names[dir];
     ld.gravity = Vec3::Zero();
@@ -159,14 +166,16 @@ LoadCapacityResult load_capacity(const Network& net, const std::vector<int>& cut
       blocks.c.segment<3>(b) = T3a0.segment<3>(3 * torque_row[i]);
     }
     std::set<std::pair<int, int>> added;
-    detail::LpSolution sol = detail::solve_lp_with_torque_rows(lp, blocks, polytope, t_max, added, &ld.lp_rounds);
+    detail::LpSolution sol = detail::solve_lp_with_torque_rows(lp, blocks, polytope, t_max, added, &ld.lp_rounds,
+                                                                     options.lp_warm_start);
     ld.lp_iterations = sol.iterations;
     if (sol.status == detail::LpSolution::unbounded) {
       // Cap λ: an optimum well below the cap is the problem's (rows not yet added had left λ
       // free); one at the cap means that nothing but the cones limits the load.
       const double cap = 1e8;
       lp.col_hi[K] = cap;
-      const detail::LpSolution capped = detail::solve_lp_with_torque_rows(lp, blocks, polytope, t_max, added, &ld.lp_rounds);
+      const detail::LpSolution capped = detail::solve_lp_with_torque_rows(lp, blocks, polytope, t_max, added, &ld.lp_rounds,
+                                                                     options.lp_warm_start);
       ld.lp_iterations += capped.iterations;
       if (capped.status == detail::LpSolution::optimal && capped.x[K] < 0.5 * cap) sol = capped;
     }
@@ -194,8 +203,46 @@ LoadCapacityResult load_capacity(const Network& net, const std::vector<int>& cut
       default:
         ld.status = "failed";
     }
-    out.directions.push_back(ld);
+    return ld;
+  };
+
+  out.directions.resize(6);
+  // Direction 0's report comes first, before the second thread starts: every run reports at least
+  // this and the closing 1.0, however the threads share the directions.
+  report_progress(progress, "load_capacity", 0.0);
+  std::optional<std::thread> worker;
+  std::atomic<int> next{0};
+  std::atomic<bool> stop{false};
+  std::exception_ptr worker_error;
+  if (options.threads >= 2) {
+    // The second thread takes directions as the calling one does; it never calls `progress` (the
+    // caller's callback may need its thread, e.g. Python's GIL held by it) and frees its GLPK
+    // environment when done (GLPK keeps one per thread, docs/robustness.md).
+    try {
+      worker.emplace([&] {
+        try {
+          for (int d; !stop && (d = next++) < 6;) out.directions[d] = solve_direction(d);
+        } catch (...) {
+          worker_error = std::current_exception();
+          stop = true;
+        }
+        detail::free_thread_glpk();
+      });
+    } catch (const std::system_error&) {  // no thread to be had: the calling thread does them all
+    }
   }
+  try {
+    for (int d; !stop && (d = next++) < 6;) {
+      if (d > 0) report_progress(progress, "load_capacity", d / 6.0);
+      out.directions[d] = solve_direction(d);
+    }
+  } catch (...) {
+    stop = true;
+    if (worker) worker->join();
+    throw;
+  }
+  if (worker) worker->join();
+  if (worker_error) std::rethrow_exception(worker_error);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   report_progress(progress, "load_capacity", 1.0);
   return out;

@@ -18,6 +18,8 @@ namespace {
 // factorisation fail, so a problem holding one is refused before GLPK sees it
 // (docs/robustness.md).
 constexpr double kLargest = 1e100, kSmallest = 1e-100;
+// Entries below this fraction of their column's largest are rounding noise (solve_lp).
+constexpr double kNoise = 1e-13;
 
 int bound_type(double lo, double hi) {
   const bool l = std::isfinite(lo), h = std::isfinite(hi);
@@ -27,25 +29,120 @@ int bound_type(double lo, double hi) {
   return GLP_FR;
 }
 
-// Everything GLPK needs, as plain arrays, and what it answers: the body below runs inside
-// run_guarded (only trivially destructible locals, nothing that throws).
-struct OneShot {
-  int rows, cols, entries;
-  int dir;
+double finite_or_zero(double v) { return std::isfinite(v) ? v : 0.0; }
+
+// The first number GLPK cannot take among the triplets from `first_tri`, the objective and column
+// bounds (when `columns`) and the row bounds from `first_row`, as a sentence; empty when all are
+// fine. solve_lp checks the whole problem; the cutting-plane rounds only the rows they add.
+std::string out_of_range(const LinearProgram& in, std::size_t first_tri, std::size_t first_row, bool columns) {
+  auto bad = [](double v, bool nonzero_entry) {
+    if (!std::isfinite(v)) return true;
+    const double a = std::abs(v);
+    return a > kLargest || (nonzero_entry && a < kSmallest);
+  };
+  auto say = [](const std::string& what, double v) {
+    std::ostringstream s;
+    s << what << " is " << v << ", outside the range the LP solver handles (magnitudes 1e-100 to 1e100)";
+    return s.str();
+  };
+  for (std::size_t t = first_tri; t < in.tri_val.size(); ++t)
+    if (in.tri_val[t] != 0.0 && bad(in.tri_val[t], true))
+      return say("a coefficient (row " + std::to_string(in.tri_row[t]) + ", column " + std::to_string(in.tri_col[t]) + ")",
+                 in.tri_val[t]);
+  if (columns)
+    for (std::size_t j = 0; j < in.obj.size(); ++j)
+      if (bad(in.obj[j], false)) return say("objective coefficient " + std::to_string(j), in.obj[j]);
+  auto bound_bad = [&](double v) { return std::isnan(v) || (std::isfinite(v) && bad(v, false)); };
+  for (std::size_t r = first_row; r < in.row_lo.size(); ++r)
+    if (bound_bad(in.row_lo[r]) || bound_bad(in.row_hi[r]))
+      return say("a bound of row " + std::to_string(r), bound_bad(in.row_lo[r]) ? in.row_lo[r] : in.row_hi[r]);
+  if (columns)
+    for (std::size_t j = 0; j < in.col_lo.size(); ++j)
+      if (bound_bad(in.col_lo[j]) || bound_bad(in.col_hi[j]))
+        return say("a bound of column " + std::to_string(j), bound_bad(in.col_lo[j]) ? in.col_lo[j] : in.col_hi[j]);
+  return {};
+}
+
+// The rows [first_row, R) of a problem as GLPK takes them: the triplets from `first_tri` that are
+// not rounding noise (|a| > kNoise × the largest |a| of their column, `col_max`), 1-based, in the
+// triplets' order (slot 0 unused, as GLPK wants), with the smallest kept |a| of each column
+// lowered into `col_min_kept`; and each row's type and finite bounds. A row left empty is free
+// when its bounds admit 0 up to rounding; `infeasible` is set when one does not.
+struct GlpkRows {
+  std::vector<int> row, col;  // 1-based, in triplet order (glp_load_matrix)
+  std::vector<double> val;
+  std::vector<int> type;
+  std::vector<double> lo, hi;
+  bool infeasible = false;
+};
+
+GlpkRows glpk_rows(const LinearProgram& in, std::size_t first_tri, std::size_t first_row,
+                   const std::vector<double>& col_max, std::vector<double>* col_min_kept) {
+  const std::size_t R = in.row_lo.size();
+  GlpkRows g;
+  g.row.push_back(0);
+  g.col.push_back(0);
+  g.val.push_back(0.0);
+  std::vector<char> used(R - first_row, 0);
+  for (std::size_t t = first_tri; t < in.tri_val.size(); ++t) {
+    const double a = std::abs(in.tri_val[t]);
+    if (!(a > kNoise * col_max[in.tri_col[t]])) continue;
+    g.row.push_back(in.tri_row[t] + 1);
+    g.col.push_back(in.tri_col[t] + 1);
+    g.val.push_back(in.tri_val[t]);
+    used[in.tri_row[t] - first_row] = 1;
+    double& m = (*col_min_kept)[in.tri_col[t]];
+    m = std::min(m, a);
+  }
+  for (std::size_t r = first_row; r < R; ++r) {
+    const bool u = used[r - first_row];
+    if (!u && (in.row_lo[r] > 1e-9 * (1.0 + std::abs(in.row_lo[r])) ||
+               in.row_hi[r] < -1e-9 * (1.0 + std::abs(in.row_hi[r]))))
+      g.infeasible = true;
+    g.type.push_back(u ? bound_type(in.row_lo[r], in.row_hi[r]) : GLP_FR);
+    g.lo.push_back(finite_or_zero(in.row_lo[r]));
+    g.hi.push_back(finite_or_zero(in.row_hi[r]));
+  }
+  return g;
+}
+
+// What a guarded GLPK body is given and answers. Bodies run inside run_guarded: only trivially
+// destructible locals, nothing that throws.
+struct GlpkCall {
+  glp_prob* p;
+  int dir, cols;  // the direction and every column's count
+  // build: every column; extend: the new columns only
+  const int* col_type;
+  const double *col_lo, *col_hi;
+  const double* obj;  // every column
+  int set_objective;  // extend: the objective or direction changed, or columns were added
+  // build: every row; extend: the new rows
+  int rows, entries;
   const int* row_type;
   const double *row_lo, *row_hi;
-  const int* col_type;
-  const double *col_lo, *col_hi, *obj;
   const int *ia, *ja;
   const double* ar;
+  int new_cols;  // extend
+  // answers
   double* x;  // cols entries
   int ret, status, iterations;
   double objective;
 };
 
-void one_shot_body(void* c) {
-  OneShot& q = *static_cast<OneShot*>(c);
+void read_answer(GlpkCall& q) {
+  q.status = glp_get_status(q.p);
+  if (q.ret == 0 && q.status == GLP_OPT) {
+    for (int j = 0; j < q.cols; ++j) q.x[j] = glp_get_col_prim(q.p, j + 1);
+    q.objective = glp_get_obj_val(q.p);
+  }
+}
+
+// A new problem holding everything, scaled, solved with presolve (and without it when the
+// presolved solve stopped with an error). Leaves the problem alive in q.p.
+void build_body(void* c) {
+  GlpkCall& q = *static_cast<GlpkCall*>(c);
   glp_prob* lp = glp_create_prob();
+  q.p = lp;
   glp_set_obj_dir(lp, q.dir);
   if (q.rows > 0) glp_add_rows(lp, q.rows);
   if (q.cols > 0) glp_add_cols(lp, q.cols);
@@ -67,104 +164,62 @@ void one_shot_body(void* c) {
     ret = glp_simplex(lp, &parm);
   }
   q.ret = ret;
-  q.status = glp_get_status(lp);
-  if (ret == 0 && q.status == GLP_OPT) {
-    for (int j = 0; j < q.cols; ++j) q.x[j] = glp_get_col_prim(lp, j + 1);
-    q.objective = glp_get_obj_val(lp);
-  }
   q.iterations = glp_get_it_cnt(lp);
-  glp_delete_prob(lp);
+  read_answer(q);
 }
 
-// The first number of the problem GLPK cannot take, as a sentence; empty when all are fine.
-std::string out_of_range(const LinearProgram& in) {
-  auto bad = [](double v, bool nonzero_entry) {
-    if (!std::isfinite(v)) return true;
-    const double a = std::abs(v);
-    return a > kLargest || (nonzero_entry && a < kSmallest);
-  };
-  auto say = [](const std::string& what, double v) {
-    std::ostringstream s;
-    s << what << " is " << v << ", outside the range the LP solver handles (magnitudes 1e-100 to 1e100)";
-    return s.str();
-  };
-  for (std::size_t t = 0; t < in.tri_val.size(); ++t)
-    if (in.tri_val[t] != 0.0 && bad(in.tri_val[t], true))
-      return say("a coefficient (row " + std::to_string(in.tri_row[t]) + ", column " + std::to_string(in.tri_col[t]) + ")",
-                 in.tri_val[t]);
-  for (std::size_t j = 0; j < in.obj.size(); ++j)
-    if (bad(in.obj[j], false)) return say("objective coefficient " + std::to_string(j), in.obj[j]);
-  auto bound_bad = [&](double v) { return std::isnan(v) || (std::isfinite(v) && bad(v, false)); };
-  for (std::size_t r = 0; r < in.row_lo.size(); ++r)
-    if (bound_bad(in.row_lo[r]) || bound_bad(in.row_hi[r]))
-      return say("a bound of row " + std::to_string(r), bound_bad(in.row_lo[r]) ? in.row_lo[r] : in.row_hi[r]);
-  for (std::size_t j = 0; j < in.col_lo.size(); ++j)
-    if (bound_bad(in.col_lo[j]) || bound_bad(in.col_hi[j]))
-      return say("a bound of column " + std::to_string(j), bound_bad(in.col_lo[j]) ? in.col_lo[j] : in.col_hi[j]);
-  return {};
+// Adds q.new_cols columns and q.rows rows (their entries sorted by row, q.ia 1-based row numbers
+// of the whole problem) with the new rows' auxiliary variables basic and the new columns
+// non-basic, scales the new rows, sets the objective when it changed, and re-solves from the last
+// basis: with the dual simplex when only rows were added (the old optimal basis stays dual
+// feasible; only the new rows' bounds are violated), else with the primal simplex (the old rows
+// are still satisfied; the new objective is not yet optimal).
+void extend_body(void* c) {
+  GlpkCall& q = *static_cast<GlpkCall*>(c);
+  glp_prob* lp = q.p;
+  const int before = glp_get_it_cnt(lp);
+  if (q.new_cols > 0) {
+    const int first = glp_add_cols(lp, q.new_cols);
+    for (int j = 0; j < q.new_cols; ++j) glp_set_col_bnds(lp, first + j, q.col_type[j], q.col_lo[j], q.col_hi[j]);
+  }
+  if (q.set_objective) {
+    glp_set_obj_dir(lp, q.dir);
+    for (int j = 0; j < q.cols; ++j) glp_set_obj_coef(lp, j + 1, q.obj[j]);
+  }
+  const int first = q.rows > 0 ? glp_add_rows(lp, q.rows) : 0;  // new rows are basic (GLP_BS)
+  int t = 1;
+  for (int r = 0; r < q.rows; ++r) {
+    const int i = first + r;
+    glp_set_row_bnds(lp, i, q.row_type[r], q.row_lo[r], q.row_hi[r]);
+    const int start = t;
+    double largest = 0.0;
+    while (t <= q.entries && q.ia[t] == i) {
+      largest = std::max(largest, std::abs(q.ar[t]) * glp_get_sjj(lp, q.ja[t]));
+      ++t;
+    }
+    if (t > start) {
+      glp_set_mat_row(lp, i, t - start, q.ja + start - 1, q.ar + start - 1);
+      // The row's scale factor as GLPK's equilibration would make it: its largest scaled entry 1,
+      // rounded to a power of 2 (no rounding error in the scaling).
+      int e = 0;
+      std::frexp(1.0 / largest, &e);
+      glp_set_rii(lp, i, std::ldexp(1.0, e - 1));
+    }
+  }
+  glp_smcp parm;
+  glp_init_smcp(&parm);
+  parm.msg_lev = GLP_MSG_OFF;
+  parm.presolve = GLP_OFF;
+  parm.meth = q.set_objective ? GLP_PRIMAL : GLP_DUALP;
+  q.ret = glp_simplex(lp, &parm);
+  q.iterations = glp_get_it_cnt(lp) - before;
+  read_answer(q);
 }
 
-}  // namespace
+void delete_body(void* c) { glp_delete_prob(static_cast<glp_prob*>(c)); }
 
-LpSolution solve_lp(const LinearProgram& in) {
+LpSolution interpret(const GlpkCall& q, std::vector<double>& x) {
   LpSolution out;
-  const int K = static_cast<int>(in.obj.size());
-  const int R = static_cast<int>(in.row_lo.size());
-  if (in.col_lo.size() != in.obj.size() || in.col_hi.size() != in.obj.size() || in.row_hi.size() != in.row_lo.size() ||
-      in.tri_row.size() != in.tri_val.size() || in.tri_col.size() != in.tri_val.size()) {
-    out.reason = "the LP's arrays differ in size";
-    return out;
-  }
-  for (std::size_t t = 0; t < in.tri_val.size(); ++t)
-    if (in.tri_row[t] < 0 || in.tri_row[t] >= R || in.tri_col[t] < 0 || in.tri_col[t] >= K) {
-      out.reason = "a coefficient names row " + std::to_string(in.tri_row[t]) + ", column " +
-                   std::to_string(in.tri_col[t]) + ", outside the LP";
-      return out;
-    }
-  out.reason = out_of_range(in);
-  if (!out.reason.empty()) return out;
-  // Entries below 1e-13 of their column's largest are rounding noise of cross products (a
-  // structural zero computed as 1e-19 would otherwise pin a variable); rows left empty become
-  // free when their bounds admit 0 up to rounding, else the LP is infeasible.
-  std::vector<double> col_max(K, 0.0);
-  for (std::size_t t = 0; t < in.tri_val.size(); ++t)
-    col_max[in.tri_col[t]] = std::max(col_max[in.tri_col[t]], std::abs(in.tri_val[t]));
-  std::vector<int> ia{0}, ja{0};
-  std::vector<double> ar{0.0};
-  std::vector<char> row_used(R, 0);
-  for (std::size_t t = 0; t < in.tri_val.size(); ++t) {
-    if (!(std::abs(in.tri_val[t]) > 1e-13 * col_max[in.tri_col[t]])) continue;
-    ia.push_back(in.tri_row[t] + 1);
-    ja.push_back(in.tri_col[t] + 1);
-    ar.push_back(in.tri_val[t]);
-    row_used[in.tri_row[t]] = 1;
-  }
-  for (int r = 0; r < R; ++r)
-    if (!row_used[r] && (in.row_lo[r] > 1e-9 * (1.0 + std::abs(in.row_lo[r])) ||
-                         in.row_hi[r] < -1e-9 * (1.0 + std::abs(in.row_hi[r])))) {
-      out.status = LpSolution::infeasible;
-      return out;
-    }
-  auto finite_or_zero = [](double v) { return std::isfinite(v) ? v : 0.0; };
-  std::vector<int> row_type(R), col_type(K);
-  std::vector<double> row_lo(R), row_hi(R), col_lo(K), col_hi(K), x(K, 0.0);
-  for (int r = 0; r < R; ++r) {
-    row_type[r] = row_used[r] ? bound_type(in.row_lo[r], in.row_hi[r]) : GLP_FR;
-    row_lo[r] = finite_or_zero(in.row_lo[r]);
-    row_hi[r] = finite_or_zero(in.row_hi[r]);
-  }
-  for (int j = 0; j < K; ++j) {
-    col_type[j] = bound_type(in.col_lo[j], in.col_hi[j]);
-    col_lo[j] = finite_or_zero(in.col_lo[j]);
-    col_hi[j] = finite_or_zero(in.col_hi[j]);
-  }
-  OneShot q{R, K, static_cast<int>(ar.size()) - 1, in.maximise ? GLP_MAX : GLP_MIN, row_type.data(), row_lo.data(),
-            row_hi.data(), col_type.data(), col_lo.data(), col_hi.data(), in.obj.data(), ia.data(), ja.data(),
-            ar.data(), x.data(), 0, 0, 0, 0.0};
-  if (!run_guarded(one_shot_body, &q)) {  // GLPK's environment (and the problem) is gone
-    out.reason = "GLPK stopped with an internal error";
-    return out;
-  }
   out.iterations = q.iterations;
   if (q.ret == 0 || q.ret == GLP_ENOPFS || q.ret == GLP_ENODFS) {
     if (q.ret == GLP_ENOPFS || q.status == GLP_NOFEAS) out.status = LpSolution::infeasible;
@@ -180,16 +235,185 @@ LpSolution solve_lp(const LinearProgram& in) {
   return out;
 }
 
+}  // namespace
+
+struct HeldLp::State {
+  glp_prob* p = nullptr;
+  unsigned generation = 0;  // GLPK's environment when `p` was made (glpk_guard.hpp)
+  // What of the LinearProgram GLPK holds: rows, triplets, and the columns' bounds and objective.
+  std::size_t rows = 0, tris = 0;
+  bool maximise = true;
+  std::vector<double> obj, col_lo, col_hi;
+  std::vector<double> col_max, col_min_kept;  // per column: largest entry, smallest entry kept
+  bool alive() const { return p && generation == glpk_generation(); }
+  void release() {
+    if (alive()) run_guarded(delete_body, p);
+    p = nullptr;
+  }
+};
+
+HeldLp::HeldLp() : s_(std::make_unique<State>()) {}
+HeldLp::~HeldLp() { s_->release(); }
+bool HeldLp::held() const { return s_->alive(); }
+
+LpSolution HeldLp::build(const LinearProgram& in) {
+  State& s = *s_;
+  s.release();
+  LpSolution out;
+  out.builds = 1;
+  const int K = static_cast<int>(in.obj.size());
+  const int R = static_cast<int>(in.row_lo.size());
+  if (in.col_lo.size() != in.obj.size() || in.col_hi.size() != in.obj.size() || in.row_hi.size() != in.row_lo.size() ||
+      in.tri_row.size() != in.tri_val.size() || in.tri_col.size() != in.tri_val.size()) {
+    out.reason = "the LP's arrays differ in size";
+    return out;
+  }
+  for (std::size_t t = 0; t < in.tri_val.size(); ++t)
+    if (in.tri_row[t] < 0 || in.tri_row[t] >= R || in.tri_col[t] < 0 || in.tri_col[t] >= K) {
+      out.reason = "a coefficient names row " + std::to_string(in.tri_row[t]) + ", column " +
+                   std::to_string(in.tri_col[t]) + ", outside the LP";
+      return out;
+    }
+  out.reason = out_of_range(in, 0, 0, true);
+  if (!out.reason.empty()) return out;
+  // Entries below 1e-13 of their column's largest are rounding noise of cross products (a
+  // structural zero computed as 1e-19 would otherwise pin a variable); rows left empty become
+  // free when their bounds admit 0 up to rounding, else the LP is infeasible.
+  std::vector<double> col_max(K, 0.0), col_min_kept(K, std::numeric_limits<double>::infinity());
+  for (std::size_t t = 0; t < in.tri_val.size(); ++t)
+    col_max[in.tri_col[t]] = std::max(col_max[in.tri_col[t]], std::abs(in.tri_val[t]));
+  const GlpkRows g = glpk_rows(in, 0, 0, col_max, &col_min_kept);
+  if (g.infeasible) {
+    out.status = LpSolution::infeasible;
+    return out;
+  }
+  std::vector<int> col_type(K);
+  std::vector<double> col_lo(K), col_hi(K), x(K, 0.0);
+  for (int j = 0; j < K; ++j) {
+    col_type[j] = bound_type(in.col_lo[j], in.col_hi[j]);
+    col_lo[j] = finite_or_zero(in.col_lo[j]);
+    col_hi[j] = finite_or_zero(in.col_hi[j]);
+  }
+  GlpkCall q{nullptr, in.maximise ? GLP_MAX : GLP_MIN, K, col_type.data(), col_lo.data(), col_hi.data(),
+             in.obj.data(), 0, R, static_cast<int>(g.val.size()) - 1, g.type.data(), g.lo.data(), g.hi.data(),
+             g.row.data(), g.col.data(), g.val.data(), 0, x.data(), 0, 0, 0, 0.0};
+  const unsigned generation = glpk_generation();
+  if (!run_guarded(build_body, &q)) {  // GLPK's environment (and the problem) is gone
+    out.reason = "GLPK stopped with an internal error";
+    return out;
+  }
+  s.p = q.p;
+  s.generation = generation;
+  s.rows = in.row_lo.size();
+  s.tris = in.tri_val.size();
+  s.maximise = in.maximise;
+  s.obj = in.obj;
+  s.col_lo = in.col_lo;
+  s.col_hi = in.col_hi;
+  s.col_max = std::move(col_max);
+  s.col_min_kept = std::move(col_min_kept);
+  LpSolution sol = interpret(q, x);
+  sol.builds = 1;
+  return sol;
+}
+
+LpSolution HeldLp::extend(const LinearProgram& in) {
+  State& s = *s_;
+  LpSolution out;
+  out.reason = "the LP is not the one GLPK holds grown by rows and columns";
+  const std::size_t R = in.row_lo.size(), T = in.tri_val.size(), K = in.obj.size(), K0 = s.obj.size();
+  if (!s.alive() || K < K0 || in.col_lo.size() != K || in.col_hi.size() != K || in.row_hi.size() != R || R < s.rows ||
+      T < s.tris || in.tri_row.size() != T || in.tri_col.size() != T)
+    return out;
+  for (std::size_t j = 0; j < K0; ++j)
+    if (in.col_lo[j] != s.col_lo[j] || in.col_hi[j] != s.col_hi[j]) return out;
+  for (std::size_t t = s.tris; t < T; ++t)
+    if (in.tri_row[t] < static_cast<int>(s.rows) || in.tri_row[t] >= static_cast<int>(R) || in.tri_col[t] < 0 ||
+        in.tri_col[t] >= static_cast<int>(K) || (t > s.tris && in.tri_row[t] < in.tri_row[t - 1]))
+      return out;
+  std::string bad = out_of_range(in, s.tris, s.rows, true);
+  if (!bad.empty()) {
+    out.reason = std::move(bad);
+    return out;
+  }
+  std::vector<double> col_max = s.col_max;
+  col_max.resize(K, 0.0);
+  for (std::size_t t = s.tris; t < T; ++t)
+    col_max[in.tri_col[t]] = std::max(col_max[in.tri_col[t]], std::abs(in.tri_val[t]));
+  for (std::size_t j = 0; j < K0; ++j)
+    if (!(s.col_min_kept[j] > kNoise * col_max[j])) return out;  // an entry held would be noise now
+  std::vector<double> col_min_kept = s.col_min_kept;
+  col_min_kept.resize(K, std::numeric_limits<double>::infinity());
+  const GlpkRows g = glpk_rows(in, s.tris, s.rows, col_max, &col_min_kept);
+  if (g.infeasible) {
+    out.reason.clear();
+    out.status = LpSolution::infeasible;
+    return out;
+  }
+  // New columns, and the objective where it changed (the least-out-of-plane LP after the force LP).
+  const int new_cols = static_cast<int>(K - K0);
+  std::vector<int> col_type(new_cols);
+  std::vector<double> col_lo(new_cols), col_hi(new_cols);
+  for (int j = 0; j < new_cols; ++j) {
+    col_type[j] = bound_type(in.col_lo[K0 + j], in.col_hi[K0 + j]);
+    col_lo[j] = finite_or_zero(in.col_lo[K0 + j]);
+    col_hi[j] = finite_or_zero(in.col_hi[K0 + j]);
+  }
+  const bool same_objective = in.maximise == s.maximise && new_cols == 0 && in.obj == s.obj;
+  std::vector<double> x(K, 0.0);
+  GlpkCall q{s.p, in.maximise ? GLP_MAX : GLP_MIN, static_cast<int>(K), col_type.data(), col_lo.data(),
+             col_hi.data(), in.obj.data(), same_objective ? 0 : 1, static_cast<int>(R - s.rows),
+             static_cast<int>(g.val.size()) - 1, g.type.data(), g.lo.data(), g.hi.data(), g.row.data(),
+             g.col.data(), g.val.data(), new_cols, x.data(), 0, 0, 0, 0.0};
+  if (!run_guarded(extend_body, &q)) {
+    s.p = nullptr;
+    out.reason = "GLPK stopped with an internal error";
+    return out;
+  }
+  s.rows = R;
+  s.tris = T;
+  s.maximise = in.maximise;
+  s.obj = in.obj;
+  s.col_lo = in.col_lo;
+  s.col_hi = in.col_hi;
+  s.col_max = std::move(col_max);
+  s.col_min_kept = std::move(col_min_kept);
+  return interpret(q, x);
+}
+
+
+void free_thread_glpk() { free_glpk_environment(); }
+
+LpSolution solve_lp(const LinearProgram& in) { return HeldLp().build(in); }
+
 
 LpSolution solve_lp_with_torque_rows(LinearProgram& lp, const TorqueBlocks& blocks, const TorquePolytope& polytope,
-                                     double t_max, std::set<std::pair<int, int>>& added, int* rounds) {
+                                     double t_max, std::set<std::pair<int, int>>& added, int* rounds, bool warm_start,
+                                     HeldLp* keep) {
   const Eigen::Index V = blocks.A.rows() / 3, cols = blocks.A.cols();
-  int iterations = 0;
+  int iterations = 0, builds = 0, warm = 0;
+  HeldLp own;
+  HeldLp& held = keep ? *keep : own;
   for (;;) {
-    LpSolution sol = solve_lp(lp);
+    LpSolution sol;
+    if (warm_start && held.held()) {
+      sol = held.extend(lp);
+      if (sol.status == LpSolution::optimal) {
+        ++warm;
+      } else {  // whatever stopped the warm solve, the rebuilt problem answers (never a worse answer)
+        iterations += sol.iterations;
+        sol = held.build(lp);
+        ++builds;
+      }
+    } else {
+      sol = held.build(lp);
+      ++builds;
+    }
     if (rounds) ++*rounds;
     iterations += sol.iterations;
     sol.iterations = iterations;
+    sol.builds = builds;
+    sol.warm_solves = warm;
     if (sol.status != LpSolution::optimal) return sol;
     const Eigen::Map<const Eigen::VectorXd> x(sol.x.data(), cols);
     const Eigen::VectorXd t = blocks.A * x + blocks.c;

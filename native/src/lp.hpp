@@ -6,8 +6,10 @@
 // and docs/method-layering.md (stability); GLPK's failure modes: docs/robustness.md.
 //
 // Two shapes of problem:
-//   LinearProgram / solve_lp      one LP, built and solved once (presolve on): forces, torque
-//                                 rows, in-plane balance, load capacity.
+//   LinearProgram / solve_lp      one LP, built and solved once (presolve on): in-plane balance;
+//                                 solve_lp_with_torque_rows keeps it in GLPK across its rounds and
+//                                 re-solves from the last basis after adding rows (dual simplex):
+//                                 forces, torque rows, load capacity.
 //   EqualityLp                    min c·x subject to A x = b, x >= 0, kept alive between solves
 //                                 so that a new right-hand side b restarts from the last basis
 //                                 (dual simplex): the stability checks of Eq. 1, which solve one
@@ -37,6 +39,12 @@ struct LpSolution {
   std::vector<double> x;
   double objective = 0.0;
   int iterations = 0;
+  /// GLPK problems built from scratch (presolve on) for this answer: 1 for solve_lp; for
+  /// solve_lp_with_torque_rows 1 when every later round was warm-started.
+  int builds = 0;
+  /// solve_lp_with_torque_rows: rounds re-solved from the previous round's basis (rows added,
+  /// dual simplex) and kept (a warm solve that stops short of an optimum is redone by a build).
+  int warm_solves = 0;
   /// When `failed`: why, as a clause ("a coefficient (row 3, column 1) is 1e-300, outside the
   /// range the LP solver handles (magnitudes 1e-100 to 1e100)", "GLPK stopped with an internal
   /// error"); empty otherwise.
@@ -49,6 +57,31 @@ struct LpSolution {
 /// runs inside glpk_guard's run_guarded. Matrix entries below 1e-13 of their column's largest are
 /// dropped as rounding noise.
 LpSolution solve_lp(const LinearProgram& lp);
+
+/// A GLPK problem kept alive between solves on the calling thread (every GLPK call guarded, as
+/// solve_lp's). build() makes it from a whole LinearProgram, exactly as solve_lp solves it
+/// (checks, noise drop, presolve on). extend() takes the same program grown by rows and columns
+/// only (the held rows and the held columns' bounds unchanged, each new triplet in a new row, rows
+/// in order; the objective and its direction may change) and re-solves from the last basis, the new
+/// rows' auxiliary variables basic: the dual simplex when only rows were added, else the primal
+/// simplex. It applies solve_lp's checks and noise rule to what is new and returns `failed`,
+/// leaving the held problem as it was, when the program is not such a growth of the held one or a
+/// held entry would now count as noise (a rebuild answers then). After a GLPK internal error
+/// nothing is held. solve_lp_with_torque_rows uses one, and passes it on when given.
+class HeldLp {
+ public:
+  HeldLp();
+  ~HeldLp();
+  HeldLp(const HeldLp&) = delete;
+  HeldLp& operator=(const HeldLp&) = delete;
+  bool held() const;
+  LpSolution build(const LinearProgram& lp);
+  LpSolution extend(const LinearProgram& lp);
+
+ private:
+  struct State;
+  std::unique_ptr<State> s_;
+};
 
 /// Torques linear in an LP's columns x: block v (rows 3v..3v+2) is t_v = A_v x + c_v, its
 /// components along the wire's n, u, v.
@@ -64,8 +97,25 @@ struct TorqueBlocks {
 /// set). `added` holds the (block, row) pairs already in `lp`; `rounds` counts the solves.
 /// Returns the last solution (when not optimal, GLPK's status with the rows so far), with the
 /// simplex iterations of every solve.
+///
+/// `warm_start` (default): the first round builds the GLPK problem as solve_lp does (the same
+/// input checks, presolve on; or extends `keep`'s); each later round adds only the new rows to it (checked and their
+/// noise dropped as solve_lp would, their auxiliary variables basic) and re-solves from the
+/// previous optimal basis with the dual simplex, which that basis stays feasible for. A warm solve
+/// that does not end optimal, or rows that would change which held entries are noise, fall back
+/// to a build of the whole `lp` (presolve on), so the answer is never worse than a rebuild's.
+/// false: every round builds from scratch (the behaviour before; tests compare the two).
+/// `keep` (optional): the held problem to start from and to leave the last one in, so that a
+/// later loop over a grown `lp` starts from this one's optimal basis (the forces' least-out-of-
+/// plane LP, which adds rows, columns and a new objective to the force LP).
 LpSolution solve_lp_with_torque_rows(LinearProgram& lp, const TorqueBlocks& blocks, const TorquePolytope& polytope,
-                                     double t_max, std::set<std::pair<int, int>>& added, int* rounds);
+                                     double t_max, std::set<std::pair<int, int>>& added, int* rounds,
+                                     bool warm_start = true, HeldLp* keep = nullptr);
+
+/// Frees the calling thread's GLPK environment (GLPK keeps one per thread and does not free it
+/// when the thread ends, ~5 kB each): a thread started to solve LPs calls this last. Problems
+/// still held on the thread are gone after it (EqualityLp::solve then says internal_error).
+void free_thread_glpk();
 
 /// min c·x subject to A x = b, x >= 0 (A rows × cols, given as triplets with 0-based indices),
 /// kept in GLPK between solves: solve(b) changes only the rows whose b changed and restarts the

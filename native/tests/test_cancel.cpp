@@ -123,8 +123,13 @@ TEST_CASE("cancel: the force LP and the load-capacity LPs", "[cancel]") {
     CountingProgress stages;
     load_capacity(net, cuts, problem, before.coefficients, {}, stages.fn());
     CHECK(stages.stages == std::vector<std::string>{"load_capacity"});
+    // On one thread: once before each direction and at the end. (On two, the calling thread
+    // reports before direction 0, before each other direction it takes, and at the end: the
+    // count depends on the threads' timing; test_load_capacity.cpp cancels those runs.)
+    LoadCapacityOptions serial;
+    serial.threads = 1;
     const int calls = cancel_at_every_call(
-        [&](const ProgressFn& p) { load_capacity(net, cuts, problem, before.coefficients, {}, p); });
+        [&](const ProgressFn& p) { load_capacity(net, cuts, problem, before.coefficients, serial, p); });
     CHECK(calls == 6 + 1);
     const LoadCapacityResult after = load_capacity(net, cuts, problem, before.coefficients);
     REQUIRE(after.directions.size() == 6);

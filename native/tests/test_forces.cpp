@@ -494,6 +494,62 @@ TEST_CASE("forces: on random networks every 3D torque stays within t_max", "[for
   CHECK(tested >= 10);
 }
 
+TEST_CASE("forces: warm-started cutting planes reach the rebuilt LP optima on random networks", "[forces][torque][warm]") {
+  // The force LP and the least-out-of-plane LP after it, each a cutting-plane loop over the 3D
+  // polytope's rows (the second starts from the first's basis): re-solving the problem GLPK holds
+  // from its last basis must give the optimum that rebuilding every round gives (relative 1e-7),
+  // with every 3D torque within t_max.
+  std::mt19937 rng(41);
+  int tested = 0;
+  for (int attempt = 0; attempt < 300 && tested < 10; ++attempt) {
+    fixtures::HookedNetwork h;
+    if (!fixtures::random_hooked_sphere(rng, attempt, 32, h)) continue;
+    ForceOptions o;
+    o.torque_fraction = attempt % 2 ? 1.0 : 0.4;
+    o.algorithm = ForceAlgorithm::lp;
+    o.least_out_of_plane = attempt % 3 != 0;
+    const auto cuts = choose_cuts(h.net);
+    ForceResult warm, cold;
+    ForceOptions rebuilt = o;
+    rebuilt.lp_warm_start = false;
+    try {
+      cold = optimize_forces(h.net, h.hooks, h.steps, cuts, rebuilt);
+    } catch (const SolverError&) {
+      CHECK_THROWS_AS(optimize_forces(h.net, h.hooks, h.steps, cuts, o), SolverError);
+      continue;
+    }
+    warm = optimize_forces(h.net, h.hooks, h.steps, cuts, o);
+    ++tested;
+    INFO("attempt " << attempt);
+    if (o.least_out_of_plane) {
+      // The second LP's optimum is its objective, the least Σ_c Σ_w |f_c · n_w| (summed here from
+      // the forces), with G_stb kept within tie_tolerance of the first LP's optimum (which of the
+      // G_stb values in that band it returns is not unique).
+      auto out_of_plane = [&](const ForceResult& f) {
+        double sum = 0.0, scale = 0.0;
+        for (std::size_t c = 0; c < h.net.crossings.size(); ++c) {
+          for (int w : h.net.crossings[c].wires) sum += std::abs(f.forces[c].dot(h.net.wires[w].plane.normal));
+          scale += f.forces[c].norm();
+        }
+        return std::pair{sum, scale};
+      };
+      const auto [warm_sum, scale] = out_of_plane(warm);
+      CHECK(warm_sum == Approx(out_of_plane(cold).first).epsilon(1e-7).margin(1e-9 * scale));
+      ForceOptions first = o;
+      first.least_out_of_plane = false;
+      const double best = optimize_forces(h.net, h.hooks, h.steps, cuts, first).g_stb;
+      CHECK(warm.g_stb >= (1 - o.tie_tolerance) * best * (1 - 1e-9));
+    } else {
+      CHECK(warm.g_stb == Approx(cold.g_stb).epsilon(1e-7).margin(1e-12));
+    }
+    for (int w = 0; w < static_cast<int>(h.net.wires.size()); ++w)
+      CHECK(fixtures::max_torque_3d(h.net.wires[w], cuts[w], wire_loads(h.net, h.hooks, warm.forces, w)) <=
+            warm.t_max * (1 + 1e-7));
+    CHECK(warm.equilibrium_residual < 1e-9);
+  }
+  CHECK(tested >= 8);
+}
+
 TEST_CASE("forces: out-of-plane shares are per wire, in that wire's own plane", "[forces][share]") {
   // Two wires in perpendicular planes (normals z and x) crossing at the origin on their common
   // line d = z × x = y. Only the planes and the crossing matter for the shares.

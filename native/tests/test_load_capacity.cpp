@@ -9,6 +9,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <thread>
 
 #include "wire_fixtures.hpp"
 
@@ -163,4 +164,124 @@ TEST_CASE("load: on random networks every 3D torque at the limit load stays with
   }
   CHECK(tested >= 8);
   CHECK(lower > 0);
+}
+
+TEST_CASE("load: warm-started cutting planes give the rebuilt capacities on random networks", "[load][torque][warm]") {
+  // Each direction's LP is a cutting-plane loop over the 3D polytope's rows: re-solving the
+  // problem GLPK holds from its last basis must give the capacity that rebuilding every round
+  // gives (relative 1e-7), direction by direction.
+  std::mt19937 rng(37);
+  int tested = 0, finite = 0;
+  for (int attempt = 0; attempt < 300 && tested < 8; ++attempt) {
+    fixtures::HookedNetwork h;
+    if (!fixtures::random_hooked_sphere(rng, attempt, 32, h)) continue;
+    const auto cuts = choose_cuts(h.net);
+    ForceOptions fo;
+    fo.torque_fraction = 0.5;
+    ForceResult pre;
+    try {
+      pre = optimize_forces(h.net, h.hooks, h.steps, cuts, fo);
+    } catch (const SolverError&) {
+      continue;
+    }
+    ++tested;
+    INFO("attempt " << attempt);
+    const ForceProblem problem(h.net, h.hooks, h.steps, cuts, fo);
+    LoadCapacityOptions lo;
+    const LoadCapacityResult warm = load_capacity(h.net, cuts, problem, pre.coefficients, lo);
+    lo.lp_warm_start = false;
+    const LoadCapacityResult cold = load_capacity(h.net, cuts, problem, pre.coefficients, lo);
+    REQUIRE(warm.directions.size() == 6);
+    for (std::size_t d = 0; d < 6; ++d) {
+      INFO("gravity " << cold.directions[d].name);
+      CHECK(warm.directions[d].status == cold.directions[d].status);
+      CHECK(warm.directions[d].multiple == Approx(cold.directions[d].multiple).epsilon(1e-7).margin(1e-12));
+      if (std::isfinite(cold.directions[d].multiple) && cold.directions[d].multiple > 0) ++finite;
+    }
+  }
+  CHECK(tested >= 6);
+  CHECK(finite >= 12);  // capacities that are neither 0 nor unbounded
+}
+
+TEST_CASE("load: two threads give the serial capacities direction by direction, progress only from the caller",
+          "[load][threads]") {
+  // The six directions' LPs are independent: solved on the calling thread and a second one they
+  // must be exactly the serial ones (GLPK keeps a state per thread, docs/robustness.md), in the
+  // order +x, -x, +y, -y, +z, -z; the progress callback is only ever called from the calling thread.
+  std::mt19937 rng(43);
+  int tested = 0;
+  for (int attempt = 0; attempt < 300 && tested < 6; ++attempt) {
+    fixtures::HookedNetwork h;
+    if (!fixtures::random_hooked_sphere(rng, attempt, 32, h)) continue;
+    const auto cuts = choose_cuts(h.net);
+    ForceOptions fo;
+    fo.torque_fraction = 0.5;
+    ForceResult pre;
+    try {
+      pre = optimize_forces(h.net, h.hooks, h.steps, cuts, fo);
+    } catch (const SolverError&) {
+      continue;
+    }
+    ++tested;
+    INFO("attempt " << attempt);
+    const ForceProblem problem(h.net, h.hooks, h.steps, cuts, fo);
+    LoadCapacityOptions lo;
+    lo.threads = 1;
+    const LoadCapacityResult serial = load_capacity(h.net, cuts, problem, pre.coefficients, lo);
+    lo.threads = 2;
+    const std::thread::id caller = std::this_thread::get_id();
+    int calls = 0, elsewhere = 0;
+    const ProgressFn progress = [&](std::string_view stage, double) {
+      ++calls;
+      if (std::this_thread::get_id() != caller || stage != "load_capacity") ++elsewhere;
+      return true;
+    };
+    const LoadCapacityResult two = load_capacity(h.net, cuts, problem, pre.coefficients, lo, progress);
+    CHECK(calls >= 2);  // at least before direction 0 and at the end
+    CHECK(elsewhere == 0);
+    REQUIRE(two.directions.size() == 6);
+    const char* names[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
+    for (std::size_t d = 0; d < 6; ++d) {
+      const LoadDirection &a = serial.directions[d], &b = two.directions[d];
+      INFO("gravity " << a.name);
+      CHECK(b.name == names[d]);
+      CHECK(b.name == a.name);
+      CHECK(b.status == a.status);
+      CHECK(b.multiple == a.multiple);  // exactly
+      CHECK(b.base == a.base);
+      CHECK(b.lp_rounds == a.lp_rounds);
+      CHECK(b.lp_iterations == a.lp_iterations);
+      CHECK(b.coefficients.size() == a.coefficients.size());
+      if (b.coefficients.size() == a.coefficients.size()) CHECK(b.coefficients == a.coefficients);
+    }
+    CHECK(two.length == serial.length);
+    CHECK(two.weight == serial.weight);
+  }
+  CHECK(tested >= 5);
+}
+
+TEST_CASE("load: cancelling with two threads throws Cancelled on the calling thread; threads 0 or 3 is an input error",
+          "[load][threads]") {
+  const Network net = gallows();
+  const std::vector<int> hooks{1};
+  const std::vector<std::vector<int>> steps{{0, 1}};
+  const auto cuts = choose_cuts(net);
+  const ForceProblem problem(net, hooks, steps, cuts);
+  const Eigen::VectorXd a0 = Eigen::VectorXd::Zero(problem.columns());
+  // The first call (before direction 0, before the second thread starts) and the second (before
+  // another direction the calling thread takes, or the closing one when the second thread took
+  // the rest) both come whatever the threads' timing.
+  for (int stop_at : {1, 2}) {
+    int calls = 0;
+    const ProgressFn progress = [&](std::string_view, double) { return ++calls < stop_at; };
+    LoadCapacityOptions lo;
+    lo.threads = 2;
+    CHECK_THROWS_AS(load_capacity(net, cuts, problem, a0, lo, progress), Cancelled);
+    CHECK(calls == stop_at);  // nothing called it after it asked to stop
+  }
+  for (int threads : {0, 3}) {
+    LoadCapacityOptions lo;
+    lo.threads = threads;
+    CHECK_THROWS_WITH(load_capacity(net, cuts, problem, a0, lo), "load capacity: threads must be 1 or 2");
+  }
 }

@@ -12,11 +12,16 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <set>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include "glpk_guard.hpp"  // native/src: private to the core
 #include "lp.hpp"
+#include "wire_fixtures.hpp"
+#include "wiresculpt/forces.hpp"
+#include "wiresculpt/torque_bound.hpp"
 
 using namespace wiresculpt::detail;
 using Catch::Matchers::Contains;
@@ -241,4 +246,261 @@ TEST_CASE("lp: a GLPK internal error on one thread leaves another thread's LPs a
   CHECK(glpk_generation() == before);  // this thread's environment was never freed
   CHECK(solved == serial);
   check_textbook();
+}
+
+// ---- The cutting-plane loop (solve_lp_with_torque_rows): warm-started rounds against rebuilt ones.
+
+namespace {
+
+const double kInf = std::numeric_limits<double>::infinity();
+
+// Warm and cold solves of one loop, from copies of the same LP.
+struct Both {
+  LpSolution warm, cold;
+  int warm_rounds = 0, cold_rounds = 0;
+  LinearProgram warm_lp;  // as the warm loop left it (its rows added)
+};
+
+Both solve_both(const LinearProgram& lp, const TorqueBlocks& blocks, const wiresculpt::TorquePolytope& polytope,
+                double t_max) {
+  Both b;
+  b.warm_lp = lp;
+  LinearProgram cold_lp = lp;
+  std::set<std::pair<int, int>> warm_added, cold_added;
+  b.warm = solve_lp_with_torque_rows(b.warm_lp, blocks, polytope, t_max, warm_added, &b.warm_rounds, true);
+  b.cold = solve_lp_with_torque_rows(cold_lp, blocks, polytope, t_max, cold_added, &b.cold_rounds, false);
+  return b;
+}
+
+// The largest gauge of the blocks' torques at x (<= 1: every row of the polytope holds).
+double worst_gauge(const TorqueBlocks& blocks, const wiresculpt::TorquePolytope& polytope, double t_max,
+                   const std::vector<double>& x) {
+  const Eigen::VectorXd t = blocks.A * Eigen::Map<const Eigen::VectorXd>(x.data(), blocks.A.cols()) + blocks.c;
+  double worst = 0.0;
+  for (Eigen::Index v = 0; v < t.size() / 3; ++v)
+    worst = std::max(worst, wiresculpt::torque_gauge(polytope, t.segment<3>(3 * v), t_max));
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("lp: torque rows added as cuts reach the textbook vertex found by hand, warm from the first basis",
+          "[lp][warm]") {
+  // The textbook LP (maximise 3x + 2y, x + y <= 4, x + 3y <= 6, 0 <= x <= 3, y >= 0) with its two
+  // rows as torque blocks of the slab polytope (rows ±n, t_max 4): block 0's n component is
+  // x + y, block 1's is (x + 3y) 4/6. The LP starts without rows (y capped at 10): round 1 is the
+  // box corner (3, 10), which violates both; round 2 adds both rows and must land on (3, 1), 11.
+  LinearProgram lp;
+  lp.obj = {3.0, 2.0};
+  lp.col_lo = {0.0, 0.0};
+  lp.col_hi = {3.0, 10.0};
+  TorqueBlocks blocks;
+  blocks.A = Eigen::MatrixXd::Zero(6, 2);
+  blocks.A.row(0) << 1.0, 1.0;
+  blocks.A.row(3) << 4.0 / 6.0, 3.0 * 4.0 / 6.0;
+  blocks.c = Eigen::VectorXd::Zero(6);
+  const auto& slab = wiresculpt::torque_polytope(wiresculpt::TorqueBound::in_plane);
+  const Both b = solve_both(lp, blocks, slab, 4.0);
+  REQUIRE(b.warm.status == LpSolution::optimal);
+  CHECK(b.warm.objective == Approx(11.0).epsilon(1e-12));
+  CHECK(b.warm.x[0] == Approx(3.0).epsilon(1e-12));
+  CHECK(b.warm.x[1] == Approx(1.0).epsilon(1e-12));
+  CHECK(b.warm_rounds == 2);
+  CHECK(b.warm.builds == 1);       // the second round added the rows to the problem GLPK held
+  CHECK(b.warm.warm_solves == 1);
+  CHECK(b.warm_lp.row_lo.size() == 2);
+  REQUIRE(b.cold.status == LpSolution::optimal);
+  CHECK(b.cold.objective == Approx(11.0).epsilon(1e-12));
+  CHECK(b.cold.builds == 2);  // the rebuilding loop, for comparison
+  CHECK(b.cold.warm_solves == 0);
+}
+
+TEST_CASE("lp: a torque along a direction grows to t_max over its gauge in the 3D polytope", "[lp][warm][torque]") {
+  // maximise λ, t = λ d (one block, λ capped far above): the optimum is λ = t_max / max_k e_k·d,
+  // taken over every row of the polytope directly (the loop sees only the rows it adds). d = n is
+  // the polytope's vertex ±n t_max: λ = t_max exactly.
+  const auto& poly = wiresculpt::torque_polytope(wiresculpt::TorqueBound::full_3d);
+  const double t_max = 1.5;
+  std::mt19937 rng(17);
+  std::normal_distribution<double> gauss;
+  std::vector<wiresculpt::Vec3> directions{wiresculpt::Vec3(1, 0, 0), wiresculpt::Vec3(-1, 0, 0)};
+  for (int k = 0; k < 30; ++k) directions.push_back(wiresculpt::Vec3(gauss(rng), gauss(rng), gauss(rng)).normalized());
+  for (const wiresculpt::Vec3& d : directions) {
+    INFO("d = " << d.transpose());
+    double largest = 0.0;
+    for (const wiresculpt::Vec3& e : poly.rows) largest = std::max(largest, e.dot(d));
+    const double expected = t_max / largest;
+    LinearProgram lp;
+    lp.obj = {1.0};
+    lp.col_lo = {0.0};
+    lp.col_hi = {1e3 * t_max};
+    TorqueBlocks blocks{d, Eigen::VectorXd::Zero(3)};
+    const Both b = solve_both(lp, blocks, poly, t_max);
+    REQUIRE(b.warm.status == LpSolution::optimal);
+    CHECK(b.warm.objective == Approx(expected).epsilon(1e-9));
+    CHECK(b.cold.objective == Approx(expected).epsilon(1e-9));
+    CHECK(worst_gauge(blocks, poly, t_max, b.warm.x) <= 1.0 + 1e-9);
+    CHECK(b.warm_rounds >= 2);  // round 1 stops at the cap, far outside the polytope
+    CHECK(b.warm.builds == 1);
+    CHECK(b.warm.warm_solves == b.warm_rounds - 1);
+  }
+}
+
+TEST_CASE("lp: warm-started torque rows reach the rebuilt optimum on generated force LPs", "[lp][warm][torque]") {
+  // The force LP of optimize_forces on random hooked spheres: maximise c·a subject to M a = 0,
+  // |n·t_v| <= t_max, N_k a >= 0, a >= 0, and the 3D polytope's rows as cuts. Warm and rebuilt
+  // loops must agree on the optimum (relative 1e-7) and both satisfy every row of the polytope.
+  std::mt19937 rng(23);
+  int compared = 0, cut = 0, warm_taken = 0;
+  long warm_iterations = 0, cold_iterations = 0;
+  for (int attempt = 0; attempt < 200 && compared < 12; ++attempt) {
+    fixtures::HookedNetwork h;
+    if (!fixtures::random_hooked_sphere(rng, attempt, 32, h)) continue;
+    const auto cuts = wiresculpt::choose_cuts(h.net);
+    wiresculpt::ForceOptions fo;
+    fo.torque_fraction = 0.5;
+    const wiresculpt::ForceProblem problem(h.net, h.hooks, h.steps, cuts, fo);
+    const int K = problem.columns();
+    if (K == 0) continue;
+    LinearProgram lp;
+    lp.obj.assign(problem.normal_weights().data(), problem.normal_weights().data() + K);
+    lp.col_lo.assign(K, 0.0);
+    lp.col_hi.assign(K, kInf);
+    auto add_rows = [&](const Eigen::MatrixXd& A, double lo, double hi) {
+      for (Eigen::Index i = 0; i < A.rows(); ++i) {
+        const int row = static_cast<int>(lp.row_lo.size());
+        lp.row_lo.push_back(lo);
+        lp.row_hi.push_back(hi);
+        for (Eigen::Index j = 0; j < A.cols(); ++j)
+          if (A(i, j) != 0.0) {
+            lp.tri_row.push_back(row);
+            lp.tri_col.push_back(static_cast<int>(j));
+            lp.tri_val.push_back(A(i, j));
+          }
+      }
+    };
+    add_rows(problem.equilibrium(), 0.0, 0.0);
+    add_rows(problem.torque_rows(), -problem.t_max(), problem.t_max());
+    add_rows(problem.normal_rows(), 0.0, kInf);
+    const TorqueBlocks blocks{problem.torque_frame_rows(), Eigen::VectorXd::Zero(problem.torque_frame_rows().rows())};
+    const Both b = solve_both(lp, blocks, problem.polytope(), problem.t_max());
+    INFO("attempt " << attempt);
+    REQUIRE(b.cold.status == b.warm.status);
+    if (b.warm.status != LpSolution::optimal) continue;
+    ++compared;
+    CHECK(b.warm.objective == Approx(b.cold.objective).epsilon(1e-7));
+    CHECK(worst_gauge(blocks, problem.polytope(), problem.t_max(), b.warm.x) <= 1.0 + 1e-7);
+    CHECK(worst_gauge(blocks, problem.polytope(), problem.t_max(), b.cold.x) <= 1.0 + 1e-7);
+    CHECK(b.warm.warm_solves + b.warm.builds == b.warm_rounds);
+    if (b.warm_rounds > 1) ++cut;
+    if (b.warm_rounds > 1 && b.warm.builds == 1 && b.warm.warm_solves == b.warm_rounds - 1) ++warm_taken;
+    warm_iterations += b.warm.iterations;
+    cold_iterations += b.cold.iterations;
+  }
+  CHECK(compared >= 10);
+  CHECK(cut >= 5);  // LPs that needed cuts
+  CHECK(warm_taken == cut);  // and every round after the first re-solved the problem GLPK held
+  CHECK(warm_iterations < cold_iterations);  // and took fewer simplex steps than rebuilding
+}
+
+TEST_CASE("lp: rows a round adds are checked as solve_lp checks them", "[lp][warm][robustness]") {
+  // One column x in [0, 10] with the row x <= 8, maximise x; the block's torque is x a (frame n),
+  // slab polytope, so round 1 (x = 8) adds the row a x <= t_max when a x > t_max.
+  auto run = [](double a, double t_max, LpSolution* cold = nullptr) {
+    LinearProgram lp;
+    lp.obj = {1.0};
+    lp.col_lo = {0.0};
+    lp.col_hi = {10.0};
+    lp.row_lo = {-kInf};
+    lp.row_hi = {8.0};
+    lp.tri_row = {0};
+    lp.tri_col = {0};
+    lp.tri_val = {1.0};
+    TorqueBlocks blocks{Eigen::Vector3d(a, 0.0, 0.0), Eigen::VectorXd::Zero(3)};
+    const auto& slab = wiresculpt::torque_polytope(wiresculpt::TorqueBound::in_plane);
+    const Both b = solve_both(lp, blocks, slab, t_max);
+    if (cold) *cold = b.cold;
+    return b.warm;
+  };
+  // A coefficient GLPK cannot take: refused with solve_lp's reason, naming the added row.
+  const LpSolution huge = run(1e200, 1.0);
+  CHECK(huge.status == LpSolution::failed);
+  CHECK(huge.reason == "a coefficient (row 1, column 0) is 1e+200, outside the range the LP solver handles "
+                       "(magnitudes 1e-100 to 1e100)");
+  // An added entry 1e14 times the held one makes that held entry rounding noise (below 1e-13 of
+  // its column's largest), which a rebuild of the whole LP drops: the loop rebuilds rather than
+  // keep it. By hand: 1e14 x <= 1e14 binds, x = 1.
+  LpSolution cold;
+  const LpSolution noisy = run(1e14, 1e14, &cold);
+  REQUIRE(noisy.status == LpSolution::optimal);
+  CHECK(noisy.builds == 2);
+  CHECK(noisy.warm_solves == 0);
+  CHECK(noisy.x[0] == Approx(1.0).epsilon(1e-9));
+  CHECK(cold.x[0] == Approx(1.0).epsilon(1e-9));
+  // An ordinary factor stays warm: 0.5 x <= 1, x = 2.
+  const LpSolution fine = run(0.5, 1.0);
+  REQUIRE(fine.status == LpSolution::optimal);
+  CHECK(fine.builds == 1);
+  CHECK(fine.warm_solves == 1);
+  CHECK(fine.x[0] == Approx(2.0).epsilon(1e-12));
+}
+
+TEST_CASE("lp: a second loop over the program grown by rows, a column and a new objective starts from the first's basis",
+          "[lp][warm]") {
+  // First the textbook LP through cuts (as above): (3, 1), 11. Then, as the forces' least-out-of-
+  // plane LP does, the same rows plus a column s >= 0, the rows 3x + 2y >= 10 and s - x >= -2,
+  // and the objective minimise s + y. By hand: s = max(0, x - 2), y >= (10 - 3x) / 2 (inside
+  // x + 3y <= 6 only for x > 2.4), so s + y = 3 - x/2, least at x = 3: (3, 0.5, 1), objective 1.5.
+  LinearProgram lp;
+  lp.obj = {3.0, 2.0};
+  lp.col_lo = {0.0, 0.0};
+  lp.col_hi = {3.0, 10.0};
+  TorqueBlocks blocks;
+  blocks.A = Eigen::MatrixXd::Zero(6, 2);
+  blocks.A.row(0) << 1.0, 1.0;
+  blocks.A.row(3) << 4.0 / 6.0, 3.0 * 4.0 / 6.0;
+  blocks.c = Eigen::VectorXd::Zero(6);
+  const auto& slab = wiresculpt::torque_polytope(wiresculpt::TorqueBound::in_plane);
+  std::set<std::pair<int, int>> added;
+  HeldLp held;
+  const LpSolution first = solve_lp_with_torque_rows(lp, blocks, slab, 4.0, added, nullptr, true, &held);
+  REQUIRE(first.status == LpSolution::optimal);
+  CHECK(first.objective == Approx(11.0).epsilon(1e-12));
+  REQUIRE(held.held());
+  LinearProgram tie = lp;
+  tie.maximise = false;
+  tie.obj = {0.0, 1.0, 1.0};
+  tie.col_lo.push_back(0.0);
+  tie.col_hi.push_back(kInf);
+  const int r = static_cast<int>(tie.row_lo.size());
+  for (auto [row, col, val] : {std::tuple{r, 0, 3.0}, std::tuple{r, 1, 2.0}, std::tuple{r + 1, 0, -1.0}, std::tuple{r + 1, 2, 1.0}}) {
+    tie.tri_row.push_back(row);
+    tie.tri_col.push_back(col);
+    tie.tri_val.push_back(val);
+  }
+  tie.row_lo.insert(tie.row_lo.end(), {10.0, -2.0});
+  tie.row_hi.insert(tie.row_hi.end(), {kInf, kInf});
+  TorqueBlocks padded{Eigen::MatrixXd::Zero(6, 3), blocks.c};
+  padded.A.leftCols(2) = blocks.A;
+  int rounds = 0;
+  const LinearProgram tie_before = tie;
+  const LpSolution second = solve_lp_with_torque_rows(tie, padded, slab, 4.0, added, &rounds, true, &held);
+  REQUIRE(second.status == LpSolution::optimal);
+  CHECK(second.objective == Approx(1.5).epsilon(1e-12));
+  CHECK(second.x[0] == Approx(3.0).epsilon(1e-12));
+  CHECK(second.x[1] == Approx(0.5).epsilon(1e-12));
+  CHECK(second.x[2] == Approx(1.0).epsilon(1e-12));
+  CHECK(second.builds == 0);  // extended the held problem, did not rebuild
+  CHECK(second.warm_solves == rounds);
+  const LpSolution rebuilt = solve_lp(tie_before);
+  REQUIRE(rebuilt.status == LpSolution::optimal);
+  CHECK(rebuilt.objective == Approx(1.5).epsilon(1e-12));
+  // A program whose held columns' bounds changed is no growth of the held one: it is rebuilt.
+  LinearProgram capped = tie_before;
+  capped.col_hi[1] = 5.0;
+  std::set<std::pair<int, int>> none;
+  const LpSolution again = solve_lp_with_torque_rows(capped, padded, slab, 4.0, none, nullptr, true, &held);
+  REQUIRE(again.status == LpSolution::optimal);
+  CHECK(again.builds == 1);
+  CHECK(again.objective == Approx(1.5).epsilon(1e-12));
 }

@@ -101,6 +101,10 @@ struct ForceOptions {
   /// Relative: the second LP keeps G_stb >= (1 - tie_tolerance) × the first LP's optimum.
   /// Default 0.03 (the bundled globe's ellipse hooks reach 0% out of plane at 3%, §12).
   double tie_tolerance = 0.03;
+  /// The LPs' cutting-plane rounds (torque rows added as solutions violate them) re-solve the
+  /// problem GLPK holds from the last basis (lp.hpp, solve_lp_with_torque_rows). false: every
+  /// round rebuilds it from scratch, as before (for tests, which compare the two). Default true.
+  bool lp_warm_start = true;
 };
 
 /// The four unit pyramid vectors of hooked crossing `c` (hook ±1) from the actual incident

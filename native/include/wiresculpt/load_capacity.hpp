@@ -40,6 +40,13 @@ struct LoadCapacityOptions {
   double tie_tolerance = 1e-6;
   /// Which torque is bounded by t_max: full_3d (default, |t_v|) or in_plane (n·t_v only).
   TorqueBound torque_bound = TorqueBound::full_3d;
+  /// As ForceOptions::lp_warm_start: false rebuilds GLPK's problem in every cutting-plane round
+  /// (for tests). Default true.
+  bool lp_warm_start = true;
+  /// The six directions' LPs are solved on this many threads, 1 or 2 (the calling thread is one
+  /// of them and the only one that reports progress; without a second thread to be had, 1). The
+  /// answers do not depend on it. Default 2.
+  int threads = 2;
 };
 
 struct LoadDirection {
@@ -67,7 +74,9 @@ struct LoadCapacityResult {
 /// Load capacity of the sculpture `net` (target shapes) with hooks, cuts and the pre-stress
 /// coefficients `a0` of `problem` (the ForceProblem optimize_forces solved; a0 has
 /// problem.columns() entries). Throws InputError for bad options or sizes. Reports progress as
-/// stage "load_capacity" before each direction's LP and honours cancellation (throws Cancelled).
+/// stage "load_capacity" from the calling thread only: before direction 0, before each other
+/// direction's LP that the calling thread solves, and at the end (7 times on one thread); honours
+/// cancellation (throws Cancelled once the second thread has stopped).
 LoadCapacityResult load_capacity(const Network& net, const std::vector<int>& cuts, const ForceProblem& problem,
                                  const Eigen::VectorXd& a0, const LoadCapacityOptions& options = {},
                                  const ProgressFn& progress = {});
