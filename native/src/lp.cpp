@@ -381,6 +381,20 @@ LpSolution HeldLp::extend(const LinearProgram& in) {
 
 void free_thread_glpk() { free_glpk_environment(); }
 
+void append_rows(LinearProgram& lp, const Eigen::MatrixXd& A, double lo, double hi) {
+  for (Eigen::Index i = 0; i < A.rows(); ++i) {
+    const int row = static_cast<int>(lp.row_lo.size());
+    lp.row_lo.push_back(lo);
+    lp.row_hi.push_back(hi);
+    for (Eigen::Index j = 0; j < A.cols(); ++j)
+      if (A(i, j) != 0.0) {
+        lp.tri_row.push_back(row);
+        lp.tri_col.push_back(static_cast<int>(j));
+        lp.tri_val.push_back(A(i, j));
+      }
+  }
+}
+
 LpSolution solve_lp(const LinearProgram& in) { return HeldLp().build(in); }
 
 

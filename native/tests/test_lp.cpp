@@ -366,22 +366,9 @@ TEST_CASE("lp: warm-started torque rows reach the rebuilt optimum on generated f
     lp.obj.assign(problem.normal_weights().data(), problem.normal_weights().data() + K);
     lp.col_lo.assign(K, 0.0);
     lp.col_hi.assign(K, kInf);
-    auto add_rows = [&](const Eigen::MatrixXd& A, double lo, double hi) {
-      for (Eigen::Index i = 0; i < A.rows(); ++i) {
-        const int row = static_cast<int>(lp.row_lo.size());
-        lp.row_lo.push_back(lo);
-        lp.row_hi.push_back(hi);
-        for (Eigen::Index j = 0; j < A.cols(); ++j)
-          if (A(i, j) != 0.0) {
-            lp.tri_row.push_back(row);
-            lp.tri_col.push_back(static_cast<int>(j));
-            lp.tri_val.push_back(A(i, j));
-          }
-      }
-    };
-    add_rows(problem.equilibrium(), 0.0, 0.0);
-    add_rows(problem.torque_rows(), -problem.t_max(), problem.t_max());
-    add_rows(problem.normal_rows(), 0.0, kInf);
+    append_rows(lp, problem.equilibrium(), 0.0, 0.0);
+    append_rows(lp, problem.torque_rows(), -problem.t_max(), problem.t_max());
+    append_rows(lp, problem.normal_rows(), 0.0, kInf);
     const TorqueBlocks blocks{problem.torque_frame_rows(), Eigen::VectorXd::Zero(problem.torque_frame_rows().rows())};
     const Both b = solve_both(lp, blocks, problem.polytope(), problem.t_max());
     INFO("attempt " << attempt);
