@@ -64,13 +64,18 @@ def wire_names():
     return sorted(o.name for o in bpy.context.scene.objects if scene_results.WIRE_KEY in o)
 
 
+def start_without_results(case):
+    """Skips `case` when the native module is missing, else forgets any search and preview."""
+    if not native.available():
+        case.skipTest(native.LOAD_ERROR)
+    ops.RESULT = None
+    ops.PREVIEW = None
+
+
 class FindStablePlanes(Case):
     def setUp(self):
         super().setUp()
-        if not native.available():
-            self.skipTest(native.LOAD_ERROR)
-        ops.RESULT = None
-        ops.PREVIEW = None
+        start_without_results(self)
         hinge_scene()
 
     def test_the_scene_is_a_hinge(self):
@@ -195,10 +200,7 @@ class NoNearbyPlacement(Case):
 
     def setUp(self):
         super().setUp()
-        if not native.available():
-            self.skipTest(native.LOAD_ERROR)
-        ops.RESULT = None
-        ops.PREVIEW = None
+        start_without_results(self)
         globe_target()
         for rotation, location in (((0, 0, 0), (0, 0, 0.5 * R)), ((0, 0, 0), (0, 0, -0.5 * R)),
                                    ((0, math.pi / 2, 0), (0, 0, 0))):
@@ -230,10 +232,7 @@ class NoNearbyPlacement(Case):
 class SuggestPlanes(Case):
     def setUp(self):
         super().setUp()
-        if not native.available():
-            self.skipTest(native.LOAD_ERROR)
-        ops.RESULT = None
-        ops.PREVIEW = None
+        start_without_results(self)
         globe_target()
 
     def test_suggest_then_apply_adds_ordinary_planes(self):

@@ -372,22 +372,9 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
     lp.obj.assign(problem.normal_weights().data(), problem.normal_weights().data() + K);
     lp.col_lo.assign(K, 0.0);
     lp.col_hi.assign(K, kInf);
-    int row = 0;
-    auto add_rows = [&](const Eigen::MatrixXd& A, double lo, double hi) {
-      for (Eigen::Index i = 0; i < A.rows(); ++i, ++row) {
-        lp.row_lo.push_back(lo);
-        lp.row_hi.push_back(hi);
-        for (Eigen::Index j = 0; j < A.cols(); ++j)
-          if (A(i, j) != 0.0) {
-            lp.tri_row.push_back(row);
-            lp.tri_col.push_back(static_cast<int>(j));
-            lp.tri_val.push_back(A(i, j));
-          }
-      }
-    };
-    add_rows(M, 0.0, 0.0);
-    add_rows(T, -problem.t_max(), problem.t_max());  // |n·t_v| <= t_max: implied by either bound
-    add_rows(Nk, 0.0, kInf);
+    detail::append_rows(lp, M, 0.0, 0.0);
+    detail::append_rows(lp, T, -problem.t_max(), problem.t_max());  // |n·t_v| <= t_max: implied by either bound
+    detail::append_rows(lp, Nk, 0.0, kInf);
     // The other rows of the bound's polytope join as solutions violate them.
     const detail::TorqueBlocks blocks{problem.torque_frame_rows(), Eigen::VectorXd::Zero(problem.torque_frame_rows().rows())};
     std::set<std::pair<int, int>> added;

@@ -246,6 +246,17 @@ struct HeldLp::State {
   std::vector<double> obj, col_lo, col_hi;
   std::vector<double> col_max, col_min_kept;  // per column: largest entry, smallest entry kept
   bool alive() const { return p && generation == glpk_generation(); }
+  // Records that GLPK now holds `in`, with its per-column largest entries and smallest kept.
+  void hold(const LinearProgram& in, std::vector<double> in_col_max, std::vector<double> in_col_min_kept) {
+    rows = in.row_lo.size();
+    tris = in.tri_val.size();
+    maximise = in.maximise;
+    obj = in.obj;
+    col_lo = in.col_lo;
+    col_hi = in.col_hi;
+    col_max = std::move(in_col_max);
+    col_min_kept = std::move(in_col_min_kept);
+  }
   void release() {
     if (alive()) run_guarded(delete_body, p);
     p = nullptr;
@@ -304,14 +315,7 @@ LpSolution HeldLp::build(const LinearProgram& in) {
   }
   s.p = q.p;
   s.generation = generation;
-  s.rows = in.row_lo.size();
-  s.tris = in.tri_val.size();
-  s.maximise = in.maximise;
-  s.obj = in.obj;
-  s.col_lo = in.col_lo;
-  s.col_hi = in.col_hi;
-  s.col_max = std::move(col_max);
-  s.col_min_kept = std::move(col_min_kept);
+  s.hold(in, std::move(col_max), std::move(col_min_kept));
   LpSolution sol = interpret(q, x);
   sol.builds = 1;
   return sol;
@@ -370,19 +374,26 @@ LpSolution HeldLp::extend(const LinearProgram& in) {
     out.reason = "GLPK stopped with an internal error";
     return out;
   }
-  s.rows = R;
-  s.tris = T;
-  s.maximise = in.maximise;
-  s.obj = in.obj;
-  s.col_lo = in.col_lo;
-  s.col_hi = in.col_hi;
-  s.col_max = std::move(col_max);
-  s.col_min_kept = std::move(col_min_kept);
+  s.hold(in, std::move(col_max), std::move(col_min_kept));
   return interpret(q, x);
 }
 
 
 void free_thread_glpk() { free_glpk_environment(); }
+
+void append_rows(LinearProgram& lp, const Eigen::MatrixXd& A, double lo, double hi) {
+  for (Eigen::Index i = 0; i < A.rows(); ++i) {
+    const int row = static_cast<int>(lp.row_lo.size());
+    lp.row_lo.push_back(lo);
+    lp.row_hi.push_back(hi);
+    for (Eigen::Index j = 0; j < A.cols(); ++j)
+      if (A(i, j) != 0.0) {
+        lp.tri_row.push_back(row);
+        lp.tri_col.push_back(static_cast<int>(j));
+        lp.tri_val.push_back(A(i, j));
+      }
+  }
+}
 
 LpSolution solve_lp(const LinearProgram& in) { return HeldLp().build(in); }
 

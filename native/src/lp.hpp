@@ -34,6 +34,10 @@ struct LinearProgram {
   std::vector<double> tri_val;
 };
 
+/// Appends the rows of the dense `A` to `lp`, each with bounds [lo, hi], keeping A's nonzero
+/// entries as triplets (A's columns are lp's first columns).
+void append_rows(LinearProgram& lp, const Eigen::MatrixXd& A, double lo, double hi);
+
 struct LpSolution {
   enum Status { optimal, infeasible, unbounded, failed } status = failed;
   std::vector<double> x;

@@ -23,6 +23,27 @@ namespace {
 
 constexpr double a_ = 0.03, c_ = 0.04, H = 0.3, X = 0.1, Z = 0.08;
 
+// A random hooked sphere (32 vertices) with its cuts and a feasible pre-stress at torque
+// fraction 0.5; false when the attempt gives no network or the forces are infeasible.
+struct Prestressed {
+  fixtures::HookedNetwork h;
+  std::vector<int> cuts;
+  ForceOptions fo;
+  ForceResult pre;
+};
+
+bool prestressed_sphere(std::mt19937& rng, int attempt, Prestressed& s) {
+  if (!fixtures::random_hooked_sphere(rng, attempt, 32, s.h)) return false;
+  s.cuts = choose_cuts(s.h.net);
+  s.fo.torque_fraction = 0.5;
+  try {
+    s.pre = optimize_forces(s.h.net, s.h.hooks, s.h.steps, s.cuts, s.fo);
+  } catch (const SolverError&) {
+    return false;
+  }
+  return true;
+}
+
 Network gallows() {
   WireSpec A;
   A.name = "gallows";
@@ -126,17 +147,12 @@ TEST_CASE("load: on random networks every 3D torque at the limit load stays with
   const double per_metre = std::numbers::pi * 0.25 * 0.003 * 0.003 * 7850.0 * 9.81;
   int tested = 0, lower = 0;
   for (int attempt = 0; attempt < 300 && tested < 10; ++attempt) {
-    fixtures::HookedNetwork h;
-    if (!fixtures::random_hooked_sphere(rng, attempt, 32, h)) continue;
-    const auto cuts = choose_cuts(h.net);
-    ForceOptions fo;
-    fo.torque_fraction = 0.5;
-    ForceResult pre;
-    try {
-      pre = optimize_forces(h.net, h.hooks, h.steps, cuts, fo);
-    } catch (const SolverError&) {
-      continue;
-    }
+    Prestressed s;
+    if (!prestressed_sphere(rng, attempt, s)) continue;
+    const fixtures::HookedNetwork& h = s.h;
+    const std::vector<int>& cuts = s.cuts;
+    const ForceOptions& fo = s.fo;
+    const ForceResult& pre = s.pre;
     ++tested;
     INFO("attempt " << attempt);
     const ForceProblem problem(h.net, h.hooks, h.steps, cuts, fo);
@@ -173,17 +189,12 @@ TEST_CASE("load: warm-started cutting planes give the rebuilt capacities on rand
   std::mt19937 rng(37);
   int tested = 0, finite = 0;
   for (int attempt = 0; attempt < 300 && tested < 8; ++attempt) {
-    fixtures::HookedNetwork h;
-    if (!fixtures::random_hooked_sphere(rng, attempt, 32, h)) continue;
-    const auto cuts = choose_cuts(h.net);
-    ForceOptions fo;
-    fo.torque_fraction = 0.5;
-    ForceResult pre;
-    try {
-      pre = optimize_forces(h.net, h.hooks, h.steps, cuts, fo);
-    } catch (const SolverError&) {
-      continue;
-    }
+    Prestressed s;
+    if (!prestressed_sphere(rng, attempt, s)) continue;
+    const fixtures::HookedNetwork& h = s.h;
+    const std::vector<int>& cuts = s.cuts;
+    const ForceOptions& fo = s.fo;
+    const ForceResult& pre = s.pre;
     ++tested;
     INFO("attempt " << attempt);
     const ForceProblem problem(h.net, h.hooks, h.steps, cuts, fo);
@@ -211,17 +222,12 @@ TEST_CASE("load: two threads give the serial capacities direction by direction, 
   std::mt19937 rng(43);
   int tested = 0;
   for (int attempt = 0; attempt < 300 && tested < 6; ++attempt) {
-    fixtures::HookedNetwork h;
-    if (!fixtures::random_hooked_sphere(rng, attempt, 32, h)) continue;
-    const auto cuts = choose_cuts(h.net);
-    ForceOptions fo;
-    fo.torque_fraction = 0.5;
-    ForceResult pre;
-    try {
-      pre = optimize_forces(h.net, h.hooks, h.steps, cuts, fo);
-    } catch (const SolverError&) {
-      continue;
-    }
+    Prestressed s;
+    if (!prestressed_sphere(rng, attempt, s)) continue;
+    const fixtures::HookedNetwork& h = s.h;
+    const std::vector<int>& cuts = s.cuts;
+    const ForceOptions& fo = s.fo;
+    const ForceResult& pre = s.pre;
     ++tested;
     INFO("attempt " << attempt);
     const ForceProblem problem(h.net, h.hooks, h.steps, cuts, fo);

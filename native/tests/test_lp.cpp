@@ -282,6 +282,19 @@ double worst_gauge(const TorqueBlocks& blocks, const wiresculpt::TorquePolytope&
   return worst;
 }
 
+// The textbook LP (maximise 3x + 2y, 0 <= x <= 3, y capped at 10) without its rows, and its
+// rows x + y <= 4, x + 3y <= 6 as torque blocks of the slab polytope (rows ±n, t_max 4): block
+// 0's n component is x + y, block 1's is (x + 3y) 4/6.
+void textbook_as_cuts(LinearProgram& lp, TorqueBlocks& blocks) {
+  lp.obj = {3.0, 2.0};
+  lp.col_lo = {0.0, 0.0};
+  lp.col_hi = {3.0, 10.0};
+  blocks.A = Eigen::MatrixXd::Zero(6, 2);
+  blocks.A.row(0) << 1.0, 1.0;
+  blocks.A.row(3) << 4.0 / 6.0, 3.0 * 4.0 / 6.0;
+  blocks.c = Eigen::VectorXd::Zero(6);
+}
+
 }  // namespace
 
 TEST_CASE("lp: torque rows added as cuts reach the textbook vertex found by hand, warm from the first basis",
@@ -291,14 +304,8 @@ TEST_CASE("lp: torque rows added as cuts reach the textbook vertex found by hand
   // x + y, block 1's is (x + 3y) 4/6. The LP starts without rows (y capped at 10): round 1 is the
   // box corner (3, 10), which violates both; round 2 adds both rows and must land on (3, 1), 11.
   LinearProgram lp;
-  lp.obj = {3.0, 2.0};
-  lp.col_lo = {0.0, 0.0};
-  lp.col_hi = {3.0, 10.0};
   TorqueBlocks blocks;
-  blocks.A = Eigen::MatrixXd::Zero(6, 2);
-  blocks.A.row(0) << 1.0, 1.0;
-  blocks.A.row(3) << 4.0 / 6.0, 3.0 * 4.0 / 6.0;
-  blocks.c = Eigen::VectorXd::Zero(6);
+  textbook_as_cuts(lp, blocks);
   const auto& slab = wiresculpt::torque_polytope(wiresculpt::TorqueBound::in_plane);
   const Both b = solve_both(lp, blocks, slab, 4.0);
   REQUIRE(b.warm.status == LpSolution::optimal);
@@ -366,22 +373,9 @@ TEST_CASE("lp: warm-started torque rows reach the rebuilt optimum on generated f
     lp.obj.assign(problem.normal_weights().data(), problem.normal_weights().data() + K);
     lp.col_lo.assign(K, 0.0);
     lp.col_hi.assign(K, kInf);
-    auto add_rows = [&](const Eigen::MatrixXd& A, double lo, double hi) {
-      for (Eigen::Index i = 0; i < A.rows(); ++i) {
-        const int row = static_cast<int>(lp.row_lo.size());
-        lp.row_lo.push_back(lo);
-        lp.row_hi.push_back(hi);
-        for (Eigen::Index j = 0; j < A.cols(); ++j)
-          if (A(i, j) != 0.0) {
-            lp.tri_row.push_back(row);
-            lp.tri_col.push_back(static_cast<int>(j));
-            lp.tri_val.push_back(A(i, j));
-          }
-      }
-    };
-    add_rows(problem.equilibrium(), 0.0, 0.0);
-    add_rows(problem.torque_rows(), -problem.t_max(), problem.t_max());
-    add_rows(problem.normal_rows(), 0.0, kInf);
+    append_rows(lp, problem.equilibrium(), 0.0, 0.0);
+    append_rows(lp, problem.torque_rows(), -problem.t_max(), problem.t_max());
+    append_rows(lp, problem.normal_rows(), 0.0, kInf);
     const TorqueBlocks blocks{problem.torque_frame_rows(), Eigen::VectorXd::Zero(problem.torque_frame_rows().rows())};
     const Both b = solve_both(lp, blocks, problem.polytope(), problem.t_max());
     INFO("attempt " << attempt);
@@ -452,14 +446,8 @@ TEST_CASE("lp: a second loop over the program grown by rows, a column and a new 
   // and the objective minimise s + y. By hand: s = max(0, x - 2), y >= (10 - 3x) / 2 (inside
   // x + 3y <= 6 only for x > 2.4), so s + y = 3 - x/2, least at x = 3: (3, 0.5, 1), objective 1.5.
   LinearProgram lp;
-  lp.obj = {3.0, 2.0};
-  lp.col_lo = {0.0, 0.0};
-  lp.col_hi = {3.0, 10.0};
   TorqueBlocks blocks;
-  blocks.A = Eigen::MatrixXd::Zero(6, 2);
-  blocks.A.row(0) << 1.0, 1.0;
-  blocks.A.row(3) << 4.0 / 6.0, 3.0 * 4.0 / 6.0;
-  blocks.c = Eigen::VectorXd::Zero(6);
+  textbook_as_cuts(lp, blocks);
   const auto& slab = wiresculpt::torque_polytope(wiresculpt::TorqueBound::in_plane);
   std::set<std::pair<int, int>> added;
   HeldLp held;
