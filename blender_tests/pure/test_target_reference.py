@@ -97,7 +97,7 @@ class AgainstConvergedSweeps(unittest.TestCase):
 
     def test_coupling_warm_start_reaches_the_cold_optimum(self):
         # A coupling round (Sec. 4.3) that lowers a vertex's bend limit starts that wire from the
-        # previous round's optimum (Memo.start). Solved with and without it, every stand-in must end
+        # previous round's optimum (Memo.starts). Solved with and without it, every stand-in must end
         # with the same distances per wire (0.1 mm), hooks, nulled crossings, coupling rounds and
         # verdict; and the start must actually be used somewhere (the Teddy's and the Airplane's
         # couplings lower vertex limits).
@@ -115,7 +115,7 @@ class AgainstConvergedSweeps(unittest.TestCase):
                 scene, _V, _F, _planes, design = bench_scenes.load_and_slice(self.scenes[name])
                 with mock.patch.object(target_shape.native, "optimize_target_shape", counted):
                     warm = pipeline.solve(copy.deepcopy(design), scene.material, scene.settings, hook_patterns=1)
-                with mock.patch.object(target_shape.Memo, "start", lambda *_args: None):
+                with mock.patch.object(target_shape.Memo, "remember_start", lambda *_args: None):
                     cold = pipeline.solve(copy.deepcopy(design), scene.material, scene.settings, hook_patterns=1)
                 for ww, wc in zip(warm["wires"], cold["wires"]):
                     self.assertAlmostEqual(ww["target_max_distance"], wc["target_max_distance"], delta=1e-4,

@@ -98,13 +98,14 @@ def prepare_wire(design, wire, settings, size, memo=None):
         options["vertex_max_bend"] = tuple(limits.get(i, 0.0) for i in range(max(limits) + 1))
     contour = to_2d(wire["contour"], origin, u, v)
     key = Memo.key(contour, wire["closed"], specs, options) if memo is not None else None
+    start_key = Memo.key(contour, wire["closed"], specs, options, Memo.LIMITS) if memo is not None else None
     result = memo.reusable(key, options["max_bend"]) if memo is not None else None
     if result is None and memo is not None:  # a coupling round: start from the looser limit's optimum
-        start = memo.start(contour, wire["closed"], specs, options)
+        start = memo.starts.get(start_key)
         if start is not None:
             options = {**options, "start": start}
     return {"contour": contour, "closed": wire["closed"], "specs": specs, "options": options, "refs": refs,
-            "frame": (origin, u, v), "key": key, "result": result}
+            "frame": (origin, u, v), "key": key, "start_key": start_key, "result": result}
 
 
 def solve_job(job, native_progress=None):
@@ -119,7 +120,7 @@ def finish_wire(job, result, memo=None):
     """Remembers a new solve in the memo; (result, refs, frame) as solve_wire returns them."""
     if memo is not None and job["result"] is None:
         memo.remember(job["key"], job["options"]["max_bend"], result)
-        memo.remember_start(job["contour"], job["closed"], job["specs"], job["options"], result)
+        memo.remember_start(job["start_key"], result)
     return result, job["refs"], job["frame"]
 
 
@@ -171,7 +172,7 @@ class Memo:
         self.nulled = []
         self.vertex_limits = {}
         self.solves = {}  # key -> (max_bend, result)
-        self.starts = {}  # key without the bend limits -> points of a converged solve
+        self.starts = {}  # key without the per-vertex bend limits (LIMITS) -> points of a converged solve
         self.same = {} if same is None else same
         self.reused = 0
 
@@ -185,14 +186,17 @@ class Memo:
 
     LIMITS = ("vertex_max_bend",)
 
-    def start(self, contour, closed, specs, options):
-        """The points of this wire problem's optimum under other per-vertex bend limits (the same
-        max_bend), or None."""
-        return self.starts.get(self.key(contour, closed, specs, options, self.LIMITS))
+    @classmethod
+    def _converged(cls, result):
+        """Whether a solve converged with every active crossing realised."""
+        return (result["nlopt_result"] in cls.CONVERGED
+                and all(s["status"] in ("ok", "inactive") for s in result["crossings"]))
 
-    def remember_start(self, contour, closed, specs, options, result):
-        if result["nlopt_result"] in self.CONVERGED and all(s["status"] in ("ok", "inactive") for s in result["crossings"]):
-            self.starts[self.key(contour, closed, specs, options, self.LIMITS)] = result["points"]
+    def remember_start(self, start_key, result):
+        """Keeps a converged solve's points as the start of the same problem under other per-vertex
+        bend limits (`start_key`: Memo.key with LIMITS left out)."""
+        if self._converged(result):
+            self.starts[start_key] = result["points"]
 
     def reusable(self, key, max_bend):
         """The remembered result for `key` if it is an optimum that the limit `max_bend` (radians)
@@ -205,8 +209,7 @@ class Memo:
         if entry is None:
             return None
         old_limit, r = entry
-        optimum = (r["feasible"] and r["nlopt_result"] in self.CONVERGED
-                   and all(s["status"] in ("ok", "inactive") for s in r["crossings"]))
+        optimum = r["feasible"] and self._converged(r)
         if not (optimum and max_bend <= old_limit and r["max_bend"] <= max_bend):
             return None
         self.reused += 1
