@@ -44,6 +44,23 @@ bool prestressed_sphere(std::mt19937& rng, int attempt, Prestressed& s) {
   return true;
 }
 
+// Runs test(s, problem) on random prestressed spheres drawn from `seed` until `wanted` of them
+// gave a network (each within INFO "attempt k"); returns how many did.
+template <class Test>
+int on_prestressed_spheres(unsigned seed, int wanted, Test test) {
+  std::mt19937 rng(seed);
+  int tested = 0;
+  for (int attempt = 0; attempt < 300 && tested < wanted; ++attempt) {
+    Prestressed s;
+    if (!prestressed_sphere(rng, attempt, s)) continue;
+    ++tested;
+    INFO("attempt " << attempt);
+    const ForceProblem problem(s.h.net, s.h.hooks, s.h.steps, s.cuts, s.fo);
+    test(s, problem);
+  }
+  return tested;
+}
+
 Network gallows() {
   WireSpec A;
   A.name = "gallows";
@@ -143,19 +160,12 @@ TEST_CASE("load: on random networks every 3D torque at the limit load stays with
   // vertex of every wire not held has |t_v| <= t_max, summed directly with each edge's weight at
   // its midpoint. The in_plane bound only limits n·t_v, so its capacities are never below the
   // 3D ones (the pre-stress does not enter: δ is free).
-  std::mt19937 rng(31);
   const double per_metre = std::numbers::pi * 0.25 * 0.003 * 0.003 * 7850.0 * 9.81;
-  int tested = 0, lower = 0;
-  for (int attempt = 0; attempt < 300 && tested < 10; ++attempt) {
-    Prestressed s;
-    if (!prestressed_sphere(rng, attempt, s)) continue;
+  int lower = 0;
+  const int tested = on_prestressed_spheres(31, 10, [&](const Prestressed& s, const ForceProblem& problem) {
     const fixtures::HookedNetwork& h = s.h;
     const std::vector<int>& cuts = s.cuts;
-    const ForceOptions& fo = s.fo;
     const ForceResult& pre = s.pre;
-    ++tested;
-    INFO("attempt " << attempt);
-    const ForceProblem problem(h.net, h.hooks, h.steps, cuts, fo);
     LoadCapacityOptions lo;
     lo.density = 7850.0;
     const LoadCapacityResult r = load_capacity(h.net, cuts, problem, pre.coefficients, lo);
@@ -177,7 +187,7 @@ TEST_CASE("load: on random networks every 3D torque at the limit load stays with
         CHECK(t <= problem.t_max() * (1 + 1e-7));
       }
     }
-  }
+  });
   CHECK(tested >= 8);
   CHECK(lower > 0);
 }
@@ -186,18 +196,11 @@ TEST_CASE("load: warm-started cutting planes give the rebuilt capacities on rand
   // Each direction's LP is a cutting-plane loop over the 3D polytope's rows: re-solving the
   // problem GLPK holds from its last basis must give the capacity that rebuilding every round
   // gives (relative 1e-7), direction by direction.
-  std::mt19937 rng(37);
-  int tested = 0, finite = 0;
-  for (int attempt = 0; attempt < 300 && tested < 8; ++attempt) {
-    Prestressed s;
-    if (!prestressed_sphere(rng, attempt, s)) continue;
+  int finite = 0;
+  const int tested = on_prestressed_spheres(37, 8, [&](const Prestressed& s, const ForceProblem& problem) {
     const fixtures::HookedNetwork& h = s.h;
     const std::vector<int>& cuts = s.cuts;
-    const ForceOptions& fo = s.fo;
     const ForceResult& pre = s.pre;
-    ++tested;
-    INFO("attempt " << attempt);
-    const ForceProblem problem(h.net, h.hooks, h.steps, cuts, fo);
     LoadCapacityOptions lo;
     const LoadCapacityResult warm = load_capacity(h.net, cuts, problem, pre.coefficients, lo);
     lo.lp_warm_start = false;
@@ -209,7 +212,7 @@ TEST_CASE("load: warm-started cutting planes give the rebuilt capacities on rand
       CHECK(warm.directions[d].multiple == Approx(cold.directions[d].multiple).epsilon(1e-7).margin(1e-12));
       if (std::isfinite(cold.directions[d].multiple) && cold.directions[d].multiple > 0) ++finite;
     }
-  }
+  });
   CHECK(tested >= 6);
   CHECK(finite >= 12);  // capacities that are neither 0 nor unbounded
 }
@@ -219,18 +222,10 @@ TEST_CASE("load: two threads give the serial capacities direction by direction, 
   // The six directions' LPs are independent: solved on the calling thread and a second one they
   // must be exactly the serial ones (GLPK keeps a state per thread, docs/robustness.md), in the
   // order +x, -x, +y, -y, +z, -z; the progress callback is only ever called from the calling thread.
-  std::mt19937 rng(43);
-  int tested = 0;
-  for (int attempt = 0; attempt < 300 && tested < 6; ++attempt) {
-    Prestressed s;
-    if (!prestressed_sphere(rng, attempt, s)) continue;
+  const int tested = on_prestressed_spheres(43, 6, [&](const Prestressed& s, const ForceProblem& problem) {
     const fixtures::HookedNetwork& h = s.h;
     const std::vector<int>& cuts = s.cuts;
-    const ForceOptions& fo = s.fo;
     const ForceResult& pre = s.pre;
-    ++tested;
-    INFO("attempt " << attempt);
-    const ForceProblem problem(h.net, h.hooks, h.steps, cuts, fo);
     LoadCapacityOptions lo;
     lo.threads = 1;
     const LoadCapacityResult serial = load_capacity(h.net, cuts, problem, pre.coefficients, lo);
@@ -262,7 +257,7 @@ TEST_CASE("load: two threads give the serial capacities direction by direction, 
     }
     CHECK(two.length == serial.length);
     CHECK(two.weight == serial.weight);
-  }
+  });
   CHECK(tested >= 5);
 }
 
