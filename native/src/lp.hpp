@@ -95,8 +95,8 @@ struct TorqueBlocks {
 };
 
 /// Solves `lp`, then adds to it, for every block whose torque lies outside `polytope` (gauge
-/// above 1 + 1e-9), the most violated row e_k·t_v <= t_max and the violated rows of its
-/// neighbours, and solves again until no block is outside: the optimum under every row of the
+/// above 1 + 1e-9), its most violated row e_k·t_v <= t_max, and solves again until no block is
+/// outside: the optimum under every row of the
 /// polytope with only the rows that matter in the LP (a cutting-plane loop over a finite row
 /// set). `added` holds the (block, row) pairs already in `lp`; `rounds` counts the solves.
 /// Returns the last solution (when not optimal, GLPK's status with the rows so far), with the

@@ -397,6 +397,58 @@ TEST_CASE("lp: warm-started torque rows reach the rebuilt optimum on generated f
   CHECK(warm_iterations < cold_iterations);  // and took fewer simplex steps than rebuilding
 }
 
+TEST_CASE("lp: the cutting-plane loop reaches the optimum of the LP that holds every row of the 3D polytope",
+          "[lp][torque]") {
+  // An independent answer: the force LP of random hooked spheres with all 180 rows of the 3D
+  // polytope at every vertex loaded from the start (one plain solve_lp, no cuts). The loop, which
+  // adds one row per vertex outside the polytope and round, must reach its optimum (relative
+  // 1e-7) with a small part of those rows.
+  std::mt19937 rng(23);  // the networks of the warm-start test above, 5 of which need cuts
+  int compared = 0, cut = 0;
+  for (int attempt = 0; attempt < 200 && compared < 12; ++attempt) {
+    fixtures::HookedNetwork h;
+    if (!fixtures::random_hooked_sphere(rng, attempt, 32, h)) continue;
+    const auto cuts = wiresculpt::choose_cuts(h.net);
+    wiresculpt::ForceOptions fo;
+    fo.torque_fraction = 0.5;
+    const wiresculpt::ForceProblem problem(h.net, h.hooks, h.steps, cuts, fo);
+    const int K = problem.columns();
+    if (K == 0) continue;
+    LinearProgram lp;
+    lp.obj.assign(problem.normal_weights().data(), problem.normal_weights().data() + K);
+    lp.col_lo.assign(K, 0.0);
+    lp.col_hi.assign(K, kInf);
+    append_rows(lp, problem.equilibrium(), 0.0, 0.0);
+    append_rows(lp, problem.torque_rows(), -problem.t_max(), problem.t_max());
+    append_rows(lp, problem.normal_rows(), 0.0, kInf);
+    const Eigen::MatrixXd& T3 = problem.torque_frame_rows();
+    const auto& poly = problem.polytope();
+    LinearProgram full = lp;
+    Eigen::MatrixXd every(static_cast<Eigen::Index>(poly.rows.size()) * (T3.rows() / 3), K);
+    for (Eigen::Index v = 0; v < T3.rows() / 3; ++v)
+      for (std::size_t k = 0; k < poly.rows.size(); ++k)
+        every.row(v * static_cast<Eigen::Index>(poly.rows.size()) + static_cast<Eigen::Index>(k)) =
+            poly.rows[k].transpose() * T3.middleRows(3 * v, 3);
+    append_rows(full, every, -kInf, problem.t_max());
+    const LpSolution all = solve_lp(full);
+    const TorqueBlocks blocks{T3, Eigen::VectorXd::Zero(T3.rows())};
+    std::set<std::pair<int, int>> added;
+    int rounds = 0;
+    const LpSolution loop = solve_lp_with_torque_rows(lp, blocks, poly, problem.t_max(), added, &rounds);
+    INFO("attempt " << attempt << ", " << every.rows() << " rows in all");
+    REQUIRE(loop.status == all.status);
+    if (all.status != LpSolution::optimal) continue;
+    ++compared;
+    CHECK(loop.objective == Approx(all.objective).epsilon(1e-7));
+    CHECK(worst_gauge(blocks, poly, problem.t_max(), loop.x) <= 1.0 + 1e-7);
+    CHECK(added.size() <= static_cast<std::size_t>(rounds) * static_cast<std::size_t>(T3.rows() / 3));
+    CHECK(added.size() * 10 < static_cast<std::size_t>(every.rows()));
+    if (rounds > 1) ++cut;
+  }
+  CHECK(compared >= 10);
+  CHECK(cut >= 5);
+}
+
 TEST_CASE("lp: rows a round adds are checked as solve_lp checks them", "[lp][warm][robustness]") {
   // One column x in [0, 10] with the row x <= 8, maximise x; the block's torque is x a (frame n),
   // slab polytope, so round 1 (x = 8) adds the row a x <= t_max when a x > t_max.
