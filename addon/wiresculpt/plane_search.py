@@ -83,6 +83,7 @@ SCREEN_SECONDS = 2.0  # a screen's layering longer than this does not pass (a se
 FINAL_HOOK_SECONDS = 10.0
 FINAL_SECONDS = 20.0
 PAIR_SINGLES = 25  # the two-plane changes pair each plane's this many cheapest one-plane changes (all 25)
+SLICE_AHEAD = 32  # nearby slices the changed planes of this many candidates in one call (Searcher.slice_ahead)
 
 
 class Placement:
@@ -215,8 +216,8 @@ class Searcher:
         slicer prepares (welds, cleans) the mesh once per call, which on the corpus' meshes costs
         ten times a plane's cut (armadillo, 52,000 triangles: 7.8 ms a call of one plane, 0.7 ms a
         plane in a call of 30). A plane's contours do not depend on the others in the call. When
-        the call refuses one of several placements, none is cached and each is sliced alone when
-        needed (so that the refusal reaches only the candidates that hold it)."""
+        the call refuses one of several placements, each is sliced alone and the refused ones are
+        left uncached, so that the refusal reaches only the candidates that hold them."""
         todo = {}
         for p in placements:
             todo.setdefault(p.key(), p)
@@ -228,9 +229,14 @@ class Searcher:
             found, info = slicing.slice_planes(self.V, self.F, [p.spec() for p in todo.values()],
                                                self.settings.get("weld_tolerance"))
         except ValueError:
-            if len(todo) > 1:
-                return
-            raise
+            if len(todo) == 1:
+                raise
+            for p in todo.values():
+                try:
+                    self.slice_ahead([p])
+                except ValueError:
+                    pass
+            return
         self.mesh_info = self.mesh_info or info
         for key, contours in zip(todo, found):
             self.cache[key] = contours
@@ -494,7 +500,6 @@ def nearby(vertices, faces, planes, material, settings, want=1, budget=BUDGET_SE
     pairs = [(a.cost + b.cost, ((i, a), (j, b))) for i, j in itertools.combinations(sorted(singles), 2)
              for a in singles[i][:PAIR_SINGLES] for b in singles[j][:PAIR_SINGLES]]
     tally = s.tally = Tally(base, singles, len(pairs))
-    s.slice_ahead(base + [c for cs in singles.values() for c in cs])  # every placement a candidate can hold
     found = []
 
     def out_of_time():
@@ -522,9 +527,11 @@ def nearby(vertices, faces, planes, material, settings, want=1, budget=BUDGET_SE
 
     def phase(options):
         deferred = []
-        for cost, changes in options:
+        for n, (cost, changes) in enumerate(options):
             if cost >= bar() or out_of_time():
                 break
+            if any(c.key() not in s.cache for _i, c in changes):  # this and the next candidates' planes at once
+                s.slice_ahead([c for _cost, ahead in options[n:n + SLICE_AHEAD] for _i, c in ahead])
             placements = list(base)
             for i, c in changes:
                 placements[i] = c
