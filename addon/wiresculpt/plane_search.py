@@ -32,8 +32,10 @@ Two searches:
   family proposal plus one plane at an area quantile along one of its axes) are screened and
   verified first.
 
-Every candidate is screened cheaply first: slicing (each plane placement sliced once, cached) and
-the layering (stages.layering), whose first step is the hook-relaxed stability check (every
+Every candidate is screened cheaply first: slicing (each plane placement sliced once per search,
+the planes of many candidates in one native call, Searcher.slice_ahead; the designs share each
+contour's points, and the layering's copy of a design copies no points) and the layering
+(stages.layering), whose first step is the hook-relaxed stability check (every
 crossing a ball joint: a mechanism is rejected in about a millisecond) and whose search then
 finds the hooks. Only survivors run the full pipeline (pipeline.solve: target shape, forces, rest
 shape, buildability) with the layering's own hooks (CANDIDATE_HOOK_PATTERNS), and a candidate is
