@@ -204,7 +204,7 @@ class Nearby(unittest.TestCase):
 
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)
 class ReusedSlices(unittest.TestCase):
-    """A screen with the search's shared slices (every placement of the nearby search sliced in one
+    """A screen with the search's shared slices (the placements of many candidates sliced in one
     native call, contours converted once and shared by the designs, the probe copied without its
     points) equals a screen from scratch: each plane sliced by its own call, the wires made by
     core.design.wire_entry, the layering run on a deep copy (the screen as it was before slices were
