@@ -4,7 +4,8 @@ planes as given ("off"), then `plane_search: "nearby"`; and for every mesh `plan
 with N planes. Every stable design is re-checked (blender_tests/pure/recheck.py). Prints a
 Markdown table and writes JSON; with --section FILE (docs/performance.md) also writes the table
 between FILE's `<!-- planes:begin -->` and `<!-- planes:end -->`, keeping the section's hand-written
-notes (from `<!-- planes:notes -->` on). --out also records the load average at the start and
+notes (from `<!-- planes:notes -->` on); with --counts "" (nearby only) the section's auto columns
+are kept as they were, and its header says from which run. --out also records the load average at the start and
 end and the commit; --from-json FILE redoes the table and section from such a file, without a run.
 
     python3.11 scripts/plane_search_corpus.py [--cache build/corpus] [--size 0.5] [--counts 5] [--out FILE]
@@ -75,23 +76,53 @@ def nearby_cell(reason):
     return f"{head}; *{todo[:160]}{'…' if len(todo) > 160 else ''}*"
 
 
-def table(rows, counts):
+def table(rows, counts, kept=None):
+    """The Markdown table: a row per mesh, the auto columns of `counts` from the rows or, when
+    `kept` = (headers, {mesh: cells}) is given (a nearby-only run), those cells as they were."""
     def verdict(r):
         if r["stable"]:
             return "stable" + ("" if not r.get("recheck") else " (re-check FAILS)")
         return "not stable"
-    lines = ["| mesh | given planes | nearby | nearby s (screened / solved) | " +
-             " | ".join(f"auto N={n} (s, screened / solved)" for n in counts) + " |",
-             "|---|---|---|---|" + "---|" * len(counts)]
+    autos = kept[0] if kept else [f"auto N={n} (s, screened / solved)" for n in counts]
+    lines = ["| " + " | ".join(["mesh", "given planes", "nearby", "nearby s (screened / solved)"] + autos) + " |",
+             "|" + "---|" * (4 + len(autos))]
     for row in rows:
         nb = row["nearby"]
         change = ("; ".join(nb.get("changes") or []) or "kept as given" if nb["stable"] else nearby_cell(nb["reason"]))
-        autos = " | ".join(f"{verdict(row[f'auto{n}'])} ({row[f'auto{n}']['seconds']:.1f}, "
-                           f"{row[f'auto{n}'].get('candidates', '-')} / {row[f'auto{n}'].get('full_solves', '-')})"
-                           for n in counts)
-        lines.append(f"| {row['mesh']} | {verdict(row['off'])} | {verdict(nb)}: {change} | {nb['seconds']:.1f} "
-                     f"({nb.get('candidates', '-')} / {nb.get('full_solves', '-')}) | {autos} |")
+        cells = (kept[1].get(row["mesh"], ["-"] * len(autos)) if kept else
+                 [f"{verdict(row[f'auto{n}'])} ({row[f'auto{n}']['seconds']:.1f}, "
+                  f"{row[f'auto{n}'].get('candidates', '-')} / {row[f'auto{n}'].get('full_solves', '-')})"
+                  for n in counts])
+        lines.append("| " + " | ".join([row["mesh"], verdict(row["off"]), f"{verdict(nb)}: {change}",
+                                        f"{nb['seconds']:.1f} ({nb.get('candidates', '-')} / "
+                                        f"{nb.get('full_solves', '-')})"] + cells) + " |")
     return lines
+
+
+def kept_auto(old):
+    """From an earlier planes section `old`: (the auto columns' headers, {mesh: their cells}) and
+    a sentence saying when that run was (date, commit, load, budget), and its auto result.
+    SystemExit when it has none, naming what is missing."""
+    rows = [[c.strip() for c in line.strip().strip("|").split(" | ")] for line in old.splitlines()
+            if line.startswith("| ")]
+    if not rows or not any(c.startswith("auto N=") for c in rows[0]):
+        raise SystemExit("plane_search_corpus: --counts \"\" (nearby only) keeps the auto columns of the "
+                         "section, but its table has none: run with --counts")
+    first = [k for k, c in enumerate(rows[0]) if c.startswith("auto N=")][0]
+    result = re.search(r"Auto(?: \(the run before\))?: stable on [^.]*\.", old)
+    before = re.search(r"The auto columns are kept from the run before \(.*?\)\.", old, re.S)
+    if before and result:  # a nearby-only section already: its auto part as it says
+        return ((rows[0][first:], {r[0]: r[first:] for r in rows[1:]}), before.group(0),
+                result.group(0).replace("Auto (the run before):", "Auto:"))
+    run = re.search(r"\((\d{4}-\d\d-\d\d), commit (\w+);", old)
+    load = re.search(r"shared: ([\d.]+) at the start, ([\d.]+) at the end", old)
+    budget = re.search(r'`"auto"` \((budget .*?)\)', old, re.S)
+    if not (run and load and budget and result):
+        raise SystemExit("plane_search_corpus: the section's header does not say when its auto columns ran "
+                         "(date, commit, load, budget, result): run with --counts")
+    about = (f"The auto columns are kept from the run before ({run.group(1)}, commit {run.group(2)}, load "
+             f"{load.group(1)} at the start and {load.group(2)} at the end; {budget.group(1)}).")
+    return (rows[0][first:], {r[0]: r[first:] for r in rows[1:]}), about, result.group(0)
 
 
 def head_commit():
@@ -104,32 +135,43 @@ def head_commit():
 
 def section(path, rows, counts, args, load, commit):
     """Writes the table and the run's header between the planes markers of `path`, keeping the
-    notes after `<!-- planes:notes -->` of the section as it was."""
+    notes after `<!-- planes:notes -->` of the section as it was. With no counts (a nearby-only
+    run), the auto columns and what the header said of them are kept from the section (kept_auto)."""
     with open(path, encoding="utf-8") as f:
         text = f.read()
     old = re.search(re.escape(BEGIN) + r".*?" + re.escape(END), text, re.S)
     notes = ""
     if old and NOTES in old.group(0):
         notes = old.group(0).split(NOTES, 1)[1].rsplit(END, 1)[0].strip("\n")
+    kept, about, auto_result = None, "", ""
+    if not counts:
+        if not old:
+            raise SystemExit(f"plane_search_corpus: {path} has no planes section whose auto columns a nearby-only "
+                             "run could keep: run with --counts")
+        kept, about, auto_result = kept_auto(old.group(0).split(NOTES, 1)[0])
+        auto_result = auto_result.replace("Auto: stable", "Auto (the run before): stable") + " "
     stable = {n: sum(1 for r in rows if r[f"auto{n}"]["stable"]) for n in counts}
     fixed = sum(1 for r in rows if not r["off"]["stable"] and r["nearby"]["stable"])
     unstable = sum(1 for r in rows if not r["off"]["stable"])
     rechecked = sum(1 for r in rows for k in ["nearby"] + [f"auto{n}" for n in counts] if r[k]["stable"])
     failed = sum(1 for r in rows for k in ["nearby"] + [f"auto{n}" for n in counts] if r[k].get("recheck"))
+    auto_run = ("" if kept else
+                f', and every mesh with `"auto"` (budget {plane_search.AUTO_SECONDS_PER_PLANE:g} s per plane, then at '
+                f"most {plane_search.FINAL_SECONDS:g} s for the comparison of hook patterns on the returned design)")
+    counts_arg = args.counts or '""'
     head = [BEGIN, "## Plane assistant on the real-mesh corpus (issue 15)", "",
-            f"`scripts/bench planes --size {args.size} --counts {args.counts} --section docs/performance.md` "
+            f"`scripts/bench planes --size {args.size} --counts {counts_arg} --section docs/performance.md` "
             f"({datetime.date.today().isoformat()}, commit {commit}; `scripts/plane_search_corpus.py`, in-process with "
             "the system Python 3.11 and the built module, no Blender): every `zzxxy5` scene of the corpus at "
             f"{args.size} m, solved with the planes as given, then with `plane_search: \"nearby\"` (budget "
-            f"{plane_search.BUDGET_SECONDS:g} s), and every mesh with `\"auto\"` (budget "
-            f"{plane_search.AUTO_SECONDS_PER_PLANE:g} s per plane, then at most {plane_search.FINAL_SECONDS:g} s "
-            "for the comparison of hook patterns on the returned design). Load average (1 min) of the 2-core "
-            f"machine, shared: {load[0]:.1f} at the start, {load[1]:.1f} at the end. Every stable design is "
-            f"re-checked by `blender_tests/pure/recheck.py`: {rechecked} stable, {failed} refused by it.", "",
-            f"Auto: stable on {', '.join(f'{stable[n]}' for n in counts)} of {len(rows)} meshes for "
-            f"N = {', '.join(str(n) for n in counts)}. Nearby: {fixed} of the {unstable} unstable scenes made "
-            "stable.", ""]
-    body = "\n".join(head + table(rows, counts) + ["", NOTES] + ([notes] if notes else []) + [END])
+            f"{plane_search.BUDGET_SECONDS:g} s){auto_run}. Load average (1 min) of the 2-core "
+            f"machine, shared: {load[0]:.1f} at the start, {load[1]:.1f} at the end. Every stable design of the run is "
+            f"re-checked by `blender_tests/pure/recheck.py`: {rechecked} stable, {failed} refused by it."
+            + (f" {about}" if about else ""), "",
+            (f"Auto: stable on {', '.join(f'{stable[n]}' for n in counts)} of {len(rows)} meshes for "
+             f"N = {', '.join(str(n) for n in counts)}. " if counts else auto_result)
+            + f"Nearby: {fixed} of the {unstable} unstable scenes made stable.", ""]
+    body = "\n".join(head + table(rows, counts, kept) + ["", NOTES] + ([notes] if notes else []) + [END])
     text = text.replace(old.group(0), body) if old else text.rstrip("\n") + "\n\n" + body + "\n"
     with open(path, "w", encoding="utf-8") as f:
         f.write(text)

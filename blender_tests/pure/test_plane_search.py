@@ -11,10 +11,12 @@ import unittest
 import numpy as np
 
 from wiresculpt import native, pipeline, plane_search
+from wiresculpt.core import contours as contour_rules
 from wiresculpt.core import design as vocabulary
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.scene import PlaneSpec, parse_scene
 from wiresculpt.core.settings import defaults
+from wiresculpt.stages import layering, slicing
 
 from helpers import ROOT, sphere
 import recheck
@@ -198,6 +200,101 @@ class Nearby(unittest.TestCase):
         self.assertNotIn("plane_search", design)
         self.assertFalse(design["stable"])
         self.assertEqual(used, HINGE)
+
+
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class ReusedSlices(unittest.TestCase):
+    """A screen with the search's shared slices (the placements of many candidates sliced in one
+    native call, contours converted once and shared by the designs, the probe copied without its
+    points) equals a screen from scratch: each plane sliced by its own call, the wires made by
+    core.design.wire_entry, the layering run on a deep copy (the screen as it was before slices were
+    shared). On the sphere with BASE's planes, whose circles and crossings are known by hand: a plane
+    at distance c R from the centre cuts the circle of radius R sqrt(1 - c^2); the planes z = c1 and
+    x = c2 (or y = c2) cross at the two points (c2, +-sqrt(1 - c1^2 - c2^2), c1) R when
+    c1^2 + c2^2 < 1; Z1 and Z2 are parallel. So every pair of BASE's planes but (Z1, Z2) crosses
+    twice: 10 crossings."""
+
+    def setUp(self):
+        self.V, self.F = sphere()
+        self.settings = settings()
+
+    def from_scratch(self, placements):
+        design = vocabulary.new_design(PRESETS["steel"], self.settings)
+        contours = 0
+        for p in placements:
+            found, info = slicing.slice_planes(self.V, self.F, [p.spec()], self.settings.get("weld_tolerance"))
+            contours += len(found[0])
+            design["stages"]["slicing"] = {"planes": len(placements), "contours": contours, "mesh": info}
+            for k in contour_rules.pick(found[0], p.contours, p.name):
+                c = found[0][k]
+                design["wires"].append(vocabulary.wire_entry(len(design["wires"]), f"{p.name}/{k}", list(p.origin),
+                                                             list(p.normal), c["closed"], c["points"]))
+        probe = copy.deepcopy(design)
+        layering.run(probe, PRESETS["steel"], self.settings)
+        return design, probe
+
+    def candidates(self, searcher):
+        """The given planes, Z1 moved down 4 % of S (z = 0.62 R), and that with X1 moved +x 2 % of S
+        (x = -0.26 R), as the nearby search makes them."""
+        base = [plane_search.Placement(p.name, p.origin, p.normal, p.contours) for p in BASE]
+        singles = {i: plane_search.single_changes(p, searcher.centre, searcher.size) for i, p in enumerate(BASE)}
+        down = [c for c in singles[0] if c.changes == ["move plane Z1 down 10 mm"]][0]
+        right = [c for c in singles[2] if c.changes == ["move plane X1 +x 5 mm"]][0]
+        return singles, [(base, (0.7, -0.3)), ([down] + base[1:], (0.62, -0.3)),
+                         ([down, base[1], right, base[3]], (0.62, -0.26))]
+
+    def by_hand(self, probe, z1, x1):
+        """The circles and crossings of Z1 at z = z1 R, Z2 at z = -0.7 R, X1 at x = x1 R and Y at y = 0."""
+        distance = {"Z1/0": z1, "Z2/0": -0.7, "X1/0": x1, "Y/0": 0.0}
+        axis = {"Z1/0": 2, "Z2/0": 2, "X1/0": 0, "Y/0": 1}
+        for w in probe["wires"]:
+            points = np.asarray(w["contour"]) / R
+            c = distance[w["name"]]
+            np.testing.assert_allclose(points[:, axis[w["name"]]], c, atol=1e-12)
+            # on the mesh's chords, within 1 % inside the sphere (its triangles span at most 7.5 deg)
+            off = np.delete(points, axis[w["name"]], axis=1)
+            radius = np.linalg.norm(off, axis=1)
+            self.assertTrue(np.all(radius <= math.sqrt(1 - c * c) + 1e-12), w["name"])
+            self.assertTrue(np.all(np.linalg.norm(points, axis=1) >= 0.99), w["name"])
+        names = {w["id"]: w["name"] for w in probe["wires"]}
+        self.assertEqual(len(probe["crossings"]), 10)
+        for c in probe["crossings"]:
+            pair = sorted(names[i] for i in c["wires"])
+            self.assertNotEqual(pair, ["Z1/0", "Z2/0"])
+            point = np.asarray(c["point"]) / R
+            for name in pair:
+                self.assertAlmostEqual(point[axis[name]], distance[name], delta=1e-9)
+            free = ({0, 1, 2} - {axis[n] for n in pair}).pop()
+            fixed = sum(distance[n] ** 2 for n in pair)
+            self.assertAlmostEqual(abs(point[free]), math.sqrt(1 - fixed), delta=0.01)
+
+    def test_a_screen_with_shared_slices_equals_one_from_scratch(self):
+        s = plane_search.Searcher(self.V, self.F, PRESETS["steel"], self.settings)
+        singles, candidates = self.candidates(s)
+        s.slice_ahead([p for c, _ in candidates for p in c] + [c for cs in singles.values() for c in cs])
+        self.assertEqual(len(s.cache), 4 + 4 * 25 - 4)  # each plane's "other contour rule" is its own placement
+        for placements, (z1, x1) in candidates * 2:  # the second round: every design from the shared lists
+            ok, design, probe = s.screen_layered(placements)
+            mine_design, mine_probe = self.from_scratch(placements)
+            self.assertTrue(ok, probe["reason"])
+            self.assertTrue(mine_probe["stable"])
+            self.assertEqual(untimed(design), untimed(mine_design))
+            self.assertEqual(untimed(probe), untimed(mine_probe))
+            self.assertEqual(json.dumps(untimed(probe), sort_keys=True), json.dumps(untimed(mine_probe), sort_keys=True))
+            self.by_hand(probe, z1, x1)
+
+    def test_slicing_ahead_leaves_refused_placements_to_their_candidates(self):
+        s = plane_search.Searcher(self.V, self.F, PRESETS["steel"], self.settings)
+        good = plane_search.Placement("Z1", (0.0, 0.0, 0.7 * R), (0, 0, 1), "largest")
+        bad = plane_search.Placement("Bad", (0.0, 0.0, 0.0), (0, 0, 1), "largest")
+        bad.origin = (math.nan, 0.0, 0.0)  # a placement the slicer refuses
+        s.slice_ahead([good, bad])
+        self.assertEqual(list(s.cache), [good.key()])  # the good one sliced alone, the refused one left
+        ok, _design, _probe = s.screen_layered([good, bad])
+        self.assertFalse(ok)
+        self.assertEqual(s.fault[0], "refused")
+        self.assertIn("expected a finite number, got nan", s.fault[2][0])
+        self.assertEqual(len(s._contours(good)), 1)
 
 
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)
