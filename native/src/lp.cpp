@@ -400,7 +400,7 @@ LpSolution solve_lp(const LinearProgram& in) { return HeldLp().build(in); }
 
 LpSolution solve_lp_with_torque_rows(LinearProgram& lp, const TorqueBlocks& blocks, const TorquePolytope& polytope,
                                      double t_max, std::set<std::pair<int, int>>& added, int* rounds, bool warm_start,
-                                     HeldLp* keep) {
+                                     HeldLp* keep, CutRows cut_rows) {
   const Eigen::Index V = blocks.A.rows() / 3, cols = blocks.A.cols();
   int iterations = 0, builds = 0, warm = 0;
   HeldLp own;
@@ -447,12 +447,12 @@ LpSolution solve_lp_with_torque_rows(LinearProgram& lp, const TorqueBlocks& bloc
       const Vec3 tv = t.segment<3>(3 * v);
       int k = -1;
       if (torque_gauge(polytope, tv, t_max, &k) <= 1.0 + 1e-9) continue;
-      // Only the most violated row. Adding the violated rows of its neighbouring facets too saved
-      // a round or two but tripled the rows GLPK carries (Airplane: 973 instead of 122 rows added
-      // for one load direction), and warm rounds are cheap: one row per block and round made the
-      // Airplane's forces call 0.024 -> 0.016 s and the Chair's 0.057 -> 0.043 s
-      // (docs/method-forces.md §15).
+      // The most violated row, and (CutRows::with_neighbours) those of its neighbours that are
+      // violated too: the optimum slides to them next otherwise (docs/method-forces.md §15).
       add(v, k);
+      if (cut_rows == CutRows::with_neighbours)
+        for (int nb : polytope.neighbours[k])
+          if (polytope.rows[nb].dot(tv) > t_max * (1.0 + 1e-9)) add(v, nb);
     }
     if (!grew) return sol;
   }

@@ -89,14 +89,17 @@ class HeldLp {
 
 /// Torques linear in an LP's columns x: block v (rows 3v..3v+2) is t_v = A_v x + c_v, its
 /// components along the wire's n, u, v.
+/// Which rows of the polytope a round of solve_lp_with_torque_rows adds per violating block.
+enum class CutRows { with_neighbours, most_violated };
+
 struct TorqueBlocks {
   Eigen::MatrixXd A;
   Eigen::VectorXd c;
 };
 
 /// Solves `lp`, then adds to it, for every block whose torque lies outside `polytope` (gauge
-/// above 1 + 1e-9), its most violated row e_k·t_v <= t_max, and solves again until no block is
-/// outside: the optimum under every row of the
+/// above 1 + 1e-9), its most violated row e_k·t_v <= t_max (and with CutRows::with_neighbours
+/// the violated rows of its neighbours), and solves again until no block is outside: the optimum under every row of the
 /// polytope with only the rows that matter in the LP (a cutting-plane loop over a finite row
 /// set). `added` holds the (block, row) pairs already in `lp`; `rounds` counts the solves.
 /// Returns the last solution (when not optimal, GLPK's status with the rows so far), with the
@@ -112,9 +115,15 @@ struct TorqueBlocks {
 /// `keep` (optional): the held problem to start from and to leave the last one in, so that a
 /// later loop over a grown `lp` starts from this one's optimal basis (the forces' least-out-of-
 /// plane LP, which adds rows, columns and a new objective to the force LP).
+/// `cut_rows`: with_neighbours (the forces' LPs) adds a block's violated neighbour rows too, a
+/// round or two fewer; most_violated (the load capacity) one row per block and round, a third
+/// of the rows for GLPK to carry (docs/method-forces.md §15). Both reach the LP's optimal value;
+/// where the LP has several optimal points they may end at different ones, which is why the
+/// forces, whose point is the design's contact forces, keep the rule they had.
 LpSolution solve_lp_with_torque_rows(LinearProgram& lp, const TorqueBlocks& blocks, const TorquePolytope& polytope,
                                      double t_max, std::set<std::pair<int, int>>& added, int* rounds,
-                                     bool warm_start = true, HeldLp* keep = nullptr);
+                                     bool warm_start = true, HeldLp* keep = nullptr,
+                                     CutRows cut_rows = CutRows::with_neighbours);
 
 /// Frees the calling thread's GLPK environment (GLPK keeps one per thread and does not free it
 /// when the thread ends, ~5 kB each): a thread started to solve LPs calls this last. Problems

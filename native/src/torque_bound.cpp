@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <set>
 
 #include "wiresculpt/error.hpp"
 
@@ -63,6 +64,7 @@ TorquePolytope geodesic_polytope(int frequency) {
   }
   TorquePolytope out;
   double nearest = 1.0;
+  std::vector<std::vector<int>> at_point(points.size());
   for (std::size_t t = 0; t < tris.size(); ++t) {
     const auto& [a, b, c] = tris[t];
     Vec3 d = (points[b] - points[a]).cross(points[c] - points[a]).normalized();
@@ -74,13 +76,22 @@ TorquePolytope geodesic_polytope(int frequency) {
       if (std::abs(points[p].x()) > 1.0 - 1e-12) out.apex.push_back(static_cast<int>(t));
     out.rows.push_back(d / r);
     nearest = std::min(nearest, r);
+    for (int p : tris[t]) at_point[p].push_back(static_cast<int>(t));
   }
   out.gap = 1.0 - nearest;
+  out.neighbours.resize(tris.size());
+  for (std::size_t t = 0; t < tris.size(); ++t) {
+    std::set<int> near;
+    for (int p : tris[t])
+      for (int other : at_point[p])
+        if (other != static_cast<int>(t)) near.insert(other);
+    out.neighbours[t].assign(near.begin(), near.end());
+  }
   return out;
 }
 
 const TorquePolytope& torque_polytope(TorqueBound bound) {
-  static const TorquePolytope slab{{Vec3(1, 0, 0), Vec3(-1, 0, 0)}, {0, 1}, 0.0};
+  static const TorquePolytope slab{{Vec3(1, 0, 0), Vec3(-1, 0, 0)}, {{}, {}}, {0, 1}, 0.0};
   static const TorquePolytope ball = geodesic_polytope(3);
   return bound == TorqueBound::in_plane ? slab : ball;
 }

@@ -419,7 +419,7 @@ TEST_CASE("forces: the 3D polytope lies inside the ball and touches it at +-n", 
     CHECK(rounds >= 2);
     CHECK(added.size() < 60);  // a few of the 180 rows
   }
-  // Finer polytopes close the gap.
+  // Finer polytopes close the gap; every facet's neighbours share a vertex with it.
   CHECK(geodesic_polytope(4).gap < poly.gap);
   CHECK(geodesic_polytope(4).rows.size() == 320);
   // The slab of in_plane: only ±n, not inside the ball.

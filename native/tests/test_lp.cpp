@@ -400,9 +400,9 @@ TEST_CASE("lp: warm-started torque rows reach the rebuilt optimum on generated f
 TEST_CASE("lp: the cutting-plane loop reaches the optimum of the LP that holds every row of the 3D polytope",
           "[lp][torque]") {
   // An independent answer: the force LP of random hooked spheres with all 180 rows of the 3D
-  // polytope at every vertex loaded from the start (one plain solve_lp, no cuts). The loop, which
-  // adds one row per vertex outside the polytope and round, must reach its optimum (relative
-  // 1e-7) with a small part of those rows.
+  // polytope at every vertex loaded from the start (one plain solve_lp, no cuts). The loop must
+  // reach its optimal value (relative 1e-7) with a small part of those rows, adding either the
+  // violated neighbour rows too (the forces) or one row per vertex and round (the load capacity).
   std::mt19937 rng(23);  // the networks of the warm-start test above, 5 of which need cuts
   int compared = 0, cut = 0;
   for (int attempt = 0; attempt < 200 && compared < 12; ++attempt) {
@@ -432,18 +432,25 @@ TEST_CASE("lp: the cutting-plane loop reaches the optimum of the LP that holds e
     append_rows(full, every, -kInf, problem.t_max());
     const LpSolution all = solve_lp(full);
     const TorqueBlocks blocks{T3, Eigen::VectorXd::Zero(T3.rows())};
-    std::set<std::pair<int, int>> added;
-    int rounds = 0;
-    const LpSolution loop = solve_lp_with_torque_rows(lp, blocks, poly, problem.t_max(), added, &rounds);
     INFO("attempt " << attempt << ", " << every.rows() << " rows in all");
-    REQUIRE(loop.status == all.status);
-    if (all.status != LpSolution::optimal) continue;
-    ++compared;
-    CHECK(loop.objective == Approx(all.objective).epsilon(1e-7));
-    CHECK(worst_gauge(blocks, poly, problem.t_max(), loop.x) <= 1.0 + 1e-7);
-    CHECK(added.size() <= static_cast<std::size_t>(rounds) * static_cast<std::size_t>(T3.rows() / 3));
-    CHECK(added.size() * 10 < static_cast<std::size_t>(every.rows()));
-    if (rounds > 1) ++cut;
+    if (all.status == LpSolution::optimal) ++compared;
+    for (const CutRows rule : {CutRows::with_neighbours, CutRows::most_violated}) {
+      INFO((rule == CutRows::most_violated ? "most violated only" : "with neighbours"));
+      LinearProgram grown = lp;
+      std::set<std::pair<int, int>> added;
+      int rounds = 0;
+      const LpSolution loop =
+          solve_lp_with_torque_rows(grown, blocks, poly, problem.t_max(), added, &rounds, true, nullptr, rule);
+      REQUIRE(loop.status == all.status);
+      if (all.status != LpSolution::optimal) continue;
+      CHECK(loop.objective == Approx(all.objective).epsilon(1e-7));
+      CHECK(worst_gauge(blocks, poly, problem.t_max(), loop.x) <= 1.0 + 1e-7);
+      CHECK(added.size() * 10 < static_cast<std::size_t>(every.rows()));
+      if (rule == CutRows::most_violated) {
+        CHECK(added.size() <= static_cast<std::size_t>(rounds) * static_cast<std::size_t>(T3.rows() / 3));
+        if (rounds > 1) ++cut;
+      }
+    }
   }
   CHECK(compared >= 10);
   CHECK(cut >= 5);

@@ -36,6 +36,8 @@ struct TorquePolytope {
   /// Rows e_k in frame components (n, u, v): the bound is e_k · t <= t_max for every k.
   /// |e_k| = 1 / (distance of facet k from the centre, relative to t_max).
   std::vector<Vec3> rows;
+  /// Per row: the rows of the facets that share a vertex with it (itself excluded).
+  std::vector<std::vector<int>> neighbours;
   /// The rows whose facets pass through +n t_max or -n t_max (pure in-plane bending at the
   /// limit). Together they bound every component of t (for the slab: both rows, every row).
   std::vector<int> apex;
