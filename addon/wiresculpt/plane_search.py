@@ -192,12 +192,15 @@ class Searcher:
         self.say = progress or (lambda stage, message: None)
         self.cancel = cancel or (lambda: False)
         self.cache = {}  # placement key -> the slicer's contours of the plane
+        # repr(placement key) -> the slicer's message refusing the plane (_contours raises it); by
+        # repr, as a refused key may hold a NaN, which is not equal to itself
+        self.refused = {}
         self.points = {}  # (placement key, contour index) -> (list, array) of its points (_points)
         self.mesh_info = None  # the slicer's report on the mesh (stages.slicing.mesh), from its first call
         self.screened = self.full_solves = self.timed_out = self.failed = 0
         self.final = None  # what finish() did with the returned design
         self.fault = None  # why the last screen did not pass (plane_faults), None when it passed
-        self.empty = None  # the plane of the last sliced() that found no contour
+        self.empty = None  # the plane of the last _sliced() that found no contour
         self.tally = None  # the nearby search's account of its candidates (plane_faults.Tally)
         self.surface = None  # (triangle centroids, areas) of the mesh, made by _surface when first needed
         self.deadline = math.inf  # perf_counter() time at which a full solve is stopped (the budget)
@@ -208,9 +211,13 @@ class Searcher:
             self.sample = self.sample[np.linspace(0, len(self.sample) - 1, 4000).astype(int)]
 
     def _contours(self, placement):
+        """The slicer's contours of `placement`; ValueError with the slicer's message when it
+        refused the plane (raised here, inside the screen of the candidate that holds it)."""
         key = placement.key()
-        if key not in self.cache:
+        if key not in self.cache and repr(key) not in self.refused:
             self.slice_ahead([placement])
+        if repr(key) in self.refused:
+            raise ValueError(self.refused[repr(key)])
         return self.cache[key]
 
     def slice_ahead(self, placements):
@@ -219,25 +226,25 @@ class Searcher:
         ten times a plane's cut (armadillo, 52,000 triangles: 7.8 ms a call of one plane, 0.7 ms a
         plane in a call of 30). A plane's contours do not depend on the others in the call. When
         the call refuses one of several placements, each is sliced alone and the refused ones are
-        left uncached, so that the refusal reaches only the candidates that hold them."""
+        remembered with the slicer's message (`refused`), so that the refusal reaches only the
+        candidates that hold them, when _contours reads them. Never raises ValueError itself: a
+        look-ahead must not end the search."""
         todo = {}
         for p in placements:
             todo.setdefault(p.key(), p)
-        for key in [k for k in todo if k in self.cache]:
+        for key in [k for k in todo if k in self.cache or repr(k) in self.refused]:
             del todo[key]
         if not todo:
             return
         try:
             found, info = slicing.slice_planes(self.V, self.F, [p.spec() for p in todo.values()],
                                                self.settings.get("weld_tolerance"))
-        except ValueError:
+        except ValueError as refusal:
             if len(todo) == 1:
-                raise
+                self.refused[repr(next(iter(todo)))] = str(refusal)
+                return
             for p in todo.values():
-                try:
-                    self.slice_ahead([p])
-                except ValueError:
-                    pass
+                self.slice_ahead([p])
             return
         self.mesh_info = self.mesh_info or info
         for key, contours in zip(todo, found):
@@ -250,7 +257,8 @@ class Searcher:
         solves get deep copies)."""
         key = (placement.key(), k)
         if key not in self.points:
-            array = np.ascontiguousarray(contour["points"], dtype=np.float64)
+            array = np.array(contour["points"], dtype=np.float64)  # a copy of its own, read-only
+            array.flags.writeable = False  # shared by every design of the placement: never changed in place
             self.points[key] = (array.tolist(), array)
         return self.points[key]
 
@@ -260,12 +268,9 @@ class Searcher:
         cuts = {k: v for k, v in (self.settings.get("cuts") or {}).items() if k in names}
         return {**self.settings, "cuts": cuts}
 
-    def sliced(self, placements):
-        """A new design from the placements' cached contours (the same wires slicing.run makes)."""
-        return self._sliced(placements)[0]
-
     def _sliced(self, placements):
-        """(sliced(placements), the float64 arrays of its wires' contours) or (None, None)."""
+        """(a new design from the placements' cached contours, the same wires slicing.run makes;
+        the float64 arrays of its wires' contours) or (None, None) when a plane finds no contour."""
         from .core import contours as rules
         from .core.design import new_design, wire_entry
 

@@ -272,7 +272,9 @@ class ReusedSlices(unittest.TestCase):
         s = plane_search.Searcher(self.V, self.F, PRESETS["steel"], self.settings)
         singles, candidates = self.candidates(s)
         s.slice_ahead([p for c, _ in candidates for p in c] + [c for cs in singles.values() for c in cs])
-        self.assertEqual(len(s.cache), 4 + 4 * 25 - 4)  # each plane's "other contour rule" is its own placement
+        # the 4 given planes and 25 changes of each, less the 4 changes of the contour rule, which
+        # cut where their given plane does (the key is the cut, not the rule)
+        self.assertEqual(len(s.cache), 4 + 4 * 25 - 4)
         for placements, (z1, x1) in candidates * 2:  # the second round: every design from the shared lists
             ok, design, probe = s.screen_layered(placements)
             mine_design, mine_probe = self.from_scratch(placements)
@@ -295,6 +297,15 @@ class ReusedSlices(unittest.TestCase):
         self.assertEqual(s.fault[0], "refused")
         self.assertIn("expected a finite number, got nan", s.fault[2][0])
         self.assertEqual(len(s._contours(good)), 1)
+        # A look-ahead of the refused placement alone does not raise (it would end the search):
+        # the refusal is kept and only reaches the candidates that hold it, when screened.
+        again = plane_search.Searcher(self.V, self.F, PRESETS["steel"], self.settings)
+        again.slice_ahead([bad])
+        self.assertEqual(list(again.cache), [])
+        self.assertIn("expected a finite number, got nan", again.refused[repr(bad.key())])
+        ok, _design, _probe = again.screen_layered([good, bad])
+        self.assertFalse(ok)
+        self.assertEqual(again.fault[0], "refused")
 
 
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)

@@ -82,6 +82,11 @@ LoadCapacityResult load_capacity(const Network& net, const std::vector<int>& cut
     if (row != T.rows()) throw InputError("load capacity: the cuts differ from those of the force problem");
   }
 
+  // One row per block and round (CutRows::most_violated) unless asked, the cheaper rule here: the
+  // design takes only the optimal value λ, which every rule reaches (the coefficients, one optimal
+  // point of possibly several, are not written; docs/method-forces.md §15).
+  const detail::CutRows cut_rows = options.lp_neighbour_rows ? detail::CutRows::with_neighbours
+                                                              : detail::CutRows::most_violated;
   // One direction's LP; reads only what is above (shared, unchanged), so two threads can run it.
   auto solve_direction = [&](int dir) {
     static const char* const names[6] = {"+x", "-x", "+y", "-y", "+z", "-z"};
@@ -166,12 +171,8 @@ LoadCapacityResult load_capacity(const Network& net, const std::vector<int>& cut
       blocks.c.segment<3>(b) = T3a0.segment<3>(3 * torque_row[i]);
     }
     std::set<std::pair<int, int>> added;
-    // One row per block and round (CutRows::most_violated), the cheaper rule here: the design
-    // takes only the optimal value λ, which every rule reaches (the coefficients, one optimal
-    // point of possibly several, are not written; docs/method-forces.md §15).
     detail::LpSolution sol = detail::solve_lp_with_torque_rows(lp, blocks, polytope, t_max, added, &ld.lp_rounds,
-                                                                     options.lp_warm_start, nullptr,
-                                                                     detail::CutRows::most_violated);
+                                                                     options.lp_warm_start, nullptr, cut_rows);
     ld.lp_iterations = sol.iterations;
     if (sol.status == detail::LpSolution::unbounded) {
       // Cap λ: an optimum well below the cap is the problem's (rows not yet added had left λ
@@ -179,8 +180,7 @@ LoadCapacityResult load_capacity(const Network& net, const std::vector<int>& cut
       const double cap = 1e8;
       lp.col_hi[K] = cap;
       const detail::LpSolution capped = detail::solve_lp_with_torque_rows(lp, blocks, polytope, t_max, added, &ld.lp_rounds,
-                                                                     options.lp_warm_start, nullptr,
-                                                                     detail::CutRows::most_violated);
+                                                                     options.lp_warm_start, nullptr, cut_rows);
       ld.lp_iterations += capped.iterations;
       if (capped.status == detail::LpSolution::optimal && capped.x[K] < 0.5 * cap) sol = capped;
     }

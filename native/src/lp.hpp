@@ -87,11 +87,11 @@ class HeldLp {
   std::unique_ptr<State> s_;
 };
 
-/// Torques linear in an LP's columns x: block v (rows 3v..3v+2) is t_v = A_v x + c_v, its
-/// components along the wire's n, u, v.
 /// Which rows of the polytope a round of solve_lp_with_torque_rows adds per violating block.
 enum class CutRows { with_neighbours, most_violated };
 
+/// Torques linear in an LP's columns x: block v (rows 3v..3v+2) is t_v = A_v x + c_v, its
+/// components along the wire's n, u, v.
 struct TorqueBlocks {
   Eigen::MatrixXd A;
   Eigen::VectorXd c;

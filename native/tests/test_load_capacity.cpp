@@ -217,6 +217,33 @@ TEST_CASE("load: warm-started cutting planes give the rebuilt capacities on rand
   CHECK(finite >= 12);  // capacities that are neither 0 nor unbounded
 }
 
+TEST_CASE("load: one row per vertex and round gives the capacities of the loop that adds neighbour rows too",
+          "[load][torque][cuts]") {
+  // The load capacity adds one polytope row per vertex outside it and round (CutRows::
+  // most_violated); the forces' loop adds the violated neighbour rows too. Both must reach each
+  // direction's optimal λ (relative 1e-7) with the same status, the capped re-solve included;
+  // the one-row loop carries fewer rows, so its rounds are at least as many.
+  int finite = 0, more_rounds = 0;
+  const int tested = on_prestressed_spheres(41, 8, [&](const Prestressed& s, const ForceProblem& problem) {
+    LoadCapacityOptions lo;
+    const LoadCapacityResult one = load_capacity(s.h.net, s.cuts, problem, s.pre.coefficients, lo);
+    lo.lp_neighbour_rows = true;
+    const LoadCapacityResult both = load_capacity(s.h.net, s.cuts, problem, s.pre.coefficients, lo);
+    REQUIRE(one.directions.size() == 6);
+    for (std::size_t d = 0; d < 6; ++d) {
+      INFO("gravity " << both.directions[d].name);
+      CHECK(one.directions[d].status == both.directions[d].status);
+      CHECK(one.directions[d].multiple == Approx(both.directions[d].multiple).epsilon(1e-7).margin(1e-12));
+      CHECK(one.directions[d].lp_rounds >= both.directions[d].lp_rounds);
+      if (one.directions[d].lp_rounds > both.directions[d].lp_rounds) ++more_rounds;
+      if (std::isfinite(both.directions[d].multiple) && both.directions[d].multiple > 0) ++finite;
+    }
+  });
+  CHECK(tested >= 6);
+  CHECK(finite >= 12);
+  CHECK(more_rounds > 0);  // the rules did take different paths
+}
+
 TEST_CASE("load: two threads give the serial capacities direction by direction, progress only from the caller",
           "[load][threads]") {
   // The six directions' LPs are independent: solved on the calling thread and a second one they

@@ -76,7 +76,8 @@ def solve_wire(design, wire, material, settings, size, native_progress=None, mem
 def prepare_wire(design, wire, settings, size, memo=None):
     """Everything one wire's solve needs, read from the design (call on the thread that owns the
     design and the memo): {"contour", "closed", "specs", "options", "refs", "frame", "key",
-    "result"}, where "result" is the memo's reusable result or None (solve_job computes it)."""
+    "start_key", "result"}, where "result" is the memo's reusable result or None (solve_job
+    computes it) and "start_key" the key of Memo.starts (None without a memo)."""
     _n, u, v = plane_frame(wire["plane"]["normal"])
     origin = wire["plane"]["origin"]
     contact = math.radians(settings["contact_angle_deg"])

@@ -43,6 +43,10 @@ struct LoadCapacityOptions {
   /// As ForceOptions::lp_warm_start: false rebuilds GLPK's problem in every cutting-plane round
   /// (for tests). Default true.
   bool lp_warm_start = true;
+  /// true: each cutting-plane round adds a vertex's violated neighbour rows too, as the forces'
+  /// loop does (for tests: both reach the same λ). Default false, one row per vertex and round,
+  /// which carries a third of the rows (docs/method-forces.md §15).
+  bool lp_neighbour_rows = false;
   /// The six directions' LPs are solved on this many threads, 1 or 2 (the calling thread is one
   /// of them and the only one that reports progress; without a second thread to be had, 1). The
   /// answers do not depend on it. Default 2.
@@ -60,7 +64,8 @@ struct LoadDirection {
   int lp_iterations = 0;
   int lp_rounds = 0;  ///< GLPK solves (torque rows are added as solutions violate them)
   /// The contact coefficients a = a0 + δ at the limit load (problem.columns(); empty unless
-  /// "optimal").
+  /// "optimal"): one optimal point of the LP, which may have several; which one depends on the
+  /// path of the cutting-plane loop (lp_neighbour_rows), λ does not.
   Eigen::VectorXd coefficients;
 };
 
