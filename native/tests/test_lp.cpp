@@ -287,6 +287,27 @@ LinearProgram force_lp(const wiresculpt::ForceProblem& problem) {
   return lp;
 }
 
+// Calls test(problem, force_lp(problem)) on the force problems of random hooked spheres drawn
+// from `seed` (torque fraction 0.5, at least one column; each within INFO "attempt k") until it
+// has returned true `wanted` times or 200 attempts are spent; returns how many times it did.
+template <class Test>
+int on_force_lps(unsigned seed, int wanted, Test test) {
+  std::mt19937 rng(seed);
+  int counted = 0;
+  for (int attempt = 0; attempt < 200 && counted < wanted; ++attempt) {
+    fixtures::HookedNetwork h;
+    if (!fixtures::random_hooked_sphere(rng, attempt, 32, h)) continue;
+    const auto cuts = wiresculpt::choose_cuts(h.net);
+    wiresculpt::ForceOptions fo;
+    fo.torque_fraction = 0.5;
+    const wiresculpt::ForceProblem problem(h.net, h.hooks, h.steps, cuts, fo);
+    if (problem.columns() == 0) continue;
+    INFO("attempt " << attempt);
+    if (test(problem, force_lp(problem))) ++counted;
+  }
+  return counted;
+}
+
 // The largest gauge of the blocks' torques at x (<= 1: every row of the polytope holds).
 double worst_gauge(const TorqueBlocks& blocks, const wiresculpt::TorquePolytope& polytope, double t_max,
                    const std::vector<double>& x) {
@@ -372,24 +393,13 @@ TEST_CASE("lp: warm-started torque rows reach the rebuilt optimum on generated f
   // The force LP of optimize_forces on random hooked spheres: maximise c·a subject to M a = 0,
   // |n·t_v| <= t_max, N_k a >= 0, a >= 0, and the 3D polytope's rows as cuts. Warm and rebuilt
   // loops must agree on the optimum (relative 1e-7) and both satisfy every row of the polytope.
-  std::mt19937 rng(23);
-  int compared = 0, cut = 0, warm_taken = 0;
+  int cut = 0, warm_taken = 0;
   long warm_iterations = 0, cold_iterations = 0;
-  for (int attempt = 0; attempt < 200 && compared < 12; ++attempt) {
-    fixtures::HookedNetwork h;
-    if (!fixtures::random_hooked_sphere(rng, attempt, 32, h)) continue;
-    const auto cuts = wiresculpt::choose_cuts(h.net);
-    wiresculpt::ForceOptions fo;
-    fo.torque_fraction = 0.5;
-    const wiresculpt::ForceProblem problem(h.net, h.hooks, h.steps, cuts, fo);
-    if (problem.columns() == 0) continue;
-    LinearProgram lp = force_lp(problem);
+  const int compared = on_force_lps(23, 12, [&](const wiresculpt::ForceProblem& problem, const LinearProgram& lp) {
     const TorqueBlocks blocks{problem.torque_frame_rows(), Eigen::VectorXd::Zero(problem.torque_frame_rows().rows())};
     const Both b = solve_both(lp, blocks, problem.polytope(), problem.t_max());
-    INFO("attempt " << attempt);
     REQUIRE(b.cold.status == b.warm.status);
-    if (b.warm.status != LpSolution::optimal) continue;
-    ++compared;
+    if (b.warm.status != LpSolution::optimal) return false;
     CHECK(b.warm.objective == Approx(b.cold.objective).epsilon(1e-7));
     CHECK(worst_gauge(blocks, problem.polytope(), problem.t_max(), b.warm.x) <= 1.0 + 1e-7);
     CHECK(worst_gauge(blocks, problem.polytope(), problem.t_max(), b.cold.x) <= 1.0 + 1e-7);
@@ -398,7 +408,8 @@ TEST_CASE("lp: warm-started torque rows reach the rebuilt optimum on generated f
     if (b.warm_rounds > 1 && b.warm.builds == 1 && b.warm.warm_solves == b.warm_rounds - 1) ++warm_taken;
     warm_iterations += b.warm.iterations;
     cold_iterations += b.cold.iterations;
-  }
+    return true;
+  });
   CHECK(compared >= 10);
   CHECK(cut >= 5);  // LPs that needed cuts
   CHECK(warm_taken == cut);  // and every round after the first re-solved the problem GLPK held
@@ -411,17 +422,8 @@ TEST_CASE("lp: the cutting-plane loop reaches the optimum of the LP that holds e
   // polytope at every vertex loaded from the start (one plain solve_lp, no cuts). The loop must
   // reach its optimal value (relative 1e-7) with a small part of those rows, adding either the
   // violated neighbour rows too (the forces) or one row per vertex and round (the load capacity).
-  std::mt19937 rng(23);  // the networks of the warm-start test above, 5 of which need cuts
-  int compared = 0, cut = 0;
-  for (int attempt = 0; attempt < 200 && compared < 12; ++attempt) {
-    fixtures::HookedNetwork h;
-    if (!fixtures::random_hooked_sphere(rng, attempt, 32, h)) continue;
-    const auto cuts = wiresculpt::choose_cuts(h.net);
-    wiresculpt::ForceOptions fo;
-    fo.torque_fraction = 0.5;
-    const wiresculpt::ForceProblem problem(h.net, h.hooks, h.steps, cuts, fo);
-    if (problem.columns() == 0) continue;
-    LinearProgram lp = force_lp(problem);
+  int cut = 0;  // the networks of the warm-start test above (seed 23), 5 of which need cuts
+  const int compared = on_force_lps(23, 12, [&](const wiresculpt::ForceProblem& problem, const LinearProgram& lp) {
     const Eigen::MatrixXd& T3 = problem.torque_frame_rows();
     const auto& poly = problem.polytope();
     LinearProgram full = lp;
@@ -433,8 +435,7 @@ TEST_CASE("lp: the cutting-plane loop reaches the optimum of the LP that holds e
     append_rows(full, every, -kInf, problem.t_max());
     const LpSolution all = solve_lp(full);
     const TorqueBlocks blocks{T3, Eigen::VectorXd::Zero(T3.rows())};
-    INFO("attempt " << attempt << ", " << every.rows() << " rows in all");
-    if (all.status == LpSolution::optimal) ++compared;
+    INFO(every.rows() << " rows in all");
     for (const CutRows rule : {CutRows::with_neighbours, CutRows::most_violated}) {
       INFO((rule == CutRows::most_violated ? "most violated only" : "with neighbours"));
       LinearProgram grown = lp;
@@ -454,7 +455,8 @@ TEST_CASE("lp: the cutting-plane loop reaches the optimum of the LP that holds e
         if (rounds > 1) ++cut;
       }
     }
-  }
+    return all.status == LpSolution::optimal;
+  });
   CHECK(compared >= 10);
   CHECK(cut >= 5);
 }
