@@ -15,9 +15,12 @@ are known by hand:
   planes, 25 one-plane changes of each plane (6 offsets and 3 tilts about 2 axes, each both ways,
   and the other contour rule) and 25 x 25 two-plane changes of each of the 3 pairs of planes:
   1 + 3 x 25 + 3 x 625 = 1951."""
+import copy
 import math
 import re
 import unittest
+
+import numpy as np
 
 from wiresculpt import native, pipeline, plane_search
 from wiresculpt.core import plane_faults
@@ -119,6 +122,53 @@ class Closest(unittest.TestCase):
         self.assertEqual(len(advice), 1)
         self.assertRegex(advice[0], rf"move planes X[AB] and X[AB] apart, so that their crossings along wire {wire} "
                                     r"are at least 30 mm apart")
+
+    def test_a_placement_held_only_by_too_close_crossings_fails_the_screen(self):
+        # The same four planes with d = 5 mm: every crossing of XA and XB (on Y and on Z) is 10 mm
+        # along the wire from the other's, less than min_segment (15 mm), so the target shape can
+        # realise neither (the straight piece between them is too short to bend) and XA and XB,
+        # which cross nothing else, would be held by nothing. With every hook the layering finds
+        # them stable; the screen, which forbids the hooks the target shape cannot realise, fails
+        # them as "dropped", and the full pipeline agrees: not stable, for crossings too close.
+        s = plane_search.Searcher(*sphere(R), PRESETS["steel"], settings())
+        d = 0.005
+        planes = [plane_search.Placement("Y", (0, 0, 0), (0, 1, 0), "largest"),
+                  plane_search.Placement("Z", (0, 0, 0), (0, 0, 1), "largest"),
+                  plane_search.Placement("XA", (d, 0, 0), (1, 0, 0), "largest"),
+                  plane_search.Placement("XB", (-d, 0, 0), (1, 0, 0), "largest")]
+        ok, design, probe = s.screen_layered(planes)
+        self.assertFalse(ok)
+        self.assertEqual(len(probe["crossings"]), 10)  # Y-Z 2, each X plane 2 on Y and 2 on Z
+        self.assertEqual(s.fault[0], "dropped")
+        self.assertEqual(sorted(s.fault[2]), ["XA/0", "XB/0"])
+        self.assertIn("(with 16 hooks forbidden", probe["reason"])  # both hooks of the 8 close crossings
+        free = plane_search.Searcher._probe(design, [np.asarray(w["contour"]) for w in design["wires"]])
+        from wiresculpt.stages import layering
+        layering.run(free, PRESETS["steel"], s.settings_for(design))
+        self.assertTrue(free["stable"], free["reason"])
+        solved = s.solve(copy.deepcopy(design))
+        self.assertFalse(solved["stable"])
+        self.assertIn("too close to", solved["reason"])
+        text = plane_faults.describe(s.fault, 0.015)
+        self.assertIn("closer than 2 x min_segment (30 mm)", text)
+        # two crossings 2 R asin(d / R) apart for d = 12 mm: 24 mm, more than min_segment but less than
+        # 2 min_segment; Y and Z run across XA and XB there (at 90 deg to the planes' common lines),
+        # outside either hook's 60 deg cone, so the target shape can realise no hook there either
+        d = 0.012
+        planes[2:] = [plane_search.Placement("XA", (d, 0, 0), (1, 0, 0), "largest"),
+                      plane_search.Placement("XB", (-d, 0, 0), (1, 0, 0), "largest")]
+        ok, design, probe = s.screen_layered(planes)
+        self.assertFalse(ok)
+        self.assertEqual(s.fault[0], "dropped")
+        gap, _wire, _others = plane_faults.closest_gap(probe)
+        self.assertTrue(0.015 < gap < 0.030, gap)
+        self.assertFalse(s.solve(copy.deepcopy(design))["stable"])
+        # far apart (d = 40 mm: 80 mm) the crossings are realisable and the placement passes
+        d = 0.04
+        planes[2:] = [plane_search.Placement("XA", (d, 0, 0), (1, 0, 0), "largest"),
+                      plane_search.Placement("XB", (-d, 0, 0), (1, 0, 0), "largest")]
+        ok, _design, probe = s.screen_layered(planes)
+        self.assertTrue(ok, probe["reason"])
 
 
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)

@@ -76,6 +76,8 @@ void read_settings(py::handle d, NetworkOptions& net, LayeringOptions& lay, Forb
                field::integer("max_step_crossings", lay.max_step_crossings),
                field::boolean("in_plane_tiebreak", lay.in_plane_tiebreak),
                field::integer("in_plane_nodes", lay.in_plane_nodes),
+               field::boolean("forbid_too_close", lay.forbid_too_close),
+               field::number("too_close_angle_tolerance", lay.too_close_angle_tolerance),
                {"forbidden_hooks", [&](py::handle v, const std::string& at) {
                   if (forbidden == nullptr) throw InputError(at + ": only layering() takes forbidden hooks");
                   forbidden->pairs = to_integer_lists(v, at);
@@ -194,7 +196,9 @@ metres on the plane, "closed": bool (default True)}.
 settings (all optional): tolerance (m, 1e-5), min_segment (m, 0.015), friction (0.32),
 contact_angle (rad, 2pi/3), bisector_span (m, 0.005), straight_angle (rad, 1 degree),
 two_wire_steps (True), max_nodes (200000), max_step_crossings (20), in_plane_tiebreak (False), in_plane_nodes (300),
-forbidden_hooks ([[crossing id, hook -1 or 1], ...]: hooks the search may not choose; default none);
+forbidden_hooks ([[crossing id, hook -1 or 1], ...]: hooks the search may not choose; default none),
+forbid_too_close (False: when True, also every hook that the target shape cannot realise for want
+of a free bending point between two crossings, too_close_hooks), too_close_angle_tolerance (rad, 0.1 deg);
 unknown keys raise ValueError.
 progress(stage, fraction) -> False cancels (raises _wiresculpt.Cancelled).
 Returns {"network": {"wires": [{id, name, origin, normal, closed, contour [[x, y, z]] (the points

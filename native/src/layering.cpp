@@ -9,7 +9,9 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "wiresculpt/contact.hpp"
 #include "wiresculpt/error.hpp"
+#include "wiresculpt/geometry.hpp"
 #include "wiresculpt/in_plane.hpp"
 #include "wiresculpt/mechanism.hpp"
 #include "wiresculpt/stability.hpp"
@@ -483,6 +485,46 @@ std::string forbidden_note(const LayeringOptions& options) {
 
 }  // namespace
 
+std::vector<std::array<bool, 2>> too_close_hooks(const Network& net, double contact_angle, double angle_tolerance) {
+  const int C = static_cast<int>(net.crossings.size());
+  std::vector<std::array<bool, 2>> ok(C, {true, true});
+  const double lmin = net.min_segment, margin = 1e-9;
+  if (!(lmin > 0.0)) return ok;
+  const double widest = contact_angle / 2.0 + angle_tolerance;
+  for (int w = 0; w < static_cast<int>(net.wires.size()); ++w) {
+    const WireSpec& wire = net.wires[w];
+    const int n = static_cast<int>(wire.points.size());
+    std::vector<double> arc(n, 0.0);
+    for (int k = 1; k < n; ++k) arc[k] = arc[k - 1] + (wire.points[k] - wire.points[k - 1]).norm();
+    const double total = polyline_length(wire.points, wire.closed);
+    const auto list = net.crossings_of(w);
+    const int m = static_cast<int>(list.size());
+    const int pairs = wire.closed ? (m >= 2 ? m : 0) : std::max(0, m - 1);
+    auto vertex = [&](int c) { return net.crossings[c].vertices[net.crossings[c].wires[0] == w ? 0 : 1]; };
+    for (int q = 0; q < pairs; ++q) {
+      const int ca = list[q], cb = list[(q + 1) % m];
+      const int va = vertex(ca), vb = vertex(cb);
+      const double dist = vb > va ? arc[vb] - arc[va] : total - arc[va] + arc[vb];
+      if (dist >= 2.0 * lmin * (1.0 - margin)) continue;  // a free bending point between them
+      const Vec3 piece = wire.points[vb] - wire.points[va];
+      if (piece.norm() < lmin * (1.0 - margin)) {
+        ok[ca] = ok[cb] = {false, false};
+        continue;
+      }
+      for (const auto& [c, edge] : {std::pair{ca, Vec3(piece)}, std::pair{cb, Vec3(-piece)}}) {
+        const Vec3 d = crossing_direction(net, c);
+        const double sign = net.crossings[c].wires[0] == w ? 1.0 : -1.0;  // hook +1: h = +d on wires[0], -d on wires[1]
+        for (int k = 0; k < 2; ++k) {
+          const Vec3 h = (k == 1 ? sign : -sign) * d;
+          const double angle = std::atan2(edge.cross(h).norm(), edge.dot(h));
+          if (angle > widest * (1.0 + margin)) ok[c][k] = false;
+        }
+      }
+    }
+  }
+  return ok;
+}
+
 LayeringResult layering(const Network& net, const LayeringOptions& options, const ProgressFn& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   validate(options.contact);
@@ -500,6 +542,16 @@ LayeringResult layering(const Network& net, const LayeringOptions& options, cons
   for (const auto& x : net.crossings)
     if (x.wires[0] < 0 || x.wires[0] >= P || x.wires[1] < 0 || x.wires[1] >= P || x.wires[0] == x.wires[1])
       throw InputError("the network has a crossing with invalid wire ids; build it with build_network");
+
+  if (options.forbid_too_close) {
+    LayeringOptions limited = options;
+    limited.forbid_too_close = false;
+    const auto realisable = too_close_hooks(net, options.contact.contact_angle, options.too_close_angle_tolerance);
+    if (limited.allowed_hooks.empty()) limited.allowed_hooks.assign(C, {true, true});
+    for (int c = 0; c < C; ++c)
+      for (int k = 0; k < 2; ++k) limited.allowed_hooks[c][k] = limited.allowed_hooks[c][k] && realisable[c][k];
+    return layering(net, limited, progress);
+  }
 
   LayeringResult r;
   r.hooks.assign(C, 0);

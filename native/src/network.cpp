@@ -395,6 +395,7 @@ Network build_network(const std::vector<WireSpec>& input, const NetworkOptions& 
       hi = hi.cwiseMax(p);
     }
   net.size = P > 0 ? (hi - lo).maxCoeff() : 0.0;
+  net.min_segment = options.min_segment;
   for (int w = 0; w < P; ++w) {
     const WireSpec& wire = net.wires[w];
     const int n = static_cast<int>(wire.points.size());

@@ -15,6 +15,7 @@
 #include "wiresculpt/in_plane.hpp"
 #include "wiresculpt/layering.hpp"
 #include "wiresculpt/stability.hpp"
+#include "wiresculpt/target_shape.hpp"
 #include "wire_fixtures.hpp"
 
 using namespace wiresculpt;
@@ -674,4 +675,110 @@ TEST_CASE("layering: options and inputs are validated") {
   o = LayeringOptions{};
   o.contact.friction = -0.1;
   CHECK_THROWS_AS(layering(net, o), InputError);
+}
+
+TEST_CASE("layering: too_close_hooks forbids exactly the hooks the target shape finds too close") {
+  // An independent check, on random cuts of a sphere whose crossings often come closer than
+  // 2 min_segment along a wire: every wire solved by the target shape (its own too_close verdict,
+  // given before solving; friction 0 and the 0.1 deg tolerance, as the pipeline passes them) with
+  // hook -1 at every crossing, then +1. A hook is too close on one of its crossing's wires exactly
+  // when too_close_hooks forbids it.
+  std::mt19937 rng(20261202);
+  const double R = 0.1, lmin = 0.015, tol = std::numbers::pi / 1800.0;
+  const double contact = 2.0 * std::numbers::pi / 3.0;
+  int networks = 0, both = 0, one = 0, neither = 0;
+  for (int attempt = 0; attempt < 400 && networks < 60; ++attempt) {
+    const std::vector<Cut> cuts = fixtures::random_cuts(rng, 4 + attempt % 2, 0.6 * R);
+    NetworkOptions no;
+    no.min_segment = lmin;
+    Network net;
+    try {
+      net = build_network(fixtures::sphere_wires(cuts, R, 48), no);
+    } catch (const InputError&) {
+      continue;
+    }
+    const int C = static_cast<int>(net.crossings.size());
+    if (C < 2) continue;
+    ++networks;
+    const auto ok = too_close_hooks(net, contact, tol);
+    REQUIRE(static_cast<int>(ok.size()) == C);
+    std::vector<std::array<bool, 2>> close(C, {false, false});
+    for (int k = 0; k < 2; ++k) {
+      const double hook = k == 1 ? 1.0 : -1.0;
+      for (int w = 0; w < static_cast<int>(net.wires.size()); ++w) {
+        const WireSpec& wire = net.wires[w];
+        Polyline2 contour;
+        for (const Vec3& p : wire.points) contour.push_back(wire.plane.to_2d(p));
+        std::vector<TargetCrossing> xs;
+        std::vector<int> ids;
+        for (int c : net.crossings_of(w)) {
+          const Crossing& x = net.crossings[c];
+          const int side = x.wires[0] == w ? 0 : 1;
+          const Vec3 h = (side == 0 ? hook : -hook) * crossing_direction(net, c);  // contact.hpp's convention
+          TargetCrossing t;
+          t.vertex = x.vertices[side];
+          t.bisector = Vec2(h.dot(wire.plane.u), h.dot(wire.plane.v));
+          t.contact_angle = contact;
+          xs.push_back(t);
+          ids.push_back(c);
+        }
+        if (xs.empty()) continue;
+        TargetShapeOptions to;
+        to.min_segment = lmin;
+        to.friction = 0.0;
+        to.angle_tolerance = tol;
+        to.max_iterations = 1;  // the verdict wanted is given before solving
+        const TargetShapeResult r = optimize_target_shape(contour, wire.closed, xs, to);
+        for (std::size_t i = 0; i < xs.size(); ++i)
+          if (r.crossings[i].status == "too_close") close[ids[i]][k] = true;
+      }
+    }
+    for (int c = 0; c < C; ++c) {
+      INFO("attempt " << attempt << ", crossing " << c);
+      CHECK(ok[c][0] == !close[c][0]);
+      CHECK(ok[c][1] == !close[c][1]);
+      const int forbidden = !ok[c][0] + !ok[c][1];
+      (forbidden == 2 ? both : forbidden == 1 ? one : neither)++;
+    }
+  }
+  CHECK(networks >= 40);
+  CHECK(both >= 10);    // too short, or both hooks' bisectors off the fixed piece
+  CHECK(one >= 5);      // the fixed piece within the cone of one hook only
+  CHECK(neither >= 50);
+}
+
+TEST_CASE("layering: forbid_too_close is layering with the too-close hooks forbidden") {
+  std::mt19937 rng(20261203);
+  const double R = 0.1;
+  int compared = 0, changed = 0;
+  for (int attempt = 0; attempt < 300 && compared < 25; ++attempt) {
+    NetworkOptions no;
+    no.min_segment = 0.015;
+    Network net;
+    try {
+      net = build_network(fixtures::sphere_wires(fixtures::random_cuts(rng, 3 + attempt % 2, 0.5 * R), R, 48), no);
+    } catch (const InputError&) {
+      continue;
+    }
+    const int C = static_cast<int>(net.crossings.size());
+    if (C < 4) continue;
+    LayeringOptions by_hand;
+    by_hand.allowed_hooks = too_close_hooks(net, by_hand.contact.contact_angle, by_hand.too_close_angle_tolerance);
+    if (std::all_of(by_hand.allowed_hooks.begin(), by_hand.allowed_hooks.end(), [](auto a) { return a[0] && a[1]; }))
+      continue;
+    ++compared;
+    LayeringOptions flag;
+    flag.forbid_too_close = true;
+    const LayeringResult a = layering(net, by_hand), b = layering(net, flag), free = layering(net, {});
+    INFO("attempt " << attempt);
+    CHECK(a.stable == b.stable);
+    CHECK(a.hooks == b.hooks);
+    CHECK(a.assembly_order == b.assembly_order);
+    CHECK(a.reason == b.reason);
+    if (free.stable != b.stable || free.hooks != b.hooks) ++changed;
+    for (int c = 0; c < C; ++c)
+      if (b.hooks[c] != 0) CHECK(by_hand.allowed_hooks[c][b.hooks[c] > 0 ? 1 : 0]);
+  }
+  CHECK(compared >= 15);
+  CHECK(changed >= 3);
 }

@@ -13,6 +13,11 @@ applies is the candidate's fault):
 - "hinge": a wire whose crossings all lie on one line (two planar wires cross only on their
   planes' common line, so a wire crossing only one other wire always hinges) or at one point: it
   turns about that line or point;
+- "dropped": none of those, but the placement has crossings closer than 2 x min_segment along a
+  wire (no free bending point between them), and the screen's layering, which forbids the hooks
+  the target shape cannot realise there (stages.layering.run's too_close), finds no stable hook
+  configuration: named by the wire with the closest two crossings and the two wires crossing it
+  there;
 - "mechanism": the layering's hook-relaxed check finds a motion of several wires, or no hook
   configuration for another reason: its own words (`reason`), cut at the first ';'.
 
@@ -24,8 +29,8 @@ import numpy as np
 
 WIRE_KINDS = ("alone", "apart", "hinge")  # faults that name the wires at fault
 PASSED_KINDS = ("near", "close", "unstable", "stopped", "failed", "unsolved", "stable")  # faults after the screen
-KINDS = ("misses", "few", "refused", "slow", "alone", "apart", "hinge", "mechanism", "near", "close", "unstable",
-         "stopped", "failed", "unsolved", "stable")
+KINDS = ("misses", "few", "refused", "slow", "alone", "apart", "hinge", "dropped", "mechanism", "near", "close",
+         "unstable", "stopped", "failed", "unsolved", "stable")
 
 
 def wire_gaps(design):
@@ -131,6 +136,20 @@ def structural_fault(design, tol=1e-6):
     return ("mechanism", (), (reason[:160],))
 
 
+def screen_fault(probe, min_segment):
+    """The fault of a placement whose screen (the layering with too_close) found it not stable:
+    structural_fault of its crossings, else "dropped" when it has crossings closer than
+    2 x min_segment along a wire (the screen forbade the hooks the target shape cannot realise
+    there), else "mechanism"."""
+    fault = structural_fault(probe)
+    if fault is not None and fault[0] != "mechanism":
+        return fault
+    closest = closest_gap(probe)
+    if closest is not None and closest[0] < 2.0 * min_segment:
+        return ("dropped", (closest[1],), closest[2])
+    return fault or ("mechanism", (), ("the layering's verdict",))
+
+
 def verdict_fault(probe, solved, min_segment):
     """The fault of a candidate that passed the screen (`probe`: its layered design) after its full
     solve `solved` ended not stable: "close" when the target shape could not realise crossings too
@@ -178,6 +197,11 @@ def describe(fault, min_segment=None):
             "" if len(wires) == 1 else " each")
     if kind == "mechanism":
         return f"are a mechanism ({other[0]})"
+    if kind == "dropped":
+        limit = f" ({2000 * min_segment:.0f} mm)" if min_segment else ""
+        by = f", where wires {other[0]} and {other[1]} cross it" if len(other) == 2 else ""
+        return (f"are no stable structure without the hooks the target shape cannot realise at crossings closer "
+                f"than 2 x min_segment{limit} along {ws}{by}")
     if kind == "near":
         limit = f" ({1000 * min_segment:.0f} mm)" if min_segment else ""
         by = f", where wires {other[0]} and {other[1]} cross it" if len(other) == 2 else ""
@@ -208,6 +232,8 @@ KIND_WORDS = {
     "alone": "leave a wire crossing no other wire",
     "apart": "leave wires apart from the rest",
     "hinge": "hinge: a wire held only at crossings on one line turns about it",
+    "dropped": "are no stable structure without the hooks the target shape cannot realise at crossings closer "
+               "than 2 x min_segment{two} along a wire",
     "mechanism": "are a mechanism of several wires",
     "near": "passed the screen, but have crossings closer than min_segment{min} along a wire (left unsolved: the "
             "target shape cannot realise them)",
@@ -227,7 +253,7 @@ def _items(fault):
     kind, wires, other = fault
     if kind == "hinge":
         return [f"wire {w} on {_wires(o)}" for w, o in zip(wires, other)]
-    if kind in ("near", "close"):
+    if kind in ("near", "close", "dropped"):
         return [f"wire {w}" + (f", where wires {other[0]} and {other[1]} cross it" if len(other) == 2 else "")
                 for w in wires]
     if kind == "misses":
@@ -286,7 +312,7 @@ def advice(faults, min_segment=None):
                            f"plane crossing wire {w}")
         elif kind == "apart":
             out.append(f"add a plane crossing {' and '.join(f'wire {w}' for w in wires)} and the rest")
-        elif kind in ("near", "close") and len(other) == 2:
+        elif kind in ("near", "close", "dropped") and len(other) == 2:
             a, b = plane_of(other[0]), plane_of(other[1])
             gap = f" at least {2000 * min_segment:.0f} mm" if min_segment else ""
             if a == b:
@@ -344,12 +370,14 @@ class Tally:
 
     def fixed(self, change):
         """The wires at fault in the planes as given that a one-plane change (screened) is free of:
-        all of them when it passed the screen, none when its fault is not about named wires."""
+        all of them when it passed the screen or failed it only for want of the hooks at crossings
+        too close along a wire ("dropped": its crossings hold no alone, apart or hinged wire), none
+        when its fault is not about named wires."""
         given = set(self.given_fault[1]) if self.given_fault and self.given_fault[0] in WIRE_KINDS else set()
         fault = self.single_fault.get(id(change))
         if fault is None:
             return set()
-        if fault[0] in PASSED_KINDS:
+        if fault[0] in PASSED_KINDS or fault[0] == "dropped":
             return given
         return given - set(fault[1]) if fault[0] in WIRE_KINDS else set()
 

@@ -41,6 +41,7 @@
 // self-equilibrated loads of three wires; and, for 0 < contact_angle/2 - atan μ < π/2, any pair
 // with two crossings is stable under forces only with opposite hooks.)
 #include <array>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -81,6 +82,16 @@ struct LayeringOptions {
   /// (pipeline.solve) to forbid what the target shape cannot realise. Empty (default): every hook
   /// allowed; otherwise one entry per crossing.
   std::vector<std::array<bool, 2>> allowed_hooks;
+  /// Forbid (on top of allowed_hooks) every hook that too_close_hooks finds the target shape
+  /// cannot realise, for crossings too close along a wire for a free bending point between them:
+  /// every later stage would null them, so a structure that needs them is never stable through
+  /// the pipeline, and with this set it fails here, in the hook-relaxed check (e) or the search.
+  /// The plane search's screen sets it (plane_search.py); the pipeline does not (it layers with
+  /// every hook and lets the target shape null what it cannot realise). Default false.
+  bool forbid_too_close = false;
+  /// Radians: too_close_hooks' angle tolerance, at least the target shape's own
+  /// (TargetShapeOptions::angle_tolerance; the pipeline's 0.1 deg). Default 0.1 deg.
+  double too_close_angle_tolerance = std::numbers::pi / 1800.0;
 };
 
 struct LayeringStats {
@@ -124,6 +135,18 @@ struct LayeringResult {
 /// cancellation (throws Cancelled). Throws InputError for an empty network, more than 64 wires or
 /// invalid options.
 LayeringResult layering(const Network& net, const LayeringOptions& options = {}, const ProgressFn& progress = {});
+
+/// Per crossing, whether the target shape can realise each hook ([c][0] hook -1, [c][1] hook
+/// +1) as far as the crossings' spacing decides it (target_shape.cpp, "too_close"): where two
+/// crossings follow each other along a wire less than 2 net.min_segment apart, the piece between
+/// them is one fixed straight segment, so
+///   - when it is shorter than net.min_segment, neither hook of either crossing can be realised;
+///   - otherwise a hook whose desired bisector on that wire (contact.hpp: +-d) lies more than
+///     contact_angle / 2 + angle_tolerance from the segment's direction cannot (the target
+///     shape's cone is contact_angle / 2 - atan(friction) wide, so this holds for any friction).
+/// Borderline lengths and angles (within 1e-9 relative) count as realisable. Every entry is
+/// true when the network was built without min_segment.
+std::vector<std::array<bool, 2>> too_close_hooks(const Network& net, double contact_angle, double angle_tolerance);
 
 /// The verdict of Eq. 1 for every prefix of a given assembly.
 struct AssemblyCheck {

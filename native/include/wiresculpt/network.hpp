@@ -66,6 +66,8 @@ struct Network {
   /// min_scale.
   double size = 0.0;
   double required_size = 0.0;
+  /// Metres: NetworkOptions::min_segment the network was built with (close_crossings' limit).
+  double min_segment = 0.0;
 
   /// Ids of the crossings on `wire`, in the order of their vertices along it.
   std::vector<int> crossings_of(int wire) const;
