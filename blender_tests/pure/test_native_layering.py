@@ -87,6 +87,39 @@ class LayeringBinding(unittest.TestCase):
             native.check_assembly(wires, free["hook"], free["steps"], {"forbidden_hooks": chosen})
         self.assertIn("only layering() takes forbidden hooks", str(ctx.exception))
 
+    def test_contour_arrays_and_forbid_too_close(self):
+        wires = [wire("X", [1, 0, 0]), wire("Y", [0, 1, 0]), wire("Z", [0, 0, 1])]
+        lists = native.layering(wires)
+        arrays = native.layering(wires, {"contour_arrays": True})
+        for a, b in zip(lists["network"]["wires"], arrays["network"]["wires"]):
+            self.assertIsInstance(a["contour"], list)
+            self.assertEqual(b["contour"].dtype, np.float64)
+            self.assertEqual(b["contour"].shape, (len(a["contour"]), 3))
+            np.testing.assert_array_equal(b["contour"], np.asarray(a["contour"]))
+        self.assertEqual(lists["hook"], arrays["hook"])
+        # Great circles of radius 0.1 m cross pi/2 x 0.1 = 157 mm apart along each wire: nothing is too
+        # close for min_segment 15 mm or 75 mm (a free point needs 150 mm).
+        for lmin in (0.015, 0.075):
+            free = native.layering(wires, {"forbid_too_close": True, "min_segment": lmin})
+            self.assertEqual(free["hook"], lists["hook"])
+            self.assertNotIn("forbidden", free["reason"])
+        # With min_segment 0.1 m every piece is one fixed straight chord (141 mm, longer than 0.1 m).
+        # At crossing (0.1, 0, 0) of Z (z = 0) and Y (y = 0) both of Z's chords run to (0, +-0.1, 0),
+        # 45 deg from -x and 135 deg from +x, so only the hook that opens Z's kink towards -x is
+        # within the 60 deg cone; that hook opens Y's kink towards +x (contact.hpp), and Y's chords run
+        # to (0, 0, +-0.1), 135 deg from +x. So no hook is realisable anywhere: all 12 forbidden.
+        near = native.layering(wires, {"forbid_too_close": True, "min_segment": 0.1})
+        self.assertFalse(near["stable"])
+        self.assertIn("12 hooks forbidden", near["reason"])
+        for bad, message in ((({"contour_arrays": 1}), "settings['contour_arrays']: expected True or False, got int"),
+                             (({"forbid_too_close": "yes"}), "settings['forbid_too_close']: expected True or False, got str")):
+            with self.assertRaises(ValueError) as ctx:
+                native.layering(wires, bad)
+            self.assertEqual(str(ctx.exception), message)
+        with self.assertRaises(ValueError) as ctx:
+            native.check_assembly(wires, lists["hook"], lists["steps"], {"contour_arrays": True})
+        self.assertIn("only layering() returns contours", str(ctx.exception))
+
     def test_max_nodes_reached_is_search_incomplete(self):
         wires = [wire("X", [1, 0, 0]), wire("Y", [0, 1, 0]), wire("Z", [0, 0, 1])]
         r = native.layering(wires, {"max_nodes": 1})

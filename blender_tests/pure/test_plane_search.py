@@ -16,7 +16,7 @@ from wiresculpt.core import design as vocabulary
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.scene import PlaneSpec, parse_scene
 from wiresculpt.core.settings import defaults
-from wiresculpt.stages import layering, slicing
+from wiresculpt.stages import layering, slicing, target_shape
 
 from helpers import ROOT, sphere
 import recheck
@@ -62,7 +62,10 @@ def round_trip(design):
 
 
 def untimed(value):
-    """`value` without the keys that hold a measured time (they differ between two equal runs)."""
+    """`value` without the keys that hold a measured time (they differ between two equal runs), its
+    arrays as lists."""
+    if isinstance(value, np.ndarray):
+        return value.tolist()
     if isinstance(value, dict):
         return {k: untimed(v) for k, v in value.items() if "seconds" not in k}
     if isinstance(value, list):
@@ -230,7 +233,9 @@ class ReusedSlices(unittest.TestCase):
                 design["wires"].append(vocabulary.wire_entry(len(design["wires"]), f"{p.name}/{k}", list(p.origin),
                                                              list(p.normal), c["closed"], c["points"]))
         probe = copy.deepcopy(design)
-        layering.run(probe, PRESETS["steel"], self.settings)
+        # as the screen layers (Searcher._layer): the hooks the target shape cannot realise forbidden,
+        # the contours as arrays
+        layering.run(probe, PRESETS["steel"], self.settings, too_close=target_shape.REALISED_ANGLE, arrays=True)
         return design, probe
 
     def candidates(self, searcher):

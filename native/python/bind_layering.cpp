@@ -42,9 +42,11 @@ std::vector<WireSpec> to_wires(py::handle list) {
 }
 
 /// settings['forbidden_hooks']: [[crossing id, hook (-1 or 1)], ...], read before the network
-/// (and so the number of crossings) is known.
+/// (and so the number of crossings) is known; settings['contour_arrays'] with it (how the
+/// network's contours come back, not an option of the core).
 struct Forbidden {
   std::vector<std::vector<int>> pairs;
+  bool contour_arrays = false;
 
   /// LayeringOptions::allowed_hooks for a network of `crossings` crossings; InputError names the
   /// entry at fault.
@@ -81,6 +83,10 @@ void read_settings(py::handle d, NetworkOptions& net, LayeringOptions& lay, Forb
                {"forbidden_hooks", [&](py::handle v, const std::string& at) {
                   if (forbidden == nullptr) throw InputError(at + ": only layering() takes forbidden hooks");
                   forbidden->pairs = to_integer_lists(v, at);
+                }},
+               {"contour_arrays", [&](py::handle v, const std::string& at) {
+                  if (forbidden == nullptr) throw InputError(at + ": only layering() returns contours");
+                  forbidden->contour_arrays = to_bool(v, at);
                 }}});
 }
 
@@ -90,13 +96,13 @@ void read_settings(py::handle d, NetworkOptions& net, LayeringOptions& lay, Forb
 /// `hook_metrics`: e_c (Eq. 2) of hook -1 and of hook +1 (the choices a later stage may weigh
 /// against each other among equal costs, pipeline.hooks_by_forces).
 py::dict network_dict(const Network& net, const std::vector<int>& hooks, const std::vector<double>& metric,
-                      const ContactOptions& contact) {
+                      const ContactOptions& contact, bool contour_arrays = false) {
   py::list wires, crossings, close;
   for (std::size_t w = 0; w < net.wires.size(); ++w) {
     const WireSpec& s = net.wires[w];
     wires.append(py::dict(py::arg("id") = w, py::arg("name") = s.name, py::arg("origin") = to_list(s.plane.origin),
                           py::arg("normal") = to_list(s.plane.normal), py::arg("closed") = s.closed,
-                          py::arg("contour") = to_lists(s.points)));
+                          py::arg("contour") = contour_arrays ? py::object(to_array(s.points)) : py::object(to_lists(s.points))));
   }
   for (std::size_t c = 0; c < net.crossings.size(); ++c) {
     const Crossing& x = net.crossings[c];
@@ -141,7 +147,7 @@ py::dict layering_py(const py::object& wire_list, const py::object& settings, co
   for (const auto& g : net.close_crossings) warnings.append(g.message);
   for (const auto& w : r.warnings) warnings.append(w);
   return py::dict(
-      py::arg("network") = network_dict(net, r.hooks, r.metric, options.contact), py::arg("hook") = r.hooks, py::arg("metric") = r.metric,
+      py::arg("network") = network_dict(net, r.hooks, r.metric, options.contact, forbidden.contour_arrays), py::arg("hook") = r.hooks, py::arg("metric") = r.metric,
       py::arg("assembly_order") = r.assembly_order, py::arg("steps") = r.steps,
       py::arg("two_hand_steps") = r.two_hand_steps, py::arg("stable") = r.stable, py::arg("reason") = r.reason,
       py::arg("warnings") = warnings,
@@ -198,7 +204,9 @@ contact_angle (rad, 2pi/3), bisector_span (m, 0.005), straight_angle (rad, 1 deg
 two_wire_steps (True), max_nodes (200000), max_step_crossings (20), in_plane_tiebreak (False), in_plane_nodes (300),
 forbidden_hooks ([[crossing id, hook -1 or 1], ...]: hooks the search may not choose; default none),
 forbid_too_close (False: when True, also every hook that the target shape cannot realise for want
-of a free bending point between two crossings, too_close_hooks), too_close_angle_tolerance (rad, 0.1 deg);
+of a free bending point between two crossings, too_close_hooks), too_close_angle_tolerance (rad, 0.1 deg),
+contour_arrays (False: when True the network's contours come back as float64 (n, 3) arrays, not
+lists: fewer Python objects for a caller that reads few of them, the plane search's screen);
 unknown keys raise ValueError.
 progress(stage, fraction) -> False cancels (raises _wiresculpt.Cancelled).
 Returns {"network": {"wires": [{id, name, origin, normal, closed, contour [[x, y, z]] (the points

@@ -30,19 +30,23 @@ def wire_specs(design, key="contour"):
             for w in design["wires"]]
 
 
-def run(design, material, settings, native_progress=None, forbidden=(), too_close=None):
+def run(design, material, settings, native_progress=None, forbidden=(), too_close=None, arrays=False):
     """Fills crossings, assembly order, stable/reason and stages.layering. Returns a progress line.
     `native_progress(stage, fraction) -> bool` (False cancels) is handed to the solver.
     `forbidden`: (crossing id, hook) pairs the search may not choose (the re-layering loop,
     pipeline.solve); crossing ids are those of the network the design's contours give.
     `too_close`: an angle tolerance (radians, the target shape's): forbid too every hook that the
     target shape cannot realise for want of a free bending point between two crossings (the native
-    forbid_too_close; the plane search's screen)."""
+    forbid_too_close; the plane search's screen). `arrays`: the wires' contours become float64
+    (n, 3) arrays instead of lists (the screen's probes: a few arrays instead of a list per point
+    for Python's garbage collector to walk)."""
     options = settings_for(material, settings)
     if forbidden:
         options["forbidden_hooks"] = [[int(c), int(h)] for c, h in sorted(forbidden)]
     if too_close is not None:
         options.update(forbid_too_close=True, too_close_angle_tolerance=float(too_close))
+    if arrays:
+        options["contour_arrays"] = True
     result = native.layering(wire_specs(design), options, native_progress)
     net = result["network"]
     for wire, solved in zip(design["wires"], net["wires"]):
