@@ -11,7 +11,6 @@
 
 #include "wiresculpt/contact.hpp"
 #include "wiresculpt/error.hpp"
-#include "wiresculpt/geometry.hpp"
 #include "wiresculpt/in_plane.hpp"
 #include "wiresculpt/mechanism.hpp"
 #include "wiresculpt/stability.hpp"
@@ -493,20 +492,11 @@ std::vector<std::array<bool, 2>> too_close_hooks(const Network& net, double cont
   const double widest = contact_angle / 2.0 + angle_tolerance;
   for (int w = 0; w < static_cast<int>(net.wires.size()); ++w) {
     const WireSpec& wire = net.wires[w];
-    const int n = static_cast<int>(wire.points.size());
-    std::vector<double> arc(n, 0.0);
-    for (int k = 1; k < n; ++k) arc[k] = arc[k - 1] + (wire.points[k] - wire.points[k - 1]).norm();
-    const double total = polyline_length(wire.points, wire.closed);
-    const auto list = net.crossings_of(w);
-    const int m = static_cast<int>(list.size());
-    const int pairs = wire.closed ? (m >= 2 ? m : 0) : std::max(0, m - 1);
     auto vertex = [&](int c) { return net.crossings[c].vertices[net.crossings[c].wires[0] == w ? 0 : 1]; };
-    for (int q = 0; q < pairs; ++q) {
-      const int ca = list[q], cb = list[(q + 1) % m];
-      const int va = vertex(ca), vb = vertex(cb);
-      const double dist = vb > va ? arc[vb] - arc[va] : total - arc[va] + arc[vb];
-      if (dist >= 2.0 * lmin * (1.0 - margin)) continue;  // a free bending point between them
-      const Vec3 piece = wire.points[vb] - wire.points[va];
+    for (const Network::Gap& gap : net.gaps_of(w)) {
+      if (gap.arc >= 2.0 * lmin * (1.0 - margin)) continue;  // a free bending point between them
+      const int ca = gap.a, cb = gap.b;
+      const Vec3 piece = wire.points[vertex(cb)] - wire.points[vertex(ca)];
       if (piece.norm() < lmin * (1.0 - margin)) {
         ok[ca] = ok[cb] = {false, false};
         continue;

@@ -228,6 +228,25 @@ struct RawCrossing {
 
 }  // namespace
 
+std::vector<Network::Gap> Network::gaps_of(int w) const {
+  const WireSpec& wire = wires.at(static_cast<std::size_t>(w));
+  const int n = static_cast<int>(wire.points.size());
+  std::vector<double> arc(n, 0.0);
+  for (int k = 1; k < n; ++k) arc[k] = arc[k - 1] + (wire.points[k] - wire.points[k - 1]).norm();
+  const double total = polyline_length(wire.points, wire.closed);
+  const auto list = crossings_of(w);
+  const int m = static_cast<int>(list.size());
+  const int pairs = wire.closed ? (m >= 2 ? m : 0) : std::max(0, m - 1);
+  auto vertex = [&](int c) { return crossings[c].vertices[crossings[c].wires[0] == w ? 0 : 1]; };
+  std::vector<Gap> out;
+  for (int q = 0; q < pairs; ++q) {
+    const int ca = list[q], cb = list[(q + 1) % m];
+    const int va = vertex(ca), vb = vertex(cb);
+    out.push_back({ca, cb, vb > va ? arc[vb] - arc[va] : total - arc[va] + arc[vb]});
+  }
+  return out;
+}
+
 std::vector<int> Network::crossings_of(int wire) const {
   std::vector<std::pair<int, int>> list;
   for (int c = 0; c < static_cast<int>(crossings.size()); ++c)
@@ -398,18 +417,9 @@ Network build_network(const std::vector<WireSpec>& input, const NetworkOptions& 
   net.min_segment = options.min_segment;
   for (int w = 0; w < P; ++w) {
     const WireSpec& wire = net.wires[w];
-    const int n = static_cast<int>(wire.points.size());
-    std::vector<double> arc(n, 0.0);
-    for (int k = 1; k < n; ++k) arc[k] = arc[k - 1] + (wire.points[k] - wire.points[k - 1]).norm();
-    const double total = polyline_length(wire.points, wire.closed);
-    const auto list = net.crossings_of(w);
-    const int m = static_cast<int>(list.size());
-    const int pairs = wire.closed ? (m >= 2 ? m : 0) : std::max(0, m - 1);
-    for (int q = 0; q < pairs; ++q) {
-      const int ca = list[q], cb = list[(q + 1) % m];
-      const int va = net.crossings[ca].vertices[net.crossings[ca].wires[0] == w ? 0 : 1];
-      const int vb = net.crossings[cb].vertices[net.crossings[cb].wires[0] == w ? 0 : 1];
-      const double dist = vb > va ? arc[vb] - arc[va] : total - arc[va] + arc[vb];
+    for (const Network::Gap& gap : net.gaps_of(w)) {
+      const int ca = gap.a, cb = gap.b;
+      const double dist = gap.arc;
       if (dist >= options.min_segment) continue;
       CrossingGap g;
       g.wire = w;

@@ -71,6 +71,16 @@ struct Network {
 
   /// Ids of the crossings on `wire`, in the order of their vertices along it.
   std::vector<int> crossings_of(int wire) const;
+
+  /// Two crossings that follow each other along a wire, in its direction, and the length of
+  /// the wire between them (metres).
+  struct Gap {
+    int a = -1, b = -1;
+    double arc = 0.0;
+  };
+  /// The gaps between consecutive crossings along `wire` (a closed wire's last one runs over its
+  /// end; none with fewer than two crossings).
+  std::vector<Gap> gaps_of(int wire) const;
 };
 
 /// Finds the crossings of `wires` and inserts them as vertices.
