@@ -118,6 +118,12 @@ class BindingInput(unittest.TestCase):
         F = np.array([[0, 1, 2]], dtype=np.int32)
         self.check(lambda: m.slice_mesh(V, F, [("a", (0, 0, 0))]), "planes[0]: expected (name, origin, normal), got 2 items")
         self.check(lambda: m.slice_mesh(V, F, [(1, (0, 0, 0), (0, 0, 1))]), "planes[0][0]: expected a string, got int")
+        # a bad origin or normal is named with its plane's name
+        good = ("Z0", (0, 0, 0), (0, 0, 1))
+        self.check(lambda: m.slice_mesh(V, F, [good, ("Z1", (0, 0, float("nan")), (0, 0, 1))]),
+                   "planes[1] (plane 'Z1') origin[2]: expected a finite number, got nan")
+        self.check(lambda: m.slice_mesh(V, F, [("Y", (0, 0, 0), (0, 1))]),
+                   "planes[0] (plane 'Y') normal: expected 3 numbers, got tuple of 2")
 
     def test_good_values_of_other_types_still_read(self):
         """numpy scalars and tuples are numbers and vectors; a numpy bool is a bool."""

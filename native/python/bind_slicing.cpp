@@ -19,16 +19,18 @@ struct PlaneSpec {
   Vec3 origin, normal;
 };
 
-/// planes: [(name, origin, normal)].
+/// planes: [(name, origin, normal)]. A bad origin or normal is named with its plane's name:
+/// "planes[0] (plane 'Z') origin: ...".
 std::vector<PlaneSpec> to_planes(py::handle planes) {
   std::vector<PlaneSpec> out;
   each_item(planes, "planes", [&](py::handle item, const std::string& where) {
     PlaneSpec p;
     std::size_t k = 0;
     each_item(item, where, [&](py::handle v, const std::string& at) {
+      const std::string named = where + " (plane '" + p.name + "')";
       if (k == 0) p.name = to_text(v, at);
-      else if (k == 1) p.origin = to_vector<3>(v, at);
-      else if (k == 2) p.normal = to_vector<3>(v, at);
+      else if (k == 1) p.origin = to_vector<3>(v, named + " origin");
+      else if (k == 2) p.normal = to_vector<3>(v, named + " normal");
       ++k;
     });
     if (k != 3) wrong(where, "(name, origin, normal)", std::to_string(k) + " items");
