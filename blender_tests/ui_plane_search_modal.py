@@ -63,7 +63,9 @@ def start_cancelled():
     seen["cancel_invoke"] = invoke()
     seen["cancel_running"] = ops.running()
     seen["status_while_running"] = ops.JOB.status() if ops.JOB else ""
-    bpy.app.timers.register(guarded(seen, cancel_mid_search), first_interval=0.3)
+    # soon after the start, so that a fast machine has not finished the search yet (a slow one only
+    # cancels it earlier)
+    bpy.app.timers.register(guarded(seen, cancel_mid_search), first_interval=0.1)
 
 
 def cancel_mid_search():
@@ -113,6 +115,11 @@ def check_full():
 
 
 def check_preview_drawn():
+    waits = seen.get("draw_waits", 0)
+    if ops.DRAWN[0] == seen["drawn_before"] and waits < 50:  # no redraw yet (a loaded machine): look again
+        seen["draw_waits"] = waits + 1
+        return 0.1
+    seen.pop("draw_waits", None)
     seen["drawn_after"] = ops.DRAWN[0]  # the viewport redrew with the preview since the click
     seen["preview_no_data"] = state() == seen.pop("moved_state")
     with override():
