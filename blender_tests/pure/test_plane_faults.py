@@ -99,16 +99,20 @@ class Structural(unittest.TestCase):
 
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)
 class Closest(unittest.TestCase):
+    @staticmethod
+    def planes(d):
+        """The sphere cut by y = 0, z = 0 and x = +-d: XA's and XB's crossings on the Y and Z circles
+        are 2 R asin(d / R) apart, the closest gaps of the network."""
+        return [plane_search.Placement("Y", (0, 0, 0), (0, 1, 0), "largest"),
+                plane_search.Placement("Z", (0, 0, 0), (0, 0, 1), "largest"),
+                plane_search.Placement("XA", (d, 0, 0), (1, 0, 0), "largest"),
+                plane_search.Placement("XB", (-d, 0, 0), (1, 0, 0), "largest")]
+
     def test_two_planes_close_together_are_named(self):
-        # the sphere cut by y = 0, z = 0 and x = +-d: XA's and XB's crossings on the Y and Z circles
-        # are 2 R asin(d / R) = 10 mm apart for d = 5 mm, the closest gaps of the network
+        # d = 5 mm: 10 mm apart
         s = plane_search.Searcher(*sphere(R), PRESETS["steel"], settings())
         d = 0.005
-        planes = [plane_search.Placement("Y", (0, 0, 0), (0, 1, 0), "largest"),
-                  plane_search.Placement("Z", (0, 0, 0), (0, 0, 1), "largest"),
-                  plane_search.Placement("XA", (d, 0, 0), (1, 0, 0), "largest"),
-                  plane_search.Placement("XB", (-d, 0, 0), (1, 0, 0), "largest")]
-        _ok, _design, probe = s.screen_layered(planes)
+        _ok, _design, probe = s.screen_layered(self.planes(d))
         gap, wire, others = plane_faults.closest_gap(probe)
         self.assertAlmostEqual(gap, 2 * R * math.asin(d / R), delta=0.02 * gap)
         self.assertIn(wire, ("Y/0", "Z/0"))
@@ -131,12 +135,7 @@ class Closest(unittest.TestCase):
         # them stable; the screen, which forbids the hooks the target shape cannot realise, fails
         # them as "dropped", and the full pipeline agrees: not stable, for crossings too close.
         s = plane_search.Searcher(*sphere(R), PRESETS["steel"], settings())
-        d = 0.005
-        planes = [plane_search.Placement("Y", (0, 0, 0), (0, 1, 0), "largest"),
-                  plane_search.Placement("Z", (0, 0, 0), (0, 0, 1), "largest"),
-                  plane_search.Placement("XA", (d, 0, 0), (1, 0, 0), "largest"),
-                  plane_search.Placement("XB", (-d, 0, 0), (1, 0, 0), "largest")]
-        ok, design, probe = s.screen_layered(planes)
+        ok, design, probe = s.screen_layered(self.planes(0.005))
         self.assertFalse(ok)
         self.assertEqual(len(probe["crossings"]), 10)  # Y-Z 2, each X plane 2 on Y and 2 on Z
         self.assertEqual(s.fault[0], "dropped")
@@ -154,20 +153,14 @@ class Closest(unittest.TestCase):
         # two crossings 2 R asin(d / R) apart for d = 12 mm: 24 mm, more than min_segment but less than
         # 2 min_segment; Y and Z run across XA and XB there (at 90 deg to the planes' common lines),
         # outside either hook's 60 deg cone, so the target shape can realise no hook there either
-        d = 0.012
-        planes[2:] = [plane_search.Placement("XA", (d, 0, 0), (1, 0, 0), "largest"),
-                      plane_search.Placement("XB", (-d, 0, 0), (1, 0, 0), "largest")]
-        ok, design, probe = s.screen_layered(planes)
+        ok, design, probe = s.screen_layered(self.planes(0.012))
         self.assertFalse(ok)
         self.assertEqual(s.fault[0], "dropped")
         gap, _wire, _others = plane_faults.closest_gap(probe)
         self.assertTrue(0.015 < gap < 0.030, gap)
         self.assertFalse(s.solve(copy.deepcopy(design))["stable"])
         # far apart (d = 40 mm: 80 mm) the crossings are realisable and the placement passes
-        d = 0.04
-        planes[2:] = [plane_search.Placement("XA", (d, 0, 0), (1, 0, 0), "largest"),
-                      plane_search.Placement("XB", (-d, 0, 0), (1, 0, 0), "largest")]
-        ok, _design, probe = s.screen_layered(planes)
+        ok, _design, probe = s.screen_layered(self.planes(0.04))
         self.assertTrue(ok, probe["reason"])
 
 
