@@ -181,7 +181,6 @@ TargetShapeProblem::TargetShapeProblem(const Polyline2& contour, bool closed,
       normals_[k] = Vec2(-t.y(), t.x());
     }
     h_ = 2.0 * length / std::max(1, m_edges);
-    for (int k = 0; k < m_edges; ++k) max_edge_ = std::max(max_edge_, (target_[(k + 1) % m] - target_[k]).norm());
     // Uniform grid of cell >= h over the target's bounding box (at most ~512 cells a side).
     Vec2 lo = target_[0], hi = target_[0];
     for (const Vec2& p : target_) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
@@ -201,6 +200,30 @@ TargetShapeProblem::TargetShapeProblem(const Polyline2& contour, bool closed,
     grid_items_.assign(target_.size(), 0);
     std::vector<int> fill(grid_start_.begin(), grid_start_.end() - 1);
     for (int k = 0; k < m; ++k) grid_items_[fill[cell_of(target_[k])]++] = k;
+    // The edges, by the cells of their bounding boxes (ecell_of is monotone, so the cell holding
+    // any point of an edge lies in that range), on a grid of its own.
+    // Cells of 2h: on the Airplane's recorded solves 1, 2 and 4 h took the same time within the
+    // noise (docs/method-target-shape.md, issue 17, fourth round).
+    edge_cell_ = 2.0 * cell_;
+    edge_nx_ = static_cast<int>((hi.x() - lo.x()) / edge_cell_) + 1;
+    edge_ny_ = static_cast<int>((hi.y() - lo.y()) / edge_cell_) + 1;
+    auto ecell_of = [&](const Vec2& p) {
+      const int ix = std::clamp(static_cast<int>((p.x() - lo.x()) / edge_cell_), 0, edge_nx_ - 1);
+      const int iy = std::clamp(static_cast<int>((p.y() - lo.y()) / edge_cell_), 0, edge_ny_ - 1);
+      return iy * edge_nx_ + ix;
+    };
+    auto edge_cells = [&](int k, auto&& visit) {
+      const Vec2 a = target_[k], b = target_[(k + 1) % m];
+      const int c0 = ecell_of(a.cwiseMin(b)), c1 = ecell_of(a.cwiseMax(b));
+      for (int iy = c0 / edge_nx_; iy <= c1 / edge_nx_; ++iy)
+        for (int ix = c0 % edge_nx_; ix <= c1 % edge_nx_; ++ix) visit(iy * edge_nx_ + ix);
+    };
+    edge_start_.assign(static_cast<std::size_t>(edge_nx_) * edge_ny_ + 1, 0);
+    for (int k = 0; k < m_edges; ++k) edge_cells(k, [&](int c) { ++edge_start_[c + 1]; });
+    for (std::size_t c = 1; c < edge_start_.size(); ++c) edge_start_[c] += edge_start_[c - 1];
+    edge_items_.assign(static_cast<std::size_t>(edge_start_.back()), 0);
+    std::vector<int> edge_fill(edge_start_.begin(), edge_start_.end() - 1);
+    for (int k = 0; k < m_edges; ++k) edge_cells(k, [&](int c) { edge_items_[edge_fill[c]++] = k; });
   }
 
   // Knots: the crossings in contour order (plus the ends of an open wire, or one canonical vertex
@@ -365,29 +388,45 @@ double TargetShapeProblem::nearest_squared(const Vec2& q, Vec2* grad) const {
   if (m_edges == 0) {
     best = (q - target_[0]).squaredNorm();
   } else {
-    const double fx = (q.x() - grid_origin_.x()) / cell_, fy = (q.y() - grid_origin_.y()) / cell_;
-    if (fx < 0 || fy < 0 || fx >= grid_nx_ || fy >= grid_ny_) {
-      for (int k = 0; k < m_edges; ++k) try_edge(k);  // outside the target's box: rare, brute force
+    const double fx = (q.x() - grid_origin_.x()) / edge_cell_, fy = (q.y() - grid_origin_.y()) / edge_cell_;
+    if (!std::isfinite(fx) || !std::isfinite(fy)) {
+      for (int k = 0; k < m_edges; ++k) try_edge(k);  // no distance to compare: as every edge says
     } else {
-      // Rings of grid cells around q; the nearest point of the polyline lies on an edge with an
-      // end within (distance + longest edge), so stop once the ring is farther than that.
-      const int cx = static_cast<int>(fx), cy = static_cast<int>(fy);
-      const int max_ring = std::max(grid_nx_, grid_ny_);
+      // Rings of grid cells around q's cell, each cell holding the edges that meet it. A cell of
+      // ring r is at least (r - 1) cells from q, and a cell farther from q than the best distance
+      // so far cannot hold a nearer point: both are skipped, with a picometre of slack for the
+      // rounding of the cell bounds, so the minimum is that of every edge (an edge tested twice,
+      // from two cells, changes nothing: only a strictly nearer point replaces the best).
+      constexpr double slack = 1e-12;  // m
+      // q's cell, or the cell of the grid nearest it when q is outside the target's box (kink
+      // neighbours pushed beyond the contour's extremes): a cell r rings from it is still at least
+      // r - 1 cells from q.
+      const int cx = static_cast<int>(std::clamp(fx, 0.0, edge_nx_ - 1.0));
+      const int cy = static_cast<int>(std::clamp(fy, 0.0, edge_ny_ - 1.0));
+      const int max_ring = std::max(edge_nx_, edge_ny_);
+      double reach2 = std::numeric_limits<double>::infinity();  // (sqrt(best) + slack)^2
+      auto visit = [&](int ix, int iy) {
+        const double x0 = grid_origin_.x() + ix * edge_cell_, y0 = grid_origin_.y() + iy * edge_cell_;
+        const double dx = std::max({0.0, x0 - q.x(), q.x() - (x0 + edge_cell_)});
+        const double dy = std::max({0.0, y0 - q.y(), q.y() - (y0 + edge_cell_)});
+        if (dx * dx + dy * dy > reach2) return;
+        const int cell = iy * edge_nx_ + ix;
+        for (int it = edge_start_[cell]; it < edge_start_[cell + 1]; ++it) {
+          const double before = best;
+          try_edge(edge_items_[it]);
+          if (best < before) reach2 = (std::sqrt(best) + slack) * (std::sqrt(best) + slack);
+        }
+      };
       for (int ring = 0; ring <= max_ring; ++ring) {
-        if (std::isfinite(best) && (ring - 1) * cell_ > std::sqrt(best) + max_edge_) break;
-        for (int iy = cy - ring; iy <= cy + ring; ++iy) {
-          if (iy < 0 || iy >= grid_ny_) continue;
+        const double gap = (ring - 1) * edge_cell_;
+        if (ring > 1 && gap * gap > reach2) break;
+        for (int iy = std::max(cy - ring, 0); iy <= std::min(cy + ring, edge_ny_ - 1); ++iy) {
           const bool edge_row = iy == cy - ring || iy == cy + ring;
-          for (int ix = cx - ring; ix <= cx + ring; ix += (edge_row ? 1 : 2 * ring)) {
-            if (ix >= 0 && ix < grid_nx_) {
-              const int cell = iy * grid_nx_ + ix;
-              for (int it = grid_start_[cell]; it < grid_start_[cell + 1]; ++it) {
-                const int k = grid_items_[it];
-                if (k < m_edges) try_edge(k);
-                if (closed_ || k > 0) try_edge((k + m - 1) % m);
-              }
-            }
-            if (ring == 0) break;
+          if (edge_row) {
+            for (int ix = std::max(cx - ring, 0); ix <= std::min(cx + ring, edge_nx_ - 1); ++ix) visit(ix, iy);
+          } else {
+            if (cx - ring >= 0) visit(cx - ring, iy);
+            if (cx + ring < edge_nx_) visit(cx + ring, iy);
           }
         }
       }

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <tuple>
@@ -363,6 +364,50 @@ TEST_CASE("target shape: analytic gradients match central differences", "[target
     const Vec2 far = contour[123] * 1.5;
     CHECK(problem.imls(far) == Approx(std::pow(problem.distance_to_contour(far), 2)).epsilon(1e-12));
   }
+}
+
+TEST_CASE("target shape: the distance to the contour is the nearest of all its segments", "[target]") {
+  // Brute force over the input contour's segments (the solver's target subdivides them, on the
+  // same lines), at random points near it, beyond its bounding box (where the grid's rings start
+  // from the nearest cell) and far away, for a closed wavy loop and an open S-curve.
+  auto brute = [](const Polyline2& c, bool closed, const Vec2& q) {
+    double best = std::numeric_limits<double>::infinity();
+    const std::size_t n = c.size(), edges = closed ? n : n - 1;
+    for (std::size_t k = 0; k < edges; ++k) {
+      const Vec2 a = c[k], d = c[(k + 1) % n] - a;
+      const double t = std::clamp((q - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
+      best = std::min(best, (q - (a + t * d)).norm());
+    }
+    return best;
+  };
+  Polyline2 s_curve;
+  for (int k = 0; k <= 400; ++k) {
+    const double t = k / 400.0;
+    s_curve.emplace_back(0.8 * t, 0.1 * std::sin(2 * pi * t));
+  }
+  std::mt19937 rng(11);
+  int outside = 0, checked = 0;
+  for (const auto& [contour, closed] : {std::pair{wavy(0.1, 0.02, 3, 700), true}, std::pair{s_curve, false}}) {
+    const TargetShapeProblem problem(contour, closed, {});
+    Vec2 lo = contour[0], hi = contour[0];
+    for (const Vec2& p : contour) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    for (double spread : {0.2, 1.0, 5.0, 40.0}) {  // multiples of the kernel support h
+      std::uniform_real_distribution<double> u(-spread * problem.kernel_support(), spread * problem.kernel_support());
+      std::uniform_int_distribution<std::size_t> at(0, contour.size() - 1);
+      for (int i = 0; i < 400; ++i) {
+        const Vec2 q = contour[at(rng)] + Vec2(u(rng), u(rng));
+        outside += (q.array() < lo.array()).any() || (q.array() > hi.array()).any();
+        CHECK(problem.distance_to_contour(q) == Approx(brute(contour, closed, q)).margin(1e-12));
+        ++checked;
+      }
+    }
+    for (const Vec2 q : {Vec2(3.0, -2.0), Vec2(-50.0, 0.01), Vec2(0.0, 1e3)}) {
+      CHECK(problem.distance_to_contour(q) == Approx(brute(contour, closed, q)).epsilon(1e-12));
+      ++outside;
+    }
+  }
+  CHECK(checked == 3200);
+  CHECK(outside > 100);
 }
 
 TEST_CASE("target shape: windows reach the optimum of one global solve", "[target]") {

@@ -267,10 +267,15 @@ class TargetShapeProblem {
   std::vector<Vec2> normals_; // unit normals at target points
   double h_ = 0.0;
   double cell_ = 0.0;
-  double max_edge_ = 0.0;     // longest target edge
   Vec2 grid_origin_ = Vec2::Zero();
   int grid_nx_ = 0, grid_ny_ = 0;
   std::vector<int> grid_start_, grid_items_;  // CSR buckets of target points
+  // CSR buckets of target edges (edge k: target_[k] to target_[k + 1]) on the same grid, each edge
+  // in every cell its bounding box meets: the nearest-point query visits only cells that can hold
+  // a point nearer than the best found so far.
+  double edge_cell_ = 0.0;
+  int edge_nx_ = 0, edge_ny_ = 0;
+  std::vector<int> edge_start_, edge_items_;
   Polyline2 initial_;
   std::vector<char> fixed_;
   std::vector<int> crossing_vertices_;
