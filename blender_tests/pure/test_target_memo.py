@@ -129,3 +129,49 @@ class AgainstColdSolves(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class Derived(unittest.TestCase):
+    """What a memo keeps of the contours and planes between rounds (Memo.frame, bisector,
+    model_size) is what the stage computes without it, and is computed again when they change."""
+
+    @classmethod
+    def setUpClass(cls):
+        settings, material = defaults(), PRESETS["steel"]
+        V, F = sphere()
+        cls.design = pipeline.slice_and_pick(V, F, PLANES, material, settings)
+        layering.run(cls.design, material, settings)
+
+    def test_the_same_as_without_a_memo(self):
+        memo = target_shape.Memo()
+        for _ in range(2):  # computed, then kept
+            for wire in self.design["wires"]:
+                u, v, contour = memo.frame(wire)
+                _n, u0, v0 = target_shape.plane_frame(wire["plane"]["normal"])
+                np.testing.assert_array_equal(contour, target_shape.to_2d(wire["contour"], wire["plane"]["origin"], u0, v0))
+                np.testing.assert_array_equal(u, u0)
+                np.testing.assert_array_equal(v, v0)
+            for c in self.design["crossings"]:
+                for k in (0, 1):
+                    np.testing.assert_array_equal(memo.bisector(self.design, c, k),
+                                                  target_shape.desired_bisector(self.design, c, k))
+            self.assertEqual(memo.model_size(self.design), target_shape.model_size(self.design))
+
+    def test_a_new_contour_plane_or_hook_is_computed_again(self):
+        design = copy.deepcopy(self.design)
+        memo = target_shape.Memo()
+        wire = design["wires"][0]
+        first = memo.frame(wire)[2]
+        wire["contour"] = [[x + 0.01, y, z] for x, y, z in wire["contour"]]  # another list
+        moved = memo.frame(wire)[2]
+        self.assertFalse(np.array_equal(first, moved))
+        wire["plane"]["origin"] = [o + 0.02 for o in wire["plane"]["origin"]]
+        self.assertFalse(np.array_equal(moved, memo.frame(wire)[2]))
+        size = memo.model_size(design)
+        wire["contour"] = [[3 * x, 3 * y, 3 * z] for x, y, z in wire["contour"]]
+        self.assertGreater(memo.model_size(design), size)
+        c = next(c for c in design["crossings"] if c["hook"] != 0)
+        h = memo.bisector(design, c, 0)
+        c["hook"] = -c["hook"]
+        np.testing.assert_array_equal(memo.bisector(design, c, 0), -h)

@@ -78,15 +78,15 @@ def prepare_wire(design, wire, settings, size, memo=None):
     design and the memo): {"contour", "closed", "specs", "options", "refs", "frame", "key",
     "start_key", "result"}, where "result" is the memo's reusable result or None (solve_job
     computes it) and "start_key" the key of Memo.starts (None without a memo)."""
-    _n, u, v = plane_frame(wire["plane"]["normal"])
     origin = wire["plane"]["origin"]
+    u, v, contour = memo.frame(wire) if memo is not None else _frame(wire)
     contact = math.radians(settings["contact_angle_deg"])
     specs, refs = [], []
     for c in design["crossings"]:
         if wire["id"] not in c["wires"]:
             continue
         k = c["wires"].index(wire["id"])
-        h = desired_bisector(design, c, k)
+        h = memo.bisector(design, c, k) if memo is not None else desired_bisector(design, c, k)
         specs.append({"vertex": c["contour_vertices"][k], "bisector": (float(h @ u), float(h @ v)),
                       "contact_angle": contact, "active": c["hook"] != 0})
         refs.append((c, k))
@@ -97,7 +97,6 @@ def prepare_wire(design, wire, settings, size, memo=None):
     limits = memo.vertex_limits.get(wire["name"]) if memo is not None else None
     if limits:  # the coupling's own limits at some points (pipeline._tighten), radians by target index
         options["vertex_max_bend"] = tuple(limits.get(i, 0.0) for i in range(max(limits) + 1))
-    contour = to_2d(wire["contour"], origin, u, v)
     key = Memo.key(contour, wire["closed"], specs, options) if memo is not None else None
     start_key = Memo.key(contour, wire["closed"], specs, options, Memo.LIMITS) if memo is not None else None
     result = memo.reusable(key, options["max_bend"]) if memo is not None else None
@@ -107,6 +106,12 @@ def prepare_wire(design, wire, settings, size, memo=None):
             options = {**options, "start": start}
     return {"contour": contour, "closed": wire["closed"], "specs": specs, "options": options, "refs": refs,
             "frame": (origin, u, v), "key": key, "start_key": start_key, "result": result}
+
+
+def _frame(wire):
+    """(u, v, contour in 2D): the wire's plane axes and its contour in that frame."""
+    _n, u, v = plane_frame(wire["plane"]["normal"])
+    return u, v, to_2d(wire["contour"], wire["plane"]["origin"], u, v)
 
 
 def solve_job(job, native_progress=None):
@@ -176,6 +181,38 @@ class Memo:
         self.starts = {}  # key without the per-vertex bend limits (LIMITS) -> points of a converged solve
         self.same = {} if same is None else same
         self.reused = 0
+        # What every round derives again from the same contours and planes (read-only after the
+        # layering, shared by the rounds' copies of the design): each wire's frame and 2D contour,
+        # each crossing's bisector and the model's size, checked against the objects they came from.
+        self._frames = {}  # wire name -> (contour, origin, normal, (u, v, 2D contour))
+        self._bisectors = {}  # (normal of wires[k], normal of the other wire, hook sign) -> h
+        self._size = None  # (the contours, size)
+
+    def frame(self, wire):
+        """_frame(wire), computed once per contour and plane."""
+        plane = wire["plane"]
+        entry = self._frames.get(wire["name"])
+        if (entry is None or entry[0] is not wire["contour"] or entry[1] != list(plane["origin"])
+                or entry[2] != list(plane["normal"])):
+            entry = (wire["contour"], list(plane["origin"]), list(plane["normal"]), _frame(wire))
+            self._frames[wire["name"]] = entry
+        return entry[3]
+
+    def bisector(self, design, crossing, k):
+        """desired_bisector(design, crossing, k), computed once per pair of plane normals and hook."""
+        normals = tuple(tuple(design["wires"][w]["plane"]["normal"]) for w in crossing["wires"])
+        key = (normals, k, crossing["hook"])
+        if key not in self._bisectors:
+            self._bisectors[key] = desired_bisector(design, crossing, k)
+        return self._bisectors[key]
+
+    def model_size(self, design):
+        """core.design.model_size(design), computed once for the same contours."""
+        contours = [w["contour"] for w in design["wires"]]
+        if self._size is None or len(self._size[0]) != len(contours) or any(
+                a is not b for a, b in zip(self._size[0], contours)):
+            self._size = (contours, model_size(design))
+        return self._size[1]
 
     @staticmethod
     def key(contour, closed, specs, options, ignore=("max_bend",)):
@@ -264,7 +301,7 @@ def run(design, material, settings, native_progress=None, memo=None):
     `memo` (a Memo) carries the nulled crossings and the solves of an earlier coupling round with a
     higher bend limit into this one, and is updated with this round's."""
     start = time.perf_counter()
-    size = model_size(design)
+    size = memo.model_size(design) if memo is not None else model_size(design)
     nulled, iterations, wire_solves = [], 0, 0
     if memo is not None:
         for failure in memo.nulled:
