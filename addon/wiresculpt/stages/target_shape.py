@@ -185,7 +185,7 @@ class Memo:
         # layering, shared by the rounds' copies of the design): each wire's frame and 2D contour,
         # each crossing's bisector and the model's size, checked against the objects they came from.
         self._frames = {}  # wire name -> (contour, origin, normal, (u, v, 2D contour))
-        self._bisectors = {}  # (normal of wires[k], normal of the other wire, hook sign) -> h
+        self._bisectors = {}  # (the two wires' plane normals, k, hook) -> h
         self._size = None  # (the contours, size)
 
     def frame(self, wire):
