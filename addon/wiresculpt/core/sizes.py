@@ -1,6 +1,7 @@
 """Size sense: a wire longer than the machine's stock, or a model too big to be a wire sculpture
 of this kind, is a warning with the figure, said before the long optimization starts."""
 import math
+from operator import itemgetter
 
 STOCK_LENGTH = 1.0   # m: the default machine profile's straight wire stock (profile key stock_length)
 LARGEST_MODEL = 1.5  # m: beyond this a sculpture of stiff planar wires sags and is hard to build
@@ -29,7 +30,7 @@ def model_size(design):
     points = [p for w in design["wires"] for p in (w.get("contour") or w.get("target") or [])]
     if not points:
         return 0.0
-    return max(max(p[k] for p in points) - min(p[k] for p in points) for k in range(3))
+    return max(max(map(itemgetter(k), points)) - min(map(itemgetter(k), points)) for k in range(3))
 
 
 def size_warnings(design, stock_length=STOCK_LENGTH, profile_name="the default machine profile"):
