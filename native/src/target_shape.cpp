@@ -380,10 +380,29 @@ double TargetShapeProblem::nearest_squared(const Vec2& q, Vec2* grad) const {
   const int m_edges = closed_ ? m : m - 1;
   double best = std::numeric_limits<double>::infinity();
   Vec2 best_point = target_[0];
+  int best_edge = -1;
+  // Equally near edges (two edges meeting at the nearest vertex: one ends there at a + 1·(b - a),
+  // the other starts there, points that can differ in the last bit) are decided as the search by
+  // target points did before (issue 17): the edge it tested first, in its order of rings, rows,
+  // cells, points and, per point k, edge k before edge k - 1; or the lower index when q was
+  // outside the points' grid. So the gradient, hence every solve, is the same as before.
+  using Rank = std::array<long long, 5>;
+  auto rank = [&](int k) {
+    const double fx = (q.x() - grid_origin_.x()) / cell_, fy = (q.y() - grid_origin_.y()) / cell_;
+    if (fx < 0 || fy < 0 || fx >= grid_nx_ || fy >= grid_ny_) return Rank{0, 0, 0, k, 0};
+    const int cx = static_cast<int>(fx), cy = static_cast<int>(fy);
+    auto from_point = [&](int v, int sub) {
+      const Vec2& p = target_[v];
+      const int ix = std::clamp(static_cast<int>((p.x() - grid_origin_.x()) / cell_), 0, grid_nx_ - 1);
+      const int iy = std::clamp(static_cast<int>((p.y() - grid_origin_.y()) / cell_), 0, grid_ny_ - 1);
+      return Rank{std::max(std::abs(ix - cx), std::abs(iy - cy)), iy, ix, v, sub};
+    };
+    return std::min(from_point(k, 0), from_point((k + 1) % m, 1));
+  };
   auto try_edge = [&](int k) {
     const Vec2 c = closest_on_segment(q, target_[k], target_[(k + 1) % m]);
     const double d2 = (q - c).squaredNorm();
-    if (d2 < best) best = d2, best_point = c;
+    if (d2 < best || (d2 == best && k != best_edge && rank(k) < rank(best_edge))) best = d2, best_point = c, best_edge = k;
   };
   if (m_edges == 0) {
     best = (q - target_[0]).squaredNorm();
