@@ -401,7 +401,7 @@ TEST_CASE("target shape: the distance to the contour is the nearest of all its s
         ++checked;
       }
     }
-    for (const Vec2 q : {Vec2(3.0, -2.0), Vec2(-50.0, 0.01), Vec2(0.0, 1e3)}) {
+    for (const Vec2& q : {Vec2(3.0, -2.0), Vec2(-50.0, 0.01), Vec2(0.0, 1e3)}) {
       CHECK(problem.distance_to_contour(q) == Approx(brute(contour, closed, q)).epsilon(1e-12));
       ++outside;
     }
