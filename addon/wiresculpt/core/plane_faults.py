@@ -93,11 +93,12 @@ def _partners(design):
 
 
 def _on_one_line(points, tol):
-    """True when the points lie on one line (or at one point) within `tol` metres."""
+    """True when the points lie on one line (or at one point) within `tol` metres (two points always
+    do: answered without numpy, as for most wires of a screened placement)."""
+    if len(points) <= 2:
+        return True
     x = np.asarray(points, dtype=float)
     x = x - x.mean(axis=0)
-    if len(x) < 2:
-        return True
     return float(np.linalg.svd(x, compute_uv=False)[1]) <= tol * max(1.0, len(x) ** 0.5)
 
 
