@@ -37,7 +37,8 @@ the planes of many candidates in one native call, Searcher.slice_ahead; the desi
 contour's points, and the layering's copy of a design copies no points) and the layering
 (stages.layering), whose first step is the hook-relaxed stability check (every
 crossing a ball joint: a mechanism is rejected in about a millisecond) and whose search then
-finds the hooks. Only survivors run the full pipeline (pipeline.solve: target shape, forces, rest
+finds the hooks; both without the hooks the target shape cannot realise at crossings too close
+along a wire (Searcher._layer). Only survivors run the full pipeline (pipeline.solve: target shape, forces, rest
 shape, buildability) with the layering's own hooks (CANDIDATE_HOOK_PATTERNS), and a candidate is
 returned only when that says stable (which means buildable, fab/buildability). The returned
 design then gets the comparison of hook patterns by their forces (Searcher.finish), bounded by
