@@ -338,7 +338,7 @@ class Searcher:
             probe = self._probe(design, arrays)
             self._layer(probe, design)
             if not probe["stable"]:
-                self.fault = plane_faults.screen_fault(probe, float(self.settings.get("min_segment") or 0.0))
+                self.fault = plane_faults.screen_fault(probe)
             return bool(probe["stable"]), design, probe
         except (ValueError, RuntimeError, native.Cancelled) as exc:
             if self.cancel():
@@ -507,7 +507,8 @@ def nearby(vertices, faces, planes, material, settings, want=1, budget=BUDGET_SE
     Order: one-plane changes by cost, then pairs (plane_faults.Tally.pair_order: those that the
     single changes' faults point at first, then by cost); within each, except that a screened candidate
     whose layering reports crossings closer along a wire than the machine's minimum segment
-    (`close_crossings`: the full pipeline mostly fails on them, at a second each) is solved only
+    (`close_crossings`; before the screen left out the hooks such crossings cannot get, the full
+    pipeline failed on most of them, at a second each; now they are rarer, and kept last) is solved only
     after the others, and only while it is cheaper than the `want`-th found, so that the answer is
     still the cheapest one-plane change the budget allows (a pair: the cheapest of its group, the
     search stopping at the first pair that costs more than the `want`-th found). When none is found,

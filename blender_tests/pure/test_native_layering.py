@@ -111,6 +111,13 @@ class LayeringBinding(unittest.TestCase):
         near = native.layering(wires, {"forbid_too_close": True, "min_segment": 0.1})
         self.assertFalse(near["stable"])
         self.assertIn("12 hooks forbidden", near["reason"])
+        self.assertEqual(sorted(map(tuple, near["too_close_forbidden"])), [(c, h) for c in range(6) for h in (-1, 1)])
+        self.assertTrue(near["too_close_decides"])  # with every hook the three circles stand
+        self.assertEqual(free["too_close_forbidden"], [])
+        self.assertFalse(lists["too_close_decides"])
+        with self.assertRaises(ValueError) as ctx:
+            native.layering(wires, {"forbid_too_close": True, "too_close_angle_tolerance": -0.01})
+        self.assertIn("too_close_angle_tolerance must be a finite angle >= 0", str(ctx.exception))
         for bad, message in ((({"contour_arrays": 1}), "settings['contour_arrays']: expected True or False, got int"),
                              (({"forbid_too_close": "yes"}), "settings['forbid_too_close']: expected True or False, got str")):
             with self.assertRaises(ValueError) as ctx:

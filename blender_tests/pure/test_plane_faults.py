@@ -84,6 +84,16 @@ class Structural(unittest.TestCase):
                     self.SIX + [(3, 1, (0, 0.5, 0.8)), (3, 1, (0, -0.5, 0.8)), (3, 2, (0.3, 0, 0.8))])
         self.assertEqual(plane_faults.structural_fault(d), ("mechanism", (), ("not stable",)))
 
+    def test_a_screen_that_fails_is_named_by_what_decided_it(self):
+        # no alone, apart or hinged wire: the layering's search stopped at max_nodes is undecided, not
+        # a fault of the planes; hooks forbidden as too close that did not decide it leave a mechanism
+        d = network(["Z/0", "X/0", "Y/0"], self.SIX)
+        self.assertEqual(plane_faults.screen_fault(dict(d, search_incomplete=True)), ("incomplete", (), ()))
+        mechanism = dict(d, too_close_forbidden=[[0, 1]], too_close_decides=False)
+        self.assertEqual(plane_faults.screen_fault(mechanism), ("mechanism", (), ("not stable",)))
+        self.assertEqual(plane_faults.screen_fault(d), ("mechanism", (), ("not stable",)))
+        self.assertIn("max_nodes", plane_faults.describe(("incomplete", (), ())))
+
     def test_words_name_the_wire_and_the_counts_add_up(self):
         faults = {("hinge", ("W/0",), ("X/0",)): 41, ("hinge", ("V/0",), ("X/0+Y/0",)): 2,
                   ("alone", ("W/0",), ()): 12, ("misses", (), ("W",)): 1, ("few", (), ()): 1}

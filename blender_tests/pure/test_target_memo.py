@@ -127,10 +127,6 @@ class AgainstColdSolves(unittest.TestCase):
                 self.assertEqual(w1["target"], w2["target"])
 
 
-if __name__ == "__main__":
-    unittest.main()
-
-
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)
 class Derived(unittest.TestCase):
     """What a memo keeps of the contours and planes between rounds (Memo.frame, bisector,
@@ -175,3 +171,7 @@ class Derived(unittest.TestCase):
         h = memo.bisector(design, c, 0)
         c["hook"] = -c["hook"]
         np.testing.assert_array_equal(memo.bisector(design, c, 0), -h)
+
+
+if __name__ == "__main__":
+    unittest.main()

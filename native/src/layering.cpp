@@ -476,10 +476,16 @@ std::string explain(const Network& net, const Search& s, bool tried_pairs) {
 // Appended to a reason when hooks were forbidden: the verdict is over the allowed ones only.
 std::string forbidden_note(const LayeringOptions& options) {
   int count = 0;
-  for (const auto& a : options.allowed_hooks) count += !a[0] + !a[1];
+  std::vector<int> at;
+  for (std::size_t c = 0; c < options.allowed_hooks.size(); ++c) {
+    const auto& a = options.allowed_hooks[c];
+    count += !a[0] + !a[1];
+    if (!a[0] || !a[1]) at.push_back(static_cast<int>(c));
+  }
   if (count == 0) return "";
   return " (with " + std::to_string(count) + " hook" + (count == 1 ? "" : "s") +
-         " forbidden because the target shape cannot realise them)";
+         " forbidden because the target shape cannot realise them, at crossing" + (at.size() == 1 ? " " : "s ") +
+         crossing_list(at) + ")";
 }
 
 }  // namespace
@@ -534,13 +540,31 @@ LayeringResult layering(const Network& net, const LayeringOptions& options, cons
       throw InputError("the network has a crossing with invalid wire ids; build it with build_network");
 
   if (options.forbid_too_close) {
+    if (!std::isfinite(options.too_close_angle_tolerance) || options.too_close_angle_tolerance < 0.0)
+      throw InputError("too_close_angle_tolerance must be a finite angle >= 0 (radians), got " +
+                       std::to_string(options.too_close_angle_tolerance));
     LayeringOptions limited = options;
     limited.forbid_too_close = false;
     const auto realisable = too_close_hooks(net, options.contact.contact_angle, options.too_close_angle_tolerance);
     if (limited.allowed_hooks.empty()) limited.allowed_hooks.assign(C, {true, true});
+    std::vector<std::array<int, 2>> forbidden;
     for (int c = 0; c < C; ++c)
-      for (int k = 0; k < 2; ++k) limited.allowed_hooks[c][k] = limited.allowed_hooks[c][k] && realisable[c][k];
-    return layering(net, limited, progress);
+      for (int k = 0; k < 2; ++k)
+        if (limited.allowed_hooks[c][k] && !realisable[c][k]) {
+          limited.allowed_hooks[c][k] = false;
+          forbidden.push_back({c, k == 1 ? 1 : -1});
+        }
+    LayeringResult r = layering(net, limited, progress);
+    r.too_close_forbidden = forbidden;
+    if (!r.stable && !forbidden.empty()) {
+      LayeringOptions every = options;  // the same allowed hooks, the too-close ones among them
+      every.forbid_too_close = false;
+      every.max_nodes = 1;
+      every.in_plane_tiebreak = false;
+      const LayeringResult unlimited = layering(net, every, progress);
+      r.too_close_decides = unlimited.stable || !unlimited.complete_search;
+    }
+    return r;
   }
 
   LayeringResult r;

@@ -402,7 +402,7 @@ double TargetShapeProblem::nearest_squared(const Vec2& q, Vec2* grad) const {
   auto try_edge = [&](int k) {
     const Vec2 c = closest_on_segment(q, target_[k], target_[(k + 1) % m]);
     const double d2 = (q - c).squaredNorm();
-    if (d2 < best || (d2 == best && k != best_edge && rank(k) < rank(best_edge))) best = d2, best_point = c, best_edge = k;
+    if (d2 < best || (d2 == best && best_edge >= 0 && k != best_edge && rank(k) < rank(best_edge))) best = d2, best_point = c, best_edge = k;
   };
   if (m_edges == 0) {
     best = (q - target_[0]).squaredNorm();

@@ -397,7 +397,7 @@ TEST_CASE("target shape: the distance to the contour is the nearest of all its s
       for (int i = 0; i < 400; ++i) {
         const Vec2 q = contour[at(rng)] + Vec2(u(rng), u(rng));
         outside += (q.array() < lo.array()).any() || (q.array() > hi.array()).any();
-        CHECK(problem.distance_to_contour(q) == Approx(brute(contour, closed, q)).margin(1e-12));
+        CHECK(problem.distance_to_contour(q) == Approx(brute(contour, closed, q)).epsilon(0).margin(1e-12));
         ++checked;
       }
     }

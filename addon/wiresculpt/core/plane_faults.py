@@ -13,11 +13,12 @@ applies is the candidate's fault):
 - "hinge": a wire whose crossings all lie on one line (two planar wires cross only on their
   planes' common line, so a wire crossing only one other wire always hinges) or at one point: it
   turns about that line or point;
-- "dropped": none of those, but the placement has crossings closer than 2 x min_segment along a
-  wire (no free bending point between them), and the screen's layering, which forbids the hooks
-  the target shape cannot realise there (stages.layering.run's too_close), finds no stable hook
-  configuration: named by the wire with the closest two crossings and the two wires crossing it
-  there;
+- "incomplete": none of those, and the layering's search reached max_nodes (a stable design may
+  still exist);
+- "dropped": none of those, and the hooks the screen's layering forbade (stages.layering.run's
+  too_close: those the target shape cannot realise at crossings closer than 2 x min_segment along
+  a wire, with no free bending point between them) decided the verdict: with them the hook-relaxed
+  check passes. Named by the closest such gap's wire and the two wires crossing it there;
 - "mechanism": the layering's hook-relaxed check finds a motion of several wires, or no hook
   configuration for another reason: its own words (`reason`), cut at the first ';'.
 
@@ -29,8 +30,8 @@ import numpy as np
 
 WIRE_KINDS = ("alone", "apart", "hinge")  # faults that name the wires at fault
 PASSED_KINDS = ("near", "close", "unstable", "stopped", "failed", "unsolved", "stable")  # faults after the screen
-KINDS = ("misses", "few", "refused", "slow", "alone", "apart", "hinge", "dropped", "mechanism", "near", "close",
-         "unstable", "stopped", "failed", "unsolved", "stable")
+KINDS = ("misses", "few", "refused", "slow", "incomplete", "alone", "apart", "hinge", "dropped", "mechanism", "near",
+         "close", "unstable", "stopped", "failed", "unsolved", "stable")
 
 
 def wire_gaps(design):
@@ -67,10 +68,11 @@ def close_gaps(design, min_segment):
     return sum(1 for g in crossing_gaps(design) if g < 2.0 * min_segment)
 
 
-def closest_gap(design):
+def closest_gap(design, among=None):
     """(gap in metres, wire name, (names of the two wires crossing it there)) of the closest two
-    consecutive crossings along any wire, or None when no wire has two crossings."""
-    gaps = wire_gaps(design)
+    consecutive crossings along any wire (with `among`, a set of crossing indices: of the gaps that
+    end at one of them), or None when there is none."""
+    gaps = [g for g in wire_gaps(design) if among is None or g[2] in among or g[3] in among]
     if not gaps:
         return None
     gap, w, ca, cb = min(gaps, key=lambda g: (g[0], g[1]))
@@ -137,17 +139,21 @@ def structural_fault(design, tol=1e-6):
     return ("mechanism", (), (reason[:160],))
 
 
-def screen_fault(probe, min_segment):
+def screen_fault(probe):
     """The fault of a placement whose screen (the layering with too_close) found it not stable:
-    structural_fault of its crossings, else "dropped" when it has crossings closer than
-    2 x min_segment along a wire (the screen forbade the hooks the target shape cannot realise
-    there), else "mechanism"."""
+    structural_fault of its crossings; else "incomplete" when max_nodes stopped the layering's
+    search (a stable design may exist); else "dropped" when the hooks the screen forbade as too
+    close decided it (`too_close_decides`: with them the hook-relaxed check passes), named by the
+    closest gap that holds a crossing with such a hook; else "mechanism"."""
     fault = structural_fault(probe)
     if fault is not None and fault[0] != "mechanism":
         return fault
-    closest = closest_gap(probe)
-    if closest is not None and closest[0] < 2.0 * min_segment:
-        return ("dropped", (closest[1],), closest[2])
+    if probe.get("search_incomplete"):
+        return ("incomplete", (), ())
+    if probe.get("too_close_decides"):
+        closest = closest_gap(probe, {c for c, _h in probe.get("too_close_forbidden", ())})
+        if closest is not None:
+            return ("dropped", (closest[1],), closest[2])
     return fault or ("mechanism", (), ("the layering's verdict",))
 
 
@@ -188,6 +194,8 @@ def describe(fault, min_segment=None):
         return f"are refused by the crossing network ({other[0]})"
     if kind == "slow":
         return "stopped in the layering's search after its screening time"
+    if kind == "incomplete":
+        return "were left undecided: the layering's search reached max_nodes"
     if kind == "alone":
         return f"leave {ws} crossing no other wire"
     if kind == "apart":
@@ -207,7 +215,7 @@ def describe(fault, min_segment=None):
         limit = f" ({1000 * min_segment:.0f} mm)" if min_segment else ""
         by = f", where wires {other[0]} and {other[1]} cross it" if len(other) == 2 else ""
         return (f"passed the screen, but have crossings closer than min_segment{limit} along {ws}{by} "
-                "(left unsolved: the target shape cannot realise such crossings)")
+                "(left unsolved: such candidates are solved last, and the search ended first)")
     if kind == "close":
         limit = f" ({2000 * min_segment:.0f} mm)" if min_segment else ""
         by = f", where wires {other[0]} and {other[1]} cross it" if len(other) == 2 else ""
@@ -230,14 +238,15 @@ KIND_WORDS = {
     "few": "leave fewer than two wires",
     "refused": "are refused by the crossing network",
     "slow": "were stopped in the layering's search (its screening time)",
+    "incomplete": "were left undecided: the layering's search reached max_nodes",
     "alone": "leave a wire crossing no other wire",
     "apart": "leave wires apart from the rest",
     "hinge": "hinge: a wire held only at crossings on one line turns about it",
     "dropped": "are no stable structure without the hooks the target shape cannot realise at crossings closer "
                "than 2 x min_segment{two} along a wire",
     "mechanism": "are a mechanism of several wires",
-    "near": "passed the screen, but have crossings closer than min_segment{min} along a wire (left unsolved: the "
-            "target shape cannot realise them)",
+    "near": "passed the screen, but have crossings closer than min_segment{min} along a wire (left unsolved: such "
+            "candidates are solved last, and the search ended first)",
     "close": "passed the screen, but have crossings closer than 2 x min_segment{two} along a wire, which the target "
              "shape cannot realise",
     "unstable": "passed the screen, but their full solve is not stable",
