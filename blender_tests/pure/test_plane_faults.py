@@ -89,9 +89,13 @@ class Structural(unittest.TestCase):
         # a fault of the planes; hooks forbidden as too close that did not decide it leave a mechanism
         d = network(["Z/0", "X/0", "Y/0"], self.SIX)
         self.assertEqual(plane_faults.screen_fault(dict(d, search_incomplete=True)), ("incomplete", (), ()))
-        mechanism = dict(d, too_close_forbidden=[[0, 1]], too_close_decides=False)
-        self.assertEqual(plane_faults.screen_fault(mechanism), ("mechanism", (), ("not stable",)))
-        self.assertEqual(plane_faults.screen_fault(d), ("mechanism", (), ("not stable",)))
+        asked = []
+        mechanism = dict(d, too_close_forbidden=[[0, 1]])
+        self.assertEqual(plane_faults.screen_fault(mechanism, lambda: asked.append(1) or False),
+                         ("mechanism", (), ("not stable",)))
+        self.assertEqual(asked, [1])  # asked whether the hooks decided it: no
+        self.assertEqual(plane_faults.screen_fault(d, lambda: asked.append(2) or True), ("mechanism", (), ("not stable",)))
+        self.assertEqual(asked, [1])  # nothing forbidden: not asked
         self.assertIn("max_nodes", plane_faults.describe(("incomplete", (), ())))
 
     def test_words_name_the_wire_and_the_counts_add_up(self):

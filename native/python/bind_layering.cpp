@@ -155,7 +155,7 @@ py::dict layering_py(const py::object& wire_list, const py::object& settings, co
                                       py::arg("sum_metric") = r.sum_metric,
                                       py::arg("unbalanced_in_plane") = r.unbalanced_in_plane),
       py::arg("complete_search") = r.complete_search, py::arg("in_plane_complete") = r.in_plane_complete,
-      py::arg("too_close_forbidden") = r.too_close_forbidden, py::arg("too_close_decides") = r.too_close_decides,
+      py::arg("too_close_forbidden") = r.too_close_forbidden,
       py::arg("stats") = py::dict(py::arg("seconds") = r.stats.seconds, py::arg("lp_solves") = r.stats.lp_solves,
                                   py::arg("nodes") = r.stats.nodes));
 }
@@ -216,8 +216,8 @@ the wires' contours), point, hook, metric, hook_metrics (e_c of hook -1 and of h
 "required_size"}, "hook": [-1|0|1 per crossing], "metric": [e_c], "assembly_order": [wire ids],
 "steps": [[ids]], "two_hand_steps": [step indices], "stable": bool, "reason": str,
 "warnings": [str], "objective": {max_metric, null_crossings, sum_metric, unbalanced_in_plane},
-"complete_search": bool, "in_plane_complete": bool, "too_close_forbidden": [[crossing id, hook]] (with
-forbid_too_close), "too_close_decides": bool (those hooks decided a verdict of not stable), "stats": {seconds, lp_solves, nodes}}. Bad
+"complete_search": bool, "in_plane_complete": bool, "too_close_forbidden": [[crossing id, hook]] (the hooks
+forbid_too_close forbade), "stats": {seconds, lp_solves, nodes}}. Bad
 input raises ValueError naming the wire or key, e.g. wires[1]['points']: expected an (n, 3) array
 of numbers, got shape (5, 2).)");
 }

@@ -556,14 +556,6 @@ LayeringResult layering(const Network& net, const LayeringOptions& options, cons
         }
     LayeringResult r = layering(net, limited, progress);
     r.too_close_forbidden = forbidden;
-    if (!r.stable && !forbidden.empty()) {
-      LayeringOptions every = options;  // the same allowed hooks, the too-close ones among them
-      every.forbid_too_close = false;
-      every.max_nodes = 1;
-      every.in_plane_tiebreak = false;
-      const LayeringResult unlimited = layering(net, every, progress);
-      r.too_close_decides = unlimited.stable || !unlimited.complete_search;
-    }
     return r;
   }
 

@@ -139,18 +139,19 @@ def structural_fault(design, tol=1e-6):
     return ("mechanism", (), (reason[:160],))
 
 
-def screen_fault(probe):
+def screen_fault(probe, decided=lambda: False):
     """The fault of a placement whose screen (the layering with too_close) found it not stable:
     structural_fault of its crossings; else "incomplete" when max_nodes stopped the layering's
-    search (a stable design may exist); else "dropped" when the hooks the screen forbade as too
-    close decided it (`too_close_decides`: with them the hook-relaxed check passes), named by the
-    closest gap that holds a crossing with such a hook; else "mechanism"."""
+    search (a stable design may exist); else "dropped" when the screen forbade hooks as too close
+    (`too_close_forbidden`) and they decided it (`decided()`, asked only then: with them the
+    hook-relaxed check passes), named by the closest gap that holds a crossing with such a hook;
+    else "mechanism"."""
     fault = structural_fault(probe)
     if fault is not None and fault[0] != "mechanism":
         return fault
     if probe.get("search_incomplete"):
         return ("incomplete", (), ())
-    if probe.get("too_close_decides"):
+    if probe.get("too_close_forbidden") and decided():
         closest = closest_gap(probe, {c for c, _h in probe.get("too_close_forbidden", ())})
         if closest is not None:
             return ("dropped", (closest[1],), closest[2])

@@ -65,7 +65,6 @@ def run(design, material, settings, native_progress=None, forbidden=(), too_clos
         design["required_size"] = net["required_size"]
     if too_close is not None:  # the screen's own keys (plane_faults.screen_fault), never in a design.json
         design["too_close_forbidden"] = [list(p) for p in result["too_close_forbidden"]]
-        design["too_close_decides"] = bool(result["too_close_decides"])
     stats = result["stats"]
     design["stages"]["layering"] = {
         "seconds": stats["seconds"], "lp_solves": stats["lp_solves"], "nodes": stats["nodes"],

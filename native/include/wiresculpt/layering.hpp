@@ -130,11 +130,6 @@ struct LayeringResult {
   /// (too_close_hooks; those allowed_hooks already forbade are not listed), by crossing; empty
   /// otherwise.
   std::vector<std::array<int, 2>> too_close_forbidden;
-  /// With forbid_too_close, when not stable and too_close_forbidden is not empty: whether those
-  /// hooks decided the verdict, i.e. with them allowed the hook-relaxed check (e) passes and the
-  /// search's first node either finds a stable structure or does not end the search. False
-  /// otherwise (the structure fails with every hook too: a mechanism, or a network apart).
-  bool too_close_decides = false;
   LayeringStats stats;
 };
 
