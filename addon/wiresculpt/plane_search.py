@@ -353,12 +353,10 @@ class Searcher:
         (or found a stable structure). About a millisecond; asked only of screens that failed with
         such hooks forbidden and no structural fault."""
         every = self._probe(design, arrays)
-        stop = min(self.deadline, time.perf_counter() + SCREEN_SECONDS)
-        layering.run(every, self.material, dict(self.settings_for(design), max_nodes=1),
-                     lambda _stage, _fraction: not (self.cancel() or time.perf_counter() > stop), arrays=True)
+        self._layer(every, design, too_close=False, max_nodes=1)
         return bool(every["stable"] or every.get("search_incomplete"))
 
-    def _layer(self, probe, design):
+    def _layer(self, probe, design, too_close=True, **settings):
         """layering.run on `probe`, stopped (native.Cancelled) by a cancel, past the deadline or
         after SCREEN_SECONDS: a layering search can take many seconds on a network of many small
         contours (elephant, N = 6: one took the whole screening time), and a screen is to be cheap.
@@ -368,11 +366,12 @@ class Searcher:
         placements that passed the screen with every hook, 252 then failed it in about 1 ms
         instead of a 20 ms hook search, and the full solves fell from 304 to the few that can
         still be stable). The probe's contours come back as arrays (`arrays`): as lists, a list per
-        point, the garbage collector's walks over them took 2 of the 5.6 s of man's 6376 screens."""
+        point, the garbage collector's walks over them took 2 of the 5.6 s of man's 6376 screens.
+        `too_close=False` allows every hook; `settings` override the search's (max_nodes)."""
         stop = min(self.deadline, time.perf_counter() + SCREEN_SECONDS)
-        layering.run(probe, self.material, self.settings_for(design),
+        layering.run(probe, self.material, dict(self.settings_for(design), **settings),
                      lambda _stage, _fraction: not (self.cancel() or time.perf_counter() > stop),
-                     too_close=target_shape.REALISED_ANGLE, arrays=True)
+                     too_close=target_shape.REALISED_ANGLE if too_close else None, arrays=True)
 
     def connected(self, placements):
         """The placements with, for each plane, the contours ("all" of them) that belong to the

@@ -498,11 +498,10 @@ std::vector<std::array<bool, 2>> too_close_hooks(const Network& net, double cont
   const double widest = contact_angle / 2.0 + angle_tolerance;
   for (int w = 0; w < static_cast<int>(net.wires.size()); ++w) {
     const WireSpec& wire = net.wires[w];
-    auto vertex = [&](int c) { return net.crossings[c].vertices[net.crossings[c].wires[0] == w ? 0 : 1]; };
     for (const Network::Gap& gap : net.gaps_of(w)) {
       if (gap.arc >= 2.0 * lmin * (1.0 - margin)) continue;  // a free bending point between them
       const int ca = gap.a, cb = gap.b;
-      const Vec3 piece = wire.points[vertex(cb)] - wire.points[vertex(ca)];
+      const Vec3 piece = wire.points[gap.vb] - wire.points[gap.va];
       if (piece.norm() < lmin * (1.0 - margin)) {
         ok[ca] = ok[cb] = {false, false};
         continue;

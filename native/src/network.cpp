@@ -242,7 +242,7 @@ std::vector<Network::Gap> Network::gaps_of(int w) const {
   for (int q = 0; q < pairs; ++q) {
     const int ca = list[q], cb = list[(q + 1) % m];
     const int va = vertex(ca), vb = vertex(cb);
-    out.push_back({ca, cb, vb > va ? arc[vb] - arc[va] : total - arc[va] + arc[vb]});
+    out.push_back({ca, cb, va, vb, vb > va ? arc[vb] - arc[va] : total - arc[va] + arc[vb]});
   }
   return out;
 }

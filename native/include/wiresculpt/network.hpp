@@ -72,10 +72,11 @@ struct Network {
   /// Ids of the crossings on `wire`, in the order of their vertices along it.
   std::vector<int> crossings_of(int wire) const;
 
-  /// Two crossings that follow each other along a wire, in its direction, and the length of
-  /// the wire between them (metres).
+  /// Two crossings that follow each other along a wire, in its direction, their vertices on
+  /// that wire, and the length of the wire between them (metres).
   struct Gap {
     int a = -1, b = -1;
+    int va = -1, vb = -1;
     double arc = 0.0;
   };
   /// The gaps between consecutive crossings along `wire` (a closed wire's last one runs over its
