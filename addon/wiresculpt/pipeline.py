@@ -122,7 +122,12 @@ def relayer(design, material, settings, say, native_progress, checkpoint, hook_p
     the solves of identical wire problems: same contour, crossings, hooks and limits). Stops when
     the design is stable, when nothing new can be forbidden, when the layering finds no stable
     assembly under the forbidden hooks or stops at max_nodes (search incomplete), or after
-    `relayer_rounds` re-layerings. Records every round in stages.relayering. Returns the design of
+    `relayer_rounds` re-layerings. With the loop on (relayer_rounds > 0) every round's layering also
+    forbids up front the hooks that crossings too close along a wire rule out (layering.run's
+    too_close, the target shape's own tolerance), which the loop would otherwise learn one round at a
+    time; when the first layering finds no stable assembly without them, it layers again with every
+    hook and goes on as without them (the old path), so the target shape shows which hooks fail and
+    why. Records every layering run in stages.relayering. Returns the design of
     the last round, or, when the last layering found no stable assembly under the forbidden hooks,
     of the last round that reached the target shape (its shapes and reason show why), saying so.
     `hook_patterns`: hooks_by_forces' `patterns` bound (None: HOOK_PATTERNS); `hook_seconds`: its
@@ -130,15 +135,31 @@ def relayer(design, material, settings, say, native_progress, checkpoint, hook_p
     extra_rounds = int(layering.knob(settings, "relayer_rounds"))
     # Layering replaces (never edits) each wire's contour, so the copies share the contours.
     pristine = _copy_sharing_contours(design) if extra_rounds else None
-    forbidden, rounds, start, shaped = set(), [], time.perf_counter(), None
+    up_front = target_shape.REALISED_ANGLE if extra_rounds else None  # None: every hook (the old path)
+    forbidden, too_close, rounds, start, shaped = set(), set(), [], time.perf_counter(), None
     same_solves = {}  # target-shape solves by exact input, for every round (target_shape.Memo `same`)
     hook_deadline = time.monotonic() + (HOOK_SECONDS if hook_seconds is None else hook_seconds)  # one bound for the hook searches of every round
-    for round_ in range(extra_rounds + 1):
+    round_ = 0
+    while True:
         began = time.perf_counter()
         checkpoint()
-        attempt = design if round_ == 0 else _copy_sharing_contours(pristine)
-        say("layering", layering.run(attempt, material, settings, native_progress, forbidden=forbidden))
+        attempt = design if not rounds else _copy_sharing_contours(pristine)
+        say("layering", layering.run(attempt, material, settings, native_progress, forbidden=forbidden, too_close=up_front))
         attempt["pending_stages"].remove("layering")
+        # The crossings' spacing is the same every round, and a learnt pair is never a too-close
+        # one, so the native lists them all each round.
+        too_close = {tuple(p) for p in attempt.pop("too_close_forbidden", ())}  # never in a design.json
+        if up_front is not None and too_close and not attempt["stable"] and round_ == 0:
+            # Nothing holds without them: layer again with every hook (the old path, for every round),
+            # so that the user sees the target shape's curves and its reason, as without the loop.
+            rounds.append({"forbidden": [], "too_close": _pairs(too_close), "stable": False,
+                           "verdict": attempt["reason"], "unrealised": [], "seconds": time.perf_counter() - began})
+            up_front, too_close = None, set()
+            say("relayering", f"the layering finds no stable assembly without the {len(rounds[-1]['too_close'])} hooks "
+                              f"that crossings too close along a wire rule out; layering again with every hook, for "
+                              f"the target shape to show what it cannot realise")
+            continue
+        excluded = forbidden | too_close
         for message in attempt.get("close_crossings", []):
             say("layering", message)
         if attempt["stable"]:
@@ -146,23 +167,24 @@ def relayer(design, material, settings, say, native_progress, checkpoint, hook_p
             # cost that use no forbidden hook; the best forces win among the stable (buildable) ones,
             # and when none is, the layering's own pattern is kept, so the round learns from it.
             attempt = hooks_by_forces(attempt, material, settings, say, native_progress, checkpoint,
-                                      patterns=hook_patterns, seconds=hook_seconds, forbidden=forbidden, deadline=hook_deadline,
+                                      patterns=hook_patterns, seconds=hook_seconds, forbidden=excluded, deadline=hook_deadline,
                                       same_solves=same_solves)
             shaped = attempt
-        learnt = target_shape.unrealisable(attempt) - forbidden
-        rounds.append({"forbidden": _pairs(forbidden), "stable": attempt["stable"],
+        learnt = target_shape.unrealisable(attempt) - excluded
+        rounds.append({"forbidden": _pairs(forbidden), "too_close": _pairs(too_close), "stable": attempt["stable"],
                        "verdict": "stable" if attempt["stable"] else attempt["reason"],
                        "unrealised": _pairs(learnt), "seconds": time.perf_counter() - began})
         if attempt["stable"] or not learnt or attempt.get("search_incomplete") or round_ == extra_rounds:
             break
         forbidden |= learnt
-        say("relayering", f"round {round_ + 1}: the target shape cannot realise "
+        round_ += 1
+        say("relayering", f"round {round_}: the target shape cannot realise "
                           f"{', '.join(f'hook {h:+d} at crossing {c}' for c, h in sorted(learnt))}; "
                           f"layering again without {'them' if len(learnt) > 1 else 'it'} "
-                          f"({len(forbidden)} hooks forbidden)")
+                          f"({len(forbidden | too_close)} hooks forbidden)")
     if "target_shape" in attempt["pending_stages"] and shaped is not None and not attempt.get("search_incomplete"):
-        shaped["reason"] += (f"; layering again without the {len(forbidden)} hooks the target shape cannot realise "
-                             f"finds no stable assembly (stages.relayering)")
+        shaped["reason"] += (f"; layering again without the {len(forbidden | too_close)} hooks the target shape cannot "
+                             f"realise finds no stable assembly (stages.relayering)")
         attempt = shaped
     attempt["stages"]["relayering"] = {"rounds": rounds, "forbidden": _pairs(forbidden),
                                        "max_rounds": extra_rounds, "seconds": time.perf_counter() - start}

@@ -37,9 +37,10 @@ def run(design, material, settings, native_progress=None, forbidden=(), too_clos
     pipeline.solve); crossing ids are those of the network the design's contours give.
     `too_close`: an angle tolerance (radians, the target shape's): forbid too every hook that the
     target shape cannot realise for want of a free bending point between two crossings (the native
-    forbid_too_close; the plane search's screen). `arrays`: the wires' contours become float64
-    (n, 3) arrays instead of lists (the screen's probes: a few arrays instead of a list per point
-    for Python's garbage collector to walk)."""
+    forbid_too_close; the plane search's screen, and pipeline.relayer's rounds); the pairs it
+    forbade go to `too_close_forbidden`, which never reaches a design.json. `arrays`: the wires'
+    contours become float64 (n, 3) arrays instead of lists (the screen's probes: a few arrays
+    instead of a list per point for Python's garbage collector to walk)."""
     options = settings_for(material, settings)
     if forbidden:
         options["forbidden_hooks"] = [[int(c), int(h)] for c, h in sorted(forbidden)]
@@ -63,7 +64,7 @@ def run(design, material, settings, native_progress=None, forbidden=(), too_clos
     if net["close_crossings"]:
         design["close_crossings"] = [g["message"] for g in net["close_crossings"]]
         design["required_size"] = net["required_size"]
-    if too_close is not None:  # the screen's own keys (plane_faults.screen_fault), never in a design.json
+    if too_close is not None:  # for the screen (plane_faults.screen_fault) and relayer, never in a design.json
         design["too_close_forbidden"] = [list(p) for p in result["too_close_forbidden"]]
     stats = result["stats"]
     design["stages"]["layering"] = {

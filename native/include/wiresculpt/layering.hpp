@@ -86,8 +86,10 @@ struct LayeringOptions {
   /// cannot realise, for crossings too close along a wire for a free bending point between them:
   /// every later stage would null them, so a structure that needs them is never stable through
   /// the pipeline, and with this set it fails here, in the hook-relaxed check (e) or the search.
-  /// The plane search's screen sets it (plane_search.py); the pipeline does not (it layers with
-  /// every hook and lets the target shape null what it cannot realise). Default false.
+  /// The plane search's screen sets it (plane_search.py), and so does the pipeline's re-layering
+  /// loop (pipeline.relayer), unless its first layering so finds no stable assembly; with
+  /// relayer_rounds 0 the pipeline layers once with every hook and lets the target shape null
+  /// what it cannot realise. Default false.
   bool forbid_too_close = false;
   /// Radians: too_close_hooks' angle tolerance, at least the target shape's own
   /// (TargetShapeOptions::angle_tolerance; the pipeline's 0.1 deg). Default 0.1 deg.
