@@ -19,10 +19,21 @@ opposite sides of d = +-y. A to +y, B to -y costs (1 + 0.737) + 0 = 1.74; A to -
 and Q, A hangs on two crossings and can turn about the line through them: the old path (re-check
 the same hooks) ends unstable. With those hooks forbidden, the layering picks the opposite ones
 (B and C then open outwards, where they have room to bend) and the design is stable; the
-independent re-check (recheck.py, numpy/scipy only) confirms it.
+independent re-check (recheck.py, numpy/scipy only) confirms it. Those two hooks are known before
+any solve (the layering's too_close), so with the loop on the pipeline forbids them up front and
+picks the opposite hooks in its first round; told nothing up front (every_hook), the loop learns
+them from the target shape in a second round.
+
+With P and Q 3 deg apart (10.5 mm, less than min_segment: CLOSE_ANGLE) the straight piece rules out
+both hooks of both, and without P and Q nothing holds A: the layering that forbids them up front
+finds no stable assembly, and the pipeline falls back to layering with every hook, so the user sees
+the target shape's curves and its reason exactly as without the up-front forbidding.
 """
+import contextlib
 import math
+import re
 import unittest
+from unittest import mock
 
 import numpy as np
 
@@ -30,13 +41,14 @@ from wiresculpt import native, pipeline
 from wiresculpt.core.design import new_design, wire_entry
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.settings import defaults
-from wiresculpt.stages import target_shape
+from wiresculpt.stages import layering, target_shape
 
 from recheck import recheck
 
 R = 0.2
 ANGLE = 47.5  # degrees along the equator from the x axis to P (Q is at 90 - ANGLE)
 A_OFF = R * math.cos(math.radians(ANGLE))
+CLOSE_ANGLE = 46.5  # P and Q 3 deg apart: 10.5 mm along A, less than min_segment
 
 
 def ring(centre, normal, radius, through, n=120):
@@ -55,17 +67,18 @@ def ring(centre, normal, radius, through, n=120):
     return np.asarray(centre) + radius * (np.outer(np.cos(t), u) + np.outer(np.sin(t), v))
 
 
-def network_design(settings):
+def network_design(settings, angle=ANGLE):
     design = new_design(PRESETS["steel"], settings)
-    y0 = math.sqrt(R * R - A_OFF * A_OFF)  # A meets B at (a, +-y0, 0), C at (+-y0, a, 0)
-    z0 = math.sqrt(R * R - 2 * A_OFF * A_OFF)  # B meets C at (a, a, +-z0)
-    ab = [(A_OFF, y0, 0.0), (A_OFF, -y0, 0.0)]
-    ac = [(y0, A_OFF, 0.0), (-y0, A_OFF, 0.0)]
-    bc = [(A_OFF, A_OFF, z0), (A_OFF, A_OFF, -z0)]
+    a = R * math.cos(math.radians(angle))
+    y0 = math.sqrt(R * R - a * a)  # A meets B at (a, +-y0, 0), C at (+-y0, a, 0)
+    z0 = math.sqrt(R * R - 2 * a * a)  # B meets C at (a, a, +-z0)
+    ab = [(a, y0, 0.0), (a, -y0, 0.0)]
+    ac = [(y0, a, 0.0), (-y0, a, 0.0)]
+    bc = [(a, a, z0), (a, a, -z0)]
     for k, (name, centre, normal, radius, through) in enumerate((
             ("A", (0.0, 0.0, 0.0), (0, 0, 1), R, ab + ac),
-            ("B", (A_OFF, 0.0, 0.0), (1, 0, 0), y0, ab + bc),
-            ("C", (0.0, A_OFF, 0.0), (0, 1, 0), y0, ac + bc))):
+            ("B", (a, 0.0, 0.0), (1, 0, 0), y0, ab + bc),
+            ("C", (0.0, a, 0.0), (0, 1, 0), y0, ac + bc))):
         design["wires"].append(wire_entry(k, name, centre, normal, True, ring(centre, normal, radius, through)))
     return design
 
@@ -84,11 +97,34 @@ def find(design, other, axis):
     return next(c for c in design["crossings"] if sorted(c["wires"]) == [0, other] and c["point"][axis] > 0.0)
 
 
+@contextlib.contextmanager
+def every_hook():
+    """The old path, forced: relayer's layerings forbid no hook up front (too_close dropped), as
+    before the loop knew the too-close hooks, so it learns them from the target shape."""
+    real = layering.run
+
+    def run(*args, **kwargs):
+        kwargs["too_close"] = None
+        return real(*args, **kwargs)
+
+    with mock.patch.object(pipeline.layering, "run", run):
+        yield
+
+
+def without_times(value):
+    """`value` (a design) without its wall-clock keys (any key `seconds`), for comparing two solves."""
+    if isinstance(value, dict):
+        return {k: without_times(v) for k, v in value.items() if k != "seconds"}
+    if isinstance(value, list):
+        return [without_times(v) for v in value]
+    return value
+
+
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)
 class Relayering(unittest.TestCase):
-    def solve(self, rounds, progress=None, cancel=None):
-        settings = dict(defaults(), relayer_rounds=rounds)
-        return pipeline.solve(network_design(settings), PRESETS["steel"], settings, progress, cancel)
+    def solve(self, rounds, progress=None, cancel=None, angle=ANGLE, **settings):
+        settings = dict(defaults(), relayer_rounds=rounds, **settings)
+        return pipeline.solve(network_design(settings, angle), PRESETS["steel"], settings, progress, cancel)
 
     def test_the_geometry_is_as_described(self):
         # P and Q 17.5 mm apart along A (between min_segment and twice it), the chord at 45 deg.
@@ -114,19 +150,59 @@ class Relayering(unittest.TestCase):
             record = old["stages"]["relayering"]
             self.assertEqual(len(record["rounds"]), 1)
             self.assertEqual(record["forbidden"], [])
+            self.assertEqual(record["rounds"][0]["too_close"], [])  # without the loop, nothing up front
+            self.assertNotIn("too_close_forbidden", old)
             # The first layering's hooks were the ones the chord rules out: A opening to +y at P
             # and to +x at Q (the nulled crossings keep the hook that failed).
             for crossing, axis in ((p, 1), (q, 0)):
                 failed = dict(crossing, hook=nulled[crossing["id"]]["hook"])
                 self.assertGreater(opening_of_a(old, failed)[axis], 0.9)
 
-    def test_relayering_finds_the_opposite_hooks(self):
-        messages = []
-        new = self.solve(8, progress=lambda stage, message: messages.append((stage, message)))
+    def assert_opposite_hooks(self, new):
+        """`new` is stable with A opening to -y at P and to -x at Q, and nothing nulled."""
         self.assertTrue(new["stable"], new["reason"])
         p, q = find(new, 1, 1), find(new, 2, 0)
         self.assertLess(opening_of_a(new, p)[1], -0.9)  # A opens to -y at P, the side the chord allows
         self.assertLess(opening_of_a(new, q)[0], -0.9)  # and to -x at Q
+        # Every crossing the design hooks is realised: the target shape nulled nothing in the end.
+        self.assertEqual(new["stages"]["target_shape"]["nulled_crossings"], [])
+        self.assertEqual(new["pending_stages"], [])
+        self.assertEqual(recheck(new), [])
+        return p, q
+
+    def test_the_first_round_forbids_the_too_close_hooks_up_front(self):
+        messages, told = [], []
+        real = pipeline.hooks_by_forces
+
+        def hooks_by_forces(*args, **kwargs):  # what the other hook patterns must avoid
+            told.append(set(kwargs["forbidden"]))
+            return real(*args, **kwargs)
+
+        with mock.patch.object(pipeline, "hooks_by_forces", hooks_by_forces):
+            new = self.solve(8, progress=lambda stage, message: messages.append((stage, message)))
+        p, q = self.assert_opposite_hooks(new)
+        record = new["stages"]["relayering"]
+        self.assertEqual(len(record["rounds"]), 1)  # no round spent learning them
+        first = record["rounds"][0]
+        self.assertEqual((first["stable"], first["verdict"], first["forbidden"], first["unrealised"]),
+                         (True, "stable", [], []))
+        # Forbidden up front: exactly the two hooks the chord rules out, A opening to +y at P and to +x
+        # at Q (the piece is longer than min_segment, so the other hook of each stays allowed).
+        too_close = {tuple(x) for x in first["too_close"]}
+        self.assertEqual(too_close, {(p["id"], -p["hook"]), (q["id"], -q["hook"])})
+        for crossing, axis in ((p, 1), (q, 0)):
+            self.assertGreater(opening_of_a(new, dict(crossing, hook=-crossing["hook"]))[axis], 0.9)
+        self.assertEqual(told, [too_close])
+        self.assertEqual(record["forbidden"], [])
+        self.assertNotIn("too_close_forbidden", new)  # the layering's own key never reaches a design.json
+        self.assertEqual(sum(1 for s, _m in messages if s == "relayering"), 0)
+        self.assertEqual(sum(1 for s, _m in messages if s == "layering"), 1)
+
+    def test_told_nothing_up_front_the_loop_learns_the_opposite_hooks(self):
+        messages = []
+        with every_hook():
+            new = self.solve(8, progress=lambda stage, message: messages.append((stage, message)))
+        p, q = self.assert_opposite_hooks(new)
         record = new["stages"]["relayering"]
         self.assertGreaterEqual(len(record["rounds"]), 2)
         self.assertFalse(record["rounds"][0]["stable"])
@@ -135,29 +211,87 @@ class Relayering(unittest.TestCase):
         forbidden = {tuple(x) for x in record["forbidden"]}
         self.assertIn((p["id"], -p["hook"]), forbidden)  # the first layering's hook at P
         self.assertEqual(set(map(tuple, record["rounds"][0]["unrealised"])), {tuple(f) for f in record["rounds"][1]["forbidden"]})
-        # Every crossing the design hooks is realised: the target shape nulled nothing in the end.
-        self.assertEqual(new["stages"]["target_shape"]["nulled_crossings"], [])
         for c in new["crossings"]:
             if c["hook"]:
                 self.assertNotIn((c["id"], c["hook"]), forbidden)
         self.assertEqual(record["max_rounds"], 8)
         for r in record["rounds"]:
             self.assertGreater(r["seconds"], 0.0)
+            self.assertEqual(r["too_close"], [])
         # Every round reports progress: a message per re-layering, and one layering per round.
         self.assertEqual(sum(1 for s, _m in messages if s == "relayering"), len(record["rounds"]) - 1)
         self.assertEqual(sum(1 for s, _m in messages if s == "layering"), len(record["rounds"]))
-        self.assertEqual(new["pending_stages"], [])
-        self.assertEqual(recheck(new), [])
 
-    def test_cancel_reaches_the_second_round(self):
+    def test_a_later_round_counts_the_too_close_hooks(self):
+        # With the machine bending at most 60 deg the target shape cannot realise the kinks the
+        # first layering picks on B and C either; the loop forbids them and layers again until the
+        # layering finds no stable assembly. The reason counts every hook that last layering was
+        # denied, the two too-close ones included, as the layering's own verdict does.
+        new = self.solve(8, max_bend_deg=60.0)
+        self.assertFalse(new["stable"])
+        record = new["stages"]["relayering"]
+        last = record["rounds"][-1]
+        p, q = find(new, 1, 1), find(new, 2, 0)
+        self.assertGreaterEqual(len(record["rounds"]), 2)
+        for r in record["rounds"]:  # the same two pairs each round, never learnt
+            self.assertEqual(len(r["too_close"]), 2)
+            self.assertEqual({c for c, _h in r["too_close"]}, {p["id"], q["id"]})
+            self.assertFalse({tuple(x) for x in r["too_close"]} & {tuple(x) for x in r["unrealised"]})
+        denied = len(last["forbidden"]) + len(last["too_close"])
+        self.assertEqual(record["forbidden"], last["forbidden"])
+        self.assertIn(f"with {denied} hooks forbidden", last["verdict"])  # the native layering's count
+        self.assertTrue(new["reason"].endswith(f"; layering again without the {denied} hooks the target shape "
+                                               f"cannot realise finds no stable assembly (stages.relayering)"),
+                        new["reason"])
+
+    def test_the_close_geometry(self):
+        # P and Q 3 deg apart along A: 10.5 mm, shorter than min_segment, so neither hook of either
+        # can be realised and the layering forbids all four up front.
+        d = self.solve(0, angle=CLOSE_ANGLE)
+        p, q = find(d, 1, 1), find(d, 2, 0)
+        self.assertAlmostEqual(R * math.radians(2 * CLOSE_ANGLE - 90.0), 0.0105, places=4)
+        self.assertLess(R * math.radians(2 * CLOSE_ANGLE - 90.0), d["machine"]["min_segment"])
+        probe = network_design(dict(defaults()), CLOSE_ANGLE)
+        layering.run(probe, PRESETS["steel"], dict(defaults()), too_close=target_shape.REALISED_ANGLE)
+        self.assertEqual(sorted(map(tuple, probe["too_close_forbidden"])),
+                         sorted((c["id"], h) for c in (p, q) for h in (-1, 1)))
+        self.assertFalse(probe["stable"])  # without P and Q, A can turn about the line through the others
+
+    def test_the_fallback_gives_the_old_paths_design(self):
+        messages = []
+        new = self.solve(8, progress=lambda stage, message: messages.append((stage, message)), angle=CLOSE_ANGLE)
+        with every_hook():
+            old = self.solve(8, angle=CLOSE_ANGLE)
+        self.assertFalse(old["stable"])
+        p, q = find(old, 1, 1), find(old, 2, 0)
+        # The old path's verdict, the target shape's: P and Q too close, then nothing stable without them.
+        self.assertIn(f"crossings {min(p['id'], q['id'])} and {max(p['id'], q['id'])}, too close", old["reason"])
+        self.assertNotIn("target_shape", old["pending_stages"])
+        # The fallback's design is the old path's, but for its record of the first layering.
+        new_record, old_record = new["stages"].pop("relayering"), old["stages"].pop("relayering")
+        self.assertEqual(without_times(new), without_times(old))
+        self.assertEqual(without_times(new_record["rounds"][1:]), without_times(old_record["rounds"]))
+        self.assertEqual((new_record["forbidden"], new_record["max_rounds"]), (old_record["forbidden"], 8))
+        first = new_record["rounds"][0]
+        self.assertEqual(sorted(map(tuple, first["too_close"])), sorted((c["id"], h) for c in (p, q) for h in (-1, 1)))
+        self.assertEqual((first["stable"], first["forbidden"], first["unrealised"]), (False, [], []))
+        self.assertIn("with 4 hooks forbidden", first["verdict"])
+        self.assertTrue(all(r["too_close"] == [] for r in new_record["rounds"][1:]))
+        said = [m for s, m in messages if s == "relayering"]
+        self.assertEqual(len(said), len(new_record["rounds"]) - 1)
+        self.assertTrue(re.search(r"no stable assembly without the 4 hooks .*layering again with every hook", said[0]),
+                        said[0])
+
+    def test_cancel_reaches_a_later_round(self):
         seen = []
 
         def cancel():
-            return any(stage == "relayering" for stage, _m in seen)
+            return any(stage == "relayering" and message.startswith("round 1:") for stage, message in seen)
 
         with self.assertRaises(pipeline.Cancelled):
-            self.solve(8, progress=lambda stage, message: seen.append((stage, message)), cancel=cancel)
-        self.assertTrue(any(stage == "relayering" for stage, _m in seen))
+            self.solve(8, progress=lambda stage, message: seen.append((stage, message)), cancel=cancel,
+                       angle=CLOSE_ANGLE)
+        self.assertTrue(cancel())
 
 
 class Unrealisable(unittest.TestCase):
