@@ -183,8 +183,12 @@ def relayer(design, material, settings, say, native_progress, checkpoint, hook_p
                           f"layering again without {'them' if len(learnt) > 1 else 'it'} "
                           f"({len(forbidden | too_close)} hooks forbidden)")
     if "target_shape" in attempt["pending_stages"] and shaped is not None and not attempt.get("search_incomplete"):
+        # The too-close hooks were forbidden before any target shape failed them: say where they are.
+        close = (f" ({len(too_close)} of them at crossing{'s' if len({c for c, _h in too_close}) > 1 else ''} "
+                 f"{', '.join(str(c) for c in sorted({c for c, _h in too_close}))}, too close to a neighbour along "
+                 f"a wire for a free bending point)") if too_close else ""
         shaped["reason"] += (f"; layering again without the {len(forbidden | too_close)} hooks the target shape cannot "
-                             f"realise finds no stable assembly (stages.relayering)")
+                             f"realise{close} finds no stable assembly (stages.relayering)")
         attempt = shaped
     attempt["stages"]["relayering"] = {"rounds": rounds, "forbidden": _pairs(forbidden),
                                        "max_rounds": extra_rounds, "seconds": time.perf_counter() - start}

@@ -240,8 +240,11 @@ class Relayering(unittest.TestCase):
         denied = len(last["forbidden"]) + len(last["too_close"])
         self.assertEqual(record["forbidden"], last["forbidden"])
         self.assertIn(f"with {denied} hooks forbidden", last["verdict"])  # the native layering's count
+        ids = sorted((p["id"], q["id"]))
         self.assertTrue(new["reason"].endswith(f"; layering again without the {denied} hooks the target shape "
-                                               f"cannot realise finds no stable assembly (stages.relayering)"),
+                                               f"cannot realise (2 of them at crossings {ids[0]}, {ids[1]}, too close "
+                                               f"to a neighbour along a wire for a free bending point) finds no "
+                                               f"stable assembly (stages.relayering)"),
                         new["reason"])
 
     def test_the_close_geometry(self):
