@@ -114,6 +114,13 @@ def _pairs(pairs):
     return [[c, h] for c, h in sorted(pairs)]
 
 
+def _at_crossings(pairs):
+    """"crossing 3" or "crossings 1, 2 and 5": the crossings of (crossing id, hook) `pairs`, named as
+    the layering's own verdict names them."""
+    ids = {c for c, _h in pairs}
+    return f"crossing{'s' if len(ids) > 1 else ''} {target_shape.id_list(ids)}"
+
+
 def relayer(design, material, settings, say, native_progress, checkpoint, hook_patterns=None, hook_seconds=None):
     """Layering, then target shape, forces and rest shape (shape_and_rest); while the result is not
     stable because the target shape could not realise some crossing's hook, forbid those (crossing,
@@ -154,10 +161,12 @@ def relayer(design, material, settings, say, native_progress, checkpoint, hook_p
             # so that the user sees the target shape's curves and its reason, as without the loop.
             rounds.append({"forbidden": [], "too_close": _pairs(too_close), "stable": False,
                            "verdict": attempt["reason"], "unrealised": [], "seconds": time.perf_counter() - began})
+            found = "stops at max_nodes before finding a" if attempt.get("search_incomplete") else "finds no"
+            say("relayering", f"the layering {found} stable assembly without the {len(too_close)} hooks at "
+                              f"{_at_crossings(too_close)}, too close to a neighbour along a wire for a free bending "
+                              f"point; layering again with every hook, for the target shape to show what it cannot "
+                              f"realise")
             up_front, too_close = None, set()
-            say("relayering", f"the layering finds no stable assembly without the {len(rounds[-1]['too_close'])} hooks "
-                              f"that crossings too close along a wire rule out; layering again with every hook, for "
-                              f"the target shape to show what it cannot realise")
             continue
         excluded = forbidden | too_close
         for message in attempt.get("close_crossings", []):
@@ -184,9 +193,8 @@ def relayer(design, material, settings, say, native_progress, checkpoint, hook_p
                           f"({len(forbidden | too_close)} hooks forbidden)")
     if "target_shape" in attempt["pending_stages"] and shaped is not None and not attempt.get("search_incomplete"):
         # The too-close hooks were forbidden before any target shape failed them: say where they are.
-        close = (f" ({len(too_close)} of them at crossing{'s' if len({c for c, _h in too_close}) > 1 else ''} "
-                 f"{', '.join(str(c) for c in sorted({c for c, _h in too_close}))}, too close to a neighbour along "
-                 f"a wire for a free bending point)") if too_close else ""
+        close = (f" ({len(too_close)} of them at {_at_crossings(too_close)}, too close to a neighbour along a wire "
+                 f"for a free bending point)") if too_close else ""
         shaped["reason"] += (f"; layering again without the {len(forbidden | too_close)} hooks the target shape cannot "
                              f"realise{close} finds no stable assembly (stages.relayering)")
         attempt = shaped

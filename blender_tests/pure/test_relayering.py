@@ -227,7 +227,15 @@ class Relayering(unittest.TestCase):
         # first layering picks on B and C either; the loop forbids them and layers again until the
         # layering finds no stable assembly. The reason counts every hook that last layering was
         # denied, the two too-close ones included, as the layering's own verdict does.
-        new = self.solve(8, max_bend_deg=60.0)
+        told = []
+        real = pipeline.hooks_by_forces
+
+        def hooks_by_forces(*args, **kwargs):  # what the other hook patterns must avoid
+            told.append(set(kwargs["forbidden"]))
+            return real(*args, **kwargs)
+
+        with mock.patch.object(pipeline, "hooks_by_forces", hooks_by_forces):
+            new = self.solve(8, max_bend_deg=60.0)
         self.assertFalse(new["stable"])
         record = new["stages"]["relayering"]
         last = record["rounds"][-1]
@@ -237,12 +245,16 @@ class Relayering(unittest.TestCase):
             self.assertEqual(len(r["too_close"]), 2)
             self.assertEqual({c for c, _h in r["too_close"]}, {p["id"], q["id"]})
             self.assertFalse({tuple(x) for x in r["too_close"]} & {tuple(x) for x in r["unrealised"]})
+        # Every round whose layering was stable told hooks_by_forces both sets: the learnt pairs (none
+        # in the first round, some in the second) and the too-close ones.
+        self.assertEqual(told, [{tuple(x) for x in r["forbidden"] + r["too_close"]} for r in record["rounds"][:-1]])
+        self.assertTrue(record["rounds"][1]["forbidden"])
         denied = len(last["forbidden"]) + len(last["too_close"])
         self.assertEqual(record["forbidden"], last["forbidden"])
         self.assertIn(f"with {denied} hooks forbidden", last["verdict"])  # the native layering's count
         ids = sorted((p["id"], q["id"]))
         self.assertTrue(new["reason"].endswith(f"; layering again without the {denied} hooks the target shape "
-                                               f"cannot realise (2 of them at crossings {ids[0]}, {ids[1]}, too close "
+                                               f"cannot realise (2 of them at crossings {ids[0]} and {ids[1]}, too close "
                                                f"to a neighbour along a wire for a free bending point) finds no "
                                                f"stable assembly (stages.relayering)"),
                         new["reason"])
@@ -261,29 +273,39 @@ class Relayering(unittest.TestCase):
         self.assertFalse(probe["stable"])  # without P and Q, A can turn about the line through the others
 
     def test_the_fallback_gives_the_old_paths_design(self):
-        messages = []
-        new = self.solve(8, progress=lambda stage, message: messages.append((stage, message)), angle=CLOSE_ANGLE)
-        with every_hook():
-            old = self.solve(8, angle=CLOSE_ANGLE)
-        self.assertFalse(old["stable"])
-        p, q = find(old, 1, 1), find(old, 2, 0)
-        # The old path's verdict, the target shape's: P and Q too close, then nothing stable without them.
-        self.assertIn(f"crossings {min(p['id'], q['id'])} and {max(p['id'], q['id'])}, too close", old["reason"])
-        self.assertNotIn("target_shape", old["pending_stages"])
-        # The fallback's design is the old path's, but for its record of the first layering.
-        new_record, old_record = new["stages"].pop("relayering"), old["stages"].pop("relayering")
-        self.assertEqual(without_times(new), without_times(old))
-        self.assertEqual(without_times(new_record["rounds"][1:]), without_times(old_record["rounds"]))
-        self.assertEqual((new_record["forbidden"], new_record["max_rounds"]), (old_record["forbidden"], 8))
-        first = new_record["rounds"][0]
-        self.assertEqual(sorted(map(tuple, first["too_close"])), sorted((c["id"], h) for c in (p, q) for h in (-1, 1)))
-        self.assertEqual((first["stable"], first["forbidden"], first["unrealised"]), (False, [], []))
-        self.assertIn("with 4 hooks forbidden", first["verdict"])
-        self.assertTrue(all(r["too_close"] == [] for r in new_record["rounds"][1:]))
-        said = [m for s, m in messages if s == "relayering"]
-        self.assertEqual(len(said), len(new_record["rounds"]) - 1)
-        self.assertTrue(re.search(r"no stable assembly without the 4 hooks .*layering again with every hook", said[0]),
-                        said[0])
+        # With relayer_rounds 1 too: the discarded layering is not one of the re-layerings, so the
+        # old path's round 1 still runs after it.
+        for rounds in (1, 8):
+            with self.subTest(relayer_rounds=rounds):
+                messages = []
+                new = self.solve(rounds, progress=lambda stage, message: messages.append((stage, message)),
+                                 angle=CLOSE_ANGLE)
+                with every_hook():
+                    old = self.solve(rounds, angle=CLOSE_ANGLE)
+                self.assertFalse(old["stable"])
+                p, q = find(old, 1, 1), find(old, 2, 0)
+                pq = f"crossings {min(p['id'], q['id'])} and {max(p['id'], q['id'])}, too close"
+                # The old path's verdict, the target shape's: P and Q too close, then nothing stable without them.
+                self.assertIn(pq, old["reason"])
+                self.assertNotIn("target_shape", old["pending_stages"])
+                # The fallback's design is the old path's, but for its record of the first layering.
+                new_record, old_record = new["stages"].pop("relayering"), old["stages"].pop("relayering")
+                self.assertEqual(without_times(new), without_times(old))
+                self.assertEqual(len(old_record["rounds"]), 2)  # round 1 learns P and Q, then nothing holds
+                self.assertEqual(without_times(new_record["rounds"][1:]), without_times(old_record["rounds"]))
+                self.assertEqual((new_record["forbidden"], new_record["max_rounds"]), (old_record["forbidden"], rounds))
+                first = new_record["rounds"][0]
+                self.assertEqual(sorted(map(tuple, first["too_close"])),
+                                 sorted((c["id"], h) for c in (p, q) for h in (-1, 1)))
+                self.assertEqual((first["stable"], first["forbidden"], first["unrealised"]), (False, [], []))
+                self.assertIn("with 4 hooks forbidden", first["verdict"])
+                self.assertTrue(all(r["too_close"] == [] for r in new_record["rounds"][1:]))
+                said = [m for s, m in messages if s == "relayering"]
+                self.assertEqual(len(said), len(new_record["rounds"]) - 1)
+                self.assertTrue(said[0].startswith(f"the layering finds no stable assembly without the 4 hooks at {pq} "),
+                                said[0])
+                self.assertIn("layering again with every hook", said[0])
+                self.assertTrue(said[1].startswith("round 1: "), said[1])
 
     def test_cancel_reaches_a_later_round(self):
         seen = []

@@ -27,7 +27,8 @@ SETTINGS = {
                   "reported as \"search incomplete\" (0: no limit)"),
     "relayer_rounds": (8, 0, 100, "int",
                        "How many times to layer again after the target shape could not realise a hook, "
-                       "with that hook forbidden (0: layer once)"),
+                       "with that hook forbidden; above 0, hooks at crossings too close along a wire to bend "
+                       "are forbidden from the start (0: layer once, with every hook)"),
     "max_solve_seconds": (600.0, 0.001, 86400.0, "s",
                           "Wall-clock budget of one solve, every stage and round included; past it the "
                           "solve stops with a message naming this key"),

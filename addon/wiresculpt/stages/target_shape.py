@@ -272,7 +272,8 @@ def unrealisable(design):
     return pairs
 
 
-def _ids(numbers):
+def id_list(numbers):
+    """"3" or "1, 2 and 5": the ids sorted, as the messages name crossings (the native's crossing_list)."""
     numbers = sorted(numbers)
     return ", ".join(map(str, numbers[:-1])) + f" and {numbers[-1]}" if len(numbers) > 1 else str(numbers[0])
 
@@ -284,7 +285,7 @@ def unrealised_summary(nulled, size):
     close = [n for n in nulled if n["status"] == "too_close"]
     if close:
         worst = max(close, key=lambda n: n["scale"])
-        parts.append(f"crossing{'s' if len(close) > 1 else ''} {_ids(n['crossing'] for n in close)}, too "
+        parts.append(f"crossing{'s' if len(close) > 1 else ''} {id_list(n['crossing'] for n in close)}, too "
                      f"close to {'their' if len(close) > 1 else 'its'} neighbours along the wires for a free "
                      f"bending point between them (the closest: {worst['message']})")
     for n in nulled:
