@@ -156,13 +156,15 @@ def relayer(design, material, settings, say, native_progress, checkpoint, hook_p
         # The crossings' spacing is the same every round, and a learnt pair is never a too-close
         # one, so the native lists them all each round.
         too_close = {tuple(p) for p in attempt.pop("too_close_forbidden", ())}  # never in a design.json
-        if up_front is not None and too_close and not attempt["stable"] and round_ == 0:
+        if (up_front is not None and too_close and not attempt["stable"] and round_ == 0
+                and not attempt.get("search_incomplete")):
             # Nothing holds without them: layer again with every hook (the old path, for every round),
-            # so that the user sees the target shape's curves and its reason, as without the loop.
+            # so that the user sees the target shape's curves and its reason, as without the loop. (A
+            # search that max_nodes stopped proved nothing; a larger one with every hook would rarely
+            # finish either, so the loop stops on its verdict, as in any later round.)
             rounds.append({"forbidden": [], "too_close": _pairs(too_close), "stable": False,
                            "verdict": attempt["reason"], "unrealised": [], "seconds": time.perf_counter() - began})
-            found = "stops at max_nodes before finding a" if attempt.get("search_incomplete") else "finds no"
-            say("relayering", f"the layering {found} stable assembly without the {len(too_close)} hooks at "
+            say("relayering", f"the layering finds no stable assembly without the {len(too_close)} hooks at "
                               f"{_at_crossings(too_close)}, too close to a neighbour along a wire for a free bending "
                               f"point; layering again with every hook, for the target shape to show what it cannot "
                               f"realise")

@@ -272,6 +272,33 @@ class Relayering(unittest.TestCase):
                          sorted((c["id"], h) for c in (p, q) for h in (-1, 1)))
         self.assertFalse(probe["stable"])  # without P and Q, A can turn about the line through the others
 
+    def test_a_first_layering_stopped_by_max_nodes_does_not_fall_back(self):
+        # A search that max_nodes stopped proved nothing: the loop stops on its verdict instead of
+        # searching again, larger, with every hook. (Here the search with the too-close hooks
+        # forbidden is made to stop at its node budget; on this network it would prove at once that
+        # nothing holds, which is the fallback's case.)
+        real = layering.run
+        calls = []
+
+        def stopped(design, *args, **kwargs):
+            text = real(design, *args, **kwargs)
+            calls.append(kwargs.get("too_close"))
+            if kwargs.get("too_close") is not None:
+                design.update(stable=False, search_incomplete=True, reason="search incomplete (stopped here)")
+            return text
+
+        messages = []
+        with mock.patch.object(pipeline.layering, "run", stopped):
+            d = self.solve(8, progress=lambda stage, message: messages.append((stage, message)), angle=CLOSE_ANGLE)
+        self.assertEqual(calls, [target_shape.REALISED_ANGLE])  # one layering, with the hooks forbidden
+        self.assertFalse(d["stable"])
+        self.assertTrue(d.get("search_incomplete"))
+        rounds = d["stages"]["relayering"]["rounds"]
+        self.assertEqual(len(rounds), 1)
+        self.assertEqual(len(rounds[0]["too_close"]), 4)
+        self.assertFalse([m for s, m in messages if s == "relayering"])
+        self.assertNotIn("too_close_forbidden", d)
+
     def test_the_fallback_gives_the_old_paths_design(self):
         # With relayer_rounds 1 too: the discarded layering is not one of the re-layerings, so the
         # old path's round 1 still runs after it.
