@@ -61,8 +61,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   o.angle_tolerance = number(in, 1e-6);
   o.length_tolerance = number(in, 1e-6);
   static const TargetShapeAlgorithm algorithms[] = {TargetShapeAlgorithm::slsqp, TargetShapeAlgorithm::auglag_lbfgs,
-                                                     TargetShapeAlgorithm::ccsaq, TargetShapeAlgorithm::mma};
-  o.algorithm = algorithms[in.ConsumeIntegralInRange<int>(0, 3)];
+                                                     TargetShapeAlgorithm::ccsaq, TargetShapeAlgorithm::mma,
+                                                     TargetShapeAlgorithm::sqp};
+  o.algorithm = algorithms[in.ConsumeIntegralInRange<int>(0, 4)];
   // A circle (or an arc) of n points, its radius from the input too (1e9 m included).
   const bool closed = in.ConsumeBool();
   const int n = in.ConsumeIntegralInRange<int>(0, 64);

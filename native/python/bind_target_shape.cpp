@@ -51,6 +51,7 @@ TargetShapeOptions to_options(py::handle d) {
                 }},
                field::choice("algorithm", o.algorithm,
                              {{"slsqp", TargetShapeAlgorithm::slsqp},
+                              {"sqp", TargetShapeAlgorithm::sqp},
                               {"auglag_lbfgs", TargetShapeAlgorithm::auglag_lbfgs},
                               {"ccsaq", TargetShapeAlgorithm::ccsaq},
                               {"mma", TargetShapeAlgorithm::mma}})});
@@ -79,7 +80,7 @@ py::dict optimize(const py::object& points, const py::object& closed_arg, const 
                   py::arg("rms_distance") = r.rms_distance, py::arg("min_segment") = r.min_segment,
                   py::arg("max_bend") = r.max_bend, py::arg("max_length_violation") = r.max_length_violation,
                   py::arg("max_angle_violation") = r.max_angle_violation, py::arg("iterations") = r.iterations,
-                  py::arg("sweeps") = r.sweeps, py::arg("seconds") = r.seconds,
+                  py::arg("sweeps") = r.sweeps, py::arg("sqp_blocks") = r.sqp_blocks, py::arg("sqp_fallbacks") = r.sqp_fallbacks, py::arg("seconds") = r.seconds,
                   py::arg("nlopt_result") = r.nlopt_result, py::arg("energy") = r.energy,
                   py::arg("feasible") = r.feasible, py::arg("warnings") = r.warnings);
 }
@@ -95,7 +96,7 @@ points: float64 (n, 2), metres; closed: bool; crossings: list of {"vertex": int 
 points), "bisector": (x, y) desired h*, "contact_angle": radians (default 2π/3), "active": bool
 (default True)}; options: dict of TargetShapeOptions fields (min_segment, max_bend, vertex_max_bend (radians per point of the result), start ((m, 2)
 points of a previous result to start from), spacing,
-regularization, friction, algorithm ("slsqp" | "auglag_lbfgs" | "ccsaq" | "mma"), ftol_rel,
+regularization, friction, algorithm ("slsqp" | "sqp" | "auglag_lbfgs" | "ccsaq" | "mma"), ftol_rel,
 xtol_rel, constraint_tol, max_iterations (1..1e7), window (0 or 4..10000), sweep_tol, sweep_ftol ([0, 1)), max_sweeps
 (1..100000), max_seconds (wall-clock budget, (0, 86400], default 120), model_size,
 angle_tolerance, length_tolerance, wire_name); progress: optional callable(stage, fraction) ->
@@ -103,7 +104,8 @@ bool, False cancels (raises Cancelled).
 Returns {"points": (m, 2), "crossing_vertices": [int], "crossings": [{"status", "realised",
 "vertex", "bisector", "contact_angle", "contact_violation", "scale", "message"}], "max_distance",
 "rms_distance", "min_segment", "max_bend", "max_length_violation", "max_angle_violation",
-"iterations", "sweeps", "seconds", "nlopt_result", "energy", "feasible", "warnings"}.
+"iterations", "sweeps", "sqp_blocks", "sqp_fallbacks", "seconds", "nlopt_result", "energy", "feasible",
+"warnings"}.
 Raises ValueError naming the wire and crossing for bad input.)");
 }
 

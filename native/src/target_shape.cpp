@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "nlopt_text.hpp"
+#include "target_shape_sqp.hpp"
 #include "wiresculpt/error.hpp"
 
 namespace wiresculpt {
@@ -641,6 +642,7 @@ struct Block {
   std::vector<int> points;       // variables, 2 per point
   std::vector<int> terms;        // energy terms depending on them
   std::vector<int> constraints;  // indices into TargetShapeProblem::constraints()
+  bool around_crossing = false;  // a window centred on an active crossing
 };
 
 struct SolverData {
@@ -654,6 +656,10 @@ struct SolverData {
   int evaluations = 0;
   int max_evaluations = 1;
   bool cancelled = false;
+
+  // Counts one evaluation and polls the progress callback at the first and then every
+  // kProgressEvery; false when it asks to cancel.
+  bool count_evaluation();
 
   void unpack(const double* x) {
     for (std::size_t k = 0; k < block->points.size(); ++k) p[block->points[k]] = scale_x * Vec2(x[2 * k], x[2 * k + 1]);
@@ -674,18 +680,28 @@ std::array<int, 3> constraint_points(const TargetShapeProblem::Constraint& c, in
 // that the pipeline solves on two threads. 16 evaluations are at most a few milliseconds.
 constexpr int kProgressEvery = 16;
 
-double objective(unsigned, const double* x, double* g, void* data) {
-  auto* d = static_cast<SolverData*>(data);
-  ++d->evaluations;
-  if (d->progress && *d->progress && (d->evaluations - 1) % kProgressEvery == 0) {
+// TargetShapeAlgorithm::sqp: SLSQP evaluations that lead a block where the basin is chosen (10: with
+// 5, one of 116 recorded corpus solves ended in another local minimum; with 10 and 20 none did).
+constexpr int kSqpBasinEvaluations = 10;
+// The result text of a block the SQP solved (TargetShapeResult::nlopt_result).
+const std::string kSqpConverged = "SQP_CONVERGED";
+
+bool SolverData::count_evaluation() {
+  ++evaluations;
+  if (progress && *progress && (evaluations - 1) % kProgressEvery == 0) {
     try {
-      report_progress(*d->progress, "target_shape",
-                      std::min(1.0, static_cast<double>(d->evaluations) / d->max_evaluations));
+      report_progress(*progress, "target_shape", std::min(1.0, static_cast<double>(evaluations) / max_evaluations));
     } catch (const Cancelled&) {
-      d->cancelled = true;
-      throw nlopt::forced_stop();
+      cancelled = true;
+      return false;
     }
   }
+  return true;
+}
+
+double objective(unsigned, const double* x, double* g, void* data) {
+  auto* d = static_cast<SolverData*>(data);
+  if (!d->count_evaluation()) throw nlopt::forced_stop();
   d->unpack(x);
   if (!g) return d->problem->energy_terms(d->p, d->block->terms, nullptr) / d->scale_f;
   std::fill(d->grad.begin(), d->grad.end(), Vec2::Zero());
@@ -727,6 +743,7 @@ void constraints_fn(unsigned m, double* result, unsigned n, const double* x, dou
 nlopt::algorithm nlopt_algorithm(TargetShapeAlgorithm a) {
   switch (a) {
     case TargetShapeAlgorithm::slsqp: return nlopt::LD_SLSQP;
+    case TargetShapeAlgorithm::sqp: return nlopt::LD_SLSQP;  // its fallback
     case TargetShapeAlgorithm::auglag_lbfgs: return nlopt::AUGLAG;
     case TargetShapeAlgorithm::ccsaq: return nlopt::LD_CCSAQ;
     case TargetShapeAlgorithm::mma: return nlopt::LD_MMA;
@@ -833,6 +850,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
         if (closed || (q >= 0 && q < m)) range.push_back((q + m) % m);
       }
       blocks.push_back(make_block(problem, range));
+      blocks.back().around_crossing = true;
     }
     const int stride = window / 2;
     const int count = closed ? (m + stride - 1) / stride : std::max(1, (m - window + stride - 1) / stride + 1);
@@ -862,6 +880,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
   auto out_of_time = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() >= o.max_seconds;
   };
+  bool choose_basin = false;  // sqp: SLSQP leads the block's first evaluations (see below)
   auto solve_block = [&](const Block& b) {
     const unsigned nvar = static_cast<unsigned>(2 * b.points.size());
     data.block = &b;
@@ -891,8 +910,59 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     const Polyline2 before = data.p;
     double f = 0.0;
     nlopt::result r = nlopt::FAILURE;
+    // TargetShapeAlgorithm::sqp: the block by Newton SQP. Where the basin is chosen (a one-block
+    // wire, or a window centred on a crossing in the first sweep, where the kinks open) SLSQP's
+    // first kSqpBasinEvaluations evaluations lead the way and SQP finishes from where they got:
+    // started cold there, Newton's long steps along the wire (where the energy is flat) reach other
+    // local minima (docs/method-target-shape.md, issue 17 fifth round). Where SQP fails (the
+    // linearised constraints are inconsistent, or its line search stalls) SLSQP solves the block
+    // from the block's start, as with algorithm slsqp.
+    bool by_sqp = false;
+    if (o.algorithm == TargetShapeAlgorithm::sqp) {
+      Polyline2 start = data.p;
+      bool ready = true;
+      if (choose_basin) {
+        std::vector<double> xp = x;
+        double fp = 0.0;
+        opt.set_maxeval(std::max(1, std::min(kSqpBasinEvaluations, o.max_iterations - data.evaluations)));
+        try {
+          opt.optimize(xp, fp);
+        } catch (const std::bad_alloc&) {
+          throw;
+        } catch (const std::exception&) {  // NLopt's stops (roundoff, failure): the point it reached
+        }
+        if (data.cancelled) throw Cancelled();
+        opt.set_maxeval(std::max(1, o.max_iterations - data.evaluations));
+        for (double v : xp) ready = ready && std::isfinite(v);
+        for (std::size_t k = 0; k < b.points.size() && ready; ++k)
+          start[b.points[k]] = data.scale_x * Vec2(xp[2 * k], xp[2 * k + 1]);
+      }
+      if (ready) {
+        detail::SqpSettings ss;
+        ss.scale_x = data.scale_x;
+        ss.scale_f = data.scale_f;
+        ss.min_segment = o.min_segment;
+        ss.regularization = o.regularization;
+        ss.constraint_tol = o.constraint_tol;
+        ss.ftol_rel = o.ftol_rel;
+        ss.on_evaluation = [&] {
+          if (!data.count_evaluation()) throw Cancelled();
+        };
+        const detail::SqpOutcome so = detail::sqp_block(problem, {&b.points, &b.terms, &b.constraints}, start, ss);
+        if (so.converged) {
+          for (std::size_t k = 0; k < b.points.size(); ++k) {
+            x[2 * k] = start[b.points[k]].x() / data.scale_x;
+            x[2 * k + 1] = start[b.points[k]].y() / data.scale_x;
+          }
+          r = nlopt::SUCCESS;
+          by_sqp = true;
+        }
+      }
+      ++result.sqp_blocks;
+      if (!by_sqp) ++result.sqp_fallbacks;
+    }
     try {
-      r = opt.optimize(x, f);
+      if (!by_sqp) r = opt.optimize(x, f);
     } catch (const nlopt::roundoff_limited&) {
       r = nlopt::ROUNDOFF_LIMITED;
     } catch (const nlopt::forced_stop&) {
@@ -931,7 +1001,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     for (int q : b.points) moved = std::max(moved, (data.p[q] - before[q]).norm());
     for (int q : b.points) data.var_of[q] = -1;
     // Keep the first non-success code (a failure in any block is the one worth reporting).
-    const std::string text = detail::nlopt_result_text(r);
+    const std::string text = by_sqp ? kSqpConverged : detail::nlopt_result_text(r);
     if (r < 0 && worst_result.empty()) worst_result = text;
     result.nlopt_result = worst_result.empty() ? text : worst_result;
     if (!finite) result.warnings.push_back("the solver diverged on part of wire " + w + "; that part keeps its previous shape");
@@ -939,6 +1009,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
   };
 
   if (blocks.size() == 1) {
+    choose_basin = true;
     solve_block(blocks[0]);
     result.sweeps = 1;
   } else if (!blocks.empty()) {
@@ -964,6 +1035,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
         any = true;
         dirty[k] = 0;
         const Polyline2 before = data.p;
+        choose_basin = sweep == 0 && blocks[k].around_crossing;
         solve_block(blocks[k]);
         for (int q : blocks[k].points)
           if ((data.p[q] - before[q]).norm() > move_tol)

@@ -50,6 +50,10 @@ struct TargetCrossing {
 
 enum class TargetShapeAlgorithm {
   slsqp,         ///< NLopt LD_SLSQP (default: see docs/method-target-shape.md)
+  /// Newton SQP per block (target_shape_sqp.hpp), led by SLSQP's first evaluations where the
+  /// basin is chosen and replaced by SLSQP where it fails; the pipeline's choice (issue 17, see
+  /// docs/method-target-shape.md)
+  sqp,
   auglag_lbfgs,  ///< NLopt AUGLAG with LD_LBFGS as the local solver
   ccsaq,         ///< NLopt LD_CCSAQ
   mma,           ///< NLopt LD_MMA
@@ -181,10 +185,13 @@ struct TargetShapeResult {
   /// that was not reported unrealisable before solving.
   double max_length_violation = 0.0;
   double max_angle_violation = 0.0;
-  int iterations = 0;         ///< NLopt energy evaluations, all blocks together
+  int iterations = 0;         ///< energy evaluations (NLopt's and the SQP's), all blocks together
   int sweeps = 0;             ///< passes over the windows (1 for a single block)
+  int sqp_blocks = 0;         ///< block solves by TargetShapeAlgorithm::sqp
+  int sqp_fallbacks = 0;      ///< of them, solved by SLSQP instead (the SQP did not converge)
   double seconds = 0.0;       ///< wall-clock time of the whole call
-  /// NLopt's result as text, e.g. "NLOPT_FTOL_REACHED": the first failure code of any block, else
+  /// NLopt's result as text, e.g. "NLOPT_FTOL_REACHED" ("SQP_CONVERGED" for a block the SQP
+  /// solved): the first failure code of any block, else
   /// the last block's code; "NLOPT_MAXEVAL_REACHED" when max_iterations ran out across windows;
   /// "none" when nothing was free.
   std::string nlopt_result;

@@ -1,0 +1,463 @@
+#include "target_shape_sqp.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Dense>
+#include <Eigen/QR>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace wiresculpt::detail {
+
+// ---------------------------------------------------------------------------------------------
+// The QP: Goldfarb and Idnani's dual method ("A numerically stable dual method for solving
+// strictly convex quadratic programs", Math. Programming 27, 1983), written for small dense
+// problems: the active constraints' least-squares step is recomputed by a QR factorisation at
+// every change instead of being updated.
+
+namespace {
+
+// The active constraints' whitened normals ñ_j (columns of Ñ) as Ñ = U R, U with orthonormal
+// columns (modified Gram-Schmidt, twice), R upper triangular: adding a column costs O(n |S|);
+// dropping one rebuilds the factorisation of the rest.
+class ActiveBasis {
+ public:
+  explicit ActiveBasis(Eigen::Index n) : U_(n, n), R_(n, n) {}
+  Eigen::Index size() const { return k_; }
+  // The part of v orthogonal to the basis (q) and its coefficients in it (w = Uᵀ v).
+  void project(const Eigen::VectorXd& v, Eigen::VectorXd& q, Eigen::VectorXd& w) const {
+    q = v;
+    w = Eigen::VectorXd::Zero(k_);
+    for (int pass = 0; pass < 2; ++pass)
+      for (Eigen::Index j = 0; j < k_; ++j) {
+        const double a = U_.col(j).dot(q);
+        q -= a * U_.col(j);
+        w[j] += a;
+      }
+  }
+  // Solves R r = w (the coefficients of v's projection in the columns of Ñ).
+  Eigen::VectorXd coefficients(const Eigen::VectorXd& w) const {
+    return R_.topLeftCorner(k_, k_).triangularView<Eigen::Upper>().solve(w);
+  }
+  void add(const Eigen::VectorXd& q, const Eigen::VectorXd& w) {
+    const double nq = q.norm();
+    U_.col(k_) = q / nq;
+    R_.col(k_).head(k_) = w;
+    R_(k_, k_) = nq;
+    ++k_;
+  }
+  void clear() { k_ = 0; }
+
+ private:
+  Eigen::MatrixXd U_, R_;
+  Eigen::Index k_ = 0;
+};
+
+}  // namespace
+
+bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,
+                     const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, double tol) {
+  const Eigen::Index n = g.size(), m = A.rows();
+  const auto L = llt.matrixL();
+  // In Goldfarb-Idnani's form the constraints are n_kᵀ d >= b_k with n_k = -a_k, b_k = c_k;
+  // ñ_k = L⁻¹ n_k, so that W⁻¹ = L⁻ᵀ L⁻¹ turns every projection into a Euclidean one.
+  const Eigen::MatrixXd Nt = L.solve(-A.transpose());  // n × m, columns ñ_k
+  d = -llt.solve(g);
+  lambda = Eigen::VectorXd::Zero(m);
+  std::vector<Eigen::Index> active;
+  std::vector<double> u;  // multipliers of `active`
+  std::vector<char> in(static_cast<std::size_t>(m), 0);
+  ActiveBasis basis(n);
+  Eigen::VectorXd q(n), w, z(n);
+  const double scale = 1.0 + g.cwiseAbs().maxCoeff();
+  const int max_steps = static_cast<int>(10 * (n + m) + 10);
+  int step = 0;
+  while (step < max_steps) {
+    // The most violated constraint not yet active.
+    Eigen::Index p = -1;
+    double worst = -tol * scale;
+    for (Eigen::Index k = 0; k < m; ++k) {
+      if (in[static_cast<std::size_t>(k)]) continue;
+      const double s = -(A.row(k).dot(d) + c[k]);
+      if (s < worst) worst = s, p = k;
+    }
+    if (p < 0) {
+      for (std::size_t j = 0; j < active.size(); ++j) lambda[active[j]] = u[j];
+      return true;
+    }
+    double up = 0.0;
+    for (; step < max_steps; ++step) {
+      const Eigen::Index na = static_cast<Eigen::Index>(active.size());
+      basis.project(Nt.col(p), q, w);
+      const Eigen::VectorXd r = basis.coefficients(w);
+      const double zn = q.squaredNorm();
+      z = L.transpose().solve(q);
+      // Dual step length: the first active multiplier to reach zero.
+      double t1 = std::numeric_limits<double>::infinity();
+      Eigen::Index drop = -1;
+      for (Eigen::Index j = 0; j < na; ++j)
+        if (r[j] > 0.0 && u[static_cast<std::size_t>(j)] / r[j] < t1) t1 = u[static_cast<std::size_t>(j)] / r[j], drop = j;
+      // Primal step length: to make constraint p hold.
+      const double sp = -(A.row(p).dot(d) + c[p]);
+      const bool dependent = zn <= 1e-14 * std::max(1.0, Nt.col(p).squaredNorm());
+      const double t2 = dependent ? std::numeric_limits<double>::infinity() : -sp / zn;
+      const double t = std::min(t1, t2);
+      if (!std::isfinite(t)) return false;  // the constraints are inconsistent
+      if (!dependent) d += t * z;
+      for (Eigen::Index j = 0; j < na; ++j) u[static_cast<std::size_t>(j)] -= t * r[j];
+      up += t;
+      if (t == t2) {  // p holds: it joins the active set
+        active.push_back(p);
+        u.push_back(up);
+        in[static_cast<std::size_t>(p)] = 1;
+        basis.add(q, w);
+        ++step;
+        break;
+      }
+      in[static_cast<std::size_t>(active[static_cast<std::size_t>(drop)])] = 0;
+      active.erase(active.begin() + drop);
+      u.erase(u.begin() + drop);
+      basis.clear();
+      for (Eigen::Index j : active) {
+        Eigen::VectorXd qj(n), wj;
+        basis.project(Nt.col(j), qj, wj);
+        basis.add(qj, wj);
+      }
+    }
+  }
+  return false;
+}
+
+bool solve_convex_qp(const Eigen::MatrixXd& W, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,
+                     const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, double tol) {
+  const Eigen::LLT<Eigen::MatrixXd> llt(W);
+  if (llt.info() != Eigen::Success) return false;
+  return solve_convex_qp(llt, g, A, c, d, lambda, tol);
+}
+
+namespace {
+
+using Mat2 = Eigen::Matrix2d;
+
+std::array<int, 3> points_of(const TargetShapeProblem::Constraint& c, int m) {
+  using Kind = TargetShapeProblem::Kind;
+  switch (c.kind) {
+    case Kind::length: return {c.vertex, (c.vertex + 1) % m, -1};
+    case Kind::bend: return {(c.vertex + m - 1) % m, c.vertex, (c.vertex + 1) % m};
+    case Kind::contact: return {c.vertex, c.neighbour, -1};
+  }
+  return {-1, -1, -1};
+}
+
+class BlockModel {
+ public:
+  BlockModel(const TargetShapeProblem& problem, const SqpBlock& block, const SqpSettings& s, const Polyline2& p)
+      : pr_(problem), b_(block), s_(s), m_(static_cast<int>(p.size())) {
+    var_.assign(m_, -1);
+    for (std::size_t k = 0; k < b_.points->size(); ++k) var_[(*b_.points)[k]] = static_cast<int>(2 * k);
+    n_ = static_cast<int>(2 * b_.points->size());
+    mc_ = static_cast<int>(b_.constraints->size());
+    grad_.assign(m_, Vec2::Zero());
+    scratch_.assign(m_, Vec2::Zero());
+  }
+  int variables() const { return n_; }
+  int constraints() const { return mc_; }
+
+  Eigen::VectorXd to_x(const Polyline2& p) const {
+    Eigen::VectorXd x(n_);
+    for (int i : *b_.points) x[var_[i]] = p[i].x() / s_.scale_x, x[var_[i] + 1] = p[i].y() / s_.scale_x;
+    return x;
+  }
+  void to_points(const Eigen::VectorXd& x, Polyline2& p) const {
+    for (int i : *b_.points) p[i] = s_.scale_x * Vec2(x[var_[i]], x[var_[i] + 1]);
+  }
+
+  // f, and (when g) its gradient; constraint values, and (when A) their Jacobian.
+  double evaluate(const Polyline2& p, Eigen::VectorXd* g, Eigen::VectorXd& c, Eigen::MatrixXd* A) {
+    double f;
+    if (g) {
+      for (int t : *b_.terms)
+        for (int sd : {-1, 0, 1}) grad_[wrap(t + sd)] = Vec2::Zero();
+      f = pr_.energy_terms(p, *b_.terms, &grad_) / s_.scale_f;
+      g->resize(n_);
+      const double gs = s_.scale_x / s_.scale_f;
+      for (int i : *b_.points) (*g)[var_[i]] = gs * grad_[i].x(), (*g)[var_[i] + 1] = gs * grad_[i].y();
+    } else {
+      f = pr_.energy_terms(p, *b_.terms) / s_.scale_f;
+    }
+    c.resize(mc_);
+    if (A) A->setZero(mc_, n_);
+    const auto& all = pr_.constraints();
+    for (int k = 0; k < mc_; ++k) {
+      const int ck = (*b_.constraints)[k];
+      if (!A) {
+        c[k] = pr_.constraint(ck, p);
+        continue;
+      }
+      const auto pts = points_of(all[ck], m_);
+      for (int q : pts)
+        if (q >= 0) scratch_[q] = Vec2::Zero();
+      c[k] = pr_.constraint(ck, p, &scratch_);
+      for (int q : pts) {
+        if (q < 0 || var_[q] < 0) continue;
+        (*A)(k, var_[q]) = s_.scale_x * scratch_[q].x();
+        (*A)(k, var_[q] + 1) = s_.scale_x * scratch_[q].y();
+      }
+    }
+    return f;
+  }
+
+  // The Hessian of f + Σ λ_k c_k over the block's variables.
+  Eigen::MatrixXd hessian(const Polyline2& p, const Eigen::VectorXd& lambda) {
+    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n_, n_);
+    const double hs = s_.scale_x * s_.scale_x / s_.scale_f;
+    auto add = [&](int a, int b, const Mat2& B, double scale) {  // B = d²/dp_a dp_b
+      if (var_[a] < 0 || var_[b] < 0) return;
+      H.block<2, 2>(var_[a], var_[b]) += scale * B;
+    };
+    const bool closed = pr_.closed();
+    // E_d: terms w_i D(p_i), w_i = Σ_j |p_i - p_j| over the neighbours j of i.
+    const double step = 1e-7 * s_.min_segment;  // differences of the IMLS gradient
+    for (int i : *b_.terms) {
+      Vec2 dD;
+      const double D = pr_.imls(p[i], &dD);
+      Mat2 HD;
+      for (int r = 0; r < 2; ++r) {  // forward differences: the error O(step) is far below what Newton needs
+        Vec2 gp, q = p[i];
+        q[r] += step;
+        pr_.imls(q, &gp);
+        HD.col(r) = (gp - dD) / step;
+      }
+      HD = (0.5 * (HD + HD.transpose())).eval();
+      double w = 0.0;
+      Mat2 Hii = Mat2::Zero();
+      for (int side : {-1, 1}) {
+        const int j0 = i + side;
+        if (!closed && (j0 < 0 || j0 >= m_)) continue;
+        const int j = wrap(j0);
+        const Vec2 e = p[i] - p[j];
+        const double len = e.norm();
+        w += len;
+        if (len <= 0.0) continue;
+        const Vec2 eh = e / len;
+        const Mat2 P = (Mat2::Identity() - eh * eh.transpose()) / len;
+        Hii += dD * eh.transpose() + eh * dD.transpose() + D * P;
+        const Mat2 Hij = -dD * eh.transpose() - D * P;  // d²/dp_i dp_j
+        add(i, j, Hij, hs);
+        add(j, i, Hij.transpose(), hs);
+        add(j, j, D * P, hs);
+      }
+      Hii += w * HD;
+      add(i, i, Hii, hs);
+    }
+    // w_r E_r: Σ_i w_r |u_i - (u_a + u_b)/2|², a constant quadratic.
+    const double wr = s_.regularization;
+    for (int i : *b_.terms) {
+      if (wr <= 0.0 || (!closed && (i == 0 || i == m_ - 1))) continue;
+      const std::array<int, 3> q{wrap(i - 1), i, wrap(i + 1)};
+      const std::array<double, 3> co{-0.5, 1.0, -0.5};
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) add(q[a], q[b], Mat2::Identity(), hs * 2.0 * wr * co[a] * co[b]);
+    }
+    // Constraints: λ_k ∇²c_k (lengths exactly, bends and contacts by central differences).
+    const auto& all = pr_.constraints();
+    const double lmin2 = s_.min_segment * s_.min_segment;
+    const double cs = s_.scale_x * s_.scale_x;
+    Polyline2& q = work_;
+    q = p;
+    for (int k = 0; k < mc_; ++k) {
+      const double l = lambda[k];
+      if (!(l > 0.0)) continue;
+      const int ck = (*b_.constraints)[k];
+      const auto pts = points_of(all[ck], m_);
+      if (all[ck].kind == TargetShapeProblem::Kind::length) {
+        const Mat2 B = (-2.0 / lmin2) * Mat2::Identity();
+        add(pts[0], pts[0], B, l * cs);
+        add(pts[1], pts[1], B, l * cs);
+        add(pts[0], pts[1], -B, l * cs);
+        add(pts[1], pts[0], -B, l * cs);
+        continue;
+      }
+      const double h = 1e-7 * s_.min_segment;
+      std::array<std::array<Vec2, 3>, 6> col{};  // d(∇c)/d(coordinate r of point pts[a])
+      for (int a = 0; a < 3; ++a) {
+        if (pts[a] < 0 || var_[pts[a]] < 0) continue;
+        for (int r = 0; r < 2; ++r) {
+          std::array<Vec2, 3> gp{}, gm{};
+          for (int sgn : {1, -1}) {
+            q[pts[a]][r] = p[pts[a]][r] + sgn * h;
+            for (int b = 0; b < 3; ++b)
+              if (pts[b] >= 0) scratch_[pts[b]] = Vec2::Zero();
+            pr_.constraint(ck, q, &scratch_);
+            for (int b = 0; b < 3; ++b)
+              if (pts[b] >= 0) (sgn > 0 ? gp : gm)[b] = scratch_[pts[b]];
+          }
+          q[pts[a]][r] = p[pts[a]][r];
+          for (int b = 0; b < 3; ++b) col[2 * a + r][b] = (gp[b] - gm[b]) / (2.0 * h);
+        }
+      }
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) {
+          if (pts[a] < 0 || pts[b] < 0 || var_[pts[a]] < 0 || var_[pts[b]] < 0) continue;
+          Mat2 B;  // d²c / dp_b dp_a, symmetrised
+          for (int r = 0; r < 2; ++r)
+            for (int s = 0; s < 2; ++s) B(s, r) = 0.5 * (col[2 * a + r][b][s] + col[2 * b + s][a][r]);
+          add(pts[b], pts[a], B, l * cs);
+        }
+    }
+    return 0.5 * (H + H.transpose());
+  }
+
+ private:
+  int wrap(int j) const { return ((j % m_) + m_) % m_; }
+
+  const TargetShapeProblem& pr_;
+  SqpBlock b_;
+  SqpSettings s_;
+  int m_;
+  int n_ = 0, mc_ = 0;
+  std::vector<int> var_;
+  Polyline2 grad_, scratch_, work_;
+};
+
+double violation(const Eigen::VectorXd& c) { return c.size() ? std::max(0.0, c.maxCoeff()) : 0.0; }
+double infeasibility(const Eigen::VectorXd& c) { return c.cwiseMax(0.0).sum(); }
+
+}  // namespace
+
+namespace {
+
+// Adds ρ a_k a_kᵀ for every constraint with λ_k > 0, then δI, until W is positive definite;
+// `factor` gets its Cholesky factor. False when it cannot be made so (not finite).
+bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::VectorXd& lambda,
+               Eigen::LLT<Eigen::MatrixXd>& factor) {
+  const Eigen::Index n = W.rows();
+  Eigen::MatrixXd AtA = Eigen::MatrixXd::Zero(n, n);
+  bool any = false;
+  for (Eigen::Index k = 0; k < A.rows(); ++k)
+    if (lambda[k] > 0.0) {
+      AtA.noalias() += A.row(k).transpose() * A.row(k);
+      any = true;
+    }
+  const double dmax = std::max(1e-12, W.diagonal().cwiseAbs().maxCoeff());
+  double rho = 0.0, delta = 0.0;
+  for (int tries = 0; tries <= 60; ++tries) {
+    Eigen::MatrixXd Wd = W + rho * AtA;
+    Wd.diagonal().array() += delta;
+    factor.compute(Wd);
+    if (factor.info() == Eigen::Success) {
+      W = std::move(Wd);
+      return true;
+    }
+    if (any && rho < 1e6 * dmax)
+      rho = rho > 0.0 ? 4.0 * rho : dmax;
+    else
+      delta = delta > 0.0 ? 4.0 * delta : 1e-8 * dmax;
+  }
+  return false;
+}
+
+}  // namespace
+
+SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, Polyline2& p_io,
+                     const SqpSettings& settings) {
+  SqpOutcome out;
+  BlockModel model(problem, block, settings, p_io);
+  const int n = model.variables(), mc = model.constraints();
+  if (n == 0) {
+    out.converged = true;
+    return out;
+  }
+  auto counted = [&] {
+    ++out.evaluations;
+    if (settings.on_evaluation) settings.on_evaluation();
+  };
+  Polyline2 p = p_io, trial = p_io;
+  Eigen::VectorXd x = model.to_x(p), g, c, ct, lambda = Eigen::VectorXd::Zero(mc), d, mu;
+  Eigen::MatrixXd A;
+  double f = model.evaluate(p, &g, c, &A);
+  counted();
+  double nu = 1.0;  // ℓ1 penalty of the merit function f + ν Σ max(0, c_k)
+  Eigen::LLT<Eigen::MatrixXd> factor(n);
+  for (int it = 0; it < settings.max_iterations; ++it) {
+    out.iterations = it + 1;
+    // Convexify. The curvature of the contact and bend constraints, weighted by their multipliers,
+    // makes the Lagrangian indefinite across the constraints that hold with equality; adding
+    // ½ρ (a_k·d)² for each of them (k with λ_k > 0) is constant along a constraint the QP keeps
+    // active (a_k·d = -c_k there), so it changes no such solution, and adds ρ a_k a_kᵀ. What is left
+    // (far from the contour) gets δI.
+    Eigen::MatrixXd W = model.hessian(p, lambda);
+    if (!convexify(W, A, lambda, factor)) return out;
+    // Inconsistent linearised constraints (a kink that cannot be opened from here): the caller's
+    // SLSQP decides, as it always did.
+    if (!solve_convex_qp(factor, g, A, c, d, mu)) return out;
+    nu = std::max(nu, 1.5 * (mu.size() ? mu.maxCoeff() : 0.0) + 1e-12);
+    auto merit = [&](double fv, const Eigen::VectorXd& cv) { return fv + nu * infeasibility(cv); };
+    const double phi0 = merit(f, c);
+    const double slope = g.dot(d) - nu * infeasibility(c);
+    // Near the solution the step can be so small that rounding leaves its merit slope >= 0: take
+    // it as it is when it raises neither the violation nor the energy (the last step of a
+    // converging iteration).
+    const bool polish = !(slope < 0.0) && d.lpNorm<Eigen::Infinity>() <= 1e-5;
+    if (!(slope < 0.0) && !polish) return out;
+    double alpha = 1.0;
+    bool accepted = false;
+    Eigen::VectorXd xt;
+    double ft = 0.0;
+    for (int ls = 0; ls < 40; ++ls) {
+      xt = x + alpha * d;
+      model.to_points(xt, trial);
+      ft = model.evaluate(trial, nullptr, ct, nullptr);
+      counted();
+      if (std::isfinite(ft) && (polish ? violation(ct) <= std::max(violation(c), settings.constraint_tol) &&
+                                             ft <= f + 1e-12 * std::abs(f)
+                                       : merit(ft, ct) <= phi0 + 1e-4 * alpha * slope)) {
+        accepted = true;
+        break;
+      }
+      if (polish) return out;
+      if (ls == 0 && mc > 0) {
+        // Second-order correction (the full step raised the violation of curved active
+        // constraints, the Maratos effect): the same QP with the constraints' values at the trial
+        // point, linearised about x.
+        Eigen::VectorXd dc, mc2;
+        const Eigen::VectorXd csoc = ct - A * d;
+        if (solve_convex_qp(factor, g, A, csoc, dc, mc2)) {
+          xt = x + dc;
+          model.to_points(xt, trial);
+          ft = model.evaluate(trial, nullptr, ct, nullptr);
+          counted();
+          if (std::isfinite(ft) && merit(ft, ct) <= phi0 + 1e-4 * slope) {
+            accepted = true;
+            mu = mc2;
+            break;
+          }
+        }
+      }
+      alpha *= 0.5;
+    }
+    if (!accepted) return out;
+    const double step = (xt - x).lpNorm<Eigen::Infinity>();
+    x = xt;
+    model.to_points(x, p);
+    const double f_old = f;
+    f = model.evaluate(p, &g, c, &A);
+    counted();
+    lambda = mu;
+    // Converged: feasible, and the step was negligible or a full step changed f by at most
+    // ftol_rel of it (SLSQP's own test).
+    const bool feasible = violation(c) <= settings.constraint_tol;
+    if (feasible && (step <= settings.step_tol ||
+                     (alpha == 1.0 && std::abs(f_old - f) <= settings.ftol_rel * std::abs(f)))) {
+      out.converged = true;
+      break;
+    }
+  }
+  if (out.converged) p_io = p;
+  return out;
+}
+
+}  // namespace wiresculpt::detail

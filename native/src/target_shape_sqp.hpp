@@ -1,0 +1,57 @@
+#pragma once
+// A Newton SQP for one block of the target-shape problem (TargetShapeAlgorithm::sqp; see
+// docs/method-target-shape.md): the Hessian of the Lagrangian (analytic but for central
+// differences of the IMLS gradient and of the bend and contact gradients), a dense convex QP per
+// step solved by the dual active-set method of Goldfarb and Idnani, an ℓ1 merit line search.
+// It reports failure, rather than guessing, where the linearised constraints are inconsistent
+// (a kink that cannot be opened) or the line search stalls: the caller then solves the block
+// with SLSQP from the same start.
+
+#include <functional>
+#include <vector>
+
+#include <Eigen/Cholesky>
+
+#include "wiresculpt/target_shape.hpp"
+
+namespace wiresculpt::detail {
+
+struct SqpBlock {
+  const std::vector<int>* points = nullptr;       ///< free points solved for (2 variables each)
+  const std::vector<int>* terms = nullptr;        ///< energy terms they change
+  const std::vector<int>* constraints = nullptr;  ///< indices into problem.constraints()
+};
+
+struct SqpSettings {
+  double scale_x = 1.0;          ///< p = scale_x x
+  double scale_f = 1.0;          ///< f = E / scale_f
+  double min_segment = 0.015;    ///< metres (the length constraints' l_min)
+  double regularization = 1e-3;  ///< w_r
+  double constraint_tol = 1e-10;
+  double step_tol = 1e-9;        ///< stop when the step is this small (scaled units) and feasible
+  double ftol_rel = 1e-12;       ///< or when f changed by at most this fraction of it and feasible
+  int max_iterations = 60;
+  /// Called at every evaluation (it may throw, e.g. Cancelled, which leaves the block unsolved).
+  std::function<void()> on_evaluation;
+};
+
+struct SqpOutcome {
+  bool converged = false;
+  int evaluations = 0;  ///< energy + constraint evaluations (gradients included)
+  int iterations = 0;
+};
+
+/// Solves the block from `p` (the whole wire's points; only the block's points change). On
+/// success `p` holds the solution; on failure `p` is left as it was.
+SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, Polyline2& p,
+                     const SqpSettings& settings);
+
+/// Minimises ½ dᵀ W d + gᵀ d subject to A d + c <= 0 (rows of A as a dense matrix), W symmetric
+/// positive definite: the dual active-set method of Goldfarb and Idnani (1983). Returns false when
+/// the constraints are inconsistent. `lambda` gets the multipliers (>= 0). Exposed for its tests.
+bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& W_factor, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,
+                     const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, double tol = 1e-12);
+bool solve_convex_qp(const Eigen::MatrixXd& W, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,
+                     const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, double tol = 1e-12);
+
+}  // namespace wiresculpt::detail

@@ -1,0 +1,219 @@
+// The target shape's Newton SQP (TargetShapeAlgorithm::sqp, target_shape_sqp.hpp): its convex QP
+// against brute force over every active set, and whole solves against SLSQP's on contours with
+// known optima (the same distances and crossings, found with fewer evaluations), its fallback on a
+// kink that cannot be opened, and cancellation.
+#include <catch2/catch.hpp>
+#include <Eigen/Dense>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "target_shape_sqp.hpp"
+#include "wiresculpt/error.hpp"
+#include "wiresculpt/target_shape.hpp"
+
+using namespace wiresculpt;
+
+namespace {
+constexpr double pi = std::numbers::pi;
+
+// min ½ dᵀWd + gᵀd s.t. A d + c <= 0 by enumeration: for every subset S of the constraints the
+// equality-constrained KKT system; the answer is the one (unique for W positive definite) that is
+// primal and dual feasible. False when no subset gives one (the constraints are inconsistent).
+bool brute_force_qp(const Eigen::MatrixXd& W, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,
+                    const Eigen::VectorXd& c, Eigen::VectorXd& best) {
+  const int n = static_cast<int>(W.rows()), m = static_cast<int>(A.rows());
+  bool found = false;
+  double best_f = 0.0;
+  for (int mask = 0; mask < (1 << m); ++mask) {
+    std::vector<int> S;
+    for (int k = 0; k < m; ++k)
+      if (mask & (1 << k)) S.push_back(k);
+    const int s = static_cast<int>(S.size());
+    if (s > n) continue;
+    Eigen::MatrixXd K = Eigen::MatrixXd::Zero(n + s, n + s);
+    Eigen::VectorXd rhs(n + s);
+    K.topLeftCorner(n, n) = W;
+    rhs.head(n) = -g;
+    for (int j = 0; j < s; ++j) {
+      K.block(0, n + j, n, 1) = A.row(S[j]).transpose();
+      K.block(n + j, 0, 1, n) = A.row(S[j]);
+      rhs[n + j] = -c[S[j]];
+    }
+    const Eigen::FullPivLU<Eigen::MatrixXd> lu(K);
+    if (lu.rank() < n + s) continue;  // dependent active normals
+    const Eigen::VectorXd sol = lu.solve(rhs);
+    const Eigen::VectorXd d = sol.head(n), lambda = sol.tail(s);
+    if (s && lambda.minCoeff() < -1e-9) continue;
+    if (m && (A * d + c).maxCoeff() > 1e-9) continue;
+    const double f = 0.5 * d.dot(W * d) + g.dot(d);
+    if (!found || f < best_f) best = d, best_f = f, found = true;
+  }
+  return found;
+}
+
+Polyline2 ellipse(double a, double b, int n) {
+  Polyline2 pts;
+  for (int k = 0; k < n; ++k) pts.emplace_back(a * std::cos(2 * pi * k / n), b * std::sin(2 * pi * k / n));
+  return pts;
+}
+
+// The largest distance between two results' points (the same resampling, so the same count).
+double largest_move(const TargetShapeResult& a, const TargetShapeResult& b) {
+  REQUIRE(a.points.size() == b.points.size());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < a.points.size(); ++i) worst = std::max(worst, (a.points[i] - b.points[i]).norm());
+  return worst;
+}
+
+void same_optimum(const TargetShapeResult& slsqp, const TargetShapeResult& sqp) {
+  // The measure of "the same optimum": distances to the contour within 0.1 mm and the
+  // same status at every crossing.
+  CHECK(std::abs(sqp.max_distance - slsqp.max_distance) < 1e-4);
+  CHECK(std::abs(sqp.rms_distance - slsqp.rms_distance) < 1e-4);
+  REQUIRE(sqp.crossings.size() == slsqp.crossings.size());
+  for (std::size_t c = 0; c < sqp.crossings.size(); ++c) CHECK(sqp.crossings[c].status == slsqp.crossings[c].status);
+  CHECK(sqp.feasible == slsqp.feasible);
+}
+}  // namespace
+
+TEST_CASE("sqp: the convex QP's answer is the KKT point that brute force over active sets finds", "[target][sqp]") {
+  std::mt19937 rng(17);
+  std::normal_distribution<double> N(0.0, 1.0);
+  int solved = 0, inconsistent = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const int n = 1 + trial % 5, m = trial % 7;
+    Eigen::MatrixXd B(n, n), A(m, n);
+    Eigen::VectorXd g(n), c(m);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) B(i, j) = N(rng);
+    const Eigen::MatrixXd W = B.transpose() * B + 0.1 * Eigen::MatrixXd::Identity(n, n);
+    for (int i = 0; i < n; ++i) g[i] = N(rng);
+    for (int k = 0; k < m; ++k) {
+      for (int j = 0; j < n; ++j) A(k, j) = N(rng);
+      c[k] = N(rng);
+    }
+    if (trial % 11 == 0 && m >= 2) {  // a parallel pair: sometimes inconsistent, sometimes not
+      A.row(1) = -2.0 * A.row(0);
+      c[1] = (trial % 22 == 0 ? 3.0 : -3.0) + 2.0 * c[0];
+    }
+    Eigen::VectorXd d_bf, d, lambda;
+    const bool feasible = brute_force_qp(W, g, A, c, d_bf);
+    const bool ok = detail::solve_convex_qp(W, g, A, c, d, lambda);
+    REQUIRE(ok == feasible);
+    if (!ok) {
+      ++inconsistent;
+      continue;
+    }
+    ++solved;
+    CHECK((d - d_bf).norm() <= 1e-8 * (1.0 + d_bf.norm()));
+    // Its multipliers satisfy the KKT conditions on their own.
+    CHECK(lambda.size() == m);
+    if (m) {
+      CHECK(lambda.minCoeff() >= 0.0);
+      CHECK((A * d + c).maxCoeff() <= 1e-9);
+      for (int k = 0; k < m; ++k) CHECK(std::abs(lambda[k] * (A.row(k).dot(d) + c[k])) <= 1e-8);
+    }
+    CHECK((W * d + g + (m ? Eigen::VectorXd(A.transpose() * lambda) : Eigen::VectorXd::Zero(n))).norm() <= 1e-8);
+  }
+  CHECK(solved > 300);
+  CHECK(inconsistent > 5);
+}
+
+TEST_CASE("sqp: the QP reports constraints that contradict each other", "[target][sqp]") {
+  // d0 <= -1 and d0 >= 1.
+  Eigen::MatrixXd A(2, 2);
+  A << 1, 0, -1, 0;
+  const Eigen::VectorXd c = (Eigen::VectorXd(2) << 1, 1).finished();
+  Eigen::VectorXd d, lambda;
+  CHECK_FALSE(detail::solve_convex_qp(Eigen::MatrixXd::Identity(2, 2), Eigen::VectorXd::Zero(2), A, c, d, lambda));
+  // Without the second one: d = (-1, 0) with multiplier 1 (the gradient of ½|d|² at d is -a).
+  Eigen::VectorXd d1, l1;
+  REQUIRE(detail::solve_convex_qp(Eigen::MatrixXd::Identity(2, 2), Eigen::VectorXd::Zero(2), A.topRows(1),
+                                  c.head(1), d1, l1));
+  CHECK(d1[0] == Approx(-1.0));
+  CHECK(d1[1] == Approx(0.0).margin(1e-15));
+  CHECK(l1[0] == Approx(1.0));
+}
+
+TEST_CASE("sqp: reaches SLSQP's optimum with fewer evaluations, in one block and in windows", "[target][sqp]") {
+  // An ellipse with four active crossings (two kinks inverted), solved as one block; and the same
+  // with windows; and a 2 m wavy loop with ten crossings (windows).
+  struct Case {
+    Polyline2 contour;
+    std::vector<TargetCrossing> xs;
+    int window;
+  };
+  std::vector<Case> cases;
+  {
+    const Polyline2 e = ellipse(0.15, 0.09, 1200);
+    std::vector<TargetCrossing> xs;
+    for (int k = 0; k < 4; ++k) {
+      const int v = k * 300 + 37;
+      xs.push_back({v, (k % 2 ? -1.0 : 1.0) * e[v].normalized(), 2 * pi / 3, true});
+    }
+    cases.push_back({e, xs, 0});
+    cases.push_back({e, xs, 8});
+  }
+  {
+    Polyline2 loop;
+    const int n = 2000;
+    for (int k = 0; k < n; ++k) {
+      const double t = 2 * pi * k / n;
+      const double rr = 0.3 + 0.04 * std::cos(5 * t) + 0.02 * std::sin(3 * t);
+      loop.emplace_back(rr * std::cos(t), rr * std::sin(t));
+    }
+    std::vector<TargetCrossing> xs;
+    for (int k = 0; k < 10; ++k) {
+      const int v = k * n / 10 + 7;
+      xs.push_back({v, (k % 2 ? 1.0 : -1.0) * loop[v].normalized(), 2 * pi / 3, true});
+    }
+    cases.push_back({loop, xs, 8});
+  }
+  for (const Case& cs : cases) {
+    TargetShapeOptions o;
+    o.window = cs.window;
+    o.sweep_ftol = 1e-3;  // as the pipeline solves
+    const TargetShapeResult a = optimize_target_shape(cs.contour, true, cs.xs, o);
+    o.algorithm = TargetShapeAlgorithm::sqp;
+    const TargetShapeResult b = optimize_target_shape(cs.contour, true, cs.xs, o);
+    same_optimum(a, b);
+    CHECK(b.energy == Approx(a.energy).epsilon(1e-3));
+    for (const auto& s : b.crossings) CHECK(s.status == "ok");
+    CHECK(b.max_length_violation <= 1e-6);
+    CHECK(b.max_angle_violation <= 1e-6);
+    // The SQP solved the blocks itself (a broken one would leave them all to SLSQP, which would
+    // pass the checks above), and in fewer evaluations.
+    CHECK(b.sqp_blocks > 0);
+    CHECK(b.sqp_fallbacks * 4 <= b.sqp_blocks);
+    CHECK(b.iterations < a.iterations);
+    CHECK(b.nlopt_result == "SQP_CONVERGED");
+    CHECK(a.sqp_blocks == 0);
+  }
+}
+
+TEST_CASE("sqp: a kink that cannot be opened is left to SLSQP and reported as before", "[target][sqp]") {
+  // Crossings 31 mm apart on a straight wire leave one free point between them; crossing 0 wants
+  // it above the wire, crossing 1 below: the linearised constraints contradict each other.
+  Polyline2 contour;
+  for (int k = 0; k <= 300; ++k) contour.emplace_back(0.3 * k / 300.0, 0.0);
+  const std::vector<TargetCrossing> xs{{100, Vec2(0, 1), 2 * pi / 3, true}, {131, Vec2(0, -1), 2 * pi / 3, true}};
+  TargetShapeOptions o;
+  const TargetShapeResult a = optimize_target_shape(contour, false, xs, o);
+  o.algorithm = TargetShapeAlgorithm::sqp;
+  const TargetShapeResult b = optimize_target_shape(contour, false, xs, o);
+  CHECK(b.sqp_fallbacks >= 1);
+  REQUIRE(b.crossings.size() == 2);
+  for (std::size_t c = 0; c < 2; ++c) CHECK(b.crossings[c].status == a.crossings[c].status);
+  CHECK((a.crossings[0].status != "ok" || a.crossings[1].status != "ok"));
+  CHECK(largest_move(a, b) < 1e-4);
+}
+
+TEST_CASE("sqp: the progress callback can cancel it", "[target][sqp]") {
+  TargetShapeOptions o;
+  o.algorithm = TargetShapeAlgorithm::sqp;
+  const Polyline2 e = ellipse(0.15, 0.09, 1200);
+  const ProgressFn stop_later = [n = 0](std::string_view, double) mutable { return ++n < 3; };
+  CHECK_THROWS_AS(optimize_target_shape(e, true, {{37, e[37].normalized(), 2 * pi / 3, true}}, o, stop_later),
+                  Cancelled);
+}
