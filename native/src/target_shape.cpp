@@ -929,6 +929,8 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
           opt.optimize(xp, fp);
         } catch (const std::bad_alloc&) {
           throw;
+        } catch (const std::invalid_argument& e) {
+          throw SolverError("target shape of wire " + w + ": NLopt rejected the problem (" + e.what() + ")");
         } catch (const std::exception&) {  // NLopt's stops (roundoff, failure): the point it reached
         }
         if (data.cancelled) throw Cancelled();
@@ -949,6 +951,9 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
           if (!data.count_evaluation()) throw Cancelled();
         };
         const detail::SqpOutcome so = detail::sqp_block(problem, {&b.points, &b.terms, &b.constraints}, start, ss);
+        // The fallback gets what is left of the call's budgets after the lead-in and the SQP.
+        opt.set_maxeval(std::max(1, o.max_iterations - data.evaluations));
+        opt.set_maxtime(std::max(1e-3, o.max_seconds - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
         if (so.converged) {
           for (std::size_t k = 0; k < b.points.size(); ++k) {
             x[2 * k] = start[b.points[k]].x() / data.scale_x;

@@ -40,6 +40,7 @@ class ActiveBasis {
   }
   // Solves R r = w (the coefficients of v's projection in the columns of Ñ).
   Eigen::VectorXd coefficients(const Eigen::VectorXd& w) const {
+    if (k_ == 0) return Eigen::VectorXd(0);
     return R_.topLeftCorner(k_, k_).triangularView<Eigen::Upper>().solve(w);
   }
   void add(const Eigen::VectorXd& q, const Eigen::VectorXd& w) {
@@ -64,7 +65,8 @@ bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::Vector
   const auto L = llt.matrixL();
   // In Goldfarb-Idnani's form the constraints are n_kᵀ d >= b_k with n_k = -a_k, b_k = c_k;
   // ñ_k = L⁻¹ n_k, so that W⁻¹ = L⁻ᵀ L⁻¹ turns every projection into a Euclidean one.
-  const Eigen::MatrixXd Nt = L.solve(-A.transpose());  // n × m, columns ñ_k
+  Eigen::MatrixXd Nt(n, m);  // n × m, columns ñ_k (Eigen's triangular solve must not see an empty right side)
+  if (m > 0) Nt = L.solve(-A.transpose());
   d = -llt.solve(g);
   lambda = Eigen::VectorXd::Zero(m);
   std::vector<Eigen::Index> active;
@@ -102,7 +104,7 @@ bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::Vector
         if (r[j] > 0.0 && u[static_cast<std::size_t>(j)] / r[j] < t1) t1 = u[static_cast<std::size_t>(j)] / r[j], drop = j;
       // Primal step length: to make constraint p hold.
       const double sp = -(A.row(p).dot(d) + c[p]);
-      const bool dependent = zn <= 1e-14 * std::max(1.0, Nt.col(p).squaredNorm());
+      const bool dependent = na == n || zn <= 1e-14 * std::max(1.0, Nt.col(p).squaredNorm());
       const double t2 = dependent ? std::numeric_limits<double>::infinity() : -sp / zn;
       const double t = std::min(t1, t2);
       if (!std::isfinite(t)) return false;  // the constraints are inconsistent
@@ -133,6 +135,7 @@ bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::Vector
 
 bool solve_convex_qp(const Eigen::MatrixXd& W, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,
                      const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, double tol) {
+  if (W.rows() == 0 || !W.allFinite()) return false;
   const Eigen::LLT<Eigen::MatrixXd> llt(W);
   if (llt.info() != Eigen::Success) return false;
   return solve_convex_qp(llt, g, A, c, d, lambda, tol);
@@ -224,12 +227,13 @@ class BlockModel {
     for (int i : *b_.terms) {
       Vec2 dD;
       const double D = pr_.imls(p[i], &dD);
-      Mat2 HD;
-      for (int r = 0; r < 2; ++r) {  // forward differences: the error O(step) is far below what Newton needs
+      Mat2 HD = Mat2::Zero();  // only the (i, i) block needs it
+      for (int r = 0; r < 2 && var_[i] >= 0; ++r) {  // forward differences: O(step) is far below what Newton needs
         Vec2 gp, q = p[i];
-        q[r] += step;
+        q[r] += std::max(step, 1e-12 * std::abs(q[r]));
+        const double taken = q[r] - p[i][r];  // the step the coordinate really took
         pr_.imls(q, &gp);
-        HD.col(r) = (gp - dD) / step;
+        HD.col(r) = (gp - dD) / taken;
       }
       HD = (0.5 * (HD + HD.transpose())).eval();
       double w = 0.0;
@@ -328,6 +332,21 @@ double infeasibility(const Eigen::VectorXd& c) { return c.cwiseMax(0.0).sum(); }
 
 }  // namespace
 
+Eigen::MatrixXd sqp_lagrangian_hessian(const TargetShapeProblem& problem, const SqpBlock& block,
+                                       const SqpSettings& settings, const Polyline2& p, const Eigen::VectorXd& lambda) {
+  BlockModel model(problem, block, settings, p);
+  return model.hessian(p, lambda);
+}
+
+Eigen::VectorXd sqp_lagrangian_gradient(const TargetShapeProblem& problem, const SqpBlock& block,
+                                        const SqpSettings& settings, const Polyline2& p, const Eigen::VectorXd& lambda) {
+  BlockModel model(problem, block, settings, p);
+  Eigen::VectorXd g, c;
+  Eigen::MatrixXd A;
+  model.evaluate(p, &g, c, &A);
+  return g + A.transpose() * lambda;
+}
+
 namespace {
 
 // Adds ρ a_k a_kᵀ for every constraint with λ_k > 0, then δI, until W is positive definite;
@@ -389,20 +408,31 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
     // ½ρ (a_k·d)² for each of them (k with λ_k > 0) is constant along a constraint the QP keeps
     // active (a_k·d = -c_k there), so it changes no such solution, and adds ρ a_k a_kᵀ. What is left
     // (far from the contour) gets δI.
+    // Eigen's Cholesky accepts NaN, so anything not finite ends here (SLSQP decides).
+    if (!std::isfinite(f) || !g.allFinite() || !c.allFinite() || !A.allFinite()) return out;
     Eigen::MatrixXd W = model.hessian(p, lambda);
-    if (!convexify(W, A, lambda, factor)) return out;
+    if (!W.allFinite() || !convexify(W, A, lambda, factor)) return out;
     // Inconsistent linearised constraints (a kink that cannot be opened from here): the caller's
     // SLSQP decides, as it always did.
     if (!solve_convex_qp(factor, g, A, c, d, mu)) return out;
+    // At a KKT point the QP's own step vanishes: converged when it is below step_tol at a feasible
+    // point (its line search could not tell so small a step from rounding).
+    if (violation(c) <= settings.constraint_tol && d.lpNorm<Eigen::Infinity>() <= settings.step_tol) {
+      out.converged = true;
+      break;
+    }
     nu = std::max(nu, 1.5 * (mu.size() ? mu.maxCoeff() : 0.0) + 1e-12);
     auto merit = [&](double fv, const Eigen::VectorXd& cv) { return fv + nu * infeasibility(cv); };
     const double phi0 = merit(f, c);
     const double slope = g.dot(d) - nu * infeasibility(c);
-    // Near the solution the step can be so small that rounding leaves its merit slope >= 0: take
-    // it as it is when it raises neither the violation nor the energy (the last step of a
-    // converging iteration).
-    const bool polish = !(slope < 0.0) && d.lpNorm<Eigen::Infinity>() <= 1e-5;
-    if (!(slope < 0.0) && !polish) return out;
+    // Feasible, and the QP predicts a decrease of at most ftol_rel of f (SLSQP's own test on the
+    // energy): nothing is left to gain, and a line search could not tell such a step from
+    // rounding.
+    if (violation(c) <= settings.constraint_tol && -slope <= settings.ftol_rel * std::abs(f)) {
+      out.converged = true;
+      break;
+    }
+    if (!(slope < 0.0)) return out;
     double alpha = 1.0;
     bool accepted = false;
     Eigen::VectorXd xt;
@@ -412,13 +442,10 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
       model.to_points(xt, trial);
       ft = model.evaluate(trial, nullptr, ct, nullptr);
       counted();
-      if (std::isfinite(ft) && (polish ? violation(ct) <= std::max(violation(c), settings.constraint_tol) &&
-                                             ft <= f + 1e-12 * std::abs(f)
-                                       : merit(ft, ct) <= phi0 + 1e-4 * alpha * slope)) {
+      if (std::isfinite(ft) && merit(ft, ct) <= phi0 + 1e-4 * alpha * slope) {
         accepted = true;
         break;
       }
-      if (polish) return out;
       if (ls == 0 && mc > 0) {
         // Second-order correction (the full step raised the violation of curved active
         // constraints, the Maratos effect): the same QP with the constraints' values at the trial
@@ -447,11 +474,12 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
     f = model.evaluate(p, &g, c, &A);
     counted();
     lambda = mu;
-    // Converged: feasible, and the step was negligible or a full step changed f by at most
-    // ftol_rel of it (SLSQP's own test).
+    // Converged: feasible after a full step (only the QP's own step, or its correction, measures
+    // how far x is from a KKT point; one that backtracking shrank to nothing does not) that was
+    // negligible or changed f by at most ftol_rel of it (SLSQP's own test).
     const bool feasible = violation(c) <= settings.constraint_tol;
-    if (feasible && (step <= settings.step_tol ||
-                     (alpha == 1.0 && std::abs(f_old - f) <= settings.ftol_rel * std::abs(f)))) {
+    if (feasible && alpha == 1.0 &&
+        (step <= settings.step_tol || std::abs(f_old - f) <= settings.ftol_rel * std::abs(f))) {
       out.converged = true;
       break;
     }

@@ -1,11 +1,12 @@
 #pragma once
 // A Newton SQP for one block of the target-shape problem (TargetShapeAlgorithm::sqp; see
-// docs/method-target-shape.md): the Hessian of the Lagrangian (analytic but for central
-// differences of the IMLS gradient and of the bend and contact gradients), a dense convex QP per
-// step solved by the dual active-set method of Goldfarb and Idnani, an ℓ1 merit line search.
-// It reports failure, rather than guessing, where the linearised constraints are inconsistent
-// (a kink that cannot be opened) or the line search stalls: the caller then solves the block
-// with SLSQP from the same start.
+// docs/method-target-shape.md): the Hessian of the Lagrangian (analytic but for forward
+// differences of the IMLS gradient and central ones of the bend and contact gradients), a dense
+// convex QP per step solved by the dual active-set method of Goldfarb and Idnani, an ℓ1 merit line
+// search with a second-order correction. It reports failure, rather than guessing, where the
+// linearised constraints are inconsistent (a kink that cannot be opened), the Lagrangian cannot be
+// convexified, a step is no descent, the line search stalls, a value is not finite, or 60
+// iterations do not converge: the caller then solves the block with SLSQP from the block's start.
 
 #include <functional>
 #include <vector>
@@ -46,9 +47,18 @@ struct SqpOutcome {
 SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, Polyline2& p,
                      const SqpSettings& settings);
 
+/// The Hessian of f + Σ λ_k c_k over the block's variables (scaled as the solver sees them: p =
+/// scale_x x, f = E / scale_f) at p, before convexification, and that function's gradient: what
+/// sqp_block steps with, exposed for its tests.
+Eigen::MatrixXd sqp_lagrangian_hessian(const TargetShapeProblem& problem, const SqpBlock& block,
+                                       const SqpSettings& settings, const Polyline2& p, const Eigen::VectorXd& lambda);
+Eigen::VectorXd sqp_lagrangian_gradient(const TargetShapeProblem& problem, const SqpBlock& block,
+                                        const SqpSettings& settings, const Polyline2& p, const Eigen::VectorXd& lambda);
+
 /// Minimises ½ dᵀ W d + gᵀ d subject to A d + c <= 0 (rows of A as a dense matrix), W symmetric
 /// positive definite: the dual active-set method of Goldfarb and Idnani (1983). Returns false when
-/// the constraints are inconsistent. `lambda` gets the multipliers (>= 0). Exposed for its tests.
+/// the constraints are inconsistent (or, never seen, its step budget runs out). `lambda` gets the
+/// multipliers (>= 0). Exposed for its tests.
 bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& W_factor, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,
                      const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, double tol = 1e-12);
 bool solve_convex_qp(const Eigen::MatrixXd& W, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,

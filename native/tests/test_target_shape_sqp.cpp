@@ -217,3 +217,119 @@ TEST_CASE("sqp: the progress callback can cancel it", "[target][sqp]") {
   CHECK_THROWS_AS(optimize_target_shape(e, true, {{37, e[37].normalized(), 2 * pi / 3, true}}, o, stop_later),
                   Cancelled);
 }
+
+namespace {
+// The block of free points in [from, to) of `problem`: its energy terms and constraints found here
+// from their definitions (a term i reads i-1, i, i+1; a constraint the points of its kind).
+struct TestBlock {
+  std::vector<int> points, terms, constraints;
+};
+
+TestBlock block_of(const TargetShapeProblem& problem, int from, int to) {
+  const int m = static_cast<int>(problem.initial().size());
+  const bool closed = problem.closed();
+  TestBlock b;
+  std::vector<char> in(m, 0);
+  for (int j = from; j < to; ++j) {  // around the end of a closed wire, [from, to) wraps
+    const int i = closed ? (j + m) % m : j;
+    if (i >= 0 && i < m && !problem.fixed()[i] && !in[i]) b.points.push_back(i), in[i] = 1;
+  }
+  auto wrap = [&](int j) { return closed ? (j + m) % m : j; };
+  auto inside = [&](int j) { return closed || (j >= 0 && j < m); };
+  for (int t = 0; t < m; ++t)
+    for (int s : {-1, 0, 1})
+      if (inside(t + s) && in[wrap(t + s)]) {
+        b.terms.push_back(t);
+        break;
+      }
+  const auto& all = problem.constraints();
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    const auto& c = all[k];
+    std::vector<int> pts;
+    if (c.kind == TargetShapeProblem::Kind::length) pts = {c.vertex, (c.vertex + 1) % m};
+    if (c.kind == TargetShapeProblem::Kind::bend) pts = {(c.vertex + m - 1) % m, c.vertex, (c.vertex + 1) % m};
+    if (c.kind == TargetShapeProblem::Kind::contact) pts = {c.vertex, c.neighbour};
+    for (int q : pts)
+      if (in[q]) {
+        b.constraints.push_back(static_cast<int>(k));
+        break;
+      }
+  }
+  return b;
+}
+}  // namespace
+
+TEST_CASE("sqp: the Hessian of the Lagrangian matches central differences of its gradient", "[target][sqp]") {
+  // An open and a closed wire, each with an active crossing; points moved off the resampling by
+  // up to 4 h (every IMLS regime); multipliers on a length, a bend and a contact constraint.
+  const TargetShapeOptions o;
+  const double lmin = o.min_segment, spacing = 1.5 * lmin;
+  detail::SqpSettings ss;
+  ss.scale_x = lmin;
+  ss.scale_f = 2.0 * spacing * lmin * lmin;
+  ss.min_segment = lmin;
+  ss.regularization = o.regularization;
+  std::mt19937 rng(5);
+  for (const bool closed : {false, true}) {
+    Polyline2 contour;
+    for (int k = 0; k < 600; ++k) {
+      const double t = k / 600.0;
+      contour.emplace_back(closed ? 0.12 * std::cos(2 * pi * t) : 0.4 * t,
+                           closed ? 0.08 * std::sin(2 * pi * t) : 0.03 * std::sin(6 * t));
+    }
+    const std::vector<TargetCrossing> xs{{300, closed ? Vec2(-1, 0) : Vec2(0, 1), 2 * pi / 3, true}};
+    const TargetShapeProblem problem(contour, closed, xs, o);
+    const int v = problem.statuses()[0].vertex;  // in the resampled polyline
+    const TestBlock tb = block_of(problem, v - 4, v + 4);
+    const detail::SqpBlock block{&tb.points, &tb.terms, &tb.constraints};
+    REQUIRE(tb.points.size() >= 6);
+    Eigen::VectorXd lambda = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(tb.constraints.size()));
+    bool kinds[3] = {false, false, false};
+    for (std::size_t k = 0; k < tb.constraints.size(); ++k) {
+      const int kind = static_cast<int>(problem.constraints()[tb.constraints[k]].kind);
+      if (!kinds[kind]) kinds[kind] = true, lambda[static_cast<Eigen::Index>(k)] = 0.3 + 0.2 * kind;
+    }
+    REQUIRE((kinds[0] && kinds[1] && kinds[2]));
+    for (double spread : {0.2, 1.0, 4.0}) {
+      std::uniform_real_distribution<double> u(-spread * problem.kernel_support(), spread * problem.kernel_support());
+      Polyline2 p = problem.initial();
+      for (int i : tb.points) p[i] += Vec2(u(rng), u(rng));
+      const Eigen::MatrixXd H = detail::sqp_lagrangian_hessian(problem, block, ss, p, lambda);
+      const Eigen::Index n = H.rows();
+      REQUIRE(n == static_cast<Eigen::Index>(2 * tb.points.size()));
+      Eigen::MatrixXd fd(n, n);
+      const double h = 1e-6;  // in the solver's units (l_min)
+      for (Eigen::Index j = 0; j < n; ++j) {
+        const int point = tb.points[static_cast<std::size_t>(j / 2)];
+        Polyline2 q = p;
+        q[point][static_cast<int>(j % 2)] += h * lmin;
+        const Eigen::VectorXd gp = detail::sqp_lagrangian_gradient(problem, block, ss, q, lambda);
+        q[point][static_cast<int>(j % 2)] -= 2 * h * lmin;
+        const Eigen::VectorXd gm = detail::sqp_lagrangian_gradient(problem, block, ss, q, lambda);
+        fd.col(j) = (gp - gm) / (2 * h);
+      }
+      CHECK((H - fd).cwiseAbs().maxCoeff() <= 1e-4 * std::max(1.0, fd.cwiseAbs().maxCoeff()));
+    }
+  }
+}
+
+TEST_CASE("sqp: an open wire with crossings reaches SLSQP's optimum", "[target][sqp]") {
+  // An open 1.2 m S-curve with four active crossings, kinks alternately to each side: wire ends
+  // take their own branches in E_d, E_r and the windows.
+  Polyline2 contour;
+  for (int k = 0; k <= 1200; ++k) contour.emplace_back(1.2 * k / 1200.0, 0.06 * std::sin(2 * pi * k / 1200.0 * 1.5));
+  std::vector<TargetCrossing> xs;
+  for (int k = 0; k < 4; ++k) xs.push_back({150 + 300 * k, Vec2(0, k % 2 ? -1.0 : 1.0), 2 * pi / 3, true});
+  for (int window : {0, 8}) {
+    TargetShapeOptions o;
+    o.window = window;
+    o.sweep_ftol = 1e-3;
+    const TargetShapeResult a = optimize_target_shape(contour, false, xs, o);
+    o.algorithm = TargetShapeAlgorithm::sqp;
+    const TargetShapeResult b = optimize_target_shape(contour, false, xs, o);
+    same_optimum(a, b);
+    for (const auto& s : b.crossings) CHECK(s.status == "ok");
+    CHECK(b.sqp_fallbacks * 4 <= b.sqp_blocks);
+    CHECK(b.iterations < a.iterations);
+  }
+}
