@@ -137,8 +137,14 @@ void read_answer(GlpkCall& q) {
   }
 }
 
+// GLPK's simplex has no iteration limit by default, and on a degenerate vertex its primal
+// simplex can cycle for ever (a load capacity LP of the globe's hook search did: the solve, and
+// Blender with it, hung). Far above what any LP here needs (tens to a few thousand iterations).
+int simplex_iteration_limit(int rows, int cols) { return 10000 + 100 * (rows + cols); }
+
 // A new problem holding everything, scaled, solved with presolve (and without it when the
-// presolved solve stopped with an error). Leaves the problem alive in q.p.
+// presolved solve stopped with an error; again with the textbook ratio test when it cycled).
+// Leaves the problem alive in q.p.
 void build_body(void* c) {
   GlpkCall& q = *static_cast<GlpkCall*>(c);
   glp_prob* lp = glp_create_prob();
@@ -157,9 +163,16 @@ void build_body(void* c) {
   glp_init_smcp(&parm);
   parm.msg_lev = GLP_MSG_OFF;
   parm.presolve = GLP_ON;
+  parm.it_lim = simplex_iteration_limit(q.rows, q.cols);
   int ret = glp_simplex(lp, &parm);
   if (ret != 0 && ret != GLP_ENOPFS && ret != GLP_ENODFS) {  // retry without presolve
     parm.presolve = GLP_OFF;
+    glp_adv_basis(lp, 0);
+    ret = glp_simplex(lp, &parm);
+  }
+  if (ret == GLP_EITLIM) {  // cycling on a degenerate vertex: again with the textbook ratio test, dual
+    parm.r_test = GLP_RT_STD;
+    parm.meth = GLP_DUALP;
     glp_adv_basis(lp, 0);
     ret = glp_simplex(lp, &parm);
   }
@@ -211,7 +224,14 @@ void extend_body(void* c) {
   parm.msg_lev = GLP_MSG_OFF;
   parm.presolve = GLP_OFF;
   parm.meth = q.set_objective ? GLP_PRIMAL : GLP_DUALP;
+  parm.it_lim = simplex_iteration_limit(glp_get_num_rows(lp), glp_get_num_cols(lp));
   q.ret = glp_simplex(lp, &parm);
+  if (q.ret == GLP_EITLIM) {  // cycling: again from a fresh basis with the textbook ratio test
+    parm.r_test = GLP_RT_STD;
+    parm.meth = GLP_DUALP;
+    glp_adv_basis(lp, 0);
+    q.ret = glp_simplex(lp, &parm);
+  }
   q.iterations = glp_get_it_cnt(lp) - before;
   read_answer(q);
 }
@@ -562,6 +582,7 @@ EqualityLp::EqualityLp(int rows, int cols, const std::vector<int>& tri_row, cons
   s_->parm.pricing = GLP_PT_STD;  // textbook pricing: these LPs are small, steepest edge does not pay
   s_->parm.meth = GLP_DUALP;  // costs >= 0: the slack basis and every optimal basis stay dual feasible
                               // when the right-hand side changes
+  s_->parm.it_lim = simplex_iteration_limit(rows, cols);  // cycling ends as a failed solve, not a hang
   EqualityBuild q{rows, cols, static_cast<int>(ar.size()) - 1, ia.data(), ja.data(), ar.data(), cost.data(), nullptr};
   const unsigned generation = glpk_generation();
   if (run_guarded(equality_build_body, &q)) {
