@@ -142,6 +142,16 @@ void read_answer(GlpkCall& q) {
 // Blender with it, hung). Far above what any LP here needs (tens to a few thousand iterations).
 int simplex_iteration_limit(int rows, int cols) { return 10000 + 100 * (rows + cols); }
 
+// `ret` of a simplex run with that limit; when it was reached (cycling on a degenerate vertex), the
+// code of a run again from a fresh basis with the textbook ratio test and the dual simplex.
+int after_cycling(glp_prob* lp, glp_smcp& parm, int ret) {
+  if (ret != GLP_EITLIM) return ret;
+  parm.r_test = GLP_RT_STD;
+  parm.meth = GLP_DUALP;
+  glp_adv_basis(lp, 0);
+  return glp_simplex(lp, &parm);
+}
+
 // A new problem holding everything, scaled, solved with presolve (and without it when the
 // presolved solve stopped with an error; again with the textbook ratio test when it cycled).
 // Leaves the problem alive in q.p.
@@ -170,13 +180,7 @@ void build_body(void* c) {
     glp_adv_basis(lp, 0);
     ret = glp_simplex(lp, &parm);
   }
-  if (ret == GLP_EITLIM) {  // cycling on a degenerate vertex: again with the textbook ratio test, dual
-    parm.r_test = GLP_RT_STD;
-    parm.meth = GLP_DUALP;
-    glp_adv_basis(lp, 0);
-    ret = glp_simplex(lp, &parm);
-  }
-  q.ret = ret;
+  q.ret = after_cycling(lp, parm, ret);
   q.iterations = glp_get_it_cnt(lp);
   read_answer(q);
 }
@@ -225,13 +229,7 @@ void extend_body(void* c) {
   parm.presolve = GLP_OFF;
   parm.meth = q.set_objective ? GLP_PRIMAL : GLP_DUALP;
   parm.it_lim = simplex_iteration_limit(glp_get_num_rows(lp), glp_get_num_cols(lp));
-  q.ret = glp_simplex(lp, &parm);
-  if (q.ret == GLP_EITLIM) {  // cycling: again from a fresh basis with the textbook ratio test
-    parm.r_test = GLP_RT_STD;
-    parm.meth = GLP_DUALP;
-    glp_adv_basis(lp, 0);
-    q.ret = glp_simplex(lp, &parm);
-  }
+  q.ret = after_cycling(lp, parm, glp_simplex(lp, &parm));
   q.iterations = glp_get_it_cnt(lp) - before;
   read_answer(q);
 }

@@ -666,14 +666,7 @@ struct SolverData {
   }
 };
 
-std::array<int, 3> constraint_points(const TargetShapeProblem::Constraint& c, int np) {
-  switch (c.kind) {
-    case TargetShapeProblem::Kind::length: return {c.vertex, (c.vertex + 1) % np, -1};
-    case TargetShapeProblem::Kind::bend: return {(c.vertex + np - 1) % np, c.vertex, (c.vertex + 1) % np};
-    case TargetShapeProblem::Kind::contact: return {c.vertex, c.neighbour, -1};
-  }
-  return {-1, -1, -1};
-}
+using detail::constraint_points;
 
 // The progress callback is polled at the first evaluation and then every this many: a Python
 // callback takes the GIL, and polled at every evaluation (20-100 µs each) it serialised the wires

@@ -12,6 +12,15 @@
 
 namespace wiresculpt::detail {
 
+std::array<int, 3> constraint_points(const TargetShapeProblem::Constraint& c, int np) {
+  switch (c.kind) {
+    case TargetShapeProblem::Kind::length: return {c.vertex, (c.vertex + 1) % np, -1};
+    case TargetShapeProblem::Kind::bend: return {(c.vertex + np - 1) % np, c.vertex, (c.vertex + 1) % np};
+    case TargetShapeProblem::Kind::contact: return {c.vertex, c.neighbour, -1};
+  }
+  return {-1, -1, -1};
+}
+
 // ---------------------------------------------------------------------------------------------
 // The QP: Goldfarb and Idnani's dual method ("A numerically stable dual method for solving
 // strictly convex quadratic programs", Math. Programming 27, 1983), written for small dense
@@ -145,16 +154,6 @@ namespace {
 
 using Mat2 = Eigen::Matrix2d;
 
-std::array<int, 3> points_of(const TargetShapeProblem::Constraint& c, int m) {
-  using Kind = TargetShapeProblem::Kind;
-  switch (c.kind) {
-    case Kind::length: return {c.vertex, (c.vertex + 1) % m, -1};
-    case Kind::bend: return {(c.vertex + m - 1) % m, c.vertex, (c.vertex + 1) % m};
-    case Kind::contact: return {c.vertex, c.neighbour, -1};
-  }
-  return {-1, -1, -1};
-}
-
 class BlockModel {
  public:
   BlockModel(const TargetShapeProblem& problem, const SqpBlock& block, const SqpSettings& s, const Polyline2& p)
@@ -200,7 +199,7 @@ class BlockModel {
         c[k] = pr_.constraint(ck, p);
         continue;
       }
-      const auto pts = points_of(all[ck], m_);
+      const auto pts = constraint_points(all[ck], m_);
       for (int q : pts)
         if (q >= 0) scratch_[q] = Vec2::Zero();
       c[k] = pr_.constraint(ck, p, &scratch_);
@@ -276,7 +275,7 @@ class BlockModel {
       const double l = lambda[k];
       if (!(l > 0.0)) continue;
       const int ck = (*b_.constraints)[k];
-      const auto pts = points_of(all[ck], m_);
+      const auto pts = constraint_points(all[ck], m_);
       if (all[ck].kind == TargetShapeProblem::Kind::length) {
         const Mat2 B = (-2.0 / lmin2) * Mat2::Identity();
         add(pts[0], pts[0], B, l * cs);

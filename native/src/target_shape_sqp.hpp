@@ -8,6 +8,7 @@
 // convexified, a step is no descent, the line search stalls, a value is not finite, or 60
 // iterations do not converge: the caller then solves the block with SLSQP from the block's start.
 
+#include <array>
 #include <functional>
 #include <vector>
 
@@ -41,6 +42,10 @@ struct SqpOutcome {
   int evaluations = 0;  ///< energy + constraint evaluations (gradients included)
   int iterations = 0;
 };
+
+/// The points constraint `c` of a wire of `np` points reads (-1: none): the edge's two ends
+/// (length), the vertex and its neighbours (bend), the crossing and its neighbour (contact).
+std::array<int, 3> constraint_points(const TargetShapeProblem::Constraint& c, int np);
 
 /// Solves the block from `p` (the whole wire's points; only the block's points change). On
 /// success `p` holds the solution; on failure `p` is left as it was.
