@@ -31,38 +31,49 @@ namespace {
 
 // The active constraints' whitened normals ñ_j (columns of Ñ) as Ñ = U R, U with orthonormal
 // columns (modified Gram-Schmidt, twice), R upper triangular: adding a column costs O(n |S|);
-// dropping one rebuilds the factorisation of the rest.
+// dropping one rebuilds the factorisation of the rest. Its buffers are allocated once per QP.
 class ActiveBasis {
  public:
-  explicit ActiveBasis(Eigen::Index n) : U_(n, n), R_(n, n) {}
+  explicit ActiveBasis(Eigen::Index n) : U_(n, n), R_(n, n), w_(n), r_(n), q_(n) {}
   Eigen::Index size() const { return k_; }
-  // The part of v orthogonal to the basis (q) and its coefficients in it (w = Uᵀ v).
-  void project(const Eigen::VectorXd& v, Eigen::VectorXd& q, Eigen::VectorXd& w) const {
+  // The part of v orthogonal to the basis (q) and its coefficients in it (w() = Uᵀ v).
+  template <typename V>
+  void project(const V& v, Eigen::VectorXd& q) {
     q = v;
-    w = Eigen::VectorXd::Zero(k_);
+    w_.head(k_).setZero();
     for (int pass = 0; pass < 2; ++pass)
       for (Eigen::Index j = 0; j < k_; ++j) {
         const double a = U_.col(j).dot(q);
         q -= a * U_.col(j);
-        w[j] += a;
+        w_[j] += a;
       }
   }
-  // Solves R r = w (the coefficients of v's projection in the columns of Ñ).
-  Eigen::VectorXd coefficients(const Eigen::VectorXd& w) const {
-    if (k_ == 0) return Eigen::VectorXd(0);
-    return R_.topLeftCorner(k_, k_).triangularView<Eigen::Upper>().solve(w);
+  // Solves R r = w() (the coefficients of the projected vector in the columns of Ñ).
+  const Eigen::VectorXd& coefficients() {
+    r_.head(k_) = w_.head(k_);
+    if (k_ > 0) R_.topLeftCorner(k_, k_).triangularView<Eigen::Upper>().solveInPlace(r_.head(k_));
+    return r_;
   }
-  void add(const Eigen::VectorXd& q, const Eigen::VectorXd& w) {
+  // Adds the vector last projected (q its orthogonal part).
+  void add(const Eigen::VectorXd& q) {
     const double nq = q.norm();
     U_.col(k_) = q / nq;
-    R_.col(k_).head(k_) = w;
+    R_.col(k_).head(k_) = w_.head(k_);
     R_(k_, k_) = nq;
     ++k_;
   }
-  void clear() { k_ = 0; }
+  // Rebuilds the basis from the given columns of Ñ, in order.
+  void rebuild(const Eigen::MatrixXd& Nt, const std::vector<Eigen::Index>& columns) {
+    k_ = 0;
+    for (Eigen::Index j : columns) {
+      project(Nt.col(j), q_);
+      add(q_);
+    }
+  }
 
  private:
   Eigen::MatrixXd U_, R_;
+  Eigen::VectorXd w_, r_, q_;
   Eigen::Index k_ = 0;
 };
 
@@ -72,17 +83,24 @@ bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::Vector
                      const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, double tol) {
   const Eigen::Index n = g.size(), m = A.rows();
   const auto L = llt.matrixL();
+  const auto U = llt.matrixU();
   // In Goldfarb-Idnani's form the constraints are n_kᵀ d >= b_k with n_k = -a_k, b_k = c_k;
   // ñ_k = L⁻¹ n_k, so that W⁻¹ = L⁻ᵀ L⁻¹ turns every projection into a Euclidean one.
-  Eigen::MatrixXd Nt(n, m);  // n × m, columns ñ_k (Eigen's triangular solve must not see an empty right side)
-  if (m > 0) Nt = L.solve(-A.transpose());
-  d = -llt.solve(g);
+  // A's rows as contiguous columns, for the scans below; ñ_k (columns of Nt) is computed the
+  // first time constraint k enters.
+  const Eigen::MatrixXd At = A.transpose();
+  Eigen::MatrixXd Nt(n, m);
+  std::vector<char> whitened(static_cast<std::size_t>(m), 0);
+  d = -g;
+  llt.solveInPlace(d);
   lambda = Eigen::VectorXd::Zero(m);
   std::vector<Eigen::Index> active;
+  active.reserve(static_cast<std::size_t>(n));
   std::vector<double> u;  // multipliers of `active`
+  u.reserve(static_cast<std::size_t>(n));
   std::vector<char> in(static_cast<std::size_t>(m), 0);
   ActiveBasis basis(n);
-  Eigen::VectorXd q(n), w, z(n);
+  Eigen::VectorXd q(n), z(n);
   const double scale = 1.0 + g.cwiseAbs().maxCoeff();
   const int max_steps = static_cast<int>(10 * (n + m) + 10);
   int step = 0;
@@ -92,27 +110,33 @@ bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::Vector
     double worst = -tol * scale;
     for (Eigen::Index k = 0; k < m; ++k) {
       if (in[static_cast<std::size_t>(k)]) continue;
-      const double s = -(A.row(k).dot(d) + c[k]);
+      const double s = -(At.col(k).dot(d) + c[k]);
       if (s < worst) worst = s, p = k;
     }
     if (p < 0) {
       for (std::size_t j = 0; j < active.size(); ++j) lambda[active[j]] = u[j];
       return true;
     }
+    if (!whitened[static_cast<std::size_t>(p)]) {
+      Nt.col(p) = -At.col(p);
+      L.solveInPlace(Nt.col(p));
+      whitened[static_cast<std::size_t>(p)] = 1;
+    }
     double up = 0.0;
     for (; step < max_steps; ++step) {
       const Eigen::Index na = static_cast<Eigen::Index>(active.size());
-      basis.project(Nt.col(p), q, w);
-      const Eigen::VectorXd r = basis.coefficients(w);
+      basis.project(Nt.col(p), q);
+      const Eigen::VectorXd& r = basis.coefficients();
       const double zn = q.squaredNorm();
-      z = L.transpose().solve(q);
+      z = q;
+      U.solveInPlace(z);
       // Dual step length: the first active multiplier to reach zero.
       double t1 = std::numeric_limits<double>::infinity();
       Eigen::Index drop = -1;
       for (Eigen::Index j = 0; j < na; ++j)
         if (r[j] > 0.0 && u[static_cast<std::size_t>(j)] / r[j] < t1) t1 = u[static_cast<std::size_t>(j)] / r[j], drop = j;
       // Primal step length: to make constraint p hold.
-      const double sp = -(A.row(p).dot(d) + c[p]);
+      const double sp = -(At.col(p).dot(d) + c[p]);
       const bool dependent = na == n || zn <= 1e-14 * std::max(1.0, Nt.col(p).squaredNorm());
       const double t2 = dependent ? std::numeric_limits<double>::infinity() : -sp / zn;
       const double t = std::min(t1, t2);
@@ -124,19 +148,14 @@ bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::Vector
         active.push_back(p);
         u.push_back(up);
         in[static_cast<std::size_t>(p)] = 1;
-        basis.add(q, w);
+        basis.add(q);
         ++step;
         break;
       }
       in[static_cast<std::size_t>(active[static_cast<std::size_t>(drop)])] = 0;
       active.erase(active.begin() + drop);
       u.erase(u.begin() + drop);
-      basis.clear();
-      for (Eigen::Index j : active) {
-        Eigen::VectorXd qj(n), wj;
-        basis.project(Nt.col(j), qj, wj);
-        basis.add(qj, wj);
-      }
+      basis.rebuild(Nt, active);
     }
   }
   return false;
@@ -346,12 +365,20 @@ Eigen::VectorXd sqp_lagrangian_gradient(const TargetShapeProblem& problem, const
   return g + A.transpose() * lambda;
 }
 
-namespace {
 
 // Adds ρ a_k a_kᵀ for every constraint with λ_k > 0, then δI, until W is positive definite;
 // `factor` gets its Cholesky factor. False when it cannot be made so (not finite).
+//
+// The shifts tried form one sequence, in this order: none; ρ = 4^k d_max for k = 0..10 (d_max the
+// largest diagonal entry; only when some λ_k > 0); then, with ρ at its last value, δ = 4^j 1e-8 d_max
+// for j = 0, 1, ...: 61 shifts at most, and the first that makes W positive definite is taken. Each
+// shift adds a positive semidefinite matrix to the one before, so once one succeeds all later ones
+// do: the first is found by a search from where the block's previous iteration ended (`guess`)
+// instead of one factorisation per shift (the δ of a window far from its contour took 12 of them at
+// every iteration). The shift taken is the same.
 bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::VectorXd& lambda,
-               Eigen::LLT<Eigen::MatrixXd>& factor) {
+               Eigen::LLT<Eigen::MatrixXd>& factor, std::array<int, 2>& guess) {
+  constexpr int kShifts = 61;
   const Eigen::Index n = W.rows();
   Eigen::MatrixXd AtA = Eigen::MatrixXd::Zero(n, n);
   bool any = false;
@@ -361,24 +388,62 @@ bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::Vector
       any = true;
     }
   const double dmax = std::max(1e-12, W.diagonal().cwiseAbs().maxCoeff());
-  double rho = 0.0, delta = 0.0;
-  for (int tries = 0; tries <= 60; ++tries) {
-    Eigen::MatrixXd Wd = W + rho * AtA;
-    Wd.diagonal().array() += delta;
-    factor.compute(Wd);
-    if (factor.info() == Eigen::Success) {
-      W = std::move(Wd);
-      return true;
+  auto shift = [&](int i) -> std::pair<double, double> {  // (ρ, δ) of shift i; ×4 is exact in binary
+    if (i == 0) return {0.0, 0.0};
+    if (any) {
+      if (i <= 11) return {std::ldexp(dmax, 2 * (i - 1)), 0.0};
+      return {std::ldexp(dmax, 20), std::ldexp(1e-8 * dmax, 2 * (i - 12))};
     }
-    if (any && rho < 1e6 * dmax)
-      rho = rho > 0.0 ? 4.0 * rho : dmax;
-    else
-      delta = delta > 0.0 ? 4.0 * delta : 1e-8 * dmax;
+    return {0.0, std::ldexp(1e-8 * dmax, 2 * (i - 1))};
+  };
+  Eigen::MatrixXd Wd(n, n);
+  std::array<signed char, kShifts> known{};  // 0 untried, 1 positive definite, -1 not
+  int factored = -1;                          // the shift `factor` holds
+  auto definite = [&](int i) {
+    if (known[i] == 0) {
+      const auto [rho, delta] = shift(i);
+      Wd = W;
+      if (rho > 0.0) Wd += rho * AtA;
+      Wd.diagonal().array() += delta;
+        factor.compute(Wd);
+      factored = i;
+      known[i] = factor.info() == Eigen::Success && Wd.allFinite() ? 1 : -1;
+    }
+    return known[i] > 0;
+  };
+  int& start = guess[any ? 0 : 1];
+  int lo = 0, hi = kShifts;  // the first definite shift lies in [lo, hi] (hi: none)
+  const int g = std::clamp(start, 0, kShifts - 1);
+  if (definite(g)) {
+    hi = g;
+    for (int step = 1; lo < hi; step *= 2) {  // gallop down
+      const int i = std::max(lo, hi - step);
+      if (definite(i)) hi = i;
+      else { lo = i + 1; break; }
+    }
+  } else {
+    lo = g + 1;
+    for (int step = 1; lo < hi; step *= 2) {  // gallop up
+      const int i = std::min(kShifts - 1, lo + step - 1);
+      if (definite(i)) { hi = i; break; }
+      lo = i + 1;
+    }
   }
-  return false;
+  while (lo < hi) {  // binary search
+    const int mid = lo + (hi - lo) / 2;
+    if (definite(mid)) hi = mid;
+    else lo = mid + 1;
+  }
+  if (hi >= kShifts) return false;
+  if (factored != hi) {
+    known[hi] = 0;
+    if (!definite(hi)) return false;
+  }
+  start = hi;
+  W.swap(Wd);
+  return true;
 }
 
-}  // namespace
 
 SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, Polyline2& p_io,
                      const SqpSettings& settings) {
@@ -400,6 +465,8 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
   counted();
   double nu = 1.0;  // ℓ1 penalty of the merit function f + ν Σ max(0, c_k)
   Eigen::LLT<Eigen::MatrixXd> factor(n);
+  std::array<int, 2> own_guess{0, 0};
+  std::array<int, 2>& shift = settings.shift_guess ? *settings.shift_guess : own_guess;
   for (int it = 0; it < settings.max_iterations; ++it) {
     out.iterations = it + 1;
     // Convexify. The curvature of the contact and bend constraints, weighted by their multipliers,
@@ -410,7 +477,7 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
     // Eigen's Cholesky accepts NaN, so anything not finite ends here (SLSQP decides).
     if (!std::isfinite(f) || !g.allFinite() || !c.allFinite() || !A.allFinite()) return out;
     Eigen::MatrixXd W = model.hessian(p, lambda);
-    if (!W.allFinite() || !convexify(W, A, lambda, factor)) return out;
+    if (!W.allFinite() || !convexify(W, A, lambda, factor, shift)) return out;
     // Inconsistent linearised constraints (a kink that cannot be opened from here): the caller's
     // SLSQP decides, as it always did.
     if (!solve_convex_qp(factor, g, A, c, d, mu)) return out;
@@ -485,6 +552,113 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
   }
   if (out.converged) p_io = p;
   return out;
+}
+
+LeadOutcome basin_lead(const TargetShapeProblem& problem, const SqpBlock& block, Polyline2& p_io,
+                       const SqpSettings& settings, int max_evaluations, double xtol_rel) {
+  LeadOutcome out;
+  BlockModel model(problem, block, settings, p_io);
+  const int n = model.variables(), mc = model.constraints();
+  if (n == 0) return out;
+  Polyline2 p = p_io;
+  Eigen::VectorXd x = model.to_x(p), g, c, r, s, mu = Eigen::VectorXd::Zero(mc);
+  Eigen::MatrixXd A;
+  // NLopt keeps the best point seen: lower f where feasible (or nothing feasible yet), else less
+  // infeasible while nothing is feasible.
+  Eigen::VectorXd best_x = x;
+  double best_f = std::numeric_limits<double>::infinity(), best_infeasibility = best_f;
+  bool best_feasible = false, feasible = false;
+  bool finite = true;
+  auto evaluate = [&](bool with_gradient) {
+    model.to_points(x, p);
+    const double f = with_gradient ? model.evaluate(p, &g, c, &A) : model.evaluate(p, nullptr, c, nullptr);
+    ++out.evaluations;
+    if (settings.on_evaluation) settings.on_evaluation();
+    finite = std::isfinite(f) && c.allFinite() && (!with_gradient || (g.allFinite() && A.allFinite()));
+    const double infeasible = violation(c);
+    feasible = infeasible <= settings.constraint_tol;
+    if (finite && ((f < best_f && (feasible || !best_feasible)) || (!best_feasible && infeasible < best_infeasibility))) {
+      best_f = f;
+      best_feasible = feasible;
+      best_infeasibility = infeasible;
+      best_x = x;
+    }
+    return f;
+  };
+  auto finish = [&] {
+    model.to_points(best_x, p_io);
+    out.done = true;
+    return out;
+  };
+  auto penalty = [&](const Eigen::VectorXd& cv) {
+    double h = 0.0;
+    for (int j = 0; j < mc; ++j) h += mu[j] * std::max(cv[j], 0.0);
+    return h;
+  };
+  double f = evaluate(true);
+  if (!finite) return out;
+  if (out.evaluations >= max_evaluations) return finish();
+  Eigen::MatrixXd B = Eigen::MatrixXd::Identity(n, n);
+  Eigen::LLT<Eigen::MatrixXd> factor(n);
+  double f_prev = std::numeric_limits<double>::infinity();
+  Eigen::VectorXd x_prev = x;
+  int resets = 1;
+  for (;;) {
+    factor.compute(B);
+    if (factor.info() != Eigen::Success) return out;
+    if (!solve_convex_qp(factor, g, A, c, s, r)) return out;  // SLSQP would relax the problem
+    const Eigen::VectorXd v = g + A.transpose() * r;  // ∇L at the start of the step
+    const Eigen::VectorXd x0 = x;
+    const double gs = g.dot(s);
+    for (int j = 0; j < mc; ++j) mu[j] = std::max(r[j], 0.5 * (mu[j] + r[j]));
+    const double h1 = penalty(c);
+    const double t0 = f + h1;
+    double h3 = gs - h1;
+    if (h3 >= 0.0) {  // no descent for the test function: restart from the identity
+      if (++resets > 5) return finish();
+      B.setIdentity();
+      continue;
+    }
+    double alpha = 1.0;
+    int line = 0;
+    for (;;) {
+      ++line;
+      h3 *= alpha;
+      s *= alpha;
+      x = x0 + s;
+      f = evaluate(line == 1);
+      if (!finite) return out;
+      if (out.evaluations >= max_evaluations) return finish();
+      const double dt = f + penalty(c) - t0;
+      if (dt <= h3 / 10.0 || line > 10) break;
+      alpha = std::max(h3 / (2.0 * (h3 - dt)), 0.1);
+    }
+    if (line > 1) {  // NLopt evaluates the accepted point again, with its gradient
+      f = evaluate(true);
+      if (!finite) return out;
+      if (out.evaluations >= max_evaluations) return finish();
+    }
+    if (std::isfinite(f_prev) && feasible) {
+      const double df = std::abs(f - f_prev);
+      if (df < settings.ftol_rel * (std::abs(f) + std::abs(f_prev)) * 0.5 || (settings.ftol_rel > 0.0 && f == f_prev))
+        return finish();
+      if ((x - x_prev).norm() < xtol_rel * x.norm()) return finish();
+    }
+    f_prev = f;
+    x_prev = x;
+    // Powell's damped BFGS update with y = ∇L(x) - ∇L(x0), both with the step's multipliers.
+    Eigen::VectorXd y = g + A.transpose() * r - v;
+    const Eigen::VectorXd Bs = B * s;
+    double sy = s.dot(y);
+    const double sBs = s.dot(Bs);
+    if (sy < 0.2 * sBs) {
+      const double theta = 0.8 * sBs / (sBs - sy);
+      y = theta * y + (1.0 - theta) * Bs;
+      sy = 0.2 * sBs;
+    }
+    B.noalias() += (y * y.transpose()) / sy;
+    B.noalias() -= (Bs * Bs.transpose()) / sBs;
+  }
 }
 
 }  // namespace wiresculpt::detail

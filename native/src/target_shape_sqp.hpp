@@ -33,6 +33,10 @@ struct SqpSettings {
   double step_tol = 1e-9;        ///< stop when the step is this small (scaled units) and feasible
   double ftol_rel = 1e-12;       ///< or when f changed by at most this fraction of it and feasible
   int max_iterations = 60;
+  /// Where the search for the convexifying shift starts (with and without active constraints),
+  /// updated to where it ended: shared by the blocks of one wire, it saves factorisations and
+  /// changes no result (see convexify). Null: each block starts from no shift.
+  std::array<int, 2>* shift_guess = nullptr;
   /// Called at every evaluation (it may throw, e.g. Cancelled, which leaves the block unsolved).
   std::function<void()> on_evaluation;
 };
@@ -42,6 +46,21 @@ struct SqpOutcome {
   int evaluations = 0;  ///< energy + constraint evaluations (gradients included)
   int iterations = 0;
 };
+
+struct LeadOutcome {
+  bool done = false;     ///< false: it met what it does not model (see basin_lead); `p` is unchanged
+  int evaluations = 0;   ///< spent, whether done or not
+};
+
+/// The first `max_evaluations` evaluations of SLSQP (Kraft's algorithm as NLopt runs it: the
+/// identity as the first Hessian guess, Powell's damped BFGS update, the ℓ1 test-function line
+/// search with its penalty update, NLopt's ftol_rel / xtol_rel tests and its choice of the best
+/// point seen), with the QP subproblem solved by solve_convex_qp instead of Kraft's LSQ, whose
+/// cost grows as n² (m + 2n) per iteration. It leads sqp_block where a kink's arrangement is chosen.
+/// Not done (and `p` unchanged) where SLSQP would solve an augmented problem (the linearised
+/// constraints are inconsistent) or a value is not finite: the caller runs NLopt's SLSQP instead.
+LeadOutcome basin_lead(const TargetShapeProblem& problem, const SqpBlock& block, Polyline2& p,
+                       const SqpSettings& settings, int max_evaluations, double xtol_rel);
 
 /// The points constraint `c` of a wire of `np` points reads (-1: none): the edge's two ends
 /// (length), the vertex and its neighbours (bend), the crossing and its neighbour (contact).
@@ -59,6 +78,14 @@ Eigen::MatrixXd sqp_lagrangian_hessian(const TargetShapeProblem& problem, const 
                                        const SqpSettings& settings, const Polyline2& p, const Eigen::VectorXd& lambda);
 Eigen::VectorXd sqp_lagrangian_gradient(const TargetShapeProblem& problem, const SqpBlock& block,
                                         const SqpSettings& settings, const Polyline2& p, const Eigen::VectorXd& lambda);
+
+/// Makes W positive definite for the QP: adds ρ a_k a_kᵀ over the constraints with λ_k > 0, then
+/// δI, taking the first of a fixed sequence of shifts that works (see the definition); `factor`
+/// gets W's Cholesky factor. `guess` (with / without active constraints) is where the search
+/// starts and is set to where it ended; it changes no result. False when no shift works. Exposed
+/// for its tests.
+bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::VectorXd& lambda,
+               Eigen::LLT<Eigen::MatrixXd>& factor, std::array<int, 2>& guess);
 
 /// Minimises ½ dᵀ W d + gᵀ d subject to A d + c <= 0 (rows of A as a dense matrix), W symmetric
 /// positive definite: the dual active-set method of Goldfarb and Idnani (1983). Returns false when

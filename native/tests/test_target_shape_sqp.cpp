@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <numbers>
+#include <nlopt.hpp>
 #include <random>
 
 #include "target_shape_sqp.hpp"
@@ -332,4 +333,196 @@ TEST_CASE("sqp: an open wire with crossings reaches SLSQP's optimum", "[target][
     CHECK(b.sqp_fallbacks * 4 <= b.sqp_blocks);
     CHECK(b.iterations < a.iterations);
   }
+}
+
+namespace {
+// NLopt's SLSQP on one block, set up here from the problem's definitions (energy and constraint
+// values with their gradients, in the solver's units), stopped after `evaluations`: what
+// detail::basin_lead replicates. Returns the wire with the block's points where NLopt left them.
+Polyline2 nlopt_slsqp_block(const TargetShapeProblem& problem, const TestBlock& b, const detail::SqpSettings& ss,
+                            const TargetShapeOptions& o, int evaluations, int& used) {
+  struct Data {
+    const TargetShapeProblem* problem;
+    const TestBlock* b;
+    const detail::SqpSettings* ss;
+    Polyline2 p, grad;
+    void unpack(const double* x) {
+      for (std::size_t k = 0; k < b->points.size(); ++k) p[b->points[k]] = ss->scale_x * Vec2(x[2 * k], x[2 * k + 1]);
+    }
+  } data{&problem, &b, &ss, problem.initial(), Polyline2(problem.initial().size(), Vec2::Zero())};
+  const unsigned n = static_cast<unsigned>(2 * b.points.size());
+  nlopt::opt opt(nlopt::LD_SLSQP, n);
+  opt.set_min_objective(
+      [](unsigned, const double* x, double* g, void* v) {
+        auto* d = static_cast<Data*>(v);
+        d->unpack(x);
+        std::fill(d->grad.begin(), d->grad.end(), Vec2::Zero());
+        const double f = d->problem->energy_terms(d->p, d->b->terms, g ? &d->grad : nullptr) / d->ss->scale_f;
+        if (g)
+          for (std::size_t k = 0; k < d->b->points.size(); ++k)
+            for (int r = 0; r < 2; ++r) g[2 * k + r] = d->ss->scale_x / d->ss->scale_f * d->grad[d->b->points[k]][r];
+        return f;
+      },
+      &data);
+  opt.add_inequality_mconstraint(
+      [](unsigned m, double* c, unsigned nv, const double* x, double* g, void* v) {
+        auto* d = static_cast<Data*>(v);
+        d->unpack(x);
+        for (unsigned k = 0; k < m; ++k) {
+          std::fill(d->grad.begin(), d->grad.end(), Vec2::Zero());
+          c[k] = d->problem->constraint(static_cast<std::size_t>(d->b->constraints[k]), d->p, g ? &d->grad : nullptr);
+          if (g)
+            for (std::size_t j = 0; j < d->b->points.size(); ++j)
+              for (int r = 0; r < 2; ++r) g[k * nv + 2 * j + r] = d->ss->scale_x * d->grad[d->b->points[j]][r];
+        }
+      },
+      &data, std::vector<double>(b.constraints.size(), o.constraint_tol));
+  opt.set_ftol_rel(o.ftol_rel);
+  opt.set_xtol_rel(o.xtol_rel);
+  opt.set_maxeval(evaluations);
+  std::vector<double> x(n);
+  for (std::size_t k = 0; k < b.points.size(); ++k)
+    for (int r = 0; r < 2; ++r) x[2 * k + r] = problem.initial()[b.points[k]][r] / ss.scale_x;
+  double f = 0.0;
+  try {
+    opt.optimize(x, f);
+  } catch (const std::exception&) {  // a stop NLopt reports by throwing: the point it reached
+  }
+  used = opt.get_numevals();
+  Polyline2 p = problem.initial();
+  for (std::size_t k = 0; k < b.points.size(); ++k) p[b.points[k]] = ss.scale_x * Vec2(x[2 * k], x[2 * k + 1]);
+  return p;
+}
+}  // namespace
+
+TEST_CASE("sqp: the basin lead takes SLSQP's first steps", "[target][sqp]") {
+  // A one-block ellipse with inverted kinks, windows around a crossing of a flat ellipse, of a 2 m
+  // loop and of an open S-curve: after every evaluation count from 1 to 12 the replica's point is
+  // NLopt's.
+  // Without friction and with a 120° bend limit, as the pipeline solves.
+  TargetShapeOptions o;
+  o.friction = 0.0;
+  o.max_bend = 2 * pi / 3;
+  detail::SqpSettings ss;
+  ss.scale_x = o.min_segment;
+  ss.scale_f = 2.0 * 1.5 * o.min_segment * o.min_segment;  // as the solver scales at the default spacing
+  ss.min_segment = o.min_segment;
+  ss.regularization = o.regularization;
+  ss.constraint_tol = o.constraint_tol;
+  ss.ftol_rel = o.ftol_rel;
+  struct Case {
+    Polyline2 contour;
+    bool closed;
+    std::vector<TargetCrossing> xs;
+    int around;  // -1: one block for the whole wire, else a window of 8 points around this crossing
+  };
+  std::vector<Case> cases;
+  {
+    const Polyline2 e = ellipse(0.09, 0.06, 1200);
+    std::vector<TargetCrossing> xs;
+    for (int k = 0; k < 3; ++k) {
+      const int v = k * 400 + 37;
+      xs.push_back({v, (k % 2 ? -1.0 : 1.0) * e[v].normalized(), 2 * pi / 3, true});
+    }
+    cases.push_back({e, true, xs, -1});
+  }
+  {
+    // A flat ellipse, kinks alternately in and out: the window around its second crossing takes
+    // SLSQP's line search back (the test function rose at the full step).
+    const Polyline2 e = ellipse(0.09, 0.027, 1200);
+    std::vector<TargetCrossing> xs;
+    for (int k = 0; k < 3; ++k) {
+      const int v = k * 400 + 17;
+      xs.push_back({v, (k % 2 ? 1.0 : -1.0) * e[v].normalized(), 2 * pi / 3, true});
+    }
+    cases.push_back({e, true, xs, 1});
+  }
+  {
+    Polyline2 loop;
+    for (int k = 0; k < 2000; ++k) {
+      const double t = 2 * pi * k / 2000;
+      const double rr = 0.3 + 0.04 * std::cos(5 * t) + 0.02 * std::sin(3 * t);
+      loop.emplace_back(rr * std::cos(t), rr * std::sin(t));
+    }
+    cases.push_back({loop, true, {{207, -loop[207].normalized(), 2 * pi / 3, true}}, 0});
+  }
+  {
+    Polyline2 s;
+    for (int k = 0; k <= 1200; ++k) s.emplace_back(1.2 * k / 1200.0, 0.06 * std::sin(2 * pi * k / 1200.0 * 1.5));
+    cases.push_back({s, false, {{450, Vec2(0, -1), 2 * pi / 3, true}}, 0});
+  }
+  for (const Case& cs : cases) {
+    const TargetShapeProblem problem(cs.contour, cs.closed, cs.xs, o);
+    const int m = static_cast<int>(problem.initial().size());
+    const int v = problem.statuses()[static_cast<std::size_t>(std::max(cs.around, 0))].vertex;
+    const TestBlock tb = cs.around < 0 ? block_of(problem, 0, m) : block_of(problem, v - 4, v + 4);
+    const detail::SqpBlock block{&tb.points, &tb.terms, &tb.constraints};
+    double moved = 0.0;
+    for (int k = 1; k <= 12; ++k) {
+      int used = 0;
+      const Polyline2 want = nlopt_slsqp_block(problem, tb, ss, o, k, used);
+      Polyline2 got = problem.initial();
+      const detail::LeadOutcome lead = detail::basin_lead(problem, block, got, ss, k, o.xtol_rel);
+      REQUIRE(lead.done);
+      CHECK(lead.evaluations == used);
+      double worst = 0.0;
+      for (int i = 0; i < m; ++i) {
+        worst = std::max(worst, (got[i] - want[i]).norm());
+        moved = std::max(moved, (want[i] - problem.initial()[i]).norm());
+      }
+      CHECK(worst <= 1e-9 * o.min_segment);
+    }
+    CHECK(moved > 1e-3 * o.min_segment);  // the steps compared are not nothing
+  }
+}
+
+TEST_CASE("sqp: convexify takes the first shift of its sequence that makes W positive definite", "[target][sqp]") {
+  // Against the plain scan of the sequence (none; ρ = 4^k d for k = 0..10 when some λ > 0; then
+  // δ = 4^j 1e-8 d with ρ at its last value), from every kind of starting guess.
+  std::mt19937 rng(11);
+  std::normal_distribution<double> N(0.0, 1.0);
+  int with_rho = 0, with_delta = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const int n = 4 + trial % 9, m = trial % 7;
+    Eigen::MatrixXd B(n, n), A(m, n);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) B(i, j) = N(rng);
+    for (int i = 0; i < m; ++i)
+      for (int j = 0; j < n; ++j) A(i, j) = N(rng);
+    Eigen::MatrixXd W = B * B.transpose();
+    W.diagonal().array() -= std::pow(10.0, -3.0 + 4.0 * (trial % 5) / 4.0) * (trial % 3);  // up to indefinite
+    Eigen::VectorXd lambda = Eigen::VectorXd::Zero(m);
+    for (int i = 0; i < m; ++i) lambda[i] = (i + trial) % 2 ? 0.5 : 0.0;
+    bool any = false;
+    Eigen::MatrixXd AtA = Eigen::MatrixXd::Zero(n, n);
+    for (int i = 0; i < m; ++i)
+      if (lambda[i] > 0) AtA += A.row(i).transpose() * A.row(i), any = true;
+    const double d = std::max(1e-12, W.diagonal().cwiseAbs().maxCoeff());
+    double rho = 0.0, delta = 0.0;
+    Eigen::MatrixXd want;
+    for (int tries = 0; tries <= 60; ++tries) {
+      Eigen::MatrixXd Wd = W + rho * AtA;
+      Wd.diagonal().array() += delta;
+      if (Eigen::LLT<Eigen::MatrixXd>(Wd).info() == Eigen::Success) {
+        want = Wd;
+        break;
+      }
+      if (any && rho < 1e6 * d) rho = rho > 0.0 ? 4.0 * rho : d;
+      else delta = delta > 0.0 ? 4.0 * delta : 1e-8 * d;
+    }
+    REQUIRE(want.size() > 0);
+    with_rho += rho > 0.0 && delta == 0.0;
+    with_delta += delta > 0.0;
+    for (int g : {0, 1, 7, 12, 30, 60}) {
+      std::array<int, 2> guess{g, g};
+      Eigen::MatrixXd got = W;
+      Eigen::LLT<Eigen::MatrixXd> factor(n);
+      REQUIRE(detail::convexify(got, A, lambda, factor, guess));
+      CHECK(got == want);
+      CHECK((factor.matrixL().toDenseMatrix() * factor.matrixU().toDenseMatrix() - want).cwiseAbs().maxCoeff() <=
+            1e-9 * want.cwiseAbs().maxCoeff());
+    }
+  }
+  CHECK(with_rho > 10);  // both parts of the sequence were exercised
+  CHECK(with_delta > 10);
 }
