@@ -675,7 +675,7 @@ constexpr int kProgressEvery = 16;
 
 // TargetShapeAlgorithm::sqp: SLSQP evaluations that lead a block where the basin is chosen (10: with
 // 5, one of 116 recorded corpus solves ended in another local minimum; with 10 and 20 none did).
-// detail::basin_lead replicates them with our own QP.
+// detail::slsqp_block replicates them with our own QP.
 constexpr int kSqpBasinEvaluations = 10;
 // The result text of a block the SQP solved (TargetShapeResult::nlopt_result).
 const std::string kSqpConverged = "SQP_CONVERGED";
@@ -910,31 +910,30 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     // first kSqpBasinEvaluations evaluations lead the way and SQP finishes from where they got:
     // started cold there, Newton's long steps along the wire (where the energy is flat) reach other
     // local minima (docs/method-target-shape.md, issue 17 fifth round). Those evaluations are
-    // SLSQP's steps replicated with our QP (detail::basin_lead, a fraction of the cost of NLopt's
+    // SLSQP's steps replicated with our QP (detail::slsqp_block, a fraction of the cost of NLopt's
     // dense least-squares subproblem), or NLopt's own where the replica stops. Where SQP fails (the
     // linearised constraints are inconsistent, or its line search stalls) SLSQP solves the block
     // from the block's start, as with algorithm slsqp.
     bool by_sqp = false;
+    detail::SqpSettings ss;
+    ss.scale_x = data.scale_x;
+    ss.scale_f = data.scale_f;
+    ss.min_segment = o.min_segment;
+    ss.regularization = o.regularization;
+    ss.constraint_tol = o.constraint_tol;
+    ss.ftol_rel = o.ftol_rel;
+    ss.shift_guess = &shift_guess;
+    ss.on_evaluation = [&] {
+      if (!data.count_evaluation()) throw Cancelled();
+    };
+    const detail::SqpBlock sb{&b.points, &b.terms, &b.constraints};
     if (o.algorithm == TargetShapeAlgorithm::sqp) {
       Polyline2 start = data.p;
       bool ready = true;
-      detail::SqpSettings ss;
-      ss.scale_x = data.scale_x;
-      ss.scale_f = data.scale_f;
-      ss.min_segment = o.min_segment;
-      ss.regularization = o.regularization;
-      ss.constraint_tol = o.constraint_tol;
-      ss.ftol_rel = o.ftol_rel;
-      ss.shift_guess = &shift_guess;
-      ss.on_evaluation = [&] {
-        if (!data.count_evaluation()) throw Cancelled();
-      };
-      const detail::SqpBlock sb{&b.points, &b.terms, &b.constraints};
       const int lead = std::max(1, std::min(kSqpBasinEvaluations, o.max_iterations - data.evaluations));
-      // SLSQP's first steps, replicated with our QP (basin_lead); NLopt's own SLSQP where the
-      // replica stops (inconsistent linearised constraints, values not finite).
-      if (choose_basin && detail::basin_lead(problem, sb, start, ss, lead, o.xtol_rel).done)
-        choose_basin = false;
+      // SLSQP's first steps, replicated with our QP (slsqp_block); NLopt's own SLSQP where the
+      // replica stops (inconsistent linearised constraints, a value not finite).
+      if (choose_basin && detail::slsqp_block(problem, sb, start, ss, lead, o.xtol_rel).done) choose_basin = false;
       if (choose_basin) {
         std::vector<double> xp = x;
         double fp = 0.0;

@@ -10,6 +10,8 @@
 #include <limits>
 #include <vector>
 
+#include <nlopt.h>
+
 namespace wiresculpt::detail {
 
 std::array<int, 3> constraint_points(const TargetShapeProblem::Constraint& c, int np) {
@@ -554,12 +556,17 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
   return out;
 }
 
-LeadOutcome basin_lead(const TargetShapeProblem& problem, const SqpBlock& block, Polyline2& p_io,
-                       const SqpSettings& settings, int max_evaluations, double xtol_rel) {
-  LeadOutcome out;
+SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& block, Polyline2& p_io,
+                         const SqpSettings& settings, int max_evaluations, double xtol_rel,
+                         const std::function<bool()>& out_of_time) {
+  SlsqpOutcome out;
   BlockModel model(problem, block, settings, p_io);
   const int n = model.variables(), mc = model.constraints();
-  if (n == 0) return out;
+  if (n == 0) {
+    out.done = true;
+    out.result = NLOPT_SUCCESS;
+    return out;
+  }
   Polyline2 p = p_io;
   Eigen::VectorXd x = model.to_x(p), g, c, r, s, mu = Eigen::VectorXd::Zero(mc);
   Eigen::MatrixXd A;
@@ -585,10 +592,17 @@ LeadOutcome basin_lead(const TargetShapeProblem& problem, const SqpBlock& block,
     }
     return f;
   };
-  auto finish = [&] {
+  auto finish = [&](int result) {
     model.to_points(best_x, p_io);
     out.done = true;
+    out.result = result;
     return out;
+  };
+  // NLopt's stops after an evaluation: the evaluation budget, then the time (0: go on).
+  auto budget = [&] {
+    if (out.evaluations >= max_evaluations) return static_cast<int>(NLOPT_MAXEVAL_REACHED);
+    if (out_of_time && out_of_time()) return static_cast<int>(NLOPT_MAXTIME_REACHED);
+    return 0;
   };
   auto penalty = [&](const Eigen::VectorXd& cv) {
     double h = 0.0;
@@ -597,7 +611,7 @@ LeadOutcome basin_lead(const TargetShapeProblem& problem, const SqpBlock& block,
   };
   double f = evaluate(true);
   if (!finite) return out;
-  if (out.evaluations >= max_evaluations) return finish();
+  if (const int stop = budget()) return finish(stop);
   Eigen::MatrixXd B = Eigen::MatrixXd::Identity(n, n);
   Eigen::LLT<Eigen::MatrixXd> factor(n);
   double f_prev = std::numeric_limits<double>::infinity();
@@ -605,9 +619,13 @@ LeadOutcome basin_lead(const TargetShapeProblem& problem, const SqpBlock& block,
   int resets = 1;
   for (;;) {
     factor.compute(B);
-    if (factor.info() != Eigen::Success) return out;
-    if (!solve_convex_qp(factor, g, A, c, s, r)) return out;  // SLSQP would relax the problem
+    if (factor.info() != Eigen::Success) return finish(NLOPT_ROUNDOFF_LIMITED);  // Kraft: E singular
+    // Inconsistent linearised constraints: SLSQP would solve its augmented problem (a slack
+    // variable relaxing them), which this replica does not model (written out with our QP, its
+    // steps left NLopt's within a few evaluations): the caller runs NLopt's SLSQP instead.
+    if (!solve_convex_qp(factor, g, A, c, s, r)) return out;
     const Eigen::VectorXd v = g + A.transpose() * r;  // ∇L at the start of the step
+    const double f0 = f;
     const Eigen::VectorXd x0 = x;
     const double gs = g.dot(s);
     for (int j = 0; j < mc; ++j) mu[j] = std::max(r[j], 0.5 * (mu[j] + r[j]));
@@ -615,7 +633,16 @@ LeadOutcome basin_lead(const TargetShapeProblem& problem, const SqpBlock& block,
     const double t0 = f + h1;
     double h3 = gs - h1;
     if (h3 >= 0.0) {  // no descent for the test function: restart from the identity
-      if (++resets > 5) return finish();
+      if (++resets > 5) {
+        // Kraft's relaxed test fails (its tolerance is 0 here); NLopt then reports the roundoff
+        // limit, or ftol reached at a feasible point (its f has not moved since the last test).
+        if (!feasible) return finish(NLOPT_ROUNDOFF_LIMITED);
+        const double df = std::abs(f - f0);
+        return finish(df < 10.0 * settings.ftol_rel * (std::abs(f) + std::abs(f0)) * 0.5 ||
+                              (settings.ftol_rel > 0.0 && f == f0)
+                          ? NLOPT_FTOL_REACHED
+                          : NLOPT_ROUNDOFF_LIMITED);
+      }
       B.setIdentity();
       continue;
     }
@@ -628,7 +655,7 @@ LeadOutcome basin_lead(const TargetShapeProblem& problem, const SqpBlock& block,
       x = x0 + s;
       f = evaluate(line == 1);
       if (!finite) return out;
-      if (out.evaluations >= max_evaluations) return finish();
+      if (const int stop = budget()) return finish(stop);
       const double dt = f + penalty(c) - t0;
       if (dt <= h3 / 10.0 || line > 10) break;
       alpha = std::max(h3 / (2.0 * (h3 - dt)), 0.1);
@@ -636,13 +663,13 @@ LeadOutcome basin_lead(const TargetShapeProblem& problem, const SqpBlock& block,
     if (line > 1) {  // NLopt evaluates the accepted point again, with its gradient
       f = evaluate(true);
       if (!finite) return out;
-      if (out.evaluations >= max_evaluations) return finish();
+      if (const int stop = budget()) return finish(stop);
     }
     if (std::isfinite(f_prev) && feasible) {
       const double df = std::abs(f - f_prev);
       if (df < settings.ftol_rel * (std::abs(f) + std::abs(f_prev)) * 0.5 || (settings.ftol_rel > 0.0 && f == f_prev))
-        return finish();
-      if ((x - x_prev).norm() < xtol_rel * x.norm()) return finish();
+        return finish(NLOPT_FTOL_REACHED);
+      if ((x - x_prev).norm() < xtol_rel * x.norm()) return finish(NLOPT_XTOL_REACHED);
     }
     f_prev = f;
     x_prev = x;

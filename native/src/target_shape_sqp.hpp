@@ -47,20 +47,25 @@ struct SqpOutcome {
   int iterations = 0;
 };
 
-struct LeadOutcome {
-  bool done = false;     ///< false: it met what it does not model (see basin_lead); `p` is unchanged
-  int evaluations = 0;   ///< spent, whether done or not
+struct SlsqpOutcome {
+  bool done = false;    ///< false: what it does not model (see slsqp_block); `p` is unchanged
+  int evaluations = 0;  ///< spent, whether done or not
+  int result = 0;       ///< the nlopt_result NLopt's SLSQP would return (NLOPT_FTOL_REACHED, ...)
 };
 
-/// The first `max_evaluations` evaluations of SLSQP (Kraft's algorithm as NLopt runs it: the
-/// identity as the first Hessian guess, Powell's damped BFGS update, the ℓ1 test-function line
-/// search with its penalty update, NLopt's ftol_rel / xtol_rel tests and its choice of the best
-/// point seen), with the QP subproblem solved by solve_convex_qp instead of Kraft's LSQ, whose
-/// cost grows as n² (m + 2n) per iteration. It leads sqp_block where a kink's arrangement is chosen.
-/// Not done (and `p` unchanged) where SLSQP would solve an augmented problem (the linearised
-/// constraints are inconsistent) or a value is not finite: the caller runs NLopt's SLSQP instead.
-LeadOutcome basin_lead(const TargetShapeProblem& problem, const SqpBlock& block, Polyline2& p,
-                       const SqpSettings& settings, int max_evaluations, double xtol_rel);
+/// SLSQP on one block as NLopt runs Kraft's algorithm: the identity as the first Hessian guess,
+/// Powell's damped BFGS update (reset to the identity when the step is no descent for the test
+/// function, at most five times), the ℓ1 test-function line search with its penalty update, and
+/// NLopt's stops (ftol_rel and xtol_rel after each line search at a feasible point, the evaluation
+/// budget, `out_of_time` after each evaluation) and its choice of the best point seen. Only the QP
+/// subproblem is solved differently: by solve_convex_qp instead of Kraft's dense least-squares
+/// routine, whose cost grows as n² (m + 2n) an iteration. It leads sqp_block where a kink's
+/// arrangement is chosen (its first evaluations match NLopt's to rounding). Not done (`p` unchanged)
+/// where the linearised constraints are inconsistent (SLSQP's augmented problem is not modelled) or
+/// a value is not finite: the caller runs NLopt's SLSQP then.
+SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& block, Polyline2& p,
+                         const SqpSettings& settings, int max_evaluations, double xtol_rel,
+                         const std::function<bool()>& out_of_time = {});
 
 /// The points constraint `c` of a wire of `np` points reads (-1: none): the edge's two ends
 /// (length), the vertex and its neighbours (bend), the crossing and its neighbour (contact).

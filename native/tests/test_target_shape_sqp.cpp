@@ -338,9 +338,9 @@ TEST_CASE("sqp: an open wire with crossings reaches SLSQP's optimum", "[target][
 namespace {
 // NLopt's SLSQP on one block, set up here from the problem's definitions (energy and constraint
 // values with their gradients, in the solver's units), stopped after `evaluations`: what
-// detail::basin_lead replicates. Returns the wire with the block's points where NLopt left them.
+// detail::slsqp_block replicates. Returns the wire with the block's points where NLopt left them.
 Polyline2 nlopt_slsqp_block(const TargetShapeProblem& problem, const TestBlock& b, const detail::SqpSettings& ss,
-                            const TargetShapeOptions& o, int evaluations, int& used) {
+                            const TargetShapeOptions& o, int evaluations, int& used, int& result) {
   struct Data {
     const TargetShapeProblem* problem;
     const TestBlock* b;
@@ -385,8 +385,9 @@ Polyline2 nlopt_slsqp_block(const TargetShapeProblem& problem, const TestBlock& 
     for (int r = 0; r < 2; ++r) x[2 * k + r] = problem.initial()[b.points[k]][r] / ss.scale_x;
   double f = 0.0;
   try {
-    opt.optimize(x, f);
+    result = opt.optimize(x, f);
   } catch (const std::exception&) {  // a stop NLopt reports by throwing: the point it reached
+    result = opt.last_optimize_result();
   }
   used = opt.get_numevals();
   Polyline2 p = problem.initial();
@@ -395,10 +396,10 @@ Polyline2 nlopt_slsqp_block(const TargetShapeProblem& problem, const TestBlock& 
 }
 }  // namespace
 
-TEST_CASE("sqp: the basin lead takes SLSQP's first steps", "[target][sqp]") {
+TEST_CASE("sqp: slsqp_block takes SLSQP's first steps", "[target][sqp]") {
   // A one-block ellipse with inverted kinks, windows around a crossing of a flat ellipse, of a 2 m
-  // loop and of an open S-curve: after every evaluation count from 1 to 12 the replica's point is
-  // NLopt's.
+  // loop and of an open S-curve: after every evaluation count from 1 to 12 the replica's point and
+  // stop are NLopt's.
   // Without friction and with a 120° bend limit, as the pipeline solves.
   TargetShapeOptions o;
   o.friction = 0.0;
@@ -451,6 +452,7 @@ TEST_CASE("sqp: the basin lead takes SLSQP's first steps", "[target][sqp]") {
     for (int k = 0; k <= 1200; ++k) s.emplace_back(1.2 * k / 1200.0, 0.06 * std::sin(2 * pi * k / 1200.0 * 1.5));
     cases.push_back({s, false, {{450, Vec2(0, -1), 2 * pi / 3, true}}, 0});
   }
+
   for (const Case& cs : cases) {
     const TargetShapeProblem problem(cs.contour, cs.closed, cs.xs, o);
     const int m = static_cast<int>(problem.initial().size());
@@ -459,12 +461,13 @@ TEST_CASE("sqp: the basin lead takes SLSQP's first steps", "[target][sqp]") {
     const detail::SqpBlock block{&tb.points, &tb.terms, &tb.constraints};
     double moved = 0.0;
     for (int k = 1; k <= 12; ++k) {
-      int used = 0;
-      const Polyline2 want = nlopt_slsqp_block(problem, tb, ss, o, k, used);
+      int used = 0, result = 0;
+      const Polyline2 want = nlopt_slsqp_block(problem, tb, ss, o, k, used, result);
       Polyline2 got = problem.initial();
-      const detail::LeadOutcome lead = detail::basin_lead(problem, block, got, ss, k, o.xtol_rel);
+      const detail::SlsqpOutcome lead = detail::slsqp_block(problem, block, got, ss, k, o.xtol_rel);
       REQUIRE(lead.done);
       CHECK(lead.evaluations == used);
+      CHECK(lead.result == result);
       double worst = 0.0;
       for (int i = 0; i < m; ++i) {
         worst = std::max(worst, (got[i] - want[i]).norm());
@@ -474,6 +477,16 @@ TEST_CASE("sqp: the basin lead takes SLSQP's first steps", "[target][sqp]") {
     }
     CHECK(moved > 1e-3 * o.min_segment);  // the steps compared are not nothing
   }
+  // Crossings 45 mm apart on a straight wire, kinks to opposite sides: the linearised constraints
+  // are inconsistent, SLSQP would solve its augmented problem, and the replica says it did not.
+  Polyline2 line;
+  for (int k = 0; k <= 300; ++k) line.emplace_back(0.3 * k / 300.0, 0.0);
+  const TargetShapeProblem problem(line, false, {{100, Vec2(0, 1), 2 * pi / 3, true}, {145, Vec2(0, -1), 2 * pi / 3, true}}, o);
+  const TestBlock tb = block_of(problem, 0, static_cast<int>(problem.initial().size()));
+  const detail::SqpBlock block{&tb.points, &tb.terms, &tb.constraints};
+  Polyline2 p = problem.initial();
+  CHECK_FALSE(detail::slsqp_block(problem, block, p, ss, 10, o.xtol_rel).done);
+  CHECK(p == problem.initial());
 }
 
 TEST_CASE("sqp: convexify takes the first shift of its sequence that makes W positive definite", "[target][sqp]") {
