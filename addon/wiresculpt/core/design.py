@@ -91,9 +91,12 @@ def crossing_direction(design, crossing):
     return d / np.linalg.norm(d)
 
 
-def model_size(design):
-    """The largest side of the bounding box of every wire's contour (m)."""
-    points = np.concatenate([np.asarray(w["contour"]) for w in design["wires"]])
+def model_size(design, contours=None):
+    """The largest side of the bounding box of every wire's contour (m); `contours`: those contours
+    already as arrays, in the wires' order."""
+    if contours is None:
+        contours = [np.asarray(w["contour"]) for w in design["wires"]]
+    points = np.concatenate(contours)
     return float(np.max(points.max(axis=0) - points.min(axis=0)))
 
 

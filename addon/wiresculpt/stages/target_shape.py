@@ -112,10 +112,11 @@ def prepare_wire(design, wire, settings, size, memo=None):
             "frame": (origin, u, v), "key": key, "start_key": start_key, "result": result}
 
 
-def _frame(wire):
-    """(u, v, contour in 2D): the wire's plane axes and its contour in that frame."""
+def _frame(wire, contour=None):
+    """(u, v, contour in 2D): the wire's plane axes and its contour in that frame (`contour`: the
+    wire's contour already as an array)."""
     _n, u, v = plane_frame(wire["plane"]["normal"])
-    return u, v, to_2d(wire["contour"], wire["plane"]["origin"], u, v)
+    return u, v, to_2d(wire["contour"] if contour is None else contour, wire["plane"]["origin"], u, v)
 
 
 def solve_job(job, native_progress=None):
@@ -191,6 +192,7 @@ class Memo:
         self._frames = {}  # wire name -> (contour, origin, normal, (u, v, 2D contour))
         self._bisectors = {}  # (the two wires' plane normals, k, hook) -> h
         self._size = None  # (the contours, size)
+        self._arrays = {}  # wire name -> (contour, the contour as a float64 array)
 
     def frame(self, wire):
         """_frame(wire), computed once per contour and plane."""
@@ -198,7 +200,7 @@ class Memo:
         entry = self._frames.get(wire["name"])
         if (entry is None or entry[0] is not wire["contour"] or entry[1] != list(plane["origin"])
                 or entry[2] != list(plane["normal"])):
-            entry = (wire["contour"], list(plane["origin"]), list(plane["normal"]), _frame(wire))
+            entry = (wire["contour"], list(plane["origin"]), list(plane["normal"]), _frame(wire, self.array(wire)))
             self._frames[wire["name"]] = entry
         return entry[3]
 
@@ -215,8 +217,17 @@ class Memo:
         contours = [w["contour"] for w in design["wires"]]
         if self._size is None or len(self._size[0]) != len(contours) or any(
                 a is not b for a, b in zip(self._size[0], contours)):
-            self._size = (contours, model_size(design))
+            self._size = (contours, model_size(design, [self.array(w) for w in design["wires"]]))
         return self._size[1]
+
+    def array(self, wire):
+        """The wire's contour as a float64 array, converted once per contour (a long contour's
+        list of lists took ~0.1 ms each time, twice per wire and round)."""
+        entry = self._arrays.get(wire["name"])
+        if entry is None or entry[0] is not wire["contour"]:
+            entry = (wire["contour"], np.asarray(wire["contour"], dtype=np.float64))
+            self._arrays[wire["name"]] = entry
+        return entry[1]
 
     @staticmethod
     def key(contour, closed, specs, options, ignore=("max_bend",)):
