@@ -503,12 +503,16 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
     if (!(slope < 0.0)) return out;
     double alpha = 1.0;
     bool accepted = false;
-    Eigen::VectorXd xt;
+    Eigen::VectorXd xt, gt;
+    Eigen::MatrixXd At;
     double ft = 0.0;
+    // Trial points are evaluated with their gradients: the accepted one (nearly always the first)
+    // is the next iterate, whose values the next iteration needs (the same numbers as evaluating it
+    // again, one evaluation fewer).
     for (int ls = 0; ls < 40; ++ls) {
       xt = x + alpha * d;
       model.to_points(xt, trial);
-      ft = model.evaluate(trial, nullptr, ct, nullptr);
+      ft = model.evaluate(trial, &gt, ct, &At);
       counted();
       if (std::isfinite(ft) && merit(ft, ct) <= phi0 + 1e-4 * alpha * slope) {
         accepted = true;
@@ -523,7 +527,7 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
         if (solve_convex_qp(factor, g, A, csoc, dc, mc2)) {
           xt = x + dc;
           model.to_points(xt, trial);
-          ft = model.evaluate(trial, nullptr, ct, nullptr);
+          ft = model.evaluate(trial, &gt, ct, &At);
           counted();
           if (std::isfinite(ft) && merit(ft, ct) <= phi0 + 1e-4 * slope) {
             accepted = true;
@@ -537,10 +541,12 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
     if (!accepted) return out;
     const double step = (xt - x).lpNorm<Eigen::Infinity>();
     x = xt;
-    model.to_points(x, p);
+    p.swap(trial);
     const double f_old = f;
-    f = model.evaluate(p, &g, c, &A);
-    counted();
+    f = ft;
+    g.swap(gt);
+    c.swap(ct);
+    A.swap(At);
     lambda = mu;
     // Converged: feasible after a full step (only the QP's own step, or its correction, measures
     // how far x is from a KKT point; one that backtracking shrank to nothing does not) that was
