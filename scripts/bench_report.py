@@ -259,7 +259,7 @@ def prose(cases, names):
 
     # target shape
     out += ["### Target shape (Sec. 4.3: one problem per wire, windows on long wires; a Newton SQP per block, "
-            "SLSQP where kinks open and where the SQP fails)", ""]
+            "led by SLSQP's first steps where kinks open, SLSQP where the SQP fails)", ""]
     if lengths:
         per_m = [(stat(c, "target_shape", "iterations") or 0) / max(c["total_wire"], 1e-9) for c in lengths]
         s_per_pt = [1e3 * stage_seconds(c, "target_shape") / max(c.get("target_points") or 1, 1) for c in lengths
@@ -274,7 +274,7 @@ def prose(cases, names):
                    + (f" (about length^{k_t:.1f})" if k_t else "") + f". That is {min(per_m):,.0f}–{max(per_m):,.0f} "
                    f"energy evaluations per metre of wire and {statistics.median(s_per_pt):.2f} ms per point: the "
                    "windowed solve (8-point windows swept until nothing moves by 0.1 µm, each by a Newton SQP "
-                   "that converges in 4–6 iterations; docs/method-target-shape.md, issue 17 fifth round) keeps each "
+                   "that converges in 4–6 iterations; docs/method-target-shape.md, issue 17 fifth and sixth rounds) keeps each "
                    "iteration small, so the cost is the number of sweeps times the number of windows. The paper saw "
                    "the same effect (its Airplane, two long wires, 51 s).")
         capped = [c for c in everything if any("MAXEVAL" in str(w) for w in [c.get("nlopt_result", "")])]
