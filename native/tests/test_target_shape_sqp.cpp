@@ -53,6 +53,15 @@ bool brute_force_qp(const Eigen::MatrixXd& W, const Eigen::VectorXd& g, const Ei
   return found;
 }
 
+// A rows × cols matrix of standard normal draws, row by row.
+Eigen::MatrixXd gaussian(int rows, int cols, std::mt19937& rng) {
+  std::normal_distribution<double> N(0.0, 1.0);
+  Eigen::MatrixXd M(rows, cols);
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) M(i, j) = N(rng);
+  return M;
+}
+
 Polyline2 ellipse(double a, double b, int n) {
   Polyline2 pts;
   for (int k = 0; k < n; ++k) pts.emplace_back(a * std::cos(2 * pi * k / n), b * std::sin(2 * pi * k / n));
@@ -84,10 +93,9 @@ TEST_CASE("sqp: the convex QP's answer is the KKT point that brute force over ac
   int solved = 0, inconsistent = 0;
   for (int trial = 0; trial < 400; ++trial) {
     const int n = 1 + trial % 5, m = trial % 7;
-    Eigen::MatrixXd B(n, n), A(m, n);
+    const Eigen::MatrixXd B = gaussian(n, n, rng);
+    Eigen::MatrixXd A(m, n);
     Eigen::VectorXd g(n), c(m);
-    for (int i = 0; i < n; ++i)
-      for (int j = 0; j < n; ++j) B(i, j) = N(rng);
     const Eigen::MatrixXd W = B.transpose() * B + 0.1 * Eigen::MatrixXd::Identity(n, n);
     for (int i = 0; i < n; ++i) g[i] = N(rng);
     for (int k = 0; k < m; ++k) {
@@ -493,15 +501,10 @@ TEST_CASE("sqp: convexify takes the first shift of its sequence that makes W pos
   // Against the plain scan of the sequence (none; ρ = 4^k d for k = 0..10 when some λ > 0; then
   // δ = 4^j 1e-8 d with ρ at its last value), from every kind of starting guess.
   std::mt19937 rng(11);
-  std::normal_distribution<double> N(0.0, 1.0);
   int with_rho = 0, with_delta = 0;
   for (int trial = 0; trial < 300; ++trial) {
     const int n = 4 + trial % 9, m = trial % 7;
-    Eigen::MatrixXd B(n, n), A(m, n);
-    for (int i = 0; i < n; ++i)
-      for (int j = 0; j < n; ++j) B(i, j) = N(rng);
-    for (int i = 0; i < m; ++i)
-      for (int j = 0; j < n; ++j) A(i, j) = N(rng);
+    const Eigen::MatrixXd B = gaussian(n, n, rng), A = gaussian(m, n, rng);
     Eigen::MatrixXd W = B * B.transpose();
     W.diagonal().array() -= std::pow(10.0, -3.0 + 4.0 * (trial % 5) / 4.0) * (trial % 3);  // up to indefinite
     Eigen::VectorXd lambda = Eigen::VectorXd::Zero(m);
