@@ -933,7 +933,8 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
       const int lead = std::max(1, std::min(kSqpBasinEvaluations, o.max_iterations - data.evaluations));
       // SLSQP's first steps, replicated with our QP (slsqp_block); NLopt's own SLSQP where the
       // replica stops (inconsistent linearised constraints, a value not finite).
-      if (choose_basin && detail::slsqp_block(problem, sb, start, ss, lead, o.xtol_rel).done) choose_basin = false;
+      if (choose_basin && detail::slsqp_block(problem, sb, start, ss, lead, o.xtol_rel, out_of_time).done)
+        choose_basin = false;
       if (choose_basin) {
         std::vector<double> xp = x;
         double fp = 0.0;

@@ -407,7 +407,7 @@ bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::Vector
       Wd = W;
       if (rho > 0.0) Wd += rho * AtA;
       Wd.diagonal().array() += delta;
-        factor.compute(Wd);
+      factor.compute(Wd);
       factored = i;
       known[i] = factor.info() == Eigen::Success && Wd.allFinite() ? 1 : -1;
     }
@@ -610,10 +610,19 @@ SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& bloc
     if (out_of_time && out_of_time()) return static_cast<int>(NLOPT_MAXTIME_REACHED);
     return 0;
   };
-  auto penalty = [&](const Eigen::VectorXd& cv) {
-    double h = 0.0;
+  // Kraft's sums, term by term onto `start`: the test function t = f + Σ μ_j max(c_j, 0).
+  auto penalty = [&](const Eigen::VectorXd& cv, double start) {
+    double h = start;
     for (int j = 0; j < mc; ++j) h += mu[j] * std::max(cv[j], 0.0);
     return h;
+  };
+  // NLopt 2.7.1's tests (src/util/stop.c): relative change of f, and of x in the 1-norm.
+  auto relstop = [](double old_value, double value, double reltol) {
+    const double d = std::abs(value - old_value);
+    return d < reltol * (std::abs(value) + std::abs(old_value)) * 0.5 || (reltol > 0.0 && value == old_value);
+  };
+  auto xstop = [](const Eigen::VectorXd& xv, const Eigen::VectorXd& old, double reltol) {
+    return (xv - old).lpNorm<1>() < reltol * xv.lpNorm<1>();
   };
   double f = evaluate(true);
   if (!finite) return out;
@@ -625,7 +634,9 @@ SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& bloc
   int resets = 1;
   for (;;) {
     factor.compute(B);
-    if (factor.info() != Eigen::Success) return finish(NLOPT_ROUNDOFF_LIMITED);  // Kraft: E singular
+    // Kraft's LDLᵀ update keeps B positive definite where this dense one may lose it to rounding:
+    // not modelled, NLopt's SLSQP decides.
+    if (factor.info() != Eigen::Success) return out;
     // Inconsistent linearised constraints: SLSQP would solve its augmented problem (a slack
     // variable relaxing them), which this replica does not model (written out with our QP, its
     // steps left NLopt's within a few evaluations): the caller runs NLopt's SLSQP instead.
@@ -635,19 +646,18 @@ SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& bloc
     const Eigen::VectorXd x0 = x;
     const double gs = g.dot(s);
     for (int j = 0; j < mc; ++j) mu[j] = std::max(r[j], 0.5 * (mu[j] + r[j]));
-    const double h1 = penalty(c);
+    const double h1 = penalty(c, 0.0);
     const double t0 = f + h1;
     double h3 = gs - h1;
     if (h3 >= 0.0) {  // no descent for the test function: restart from the identity
       if (++resets > 5) {
         // Kraft's relaxed test fails (its tolerance is 0 here); NLopt then reports the roundoff
-        // limit, or ftol reached at a feasible point (its f has not moved since the last test).
+        // limit, or at a feasible point its ftol or xtol test ×10 against the start of this step
+        // (where x and f still are).
         if (!feasible) return finish(NLOPT_ROUNDOFF_LIMITED);
-        const double df = std::abs(f - f0);
-        return finish(df < 10.0 * settings.ftol_rel * (std::abs(f) + std::abs(f0)) * 0.5 ||
-                              (settings.ftol_rel > 0.0 && f == f0)
-                          ? NLOPT_FTOL_REACHED
-                          : NLOPT_ROUNDOFF_LIMITED);
+        if (relstop(f0, f, 10.0 * settings.ftol_rel)) return finish(NLOPT_FTOL_REACHED);
+        if (xstop(x, x0, 10.0 * xtol_rel)) return finish(NLOPT_XTOL_REACHED);
+        return finish(NLOPT_ROUNDOFF_LIMITED);
       }
       B.setIdentity();
       continue;
@@ -662,7 +672,7 @@ SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& bloc
       f = evaluate(line == 1);
       if (!finite) return out;
       if (const int stop = budget()) return finish(stop);
-      const double dt = f + penalty(c) - t0;
+      const double dt = penalty(c, f) - t0;
       if (dt <= h3 / 10.0 || line > 10) break;
       alpha = std::max(h3 / (2.0 * (h3 - dt)), 0.1);
     }
@@ -671,11 +681,10 @@ SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& bloc
       if (!finite) return out;
       if (const int stop = budget()) return finish(stop);
     }
-    if (std::isfinite(f_prev) && feasible) {
-      const double df = std::abs(f - f_prev);
-      if (df < settings.ftol_rel * (std::abs(f) + std::abs(f_prev)) * 0.5 || (settings.ftol_rel > 0.0 && f == f_prev))
-        return finish(NLOPT_FTOL_REACHED);
-      if ((x - x_prev).norm() < xtol_rel * x.norm()) return finish(NLOPT_XTOL_REACHED);
+    // NLopt 2.7.1 tests after every line search, feasible or not (2.9 added "at a feasible point").
+    if (std::isfinite(f_prev)) {
+      if (relstop(f_prev, f, settings.ftol_rel)) return finish(NLOPT_FTOL_REACHED);
+      if (xstop(x, x_prev, xtol_rel)) return finish(NLOPT_XTOL_REACHED);
     }
     f_prev = f;
     x_prev = x;
@@ -684,10 +693,11 @@ SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& bloc
     const Eigen::VectorXd Bs = B * s;
     double sy = s.dot(y);
     const double sBs = s.dot(Bs);
-    if (sy < 0.2 * sBs) {
-      const double theta = 0.8 * sBs / (sBs - sy);
+    const double damped = sBs * 0.2;
+    if (sy < damped) {
+      const double theta = (sBs - damped) / (sBs - sy);
       y = theta * y + (1.0 - theta) * Bs;
-      sy = 0.2 * sBs;
+      sy = damped;
     }
     B.noalias() += (y * y.transpose()) / sy;
     B.noalias() -= (Bs * Bs.transpose()) / sBs;

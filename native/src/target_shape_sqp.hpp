@@ -53,16 +53,19 @@ struct SlsqpOutcome {
   int result = 0;       ///< the nlopt_result NLopt's SLSQP would return (NLOPT_FTOL_REACHED, ...)
 };
 
-/// SLSQP on one block as NLopt runs Kraft's algorithm: the identity as the first Hessian guess,
-/// Powell's damped BFGS update (reset to the identity when the step is no descent for the test
-/// function, at most five times), the ℓ1 test-function line search with its penalty update, and
-/// NLopt's stops (ftol_rel and xtol_rel after each line search at a feasible point, the evaluation
-/// budget, `out_of_time` after each evaluation) and its choice of the best point seen. Only the QP
-/// subproblem is solved differently: by solve_convex_qp instead of Kraft's dense least-squares
-/// routine, whose cost grows as n² (m + 2n) an iteration. It leads sqp_block where a kink's
-/// arrangement is chosen (its first evaluations match NLopt's to rounding). Not done (`p` unchanged)
-/// where the linearised constraints are inconsistent (SLSQP's augmented problem is not modelled) or
-/// a value is not finite: the caller runs NLopt's SLSQP then.
+/// SLSQP on one block as NLopt 2.7.1 (the version linked) runs Kraft's algorithm: the identity as the
+/// first Hessian guess, Powell's damped BFGS update (reset to the identity when the step is no
+/// descent for the test function, at most five times), the ℓ1 test-function line search with its
+/// penalty update, and NLopt's stops (ftol_rel and xtol_rel, in the 1-norm, after each line search;
+/// the evaluation budget and `out_of_time` after each evaluation; the relaxed test after the fifth
+/// reset) and its choice of the best point seen. Only the linear algebra differs: the QP subproblem
+/// is solved by solve_convex_qp instead of Kraft's dense least-squares routine (whose cost grows as
+/// n² (m + 2n) an iteration), and B is updated as a dense matrix, not as LDLᵀ factors. So the steps
+/// are NLopt's to rounding: the same points, evaluation counts and stop codes away from convergence;
+/// near it (a warm start) rounding decides where the ftol test fires. It leads sqp_block where a
+/// kink's arrangement is chosen. Not done (`p` unchanged) where the linearised constraints are
+/// inconsistent (SLSQP's augmented problem is not modelled), B loses positive definiteness to
+/// rounding, or a value is not finite: the caller runs NLopt's SLSQP then.
 SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& block, Polyline2& p,
                          const SqpSettings& settings, int max_evaluations, double xtol_rel,
                          const std::function<bool()>& out_of_time = {});
@@ -87,8 +90,9 @@ Eigen::VectorXd sqp_lagrangian_gradient(const TargetShapeProblem& problem, const
 /// Makes W positive definite for the QP: adds ρ a_k a_kᵀ over the constraints with λ_k > 0, then
 /// δI, taking the first of a fixed sequence of shifts that works (see the definition); `factor`
 /// gets W's Cholesky factor. `guess` (with / without active constraints) is where the search
-/// starts and is set to where it ended; it changes no result. False when no shift works. Exposed
-/// for its tests.
+/// starts and is set to where it ended; in exact arithmetic it changes no result (in floating point
+/// a factorisation that succeeds at one shift could fail at a much larger one; not seen). False when
+/// no shift works. Exposed for its tests.
 bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::VectorXd& lambda,
                Eigen::LLT<Eigen::MatrixXd>& factor, std::array<int, 2>& guess);
 

@@ -4,7 +4,9 @@
 // kink that cannot be opened, and cancellation.
 #include <catch2/catch.hpp>
 #include <Eigen/Dense>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <nlopt.hpp>
 #include <random>
@@ -484,6 +486,19 @@ TEST_CASE("sqp: slsqp_block takes SLSQP's first steps", "[target][sqp]") {
       CHECK(worst <= 1e-9 * o.min_segment);
     }
     CHECK(moved > 1e-3 * o.min_segment);  // the steps compared are not nothing
+    // Run to NLopt's own stop (ftol or xtol, well within 400 evaluations): the same stop, the
+    // same point.
+    int used = 0, result = 0;
+    const Polyline2 want = nlopt_slsqp_block(problem, tb, ss, o, 400, used, result);
+    Polyline2 got = problem.initial();
+    const detail::SlsqpOutcome full = detail::slsqp_block(problem, block, got, ss, 400, o.xtol_rel);
+    REQUIRE(full.done);
+    CHECK(used < 400);
+    CHECK(full.result == result);
+    CHECK(full.evaluations == used);
+    double worst = 0.0;
+    for (int i = 0; i < m; ++i) worst = std::max(worst, (got[i] - want[i]).norm());
+    CHECK(worst <= 1e-8 * o.min_segment);
   }
   // Crossings 45 mm apart on a straight wire, kinks to opposite sides: the linearised constraints
   // are inconsistent, SLSQP would solve its augmented problem, and the replica says it did not.
@@ -529,7 +544,7 @@ TEST_CASE("sqp: convexify takes the first shift of its sequence that makes W pos
     REQUIRE(want.size() > 0);
     with_rho += rho > 0.0 && delta == 0.0;
     with_delta += delta > 0.0;
-    for (int g : {0, 1, 7, 12, 30, 60}) {
+    for (int g : {-5, 0, 1, 7, 12, 30, 60, 100}) {
       std::array<int, 2> guess{g, g};
       Eigen::MatrixXd got = W;
       Eigen::LLT<Eigen::MatrixXd> factor(n);
@@ -541,4 +556,13 @@ TEST_CASE("sqp: convexify takes the first shift of its sequence that makes W pos
   }
   CHECK(with_rho > 10);  // both parts of the sequence were exercised
   CHECK(with_delta > 10);
+  // No shift makes a matrix with a NaN definite: false, W as it was (its NaN included).
+  Eigen::MatrixXd W = Eigen::MatrixXd::Identity(3, 3);
+  W(1, 1) = std::numeric_limits<double>::quiet_NaN();
+  Eigen::LLT<Eigen::MatrixXd> factor(3);
+  std::array<int, 2> guess{0, 0};
+  CHECK_FALSE(detail::convexify(W, Eigen::MatrixXd(0, 3), Eigen::VectorXd(0), factor, guess));
+  CHECK(W(0, 0) == 1.0);
+  CHECK(W(2, 2) == 1.0);
+  CHECK(std::isnan(W(1, 1)));
 }
