@@ -915,19 +915,19 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     // linearised constraints are inconsistent, or its line search stalls) SLSQP solves the block
     // from the block's start, as with algorithm slsqp.
     bool by_sqp = false;
-    detail::SqpSettings ss;
-    ss.scale_x = data.scale_x;
-    ss.scale_f = data.scale_f;
-    ss.min_segment = o.min_segment;
-    ss.regularization = o.regularization;
-    ss.constraint_tol = o.constraint_tol;
-    ss.ftol_rel = o.ftol_rel;
-    ss.shift_guess = &shift_guess;
-    ss.on_evaluation = [&] {
-      if (!data.count_evaluation()) throw Cancelled();
-    };
-    const detail::SqpBlock sb{&b.points, &b.terms, &b.constraints};
     if (o.algorithm == TargetShapeAlgorithm::sqp) {
+      detail::SqpSettings ss;
+      ss.scale_x = data.scale_x;
+      ss.scale_f = data.scale_f;
+      ss.min_segment = o.min_segment;
+      ss.regularization = o.regularization;
+      ss.constraint_tol = o.constraint_tol;
+      ss.ftol_rel = o.ftol_rel;
+      ss.shift_guess = &shift_guess;
+      ss.on_evaluation = [&] {
+        if (!data.count_evaluation()) throw Cancelled();
+      };
+      const detail::SqpBlock sb{&b.points, &b.terms, &b.constraints};
       Polyline2 start = data.p;
       bool ready = true;
       const int lead = std::max(1, std::min(kSqpBasinEvaluations, o.max_iterations - data.evaluations));

@@ -367,7 +367,6 @@ Eigen::VectorXd sqp_lagrangian_gradient(const TargetShapeProblem& problem, const
   return g + A.transpose() * lambda;
 }
 
-
 // Adds ρ a_k a_kᵀ for every constraint with λ_k > 0, then δI, until W is positive definite;
 // `factor` gets its Cholesky factor. False when it cannot be made so (not finite).
 //
@@ -445,7 +444,6 @@ bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::Vector
   W.swap(Wd);
   return true;
 }
-
 
 SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, Polyline2& p_io,
                      const SqpSettings& settings) {

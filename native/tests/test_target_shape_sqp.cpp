@@ -64,6 +64,17 @@ Eigen::MatrixXd gaussian(int rows, int cols, std::mt19937& rng) {
   return M;
 }
 
+// A 2 m wavy loop of n points (radius 0.3 m with a 5-lobe and a 3-lobe ripple).
+Polyline2 wavy_loop(int n) {
+  Polyline2 loop;
+  for (int k = 0; k < n; ++k) {
+    const double t = 2 * pi * k / n;
+    const double rr = 0.3 + 0.04 * std::cos(5 * t) + 0.02 * std::sin(3 * t);
+    loop.emplace_back(rr * std::cos(t), rr * std::sin(t));
+  }
+  return loop;
+}
+
 Polyline2 ellipse(double a, double b, int n) {
   Polyline2 pts;
   for (int k = 0; k < n; ++k) pts.emplace_back(a * std::cos(2 * pi * k / n), b * std::sin(2 * pi * k / n));
@@ -167,13 +178,8 @@ TEST_CASE("sqp: reaches SLSQP's optimum with fewer evaluations, in one block and
     cases.push_back({e, xs, 8});
   }
   {
-    Polyline2 loop;
     const int n = 2000;
-    for (int k = 0; k < n; ++k) {
-      const double t = 2 * pi * k / n;
-      const double rr = 0.3 + 0.04 * std::cos(5 * t) + 0.02 * std::sin(3 * t);
-      loop.emplace_back(rr * std::cos(t), rr * std::sin(t));
-    }
+    const Polyline2 loop = wavy_loop(n);
     std::vector<TargetCrossing> xs;
     for (int k = 0; k < 10; ++k) {
       const int v = k * n / 10 + 7;
@@ -449,12 +455,7 @@ TEST_CASE("sqp: slsqp_block takes SLSQP's first steps", "[target][sqp]") {
     cases.push_back({e, true, xs, 1});
   }
   {
-    Polyline2 loop;
-    for (int k = 0; k < 2000; ++k) {
-      const double t = 2 * pi * k / 2000;
-      const double rr = 0.3 + 0.04 * std::cos(5 * t) + 0.02 * std::sin(3 * t);
-      loop.emplace_back(rr * std::cos(t), rr * std::sin(t));
-    }
+    const Polyline2 loop = wavy_loop(2000);
     cases.push_back({loop, true, {{207, -loop[207].normalized(), 2 * pi / 3, true}}, 0});
   }
   {
