@@ -657,6 +657,57 @@ struct SolverData {
   int max_evaluations = 1;
   bool cancelled = false;
 
+  // TargetShapeAlgorithm::sqp where NLopt's SLSQP leads a block (slsqp_block stopped): one NLopt run
+  // is both the lead-in and the fallback. Before its evaluation lead + 1, `take_over` gets the point
+  // NLopt would have returned had it stopped after `lead` evaluations (the best point so far, by
+  // SLSQP's own rule in NLopt's slsqp.c) and returns true when the SQP solved the block from there;
+  // NLopt is then stopped. Otherwise NLopt goes on exactly as a second run from the block's start
+  // would (SLSQP is deterministic), without repeating its first `lead` evaluations.
+  struct LeadIn {
+    int lead = 0;
+    double tol = 0.0;  // the constraints' tolerance (NLopt's feasibility test)
+    std::function<bool(const std::vector<double>&)> take_over;
+    int evaluations = 0;  // this run's, so far
+    bool fired = false, took_over = false;
+    std::vector<double> best_x;
+    double best_f = std::numeric_limits<double>::infinity(), best_infeasibility = best_f;
+    bool best_feasible = false;
+    std::vector<double> last_x;  // the evaluation in progress, settled at the next one
+    double last_f = 0.0, last_infeasibility = 0.0;
+    bool last_feasible = true, pending = false;
+
+    void settle() {  // slsqp.c: "update best point so far"
+      if (pending && std::isfinite(last_f) &&
+          ((last_f < best_f && (last_feasible || !best_feasible)) || (!best_feasible && last_infeasibility < best_infeasibility))) {
+        best_f = last_f;
+        best_feasible = last_feasible;
+        best_infeasibility = last_infeasibility;
+        best_x = last_x;
+      }
+      pending = false;
+    }
+    void begin(const double* x, std::size_t n) {
+      settle();
+      if (!fired && evaluations == lead) {
+        fired = true;
+        if (take_over(best_x)) {
+          took_over = true;
+          throw nlopt::forced_stop();
+        }
+      }
+      ++evaluations;
+      last_x.assign(x, x + n);
+      last_f = std::numeric_limits<double>::quiet_NaN();
+      last_infeasibility = 0.0;
+      last_feasible = pending = true;
+    }
+    void constraint(double c) {
+      last_infeasibility = std::max(last_infeasibility, c);
+      last_feasible = last_feasible && c <= tol;
+    }
+  };
+  LeadIn* lead_in = nullptr;
+
   // Counts one evaluation and polls the progress callback at the first and then every
   // kProgressEvery; false when it asks to cancel.
   bool count_evaluation();
@@ -693,19 +744,25 @@ bool SolverData::count_evaluation() {
   return true;
 }
 
-double objective(unsigned, const double* x, double* g, void* data) {
+double objective(unsigned n, const double* x, double* g, void* data) {
   auto* d = static_cast<SolverData*>(data);
+  if (d->lead_in) d->lead_in->begin(x, n);
   if (!d->count_evaluation()) throw nlopt::forced_stop();
   d->unpack(x);
-  if (!g) return d->problem->energy_terms(d->p, d->block->terms, nullptr) / d->scale_f;
-  std::fill(d->grad.begin(), d->grad.end(), Vec2::Zero());
-  const double E = d->problem->energy_terms(d->p, d->block->terms, &d->grad);
-  const double gs = d->scale_x / d->scale_f;
-  for (std::size_t k = 0; k < d->block->points.size(); ++k) {
-    g[2 * k] = gs * d->grad[d->block->points[k]].x();
-    g[2 * k + 1] = gs * d->grad[d->block->points[k]].y();
+  double f;
+  if (!g) {
+    f = d->problem->energy_terms(d->p, d->block->terms, nullptr) / d->scale_f;
+  } else {
+    std::fill(d->grad.begin(), d->grad.end(), Vec2::Zero());
+    f = d->problem->energy_terms(d->p, d->block->terms, &d->grad) / d->scale_f;
+    const double gs = d->scale_x / d->scale_f;
+    for (std::size_t k = 0; k < d->block->points.size(); ++k) {
+      g[2 * k] = gs * d->grad[d->block->points[k]].x();
+      g[2 * k + 1] = gs * d->grad[d->block->points[k]].y();
+    }
   }
-  return E / d->scale_f;
+  if (d->lead_in) d->lead_in->last_f = f;
+  return f;
 }
 
 void constraints_fn(unsigned m, double* result, unsigned n, const double* x, double* g, void* data) {
@@ -718,6 +775,7 @@ void constraints_fn(unsigned m, double* result, unsigned n, const double* x, dou
     const int ck = d->block->constraints[k];
     if (!g) {
       result[k] = d->problem->constraint(ck, d->p);
+      if (d->lead_in) d->lead_in->constraint(result[k]);
       continue;
     }
     // A constraint touches at most three points: clear them, evaluate, scatter.
@@ -725,6 +783,7 @@ void constraints_fn(unsigned m, double* result, unsigned n, const double* x, dou
     for (int q : pts)
       if (q >= 0) d->cgrad[q] = Vec2::Zero();
     result[k] = d->problem->constraint(ck, d->p, &d->cgrad);
+    if (d->lead_in) d->lead_in->constraint(result[k]);
     double* row = g + static_cast<std::size_t>(k) * n;
     for (int q : pts) {
       if (q < 0 || d->var_of[q] < 0) continue;
@@ -913,8 +972,9 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     // SLSQP's steps replicated with our QP (detail::slsqp_block, a fraction of the cost of NLopt's
     // dense least-squares subproblem), or NLopt's own where the replica stops. Where SQP fails (the
     // linearised constraints are inconsistent, or its line search stalls) SLSQP solves the block
-    // from the block's start, as with algorithm slsqp.
-    bool by_sqp = false;
+    // from the block's start, as with algorithm slsqp; where NLopt led, that is its lead-in's own
+    // run going on (SolverData::LeadIn), so its first evaluations are not repeated.
+    bool by_sqp = false, nlopt_ran = false;
     if (o.algorithm == TargetShapeAlgorithm::sqp) {
       detail::SqpSettings ss;
       ss.scale_x = data.scale_x;
@@ -929,49 +989,68 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
       };
       const detail::SqpBlock sb{&b.points, &b.terms, &b.constraints};
       Polyline2 start = data.p;
-      bool ready = true;
       const int lead = std::max(1, std::min(kSqpBasinEvaluations, o.max_iterations - data.evaluations));
       // SLSQP's first steps, replicated with our QP (slsqp_block); NLopt's own SLSQP where the
       // replica stops (inconsistent linearised constraints, a value not finite).
       if (choose_basin && detail::slsqp_block(problem, sb, start, ss, lead, o.xtol_rel, out_of_time).done)
         choose_basin = false;
+      auto finish_by_sqp = [&] {
+        for (std::size_t k = 0; k < b.points.size(); ++k) {
+          x[2 * k] = start[b.points[k]].x() / data.scale_x;
+          x[2 * k + 1] = start[b.points[k]].y() / data.scale_x;
+        }
+        r = nlopt::SUCCESS;
+        by_sqp = true;
+      };
+      // SQP from the point the lead-in reached (none when it is not finite); true when it converged.
+      auto sqp_from = [&](const std::vector<double>& xp) {
+        for (double v : xp)
+          if (!std::isfinite(v)) return false;
+        for (std::size_t k = 0; k < b.points.size(); ++k) start[b.points[k]] = data.scale_x * Vec2(xp[2 * k], xp[2 * k + 1]);
+        return detail::sqp_block(problem, sb, start, ss).converged;
+      };
       if (choose_basin) {
-        std::vector<double> xp = x;
-        double fp = 0.0;
-        opt.set_maxeval(std::max(1, std::min(lead, o.max_iterations - data.evaluations)));
+        // NLopt's SLSQP leads: its run goes on as the fallback where the SQP fails (SolverData::LeadIn).
+        SolverData::LeadIn lead_in;
+        lead_in.lead = std::max(1, std::min(lead, o.max_iterations - data.evaluations));
+        lead_in.tol = o.constraint_tol;
+        lead_in.take_over = sqp_from;
+        data.lead_in = &lead_in;
+        opt.set_maxeval(std::max(1, o.max_iterations - data.evaluations));
         try {
-          opt.optimize(xp, fp);
-        } catch (const std::bad_alloc&) {
-          throw;
+          r = opt.optimize(x, f);
+        } catch (const nlopt::roundoff_limited&) {
+          r = nlopt::ROUNDOFF_LIMITED;
+        } catch (const nlopt::forced_stop&) {
+          r = nlopt::FORCED_STOP;
         } catch (const std::invalid_argument& e) {
+          data.lead_in = nullptr;
           throw SolverError("target shape of wire " + w + ": NLopt rejected the problem (" + e.what() + ")");
-        } catch (const std::exception&) {  // NLopt's stops (roundoff, failure): the point it reached
+        } catch (const std::bad_alloc&) {
+          data.lead_in = nullptr;
+          throw;
+        } catch (const std::runtime_error&) {
+          r = nlopt::FAILURE;
         }
+        data.lead_in = nullptr;
         if (data.cancelled) throw Cancelled();
-        opt.set_maxeval(std::max(1, o.max_iterations - data.evaluations));
-        for (double v : xp) ready = ready && std::isfinite(v);
-        for (std::size_t k = 0; k < b.points.size() && ready; ++k)
-          start[b.points[k]] = data.scale_x * Vec2(xp[2 * k], xp[2 * k + 1]);
-      }
-      if (ready) {
-        const detail::SqpOutcome so = detail::sqp_block(problem, sb, start, ss);
-        // The fallback gets what is left of the call's budgets after the lead-in and the SQP.
-        opt.set_maxeval(std::max(1, o.max_iterations - data.evaluations));
-        opt.set_maxtime(std::max(1e-3, o.max_seconds - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
-        if (so.converged) {
-          for (std::size_t k = 0; k < b.points.size(); ++k) {
-            x[2 * k] = start[b.points[k]].x() / data.scale_x;
-            x[2 * k + 1] = start[b.points[k]].y() / data.scale_x;
-          }
-          r = nlopt::SUCCESS;
-          by_sqp = true;
+        nlopt_ran = true;
+        if (lead_in.took_over) {
+          finish_by_sqp();
+        } else if (!lead_in.fired && sqp_from(x)) {  // NLopt stopped within the lead-in: SQP from its point
+          finish_by_sqp();
         }
+      } else if (detail::sqp_block(problem, sb, start, ss).converged) {  // from the replica's point or the block's start
+        finish_by_sqp();
       }
+      // The fallback gets what is left of the call's budgets after the lead-in and the SQP.
+      opt.set_maxeval(std::max(1, o.max_iterations - data.evaluations));
+      opt.set_maxtime(std::max(1e-3, o.max_seconds - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
       ++result.sqp_blocks;
       if (!by_sqp) ++result.sqp_fallbacks;
     }
     try {
-      if (!by_sqp) r = opt.optimize(x, f);
+      if (!by_sqp && !nlopt_ran) r = opt.optimize(x, f);
     } catch (const nlopt::roundoff_limited&) {
       r = nlopt::ROUNDOFF_LIMITED;
     } catch (const nlopt::forced_stop&) {

@@ -226,6 +226,30 @@ TEST_CASE("sqp: a kink that cannot be opened is left to SLSQP and reported as be
   CHECK(largest_move(a, b) < 1e-4);
 }
 
+TEST_CASE("sqp: where NLopt leads a block and the SQP fails, its one run is the fallback", "[target][sqp]") {
+  // The wire above in one block: slsqp_block refuses it (the linearised constraints contradict each
+  // other), so NLopt's SLSQP leads, and the SQP fails too. SLSQP is deterministic, so the answer
+  // must be SLSQP's own, bit for bit, and its first evaluations are not paid twice: besides
+  // SLSQP's evaluations only the replica's and the SQP's few (a restart from the block's start
+  // would add the lead-in's 10 again).
+  Polyline2 contour;
+  for (int k = 0; k <= 300; ++k) contour.emplace_back(0.3 * k / 300.0, 0.0);
+  const std::vector<TargetCrossing> xs{{100, Vec2(0, 1), 2 * pi / 3, true}, {131, Vec2(0, -1), 2 * pi / 3, true}};
+  TargetShapeOptions o;
+  o.algorithm = TargetShapeAlgorithm::slsqp;
+  const TargetShapeResult a = optimize_target_shape(contour, false, xs, o);
+  o.algorithm = TargetShapeAlgorithm::sqp;
+  const TargetShapeResult b = optimize_target_shape(contour, false, xs, o);
+  REQUIRE(b.sqp_blocks == 1);
+  REQUIRE(b.sqp_fallbacks == 1);
+  CHECK(a.iterations > 10);  // SLSQP ran past the lead-in
+  CHECK(largest_move(a, b) == 0.0);
+  CHECK(b.energy == a.energy);
+  CHECK(b.nlopt_result == a.nlopt_result);
+  CHECK(b.iterations > a.iterations);
+  CHECK(b.iterations - a.iterations < 10);
+}
+
 TEST_CASE("sqp: the progress callback can cancel it", "[target][sqp]") {
   TargetShapeOptions o;
   o.algorithm = TargetShapeAlgorithm::sqp;
