@@ -2,14 +2,15 @@
 optimum" check and its instruction counts, kept with the code rather than in /tmp):
 
     /usr/bin/python3.11 scripts/target_calls.py record CALLS.pkl [NAME...]
-    /usr/bin/python3.11 scripts/target_calls.py replay CALLS.pkl RESULTS.pkl [--root CHECKOUT] [--only K]
+    /usr/bin/python3.11 scripts/target_calls.py replay CALLS.pkl RESULTS.pkl [--root CHECKOUT] [--only K] [--case NAME]
     /usr/bin/python3.11 scripts/target_calls.py compare A.pkl B.pkl
 
 record: every call of native.optimize_target_shape made by pipeline.solve(hook_patterns=1) (as Live
 solves) on the Table 2 stand-ins and the bundled globe (or the cases named), with its inputs.
-replay: runs the recorded calls through --root's module (default this checkout's) and keeps the
-results; under `valgrind --tool=callgrind --toggle-collect='wiresculpt::python::*'` the counts are
-the solver's instructions. --only K replays call K alone.
+replay: runs the recorded calls (--only K: call K alone; --case NAME: that case's) through --root's
+module (default this checkout's) and keeps the results. Under `valgrind --tool=callgrind
+--toggle-collect='*optimize*'` the counts are the solver's instructions (the release module is
+stripped; a RelWithDebInfo build names the functions).
 compare: per call, the largest distance between the two results' points, the change of each wire's
 largest and RMS distance to its contour, and whether every crossing's status is the same; prints
 the calls that differ by more than 0.1 mm or in a status, and a summary.
@@ -65,7 +66,7 @@ def record(out, names):
     print(f"{len(calls)} calls recorded into {out}")
 
 
-def replay(calls_path, out, root, only):
+def replay(calls_path, out, root, only, case=None):
     sys.path.insert(0, os.path.join(os.path.abspath(root), "addon"))
     from wiresculpt import native  # noqa: E402
 
@@ -74,7 +75,7 @@ def replay(calls_path, out, root, only):
         calls = pickle.load(f)
     results = []
     for k, c in enumerate(calls):
-        if only is not None and k != only:
+        if (only is not None and k != only) or (case is not None and c["case"] != case):
             continue
         r = module.optimize_target_shape(c["contour"], c["closed"], c["specs"], c["options"], None)
         results.append({"case": c["case"], "index": k, "points": [tuple(map(float, p)) for p in r["points"]],
@@ -124,6 +125,7 @@ def main(argv=None):
     p.add_argument("out", nargs="?")
     p.add_argument("--root", default=ROOT)
     p.add_argument("--only", type=int)
+    p.add_argument("--case", help="replay only the calls of this case")
     p = sub.add_parser("compare")
     p.add_argument("a")
     p.add_argument("b")
@@ -131,7 +133,7 @@ def main(argv=None):
     if args.command == "record":
         record(args.out, [c for c in CASES if not args.names or any(n in c for n in args.names)])
     elif args.command == "replay":
-        replay(args.calls, args.out, args.root, args.only)
+        replay(args.calls, args.out, args.root, args.only, args.case)
     else:
         sys.exit(1 if compare(args.a, args.b) else 0)
 
