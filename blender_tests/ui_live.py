@@ -120,8 +120,7 @@ def latest_wins():
         seen["latest_results"] = live.STATE.results[shown:]  # the first position's verdict never shown
         seen["latest_line"] = live.line()
         seen["latest_z_solved"] = dict(live.STATE.solved[2])["Slice A"][11]  # matrix row 2, column 3
-        # Live idles a second before it is turned off: its idle ticks (every TICK_SECONDS) are timed too.
-        bpy.app.timers.register(guarded(seen, turn_off), first_interval=1.0)
+        bpy.app.timers.register(guarded(seen, turn_off), first_interval=0.05)
         return None
 
     bpy.app.timers.register(guarded(seen, wait), first_interval=0.01)

@@ -4,8 +4,7 @@ show the verdict (docs/user-guide.md, Live).
 A bpy.app.timers callback (tick, every TICK_SECONDS while nothing changes, every
 ACTIVE_TICK_SECONDS while planes move or a job runs) compares a snapshot of the slicing planes'
 and the target's matrix_world (and the ticked contours) with the last one it saw. A snapshot that
-stayed the same for SETTLE_SECONDS (counted from the depsgraph update that evaluated it) and
-differs from the one solved (or being solved) starts a LiveJob on
+stayed the same for SETTLE_SECONDS and differs from the one solved (or being solved) starts a LiveJob on
 a worker thread: slice_and_pick then pipeline.solve with the hook search limited to the
 layering's own pattern (hook_patterns=1) and the user's relayer_rounds. Latest position wins: a
 running job whose snapshot is no longer current is cancelled (its cancel event; it is never waited
@@ -64,18 +63,9 @@ class LiveState:
         self.drawn_at = None  # time.monotonic() of the overlay's latest draw of the preview
         self.job_seconds = None  # the shown verdict's LiveJob wall time (the bench reads it)
         self.drawn = 0  # overlay draws of the preview (the test reads it)
-        self.ticked_at = 0.0  # time.monotonic() of the previous tick
 
 
 STATE = LiveState()
-_EVALUATED = [0.0]  # time.monotonic() of the latest depsgraph update (_evaluated)
-
-
-@bpy.app.handlers.persistent
-def _evaluated(*_args):
-    """depsgraph_update_post: when the scene was last evaluated (a moved plane's matrix_world
-    changes then, not when its location is set)."""
-    _EVALUATED[0] = time.monotonic()
 
 
 def triangle_count(obj):
@@ -209,13 +199,7 @@ def _step():
         STATE.job = job = None
     now = time.monotonic()
     if key != STATE.seen:
-        # The snapshot changed since the previous tick and has held since the depsgraph update that
-        # evaluated it, when one came since then. A slow viewport redraws in between (under
-        # software OpenGL each redraw takes 0.2 s, and the timer only runs between redraws):
-        # counting the settle time from this tick would wait one more redraw before solving.
-        changed = _EVALUATED[0]
-        STATE.seen, STATE.seen_since = key, changed if STATE.ticked_at < changed <= now else now
-    STATE.ticked_at = now
+        STATE.seen, STATE.seen_since = key, now
     settled = now - STATE.seen_since >= SETTLE_SECONDS
     if job is None and settled and key != STATE.solved:
         message = refusal(scene.wiresculpt.target)
@@ -314,13 +298,11 @@ def register():
     LIVE_HOOKS.append(live_changed)
     bpy.app.handlers.load_pre.append(_load_pre)
     bpy.app.handlers.load_post.append(_load_post)
-    bpy.app.handlers.depsgraph_update_post.append(_evaluated)
 
 
 def unregister():
     stop()
-    for handlers, fn in ((bpy.app.handlers.load_pre, _load_pre), (bpy.app.handlers.load_post, _load_post),
-                         (bpy.app.handlers.depsgraph_update_post, _evaluated)):
+    for handlers, fn in ((bpy.app.handlers.load_pre, _load_pre), (bpy.app.handlers.load_post, _load_post)):
         if fn in handlers:
             handlers.remove(fn)
     if live_changed in LIVE_HOOKS:
