@@ -6,6 +6,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <numbers>
 #include <sstream>
@@ -669,6 +670,7 @@ struct SolverData {
     std::function<bool(const std::vector<double>&)> take_over;
     int evaluations = 0;  // this run's, so far
     bool fired = false, took_over = false;
+    std::exception_ptr error;  // what take_over threw (NLopt's wrapper would turn it into a failure)
     std::vector<double> best_x;
     double best_f = std::numeric_limits<double>::infinity(), best_infeasibility = best_f;
     bool best_feasible = false;
@@ -688,12 +690,16 @@ struct SolverData {
     }
     void begin(const double* x, std::size_t n) {
       settle();
-      if (!fired && evaluations == lead) {
+      // No finite f in the lead-in (only where the points were not finite): no SQP, as before.
+      if (!fired && evaluations == lead && !best_x.empty()) {
         fired = true;
-        if (take_over(best_x)) {
-          took_over = true;
+        try {
+          took_over = take_over(best_x);
+        } catch (...) {  // e.g. Cancelled: stop NLopt, the caller throws it again
+          error = std::current_exception();
           throw nlopt::forced_stop();
         }
+        if (took_over) throw nlopt::forced_stop();
       }
       ++evaluations;
       last_x.assign(x, x + n);
@@ -702,7 +708,7 @@ struct SolverData {
       last_feasible = pending = true;
     }
     void constraint(double c) {
-      last_infeasibility = std::max(last_infeasibility, c);
+      last_infeasibility = last_infeasibility >= c ? last_infeasibility : c;  // slsqp.c's MAX2, NaN included
       last_feasible = last_feasible && c <= tol;
     }
   };
@@ -1033,6 +1039,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
           r = nlopt::FAILURE;
         }
         data.lead_in = nullptr;
+        if (lead_in.error) std::rethrow_exception(lead_in.error);
         if (data.cancelled) throw Cancelled();
         nlopt_ran = true;
         if (lead_in.took_over) {
@@ -1043,7 +1050,8 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
       } else if (detail::sqp_block(problem, sb, start, ss).converged) {  // from the replica's point or the block's start
         finish_by_sqp();
       }
-      // The fallback gets what is left of the call's budgets after the lead-in and the SQP.
+      // The fallback gets what is left of the call's budgets after the lead-in and the SQP (where
+      // NLopt led, its run was the fallback: its budget was what was left before the lead-in).
       opt.set_maxeval(std::max(1, o.max_iterations - data.evaluations));
       opt.set_maxtime(std::max(1e-3, o.max_seconds - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
       ++result.sqp_blocks;

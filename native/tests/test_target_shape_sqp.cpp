@@ -250,6 +250,22 @@ TEST_CASE("sqp: where NLopt leads a block and the SQP fails, its one run is the 
   CHECK(b.iterations - a.iterations < 10);
 }
 
+TEST_CASE("sqp: a cancel while NLopt's lead-in run goes on as the fallback reaches the caller", "[target][sqp]") {
+  // The wire above: the progress polls at evaluation 1 (the replica's first) and at 17 and 33
+  // (kProgressEvery; in NLopt's run, after the SQP's failed take-over at 11) each cancel the call.
+  Polyline2 contour;
+  for (int k = 0; k <= 300; ++k) contour.emplace_back(0.3 * k / 300.0, 0.0);
+  const std::vector<TargetCrossing> xs{{100, Vec2(0, 1), 2 * pi / 3, true}, {131, Vec2(0, -1), 2 * pi / 3, true}};
+  TargetShapeOptions o;
+  o.algorithm = TargetShapeAlgorithm::sqp;
+  for (int stop_at : {2, 3, 4}) {
+    int polls = 0;
+    const ProgressFn stop = [&](std::string_view, double) { return ++polls < stop_at; };
+    CHECK_THROWS_AS(optimize_target_shape(contour, false, xs, o, stop), Cancelled);
+    CHECK(polls == stop_at);
+  }
+}
+
 TEST_CASE("sqp: the progress callback can cancel it", "[target][sqp]") {
   TargetShapeOptions o;
   o.algorithm = TargetShapeAlgorithm::sqp;
