@@ -397,12 +397,12 @@ def markdown(data):
             "software OpenGL): a slicing plane moved 1 mm along its normal, back and forth, five times, "
             "with Live on; each from the moment the plane's location is set to the overlay's first draw "
             "of the new verdict's wires (median; *job*: the median wall time of the live job itself, slicing, solve and the preview's curves, on its worker thread). It includes Live's settle time "
-            f"({LIVE_SETTLE_MS} ms, counted from the depsgraph update that evaluated the move), its "
-            "timer, re-slicing and the solve, and Blender's own redraws, which here take longer than the "
-            "solve: under software OpenGL a redraw of the 3D view takes about 0.2 s, the viewport's "
-            "default anti-aliasing redraws it 8 times after every change, and the timer only runs "
-            "between redraws, so the round trip is about three redraws (the move's, the one the solve "
-            "runs beside, the verdict's) plus the job; with a GPU a redraw takes milliseconds. The globe "
+            f"({LIVE_SETTLE_MS} ms), its timer, re-slicing and the solve, and Blender's own redraws, "
+            "which here take longer than the solve: under software OpenGL a redraw of the 3D view takes "
+            "about 0.2 s, the viewport's default anti-aliasing redraws it 8 times after every change, and "
+            "the timer only runs between redraws, so the round trip is about four redraws (the move's, the "
+            "one after the timer first sees it, the one the solve runs beside, the verdict's) plus the job; "
+            "with a GPU a redraw takes milliseconds (docs/method-target-shape.md, issue 17 seventh round). The globe "
             "is the bundled example (scripts/examples/globe), which has no counterpart in the paper.",
             "",
         ]
