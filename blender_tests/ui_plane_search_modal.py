@@ -7,6 +7,7 @@ import json
 import math
 import os
 import sys
+import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [os.path.join(os.path.dirname(HERE), "addon"), HERE]
@@ -24,6 +25,7 @@ R = 0.125
 HINGE = (((0, 0, 0), (0, 0, 0.7 * R)), ((0, 0, 0), (0, 0, -0.7 * R)), ((0, math.pi / 2, 0), (-0.3 * R, 0, 0)),
          ((math.pi / 2, 0, 0), (0, 0, 0)), ((0, math.pi / 2, 0), (0.8 * R, 0, 0)))
 seen = {}
+HELD = []  # the HeldSearch of the cancelled search, while it runs
 
 
 def state():
@@ -58,18 +60,40 @@ def invoke():
         return sorted(bpy.ops.wiresculpt.find_planes('INVOKE_DEFAULT'))
 
 
+class HeldSearch:
+    """plane_search.nearby waiting (polling its cancel) up to HOLD_SECONDS before it searches, so the
+    cancel surely lands mid-search: the hinged globe's whole search takes under a second, less than
+    a few software-OpenGL redraws before the cancel's timer runs."""
+
+    HOLD_SECONDS = 30.0
+
+    def __init__(self):
+        from wiresculpt import plane_search
+
+        self.module, self.original = plane_search, plane_search.nearby
+
+        def held(*args, cancel=None, **kwargs):
+            until = time.monotonic() + self.HOLD_SECONDS
+            while not (cancel and cancel()) and time.monotonic() < until:
+                time.sleep(0.005)
+            return self.original(*args, cancel=cancel, **kwargs)
+        plane_search.nearby = held
+
+    def restore(self):
+        self.module.nearby = self.original
+
+
 def start_cancelled():
     seen["before_cancel"] = state()
+    HELD.append(HeldSearch())
     seen["cancel_invoke"] = invoke()
     seen["cancel_running"] = ops.running()
     seen["status_while_running"] = ops.JOB.status() if ops.JOB else ""
-    # soon after the start, so that a fast machine has not finished the search yet (a slow one only
-    # cancels it earlier)
     bpy.app.timers.register(guarded(seen, cancel_mid_search), first_interval=0.1)
 
 
 def cancel_mid_search():
-    seen["cancel_still_running"] = ops.running()  # the search takes seconds: still at work
+    seen["cancel_still_running"] = ops.running()  # held until the cancel: still at work
     seen["cancel_op"] = sorted(bpy.ops.wiresculpt.find_planes_cancel())
     bpy.app.timers.register(guarded(seen, check_cancelled), first_interval=0.2)
 
@@ -77,6 +101,7 @@ def cancel_mid_search():
 def check_cancelled():
     if ops.running():
         return 0.2
+    HELD.pop().restore()
     seen["cancel_unchanged"] = state() == seen.pop("before_cancel")
     seen["cancel_no_candidates"] = ops.RESULT is None
     bpy.app.timers.register(guarded(seen, start_full), first_interval=0.1)
