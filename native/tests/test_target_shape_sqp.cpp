@@ -10,6 +10,7 @@
 #include <numbers>
 #include <nlopt.hpp>
 #include <random>
+#include <utility>
 
 #include "target_shape_sqp.hpp"
 #include "wiresculpt/error.hpp"
@@ -209,12 +210,19 @@ TEST_CASE("sqp: reaches SLSQP's optimum with fewer evaluations, in one block and
   }
 }
 
-TEST_CASE("sqp: a kink that cannot be opened is left to SLSQP and reported as before", "[target][sqp]") {
-  // Crossings 31 mm apart on a straight wire leave one free point between them; crossing 0 wants
-  // it above the wire, crossing 1 below: the linearised constraints contradict each other.
+namespace {
+// Crossings 31 mm apart on a straight 0.3 m wire leave one free point between them; crossing 0
+// wants it above the wire, crossing 1 below: the linearised constraints contradict each other.
+std::pair<Polyline2, std::vector<TargetCrossing>> contradicting_kinks() {
   Polyline2 contour;
   for (int k = 0; k <= 300; ++k) contour.emplace_back(0.3 * k / 300.0, 0.0);
-  const std::vector<TargetCrossing> xs{{100, Vec2(0, 1), 2 * pi / 3, true}, {131, Vec2(0, -1), 2 * pi / 3, true}};
+  return {contour, {{100, Vec2(0, 1), 2 * pi / 3, true}, {131, Vec2(0, -1), 2 * pi / 3, true}}};
+}
+}  // namespace
+
+TEST_CASE("sqp: a kink that cannot be opened is left to SLSQP and reported as before", "[target][sqp]") {
+  // contradicting_kinks(): no free point can open both kinks.
+  const auto [contour, xs] = contradicting_kinks();
   TargetShapeOptions o;
   const TargetShapeResult a = optimize_target_shape(contour, false, xs, o);
   o.algorithm = TargetShapeAlgorithm::sqp;
@@ -232,9 +240,7 @@ TEST_CASE("sqp: where NLopt leads a block and the SQP fails, its one run is the 
   // must be SLSQP's own, bit for bit, and its first evaluations are not paid twice: besides
   // SLSQP's evaluations only the replica's and the SQP's few (a restart from the block's start
   // would add the lead-in's 10 again).
-  Polyline2 contour;
-  for (int k = 0; k <= 300; ++k) contour.emplace_back(0.3 * k / 300.0, 0.0);
-  const std::vector<TargetCrossing> xs{{100, Vec2(0, 1), 2 * pi / 3, true}, {131, Vec2(0, -1), 2 * pi / 3, true}};
+  const auto [contour, xs] = contradicting_kinks();
   TargetShapeOptions o;
   o.algorithm = TargetShapeAlgorithm::slsqp;
   const TargetShapeResult a = optimize_target_shape(contour, false, xs, o);
@@ -253,9 +259,7 @@ TEST_CASE("sqp: where NLopt leads a block and the SQP fails, its one run is the 
 TEST_CASE("sqp: a cancel while NLopt's lead-in run goes on as the fallback reaches the caller", "[target][sqp]") {
   // The wire above: the progress polls at evaluation 1 (the replica's first) and at 17 and 33
   // (kProgressEvery; in NLopt's run, after the SQP's failed take-over at 11) each cancel the call.
-  Polyline2 contour;
-  for (int k = 0; k <= 300; ++k) contour.emplace_back(0.3 * k / 300.0, 0.0);
-  const std::vector<TargetCrossing> xs{{100, Vec2(0, 1), 2 * pi / 3, true}, {131, Vec2(0, -1), 2 * pi / 3, true}};
+  const auto [contour, xs] = contradicting_kinks();
   TargetShapeOptions o;
   o.algorithm = TargetShapeAlgorithm::sqp;
   for (int stop_at : {2, 3, 4}) {
