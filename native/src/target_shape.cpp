@@ -981,6 +981,22 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     // from the block's start, as with algorithm slsqp; where NLopt led, that is its lead-in's own
     // run going on (SolverData::LeadIn), so its first evaluations are not repeated.
     bool by_sqp = false, nlopt_ran = false;
+    // NLopt from x (updated in place), its stops as result codes; a rejected problem is the solver's error.
+    auto run_nlopt = [&]() -> nlopt::result {
+      try {
+        return opt.optimize(x, f);
+      } catch (const nlopt::roundoff_limited&) {
+        return nlopt::ROUNDOFF_LIMITED;
+      } catch (const nlopt::forced_stop&) {
+        return nlopt::FORCED_STOP;
+      } catch (const std::invalid_argument& e) {
+        throw SolverError("target shape of wire " + w + ": NLopt rejected the problem (" + e.what() + ")");
+      } catch (const std::bad_alloc&) {
+        throw;
+      } catch (const std::runtime_error&) {
+        return nlopt::FAILURE;
+      }
+    };
     if (o.algorithm == TargetShapeAlgorithm::sqp) {
       detail::SqpSettings ss;
       ss.scale_x = data.scale_x;
@@ -1021,24 +1037,15 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
         lead_in.lead = std::max(1, std::min(lead, o.max_iterations - data.evaluations));
         lead_in.tol = o.constraint_tol;
         lead_in.take_over = sqp_from;
-        data.lead_in = &lead_in;
         opt.set_maxeval(std::max(1, o.max_iterations - data.evaluations));
-        try {
-          r = opt.optimize(x, f);
-        } catch (const nlopt::roundoff_limited&) {
-          r = nlopt::ROUNDOFF_LIMITED;
-        } catch (const nlopt::forced_stop&) {
-          r = nlopt::FORCED_STOP;
-        } catch (const std::invalid_argument& e) {
-          data.lead_in = nullptr;
-          throw SolverError("target shape of wire " + w + ": NLopt rejected the problem (" + e.what() + ")");
-        } catch (const std::bad_alloc&) {
-          data.lead_in = nullptr;
-          throw;
-        } catch (const std::runtime_error&) {
-          r = nlopt::FAILURE;
+        {
+          struct Attached {  // the callbacks see the lead-in only during this run
+            SolverData& d;
+            ~Attached() { d.lead_in = nullptr; }
+          } attached{data};
+          data.lead_in = &lead_in;
+          r = run_nlopt();
         }
-        data.lead_in = nullptr;
         if (lead_in.error) std::rethrow_exception(lead_in.error);
         if (data.cancelled) throw Cancelled();
         nlopt_ran = true;
@@ -1057,19 +1064,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
       ++result.sqp_blocks;
       if (!by_sqp) ++result.sqp_fallbacks;
     }
-    try {
-      if (!by_sqp && !nlopt_ran) r = opt.optimize(x, f);
-    } catch (const nlopt::roundoff_limited&) {
-      r = nlopt::ROUNDOFF_LIMITED;
-    } catch (const nlopt::forced_stop&) {
-      r = nlopt::FORCED_STOP;
-    } catch (const std::invalid_argument& e) {
-      throw SolverError("target shape of wire " + w + ": NLopt rejected the problem (" + e.what() + ")");
-    } catch (const std::bad_alloc&) {
-      throw;
-    } catch (const std::runtime_error&) {
-      r = nlopt::FAILURE;
-    }
+    if (!by_sqp && !nlopt_ran) r = run_nlopt();
     if (data.cancelled) throw Cancelled();
     bool finite = true;
     for (double v : x) finite = finite && std::isfinite(v);
