@@ -19,7 +19,7 @@ import wiresculpt  # noqa: E402
 wiresculpt.register()
 from wiresculpt import pipeline  # noqa: E402
 from wiresculpt.operators import live  # noqa: E402
-from ui_steps import globe_scene as setup, guarded, report, start_watchdog  # noqa: E402
+from ui_steps import Held, globe_scene as setup, guarded, report, start_watchdog  # noqa: E402
 
 seen = {"verdicts": [], "durations": []}
 # plane A's z (the globe's radius is 0.125): through the mesh, above it, through it again
@@ -71,29 +71,14 @@ def step(k):
     bpy.app.timers.register(guarded(seen, wait), first_interval=0.05)
 
 
-class SlowSolve:
-    """pipeline.solve waiting (polling its cancel) up to HOLD_SECONDS first, so that the second
-    move surely lands while the first position's job runs (the globe solves within a tick)."""
-
-    HOLD_SECONDS = 3.0
-
-    def __init__(self):
-        self.original = pipeline.solve
-        pipeline.solve = self.solve
-
-    def solve(self, design, material, settings, progress=None, cancel=None, **options):
-        deadline = time.monotonic() + self.HOLD_SECONDS
-        while cancel is not None and not cancel() and time.monotonic() < deadline:
-            time.sleep(0.01)
-        return self.original(design, material, settings, progress, cancel, **options)
-
-    def restore(self):
-        pipeline.solve = self.original
+# pipeline.solve waits (polling its cancel) up to this long first, so that the second move surely
+# lands while the first position's job runs (the globe solves within a tick).
+HOLD_SECONDS = 3.0
 
 
 def latest_wins():
     """Two moves: the second lands while the first's solve runs; only the last one is shown."""
-    slow = SlowSolve()
+    slow = Held(pipeline, "solve", HOLD_SECONDS)
     shown = len(live.STATE.results)
     plane().location.z = 0.04
     began = time.monotonic()

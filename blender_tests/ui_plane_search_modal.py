@@ -7,7 +7,6 @@ import json
 import math
 import os
 import sys
-import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [os.path.join(os.path.dirname(HERE), "addon"), HERE]
@@ -18,14 +17,15 @@ import wiresculpt  # noqa: E402
 
 wiresculpt.register()
 from wiresculpt.blend.mesh import import_mesh  # noqa: E402
+from wiresculpt import plane_search  # noqa: E402
 from wiresculpt.operators import plane_search as ops  # noqa: E402
-from ui_steps import guarded, report, start_watchdog  # noqa: E402
+from ui_steps import Held, guarded, report, start_watchdog  # noqa: E402
 
 R = 0.125
 HINGE = (((0, 0, 0), (0, 0, 0.7 * R)), ((0, 0, 0), (0, 0, -0.7 * R)), ((0, math.pi / 2, 0), (-0.3 * R, 0, 0)),
          ((math.pi / 2, 0, 0), (0, 0, 0)), ((0, math.pi / 2, 0), (0.8 * R, 0, 0)))
 seen = {}
-HELD = []  # the HeldSearch of the cancelled search, while it runs
+HELD = []  # the Held search of the cancel step, while it runs
 
 
 def state():
@@ -60,32 +60,15 @@ def invoke():
         return sorted(bpy.ops.wiresculpt.find_planes('INVOKE_DEFAULT'))
 
 
-class HeldSearch:
-    """plane_search.nearby waiting (polling its cancel) up to HOLD_SECONDS before it searches, so the
-    cancel surely lands mid-search: the hinged globe's whole search takes under a second, less than
-    a few software-OpenGL redraws before the cancel's timer runs."""
-
-    HOLD_SECONDS = 30.0
-
-    def __init__(self):
-        from wiresculpt import plane_search
-
-        self.module, self.original = plane_search, plane_search.nearby
-
-        def held(*args, cancel=None, **kwargs):
-            until = time.monotonic() + self.HOLD_SECONDS
-            while not (cancel and cancel()) and time.monotonic() < until:
-                time.sleep(0.005)
-            return self.original(*args, cancel=cancel, **kwargs)
-        plane_search.nearby = held
-
-    def restore(self):
-        self.module.nearby = self.original
+# The cancelled search waits (polling its cancel) up to this long before it searches, so the cancel
+# surely lands mid-search: the hinged globe's whole search takes under a second, less than a few
+# software-OpenGL redraws before the cancel's timer runs.
+HOLD_SECONDS = 30.0
 
 
 def start_cancelled():
     seen["before_cancel"] = state()
-    HELD.append(HeldSearch())
+    HELD.append(Held(plane_search, "nearby", HOLD_SECONDS))
     seen["cancel_invoke"] = invoke()
     seen["cancel_running"] = ops.running()
     seen["status_while_running"] = ops.JOB.status() if ops.JOB else ""

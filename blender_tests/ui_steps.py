@@ -1,6 +1,7 @@
 """Shared by the ui_*.py scripts the modal tests run in a Blender with a window: timer steps that
 print what they saw as one line `MODAL {json}` and quit, and never hang the test."""
 import json
+import time
 
 import bpy
 
@@ -20,6 +21,25 @@ def guarded(seen, step):
             report(seen, error=f"{type(exc).__name__}: {exc}")
             return None
     return run
+
+
+class Held:
+    """`module.name` made to wait, polling its `cancel` keyword, up to `seconds` before it runs, so
+    that a test's cancel or next move surely lands while the work is under way however fast the
+    work has become. restore() puts the original back."""
+
+    def __init__(self, module, name, seconds):
+        self.module, self.name, self.original = module, name, getattr(module, name)
+
+        def held(*args, cancel=None, **kwargs):
+            until = time.monotonic() + seconds
+            while cancel is not None and not cancel() and time.monotonic() < until:
+                time.sleep(0.01)
+            return self.original(*args, cancel=cancel, **kwargs)
+        setattr(module, name, held)
+
+    def restore(self):
+        setattr(self.module, self.name, self.original)
 
 
 def start_watchdog(seen, seconds=60.0):
