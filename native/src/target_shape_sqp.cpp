@@ -397,18 +397,24 @@ bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::Vector
     }
     return {0.0, std::ldexp(1e-8 * dmax, 2 * (i - 1))};
   };
-  Eigen::MatrixXd Wd(n, n);
   std::array<signed char, kShifts> known{};  // 0 untried, 1 positive definite, -1 not
-  int factored = -1;                          // the shift `factor` holds
+  // Two slots for the shifted matrix and its factor: a shift that works keeps its slot (the next
+  // try goes to the other), so the first definite shift, always the last that worked, need not be
+  // factored again after a later try failed.
+  std::array<Eigen::MatrixXd, 2> Wd{Eigen::MatrixXd(n, n), Eigen::MatrixXd(n, n)};
+  std::array<Eigen::LLT<Eigen::MatrixXd>, 2> llt{Eigen::LLT<Eigen::MatrixXd>(n), Eigen::LLT<Eigen::MatrixXd>(n)};
+  std::array<int, 2> held{-1, -1};  // the shift each slot holds
+  int slot = 0;                     // where the next try goes
   auto definite = [&](int i) {
     if (known[i] == 0) {
       const auto [rho, delta] = shift(i);
-      Wd = W;
-      if (rho > 0.0) Wd += rho * AtA;
-      Wd.diagonal().array() += delta;
-      factor.compute(Wd);
-      factored = i;
-      known[i] = factor.info() == Eigen::Success && Wd.allFinite() ? 1 : -1;
+      Wd[slot] = W;
+      if (rho > 0.0) Wd[slot] += rho * AtA;
+      Wd[slot].diagonal().array() += delta;
+      llt[slot].compute(Wd[slot]);
+      held[slot] = i;
+      known[i] = llt[slot].info() == Eigen::Success && Wd[slot].allFinite() ? 1 : -1;
+      if (known[i] > 0) slot ^= 1;
     }
     return known[i] > 0;
   };
@@ -436,12 +442,10 @@ bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::Vector
     else lo = mid + 1;
   }
   if (hi >= kShifts) return false;
-  if (factored != hi) {
-    known[hi] = 0;
-    if (!definite(hi)) return false;
-  }
+  const int kept = held[0] == hi ? 0 : 1;  // hi worked after every other success, so it was kept
   start = hi;
-  W.swap(Wd);
+  factor = llt[kept];
+  W.swap(Wd[kept]);
   return true;
 }
 
