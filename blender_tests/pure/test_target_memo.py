@@ -9,6 +9,7 @@ import numpy as np
 
 from wiresculpt import native, pipeline
 from wiresculpt.core.materials import PRESETS
+from wiresculpt.core.polylines import point_array
 from wiresculpt.core.settings import defaults
 from wiresculpt.stages import layering, target_shape
 
@@ -171,6 +172,27 @@ class Derived(unittest.TestCase):
         h = memo.bisector(design, c, 0)
         c["hook"] = -c["hook"]
         np.testing.assert_array_equal(memo.bisector(design, c, 0), -h)
+
+
+class PointArray(unittest.TestCase):
+    """core.polylines.point_array, the memo's conversion of a contour: the numbers np.asarray gives."""
+
+    def test_the_same_floats_as_numpy(self):
+        rng = np.random.default_rng(7)
+        contour = (rng.normal(size=(500, 3)) * 10.0 ** rng.integers(-12, 3, size=(500, 1))).tolist()
+        contour[3] = [1, 2, 3]  # ints too
+        got = point_array(contour)
+        want = np.asarray(contour, dtype=np.float64)
+        self.assertEqual(got.dtype, np.float64)
+        self.assertEqual(got.shape, (500, 3))
+        self.assertTrue(np.array_equal(got, want))  # bit for bit (no NaN here)
+
+    def test_what_is_not_a_list_of_points_fails_as_numpy_does(self):
+        for bad in ([[1.0, 2.0, 3.0], [4.0, 5.0]], [[1.0, 2.0], [3.0, 4.0, 5.0, 6.0]], [[1.0, 2.0, "x"]]):
+            with self.assertRaises(ValueError, msg=bad):
+                point_array(bad)
+        self.assertEqual(point_array(np.zeros((2, 3))).shape, (2, 3))
+        self.assertEqual(point_array([]).shape, (0,))
 
 
 if __name__ == "__main__":

@@ -19,7 +19,7 @@ import numpy as np
 from .. import native
 from ..core.design import crossing_direction, model_size
 from ..core.frames import plane_frame, to_2d, to_3d
-from ..core.polylines import polyline_length
+from ..core.polylines import point_array, polyline_length
 from . import layering
 
 FAILED = ("too_close", "infeasible", "open_end")
@@ -225,7 +225,7 @@ class Memo:
         list of lists took ~0.1 ms each time, twice per wire and round)."""
         entry = self._arrays.get(wire["name"])
         if entry is None or entry[0] is not wire["contour"]:
-            entry = (wire["contour"], np.asarray(wire["contour"], dtype=np.float64))
+            entry = (wire["contour"], point_array(wire["contour"]))
             self._arrays[wire["name"]] = entry
         return entry[1]
 
