@@ -552,10 +552,10 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
     lambda = mu;
     // Converged: feasible after a full step (only the QP's own step, or its correction, measures
     // how far x is from a KKT point; one that backtracking shrank to nothing does not) that was
-    // negligible or changed f by at most ftol_rel of it (SLSQP's own test).
+    // at most settle_step, or changed f by at most ftol_rel of it (SLSQP's own test).
     const bool feasible = violation(c) <= settings.constraint_tol;
     if (feasible && alpha == 1.0 &&
-        (step <= settings.step_tol || std::abs(f_old - f) <= settings.ftol_rel * std::abs(f))) {
+        (step <= std::max(settings.step_tol, settings.settle_step) || std::abs(f_old - f) <= settings.ftol_rel * std::abs(f))) {
       out.converged = true;
       break;
     }

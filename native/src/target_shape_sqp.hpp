@@ -31,6 +31,14 @@ struct SqpSettings {
   double regularization = 1e-3;  ///< w_r
   double constraint_tol = 1e-10;
   double step_tol = 1e-9;        ///< stop when the step is this small (scaled units) and feasible
+  /// Also stop after a full step of at most this (scaled units) to a feasible point, without the
+  /// QP that would confirm it: Newton's next step there is smaller still (about the square of
+  /// this one where it converges superlinearly), so the point stops within about this of where
+  /// that QP would have ended it (1e-4: 1.5 nm at the default 15 mm minimum segment; mostly the
+  /// confirming QP would not have moved it at all), for a seventh fewer QPs
+  /// (docs/method-target-shape.md, issue 17 eighth round). 0: every step is confirmed by one
+  /// more QP (step_tol, ftol_rel).
+  double settle_step = 1e-4;
   double ftol_rel = 1e-12;       ///< or when f changed by at most this fraction of it and feasible
   int max_iterations = 60;
   /// Where the search for the convexifying shift starts (with and without active constraints),

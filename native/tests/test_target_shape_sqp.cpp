@@ -557,6 +557,67 @@ TEST_CASE("sqp: slsqp_block takes SLSQP's first steps", "[target][sqp]") {
   CHECK(p == problem.initial());
 }
 
+TEST_CASE("sqp: a settled step ends the block within that step of the confirmed optimum", "[target][sqp]") {
+  // settle_step stops after a full step of at most that size (scaled) to a feasible point, without
+  // the QP that would confirm it. Against the same blocks run until the QP's own step vanishes
+  // (settle_step 0, the reference): every point within settle_step (scaled) of it, never more
+  // iterations, and fewer in most (or the test would compare nothing). The blocks: every window
+  // of 8 points of the 2 m wavy loop with ten crossings, and the whole of a small ellipse, each
+  // started with its points pushed 1-2 mm off the contour so that it has somewhere to go.
+  TargetShapeOptions o;
+  o.friction = 0.0;
+  o.max_bend = 2 * pi / 3;
+  detail::SqpSettings ss;
+  ss.scale_x = o.min_segment;
+  ss.scale_f = 2.0 * 1.5 * o.min_segment * o.min_segment;
+  ss.min_segment = o.min_segment;
+  ss.regularization = o.regularization;
+  ss.constraint_tol = o.constraint_tol;
+  ss.ftol_rel = o.ftol_rel;
+  REQUIRE(ss.settle_step > ss.step_tol);  // the default settles
+  int fewer = 0, blocks = 0;
+  std::vector<std::pair<Polyline2, std::vector<TargetCrossing>>> wires;
+  {
+    const int n = 2000;
+    const Polyline2 loop = wavy_loop(n);
+    std::vector<TargetCrossing> xs;
+    for (int k = 0; k < 10; ++k) {
+      const int v = k * n / 10 + 7;
+      xs.push_back({v, (k % 2 ? 1.0 : -1.0) * loop[v].normalized(), 2 * pi / 3, true});
+    }
+    wires.emplace_back(loop, xs);
+    wires.emplace_back(ellipse(0.06, 0.04, 1200), std::vector<TargetCrossing>{});
+  }
+  for (const auto& [contour, xs] : wires) {
+    const TargetShapeProblem problem(contour, true, xs, o);
+    const int m = static_cast<int>(problem.initial().size());
+    Polyline2 start = problem.initial();
+    for (int i = 0; i < m; ++i)
+      if (!problem.fixed()[i]) start[i] += 1e-3 * Vec2(1.0 + std::sin(0.7 * i), std::cos(1.3 * i));
+    std::vector<TestBlock> tbs;
+    if (xs.empty()) tbs.push_back(block_of(problem, 0, m));
+    for (int from = 0; !xs.empty() && from < m; from += 4) tbs.push_back(block_of(problem, from, from + 8));
+    for (const TestBlock& tb : tbs) {
+      const detail::SqpBlock block{&tb.points, &tb.terms, &tb.constraints};
+      detail::SqpSettings confirmed = ss;
+      confirmed.settle_step = 0.0;
+      Polyline2 want = start, got = start;
+      const detail::SqpOutcome a = detail::sqp_block(problem, block, want, confirmed);
+      const detail::SqpOutcome r = detail::sqp_block(problem, block, got, ss);
+      if (!a.converged) continue;  // a kink the SQP leaves to SLSQP
+      ++blocks;
+      REQUIRE(r.converged);
+      CHECK(r.iterations <= a.iterations);
+      fewer += r.iterations < a.iterations;
+      double worst = 0.0;
+      for (int i = 0; i < m; ++i) worst = std::max(worst, (got[i] - want[i]).norm());
+      CHECK(worst <= ss.settle_step * ss.scale_x);
+    }
+  }
+  CHECK(blocks > 15);
+  CHECK(fewer * 2 > blocks);
+}
+
 TEST_CASE("sqp: convexify takes the first shift of its sequence that makes W positive definite", "[target][sqp]") {
   // Against the plain scan of the sequence (none; ρ = 4^k d for k = 0..10 when some λ > 0; then
   // δ = 4^j 1e-8 d with ρ at its last value), from every kind of starting guess.
