@@ -378,7 +378,7 @@ Eigen::VectorXd sqp_lagrangian_gradient(const TargetShapeProblem& problem, const
 // instead of one factorisation per shift (the δ of a window far from its contour took 12 of them at
 // every iteration). The shift taken is the same.
 bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::VectorXd& lambda,
-               Eigen::LLT<Eigen::MatrixXd>& factor, std::array<int, 2>& guess) {
+               Eigen::LLT<Eigen::MatrixXd>& factor, std::array<int, 2>& guess, double* delta_taken) {
   constexpr int kShifts = 61;
   const Eigen::Index n = W.rows();
   Eigen::MatrixXd AtA = Eigen::MatrixXd::Zero(n, n);
@@ -446,6 +446,7 @@ bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::Vector
   start = hi;
   factor = llt[kept];
   W.swap(Wd[kept]);
+  if (delta_taken) *delta_taken = shift(hi).second;
   return true;
 }
 
@@ -481,7 +482,8 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
     // Eigen's Cholesky accepts NaN, so anything not finite ends here (SLSQP decides).
     if (!std::isfinite(f) || !g.allFinite() || !c.allFinite() || !A.allFinite()) return out;
     Eigen::MatrixXd W = model.hessian(p, lambda);
-    if (!W.allFinite() || !convexify(W, A, lambda, factor, shift)) return out;
+    double delta = 0.0;
+    if (!W.allFinite() || !convexify(W, A, lambda, factor, shift, &delta)) return out;
     // Inconsistent linearised constraints (a kink that cannot be opened from here): the caller's
     // SLSQP decides, as it always did.
     if (!solve_convex_qp(factor, g, A, c, d, mu)) return out;
@@ -552,10 +554,11 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
     lambda = mu;
     // Converged: feasible after a full step (only the QP's own step, or its correction, measures
     // how far x is from a KKT point; one that backtracking shrank to nothing does not) that was
-    // at most settle_step, or changed f by at most ftol_rel of it (SLSQP's own test).
+    // negligible, or a Newton step (no δI: a δ-damped one converges only linearly) of at most
+    // settle_step, or that changed f by at most ftol_rel of it (SLSQP's own test).
     const bool feasible = violation(c) <= settings.constraint_tol;
-    if (feasible && alpha == 1.0 &&
-        (step <= std::max(settings.step_tol, settings.settle_step) || std::abs(f_old - f) <= settings.ftol_rel * std::abs(f))) {
+    const double settled = delta == 0.0 ? std::max(settings.step_tol, settings.settle_step) : settings.step_tol;
+    if (feasible && alpha == 1.0 && (step <= settled || std::abs(f_old - f) <= settings.ftol_rel * std::abs(f))) {
       out.converged = true;
       break;
     }

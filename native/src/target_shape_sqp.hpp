@@ -31,13 +31,13 @@ struct SqpSettings {
   double regularization = 1e-3;  ///< w_r
   double constraint_tol = 1e-10;
   double step_tol = 1e-9;        ///< stop when the step is this small (scaled units) and feasible
-  /// Also stop after a full step of at most this (scaled units) to a feasible point, without the
-  /// QP that would confirm it: Newton's next step there is smaller still (about the square of
-  /// this one where it converges superlinearly), so the point stops within about this of where
-  /// that QP would have ended it (1e-4: 1.5 nm at the default 15 mm minimum segment; mostly the
-  /// confirming QP would not have moved it at all), for a seventh fewer QPs
-  /// (docs/method-target-shape.md, issue 17 eighth round). 0: every step is confirmed by one
-  /// more QP (step_tol, ftol_rel).
+  /// Also stop after a full Newton step (convexify added no δI) of at most this (scaled units) to
+  /// a feasible point, without the QP that would confirm it: Newton's next step there is smaller
+  /// still (about the square of this one, which converges quadratically), so the point stops
+  /// within about this of where that QP would have ended it (1e-4: 1.5 µm at the default 15 mm
+  /// minimum segment; mostly the confirming QP would not have moved it at all), for a seventh
+  /// fewer SQP iterations (docs/method-target-shape.md, issue 17 eighth round). 0: every step is
+  /// confirmed by one more QP (step_tol, ftol_rel).
   double settle_step = 1e-4;
   double ftol_rel = 1e-12;       ///< or when f changed by at most this fraction of it and feasible
   int max_iterations = 60;
@@ -100,9 +100,10 @@ Eigen::VectorXd sqp_lagrangian_gradient(const TargetShapeProblem& problem, const
 /// gets W's Cholesky factor. `guess` (with / without active constraints) is where the search
 /// starts and is set to where it ended; in exact arithmetic it changes no result (in floating point
 /// a factorisation that succeeds at one shift could fail at a much larger one; not seen). False when
-/// no shift works. Exposed for its tests.
+/// no shift works. `delta_taken`, when non-null, gets the δ of the shift taken (0: W's curvature is the
+/// Lagrangian's along the active constraints, so the step is Newton's). Exposed for its tests.
 bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::VectorXd& lambda,
-               Eigen::LLT<Eigen::MatrixXd>& factor, std::array<int, 2>& guess);
+               Eigen::LLT<Eigen::MatrixXd>& factor, std::array<int, 2>& guess, double* delta_taken = nullptr);
 
 /// Minimises ½ dᵀ W d + gᵀ d subject to A d + c <= 0 (rows of A as a dense matrix), W symmetric
 /// positive definite: the dual active-set method of Goldfarb and Idnani (1983). Returns false when
