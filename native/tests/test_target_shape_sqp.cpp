@@ -625,7 +625,8 @@ TEST_CASE("sqp: a settled step ends the block within that step of the confirmed 
 
 TEST_CASE("sqp: convexify takes the first shift of its sequence that makes W positive definite", "[target][sqp]") {
   // Against the plain scan of the sequence (none; ρ = 4^k d for k = 0..10 when some λ > 0; then
-  // δ = 4^j 1e-8 d with ρ at its last value), from every kind of starting guess.
+  // δ = 4^j 1e-8 d with ρ at its last value), from every kind of starting guess: the same matrix,
+  // its factor, and the δ it reports.
   std::mt19937 rng(11);
   int with_rho = 0, with_delta = 0;
   for (int trial = 0; trial < 300; ++trial) {
@@ -659,8 +660,10 @@ TEST_CASE("sqp: convexify takes the first shift of its sequence that makes W pos
       std::array<int, 2> guess{g, g};
       Eigen::MatrixXd got = W;
       Eigen::LLT<Eigen::MatrixXd> factor(n);
-      REQUIRE(detail::convexify(got, A, lambda, factor, guess));
+      double delta_taken = -1.0;
+      REQUIRE(detail::convexify(got, A, lambda, factor, guess, &delta_taken));
       CHECK(got == want);
+      CHECK(delta_taken == delta);  // what settle_step asks: was W's curvature shifted by δI
       CHECK((factor.matrixL().toDenseMatrix() * factor.matrixU().toDenseMatrix() - want).cwiseAbs().maxCoeff() <=
             1e-9 * want.cwiseAbs().maxCoeff());
     }
