@@ -76,6 +76,18 @@ Polyline2 wavy_loop(int n) {
   return loop;
 }
 
+// Ten active crossings on a closed contour of n points, evenly spaced from point 7, their kinks
+// opening alternately inwards and outwards (-p̂, +p̂, ...).
+std::vector<TargetCrossing> ten_alternating_kinks(const Polyline2& loop) {
+  const int n = static_cast<int>(loop.size());
+  std::vector<TargetCrossing> xs;
+  for (int k = 0; k < 10; ++k) {
+    const int v = k * n / 10 + 7;
+    xs.push_back({v, (k % 2 ? 1.0 : -1.0) * loop[v].normalized(), 2 * pi / 3, true});
+  }
+  return xs;
+}
+
 Polyline2 ellipse(double a, double b, int n) {
   Polyline2 pts;
   for (int k = 0; k < n; ++k) pts.emplace_back(a * std::cos(2 * pi * k / n), b * std::sin(2 * pi * k / n));
@@ -179,14 +191,8 @@ TEST_CASE("sqp: reaches SLSQP's optimum with fewer evaluations, in one block and
     cases.push_back({e, xs, 8});
   }
   {
-    const int n = 2000;
-    const Polyline2 loop = wavy_loop(n);
-    std::vector<TargetCrossing> xs;
-    for (int k = 0; k < 10; ++k) {
-      const int v = k * n / 10 + 7;
-      xs.push_back({v, (k % 2 ? 1.0 : -1.0) * loop[v].normalized(), 2 * pi / 3, true});
-    }
-    cases.push_back({loop, xs, 8});
+    const Polyline2 loop = wavy_loop(2000);
+    cases.push_back({loop, ten_alternating_kinks(loop), 8});
   }
   for (const Case& cs : cases) {
     TargetShapeOptions o;
@@ -583,14 +589,8 @@ TEST_CASE("sqp: a settled step ends the block within that step of the confirmed 
   int fewer = 0, blocks = 0;
   std::vector<std::pair<Polyline2, std::vector<TargetCrossing>>> wires;
   {
-    const int n = 2000;
-    const Polyline2 loop = wavy_loop(n);
-    std::vector<TargetCrossing> xs;
-    for (int k = 0; k < 10; ++k) {
-      const int v = k * n / 10 + 7;
-      xs.push_back({v, (k % 2 ? 1.0 : -1.0) * loop[v].normalized(), 2 * pi / 3, true});
-    }
-    wires.emplace_back(loop, xs);
+    const Polyline2 loop = wavy_loop(2000);
+    wires.emplace_back(loop, ten_alternating_kinks(loop));
     wires.emplace_back(ellipse(0.06, 0.04, 1200), std::vector<TargetCrossing>{});
   }
   for (const auto& [contour, xs] : wires) {
