@@ -5,7 +5,7 @@ optimum" check and its instruction counts, kept with the code rather than in /tm
     /usr/bin/python3.11 scripts/target_calls.py replay CALLS.pkl RESULTS.pkl [--root CHECKOUT] [--only K] [--case NAME]
     /usr/bin/python3.11 scripts/target_calls.py compare A.pkl B.pkl
 
-record: every call of native.optimize_target_shape made by pipeline.solve(hook_patterns=1) (as Live
+record: every wire solved by native.optimize_target_shapes in pipeline.solve(hook_patterns=1) (as Live
 solves) on the Table 2 stand-ins and the bundled globe (or the cases named), with its inputs.
 replay: runs the recorded calls (--only K: call K alone; --case NAME: that case's) through --root's
 module (default this checkout's) and keeps the results. Under `valgrind --tool=callgrind
@@ -39,17 +39,18 @@ def record(out, names):
         cases = {c["name"]: c for c in json.load(f)["cases"]}
     module = native.require()
     calls = []
-    real = module.optimize_target_shape
+    real = module.optimize_target_shapes
 
     class Recording:
         def __getattr__(self, name):
             return getattr(module, name)
 
         @staticmethod
-        def optimize_target_shape(contour, closed, specs, options, progress=None):
-            calls.append({"case": current[0], "contour": copy.deepcopy(contour), "closed": closed,
-                          "specs": copy.deepcopy(specs), "options": copy.deepcopy(options)})
-            return real(contour, closed, specs, options, progress)
+        def optimize_target_shapes(problems, progress=None, threads=2):
+            calls.extend({"case": current[0], "contour": copy.deepcopy(p["points"]), "closed": p["closed"],
+                          "specs": copy.deepcopy(p["crossings"]), "options": copy.deepcopy(p["options"])}
+                         for p in problems)
+            return real(problems, progress, threads)
 
     current = [None]
     original = native.require

@@ -191,6 +191,12 @@ def optimize_target_shape(points, closed, crossings, options=None, progress=None
                                            {} if options is None else options, progress)
 
 
+def optimize_target_shapes(problems, progress=None, threads=2):
+    """optimize_target_shape of each problem ({"points", "closed", "crossings", "options"}), on up to
+    `threads` (1 or 2) native threads: the results in the problems' order, each as if solved alone."""
+    return require().optimize_target_shapes(_with_points(problems, "problems", "points", 2), progress, threads)
+
+
 def forces_and_rest(wires, crossings, steps, material, settings=None, progress=None):
     """Forces, cuts, rest shapes and load capacity (Sec. 4.4), in the design's key names.
     wires: [{"name", "origin", "normal", "target" (n, 3) m, "closed", "cut"}]."""

@@ -91,6 +91,15 @@ class BindingInput(unittest.TestCase):
              "options['max_sweeps']: expected an integer, got str"),
             (lambda: m.optimize_target_shape(LINE, False, [], {"min_segment": float("inf")}),
              "options['min_segment']: expected a finite number, got inf"),
+            (lambda: m.optimize_target_shapes([{"points": LINE, "closed": False}, {"points": LINE}]),
+             "problems[1]: the key 'closed' is missing"),
+            (lambda: m.optimize_target_shapes([{"points": LINE, "closed": False, "crossings": [{"bisector": [0, 1]}]}]),
+             "problems[0]['crossings'][0]: the key 'vertex' is missing"),
+            (lambda: m.optimize_target_shapes([{"points": LINE, "closed": False, "options": {"window": "8"}}]),
+             "problems[0]['options']['window']: expected an integer, got str"),
+            (lambda: m.optimize_target_shapes([{"points": LINE, "closed": False, "start": []}]),
+             "problems[0]: unknown key 'start' (expected points, closed, crossings, options)"),
+            (lambda: m.optimize_target_shapes([], None, 3), "target shapes: threads must be 1 or 2"),
         ]
         self.check_all(cases)
 

@@ -52,13 +52,13 @@ class Coupling(unittest.TestCase):
 
         class Counting:  # counts the native target-shape solves of every round
             def __getattr__(_self, name):
-                if name != "optimize_target_shape":
+                if name != "optimize_target_shapes":
                     return getattr(module, name)
 
-                def solve(*args):
-                    self.calls += 1
-                    self.starts += "start" in args[3]
-                    return module.optimize_target_shape(*args)
+                def solve(problems, *args):
+                    self.calls += len(problems)
+                    self.starts += sum("start" in p["options"] for p in problems)
+                    return module.optimize_target_shapes(problems, *args)
                 return solve
         saved_require = native.require
         native.require = Counting

@@ -19,6 +19,14 @@ STAND_INS = ["duck", "teddy", "airplane", "car", "chair", "length-3.0m"]
 REFERENCE = {"sweep_ftol": 0.0, "sweep_tol": 1e-9, "max_iterations": 1_000_000, "algorithm": "slsqp"}
 
 
+def one_by_one(solve):
+    """A stand-in for native.optimize_target_shapes that hands each problem to `solve`, a function
+    with native.optimize_target_shape's arguments, one after the other."""
+    def solve_all(problems, progress=None, threads=2):
+        return [solve(p["points"], p["closed"], p["crossings"], p["options"], progress) for p in problems]
+    return solve_all
+
+
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)
 class AgainstConvergedSweeps(unittest.TestCase):
     @classmethod
@@ -45,8 +53,7 @@ class AgainstConvergedSweeps(unittest.TestCase):
             calls.append(options)
             return real(points, closed, crossings, {**(options or {}), **REFERENCE}, progress)
 
-        with mock.patch.object(target_shape, "MAX_THREADS", 1), \
-                mock.patch.object(target_shape.native, "optimize_target_shape", converged):
+        with mock.patch.object(target_shape.native, "optimize_target_shapes", one_by_one(converged)):
             target_shape.run(design, scene.material, scene.settings)
         self.assertTrue(calls)
         self.assertTrue(all(o["sweep_ftol"] == target_shape.SWEEP_FTOL for o in calls))  # what REFERENCE replaced
@@ -90,7 +97,7 @@ class AgainstConvergedSweeps(unittest.TestCase):
             keys.append(target_shape.Memo.key(points, closed, crossings, options) + (options["max_bend"],))
             return real(points, closed, crossings, options, progress)
 
-        with mock.patch.object(target_shape.native, "optimize_target_shape", counted):
+        with mock.patch.object(target_shape.native, "optimize_target_shapes", one_by_one(counted)):
             solved = pipeline.solve(design, scene.material, scene.settings)
         self.assertGreaterEqual(len(solved["stages"]["relayering"]["rounds"]), 2)  # the case it is about
         self.assertEqual(len(keys), len(set(keys)))
@@ -114,7 +121,7 @@ class AgainstConvergedSweeps(unittest.TestCase):
         for name in ["globe"] + STAND_INS[:-1]:
             with self.subTest(name):
                 scene, _V, _F, _planes, design = bench_scenes.load_and_slice(self.scenes[name])
-                with mock.patch.object(target_shape.native, "optimize_target_shape", counted):
+                with mock.patch.object(target_shape.native, "optimize_target_shapes", one_by_one(counted)):
                     warm = pipeline.solve(copy.deepcopy(design), scene.material, scene.settings, hook_patterns=1)
                 with mock.patch.object(target_shape.Memo, "remember_start", lambda *_args: None):
                     cold = pipeline.solve(copy.deepcopy(design), scene.material, scene.settings, hook_patterns=1)
@@ -153,7 +160,7 @@ class AgainstConvergedSweeps(unittest.TestCase):
                 windows = copy.deepcopy(design)
                 target_shape.run(windows, scene.material, scene.settings)
                 block = copy.deepcopy(design)
-                with mock.patch.object(target_shape.native, "optimize_target_shape", one_block):
+                with mock.patch.object(target_shape.native, "optimize_target_shapes", one_by_one(one_block)):
                     target_shape.run(block, scene.material, scene.settings)
                 for ww, wb in zip(windows["wires"], block["wires"]):
                     self.assertAlmostEqual(ww["target_max_distance"], wb["target_max_distance"], delta=1e-4,
@@ -167,33 +174,52 @@ class AgainstConvergedSweeps(unittest.TestCase):
         self.assertTrue([m for m in sizes if 28 < m <= 32])
 
 
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
 class Threads(unittest.TestCase):
-    """solve_all keeps the order of its jobs and hands back the memo's results untouched."""
+    """solve_all: one native call for the wires to solve, on two threads, each result that of its
+    wire solved alone (solve_job), in the jobs' order, with the memo's results handed back untouched."""
 
-    def test_order_and_reused_results(self):
+    @classmethod
+    def setUpClass(cls):
+        scene, _V, _F, _planes, cls.design = bench_scenes.load_and_slice(GLOBE)
+        layering.run(cls.design, scene.material, scene.settings)
+        cls.settings = scene.settings
+
+    def jobs(self):
+        size = target_shape.model_size(self.design)
+        return [target_shape.prepare_wire(self.design, w, self.settings, size) for w in self.design["wires"]]
+
+    def test_each_result_is_its_wire_alone_in_order(self):
+        jobs = self.jobs()
+        self.assertGreaterEqual(len(jobs), 3)
         kept = {"kept": True}
-        jobs = [{"result": None, "n": k} for k in range(5)]
-        jobs[2]["result"] = kept
+        jobs[1]["result"] = kept
+        jobs.insert(0, jobs.pop())  # another order than the native call's own
+        alone = [target_shape.solve_job(job) for job in jobs]
+        with mock.patch.object(target_shape, "MAX_THREADS", 2), mock.patch.object(target_shape.os, "cpu_count", lambda: 2):
+            together = target_shape.solve_all(jobs)
+        self.assertIs(together[2], kept)
+        for a, b in zip(alone, together):
+            if a is kept:
+                continue
+            self.assertEqual(a["points"].tolist(), b["points"].tolist())
+            self.assertEqual(a["crossings"], b["crossings"])
+            self.assertEqual(a["energy"], b["energy"])
 
-        def solve(job, _progress=None):
-            return job["result"] if job["result"] is not None else {"n": job["n"]}
+    def test_a_bad_wire_is_named_and_cancelling_stops_all(self):
+        jobs = self.jobs()
+        jobs[1]["specs"] = [dict(jobs[1]["specs"][0], vertex=10**6)]
+        with self.assertRaisesRegex(ValueError, self.design["wires"][1]["name"]):
+            target_shape.solve_all(jobs)
+        asked = []
 
-        with mock.patch.object(target_shape, "solve_job", solve), mock.patch.object(target_shape, "MAX_THREADS", 2):
-            results = target_shape.solve_all(jobs)
-        self.assertIs(results[2], kept)
-        self.assertEqual([r.get("n") for k, r in enumerate(results) if k != 2], [0, 1, 3, 4])
+        def stop(stage, fraction):
+            asked.append(fraction)
+            return len(asked) < 2
 
-    def test_an_error_on_a_thread_reaches_the_caller(self):
-        def solve(job, _progress=None):
-            if job["n"] == 1:
-                raise native.Cancelled()
-            return {}
-
-        jobs = [{"result": None, "n": k} for k in range(3)]
-        with mock.patch.object(target_shape, "solve_job", solve), mock.patch.object(target_shape, "MAX_THREADS", 2), \
-                mock.patch.object(target_shape.os, "cpu_count", lambda: 2):
-            with self.assertRaises(native.Cancelled):
-                target_shape.solve_all(jobs)
+        with self.assertRaises(native.Cancelled):
+            target_shape.solve_all(self.jobs(), stop)
+        self.assertEqual(len(asked), 2)
 
 
 if __name__ == "__main__":

@@ -1,4 +1,5 @@
-// optimize_target_shape: convert, release the GIL around the core call, convert back.
+// optimize_target_shape and optimize_target_shapes: convert, release the GIL around the core call,
+// convert back.
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
@@ -15,9 +16,9 @@ namespace py = pybind11;
 namespace wiresculpt::python {
 namespace {
 
-std::vector<TargetCrossing> to_crossings(py::handle items) {
+std::vector<TargetCrossing> to_crossings(py::handle items, const std::string& path) {
   std::vector<TargetCrossing> out;
-  each_item(items, "crossings", [&](py::handle item, const std::string& where) {
+  each_item(items, path, [&](py::handle item, const std::string& where) {
     TargetCrossing x;
     const auto seen = read_fields(
         item, where,
@@ -30,9 +31,9 @@ std::vector<TargetCrossing> to_crossings(py::handle items) {
   return out;
 }
 
-TargetShapeOptions to_options(py::handle d) {
+TargetShapeOptions to_options(py::handle d, const std::string& path) {
   TargetShapeOptions o;
-  read_fields(d, "options",
+  read_fields(d, path,
               {field::number("min_segment", o.min_segment), field::number("max_bend", o.max_bend),
                field::number("spacing", o.spacing), field::number("regularization", o.regularization),
                field::number("friction", o.friction), field::number("ftol_rel", o.ftol_rel),
@@ -58,15 +59,7 @@ TargetShapeOptions to_options(py::handle d) {
   return o;
 }
 
-py::dict optimize(const py::object& points, const py::object& closed_arg, const py::object& crossings,
-                  const py::object& options, const py::object& progress) {
-  const Polyline2 contour = to_points<2>(points, "points");
-  const bool closed = to_bool(closed_arg, "closed");
-  const std::vector<TargetCrossing> xs = to_crossings(crossings);
-  const TargetShapeOptions o = to_options(options);
-  PythonProgress reporter(progress);
-  const ProgressFn fn = reporter.fn();
-  const TargetShapeResult r = reporter.run([&] { return optimize_target_shape(contour, closed, xs, o, fn); });
+py::dict to_dict(const TargetShapeResult& r) {
   py::list statuses;
   for (const TargetCrossingStatus& s : r.crossings)
     statuses.append(py::dict(py::arg("status") = s.status, py::arg("realised") = s.realised,
@@ -83,6 +76,39 @@ py::dict optimize(const py::object& points, const py::object& closed_arg, const 
                   py::arg("sweeps") = r.sweeps, py::arg("sqp_blocks") = r.sqp_blocks, py::arg("sqp_fallbacks") = r.sqp_fallbacks, py::arg("seconds") = r.seconds,
                   py::arg("nlopt_result") = r.nlopt_result, py::arg("energy") = r.energy,
                   py::arg("feasible") = r.feasible, py::arg("warnings") = r.warnings);
+}
+
+py::dict optimize(const py::object& points, const py::object& closed_arg, const py::object& crossings,
+                  const py::object& options, const py::object& progress) {
+  const Polyline2 contour = to_points<2>(points, "points");
+  const bool closed = to_bool(closed_arg, "closed");
+  const std::vector<TargetCrossing> xs = to_crossings(crossings, "crossings");
+  const TargetShapeOptions o = to_options(options, "options");
+  PythonProgress reporter(progress);
+  const ProgressFn fn = reporter.fn();
+  return to_dict(reporter.run([&] { return optimize_target_shape(contour, closed, xs, o, fn); }));
+}
+
+py::list optimize_all(const py::object& problems, const py::object& progress, const py::object& threads_arg) {
+  std::vector<TargetShapeJob> jobs;
+  each_item(problems, "problems", [&](py::handle item, const std::string& where) {
+    TargetShapeJob job;
+    const auto seen = read_fields(
+        item, where,
+        {{"points", [&](py::handle v, const std::string& at) { job.contour = to_points<2>(v, at); }},
+         field::boolean("closed", job.closed),
+         {"crossings", [&](py::handle v, const std::string& at) { job.crossings = to_crossings(v, at); }},
+         {"options", [&](py::handle v, const std::string& at) { job.options = to_options(v, at); }}});
+    require_keys(seen, where, {"points", "closed"});
+    jobs.push_back(std::move(job));
+  });
+  const int threads = to_integer(threads_arg, "threads");
+  PythonProgress reporter(progress);
+  const ProgressFn fn = reporter.fn();
+  const std::vector<TargetShapeResult> results = reporter.run([&] { return optimize_target_shapes(jobs, threads, fn); });
+  py::list out;
+  for (const TargetShapeResult& r : results) out.append(to_dict(r));
+  return out;
 }
 
 }  // namespace
@@ -107,6 +133,18 @@ Returns {"points": (m, 2), "crossing_vertices": [int], "crossings": [{"status", 
 "iterations", "sweeps", "sqp_blocks", "sqp_fallbacks", "seconds", "nlopt_result", "energy", "feasible",
 "warnings"}.
 Raises ValueError naming the wire and crossing for bad input.)");
+  m.def("optimize_target_shapes", &optimize_all, py::arg("problems"), py::arg("progress") = py::none(),
+        py::arg("threads") = 2,
+        R"(optimize_target_shape of every problem, on this thread and, with threads=2, one more (the
+GIL released throughout).
+
+problems: list of {"points", "closed", "crossings" (default []), "options" (default {})}, each
+as optimize_target_shape's arguments of those names; progress: optional callable(stage, fraction)
+-> bool, called on this thread only, False cancels every problem (raises Cancelled); threads: 1 or 2.
+Returns the list of optimize_target_shape's results, in the problems' order: each the same as that
+problem solved alone (the problems are taken the dearest first, which changes only how long the
+call takes). Raises the error of the first problem (in their order) that has one, after all
+stopped: ValueError naming the problem, wire and crossing for bad input.)");
 }
 
 }  // namespace wiresculpt::python

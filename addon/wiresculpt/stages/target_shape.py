@@ -12,7 +12,6 @@ import math
 import os
 import re
 import time
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -53,8 +52,10 @@ SWEEP_FTOL = 1e-3
 # crossings and verdict; at 24 or 16 some (the Chair's 26-point backrest) reach other optima
 # (docs/method-target-shape.md, issue 17).
 ONE_BLOCK_POINTS = 28
-# Wires are independent problems: up to this many are solved at once, each on its own thread (the
-# native call releases the GIL; each result depends only on its own wire, so the order is kept).
+# Wires are independent problems: a round's are solved in one native call (optimize_target_shapes)
+# on up to this many threads, the dearest first, with the GIL released throughout; each result
+# depends only on its own wire, so the order is kept. (Issue 17, ninth round: a Python thread pool
+# per round cost about a millisecond more on the Duck and the Car.)
 MAX_THREADS = 2
 # Blocks by the Newton SQP (led by SLSQP's first evaluations where a kink's arrangement is chosen,
 # SLSQP where it fails): 2-4.5x fewer instructions than SLSQP alone, the same distances and crossings
@@ -136,16 +137,15 @@ def finish_wire(job, result, memo=None):
 
 
 def solve_all(jobs, native_progress=None):
-    """The results of solve_job for every job, in order: up to MAX_THREADS at once."""
+    """The results of solve_job for every job, in order: the ones to solve in one native call, on up
+    to MAX_THREADS threads."""
     todo = [k for k, job in enumerate(jobs) if job["result"] is None]
-    threads = min(MAX_THREADS, os.cpu_count() or 1, len(todo))
-    if threads <= 1:
-        return [solve_job(job, native_progress) for job in jobs]
+    threads = max(1, min(MAX_THREADS, os.cpu_count() or 1, len(todo)))
     results = [job["result"] for job in jobs]
-    with ThreadPoolExecutor(max_workers=threads, thread_name_prefix="wiresculpt-target") as pool:
-        futures = {k: pool.submit(solve_job, jobs[k], native_progress) for k in todo}
-        for k, future in futures.items():  # waits for all; the first error (e.g. Cancelled) is raised
-            results[k] = future.result()
+    problems = [{"points": jobs[k]["contour"], "closed": jobs[k]["closed"], "crossings": jobs[k]["specs"],
+                 "options": jobs[k]["options"]} for k in todo]
+    for k, result in zip(todo, native.optimize_target_shapes(problems, native_progress, threads) if todo else []):
+        results[k] = result
     return results
 
 

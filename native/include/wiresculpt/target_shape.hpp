@@ -214,6 +214,25 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
                                         const TargetShapeOptions& options = {},
                                         const ProgressFn& progress = {});
 
+/// One wire's problem for optimize_target_shapes: optimize_target_shape's arguments.
+struct TargetShapeJob {
+  Polyline2 contour;
+  bool closed = false;
+  std::vector<TargetCrossing> crossings;
+  TargetShapeOptions options;
+};
+
+/// optimize_target_shape of every job, on the calling thread and, with threads = 2, one more
+/// started here: each thread takes the next job, the dearest first by a guess from the contour's
+/// length (only the order of the work, never a result, depends on it). Every result is the one
+/// optimize_target_shape returns for that job alone, and they come back in the jobs' order.
+/// Only the calling thread calls `progress` (with a job's own fractions, and while it waits for
+/// the other thread's last job); when it asks to stop, both threads stop at their next
+/// evaluation. After both threads stopped, throws the error of the first job (in the jobs'
+/// order) that threw one: InputError naming its wire, or Cancelled. threads: 1 or 2.
+std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetShapeJob>& jobs, int threads = 2,
+                                                      const ProgressFn& progress = {});
+
 /// The optimisation problem of one wire, exposed for tests and diagnostics: the initial
 /// resampled polyline and every term with its analytic gradient with respect to ALL points
 /// (fixed ones included). optimize_target_shape builds one of these.

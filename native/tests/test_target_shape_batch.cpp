@@ -1,0 +1,125 @@
+// optimize_target_shapes (a round's wires on two threads) against optimize_target_shape of each
+// wire alone: the same results bit for bit, in the jobs' order whatever order the threads take
+// them in; errors and cancellation as one call's.
+#include <catch2/catch.hpp>
+#include <atomic>
+#include <cmath>
+#include <mutex>
+#include <numbers>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "wiresculpt/error.hpp"
+#include "wiresculpt/target_shape.hpp"
+
+using namespace wiresculpt;
+using Catch::Matchers::Contains;
+
+namespace {
+constexpr double pi = std::numbers::pi;
+
+// A closed wavy loop r = r0 + a cos(lobes t) of n points with `kinks` active crossings whose
+// bisectors alternate outwards and inwards.
+TargetShapeJob loop(const std::string& name, double r0, double a, int lobes, int n, int kinks) {
+  TargetShapeJob job;
+  job.closed = true;
+  for (int k = 0; k < n; ++k) {
+    const double t = 2 * pi * k / n;
+    const double r = r0 + a * std::cos(lobes * t);
+    job.contour.emplace_back(r * std::cos(t), r * std::sin(t));
+  }
+  for (int k = 0; k < kinks; ++k) {
+    const int v = k * n / kinks + 3;
+    job.crossings.push_back({v, (k % 2 ? -1.0 : 1.0) * job.contour[v].normalized(), 2 * pi / 3, true});
+  }
+  job.options.wire_name = name;
+  job.options.sweep_ftol = 1e-3;
+  job.options.algorithm = TargetShapeAlgorithm::sqp;
+  return job;
+}
+
+// Short loops first, so that the dearest-first order differs from the jobs' order: one-block
+// wires (under 32 points) and windowed ones (the 0.6 m and 1 m loops).
+std::vector<TargetShapeJob> round_of_wires() {
+  return {loop("Alpha", 0.05, 0.005, 3, 200, 2), loop("Bravo", 0.09, 0.01, 4, 300, 3), loop("Charlie", 0.16, 0.02, 5, 600, 4),
+          loop("Delta", 0.06, 0.0, 1, 200, 0), loop("Echo", 0.1, 0.015, 3, 400, 4)};
+}
+
+void check_same(const TargetShapeResult& a, const TargetShapeResult& b) {
+  REQUIRE(a.points.size() == b.points.size());
+  for (std::size_t i = 0; i < a.points.size(); ++i) CHECK(a.points[i] == b.points[i]);
+  CHECK(a.energy == b.energy);
+  CHECK(a.max_distance == b.max_distance);
+  CHECK(a.iterations == b.iterations);
+  CHECK(a.crossing_vertices == b.crossing_vertices);
+  REQUIRE(a.crossings.size() == b.crossings.size());
+  for (std::size_t c = 0; c < a.crossings.size(); ++c) {
+    CHECK(a.crossings[c].status == b.crossings[c].status);
+    CHECK(a.crossings[c].message == b.crossings[c].message);
+  }
+  CHECK(a.nlopt_result == b.nlopt_result);
+  CHECK(a.feasible == b.feasible);
+}
+}  // namespace
+
+TEST_CASE("target shapes: each result is its wire's alone, in the jobs' order, on one or two threads", "[target]") {
+  const std::vector<TargetShapeJob> jobs = round_of_wires();
+  std::vector<TargetShapeResult> alone;
+  for (const TargetShapeJob& j : jobs) alone.push_back(optimize_target_shape(j.contour, j.closed, j.crossings, j.options));
+  // The jobs differ (else a swapped pair would pass): each wire's own number of points.
+  std::set<std::size_t> sizes;
+  for (const TargetShapeResult& r : alone) sizes.insert(r.points.size());
+  REQUIRE(sizes.size() == jobs.size());
+  for (int threads : {1, 2}) {
+    for (int rep = 0; rep < 3; ++rep) {
+      const std::vector<TargetShapeResult> together = optimize_target_shapes(jobs, threads);
+      REQUIRE(together.size() == jobs.size());
+      for (std::size_t k = 0; k < jobs.size(); ++k) {
+        INFO("threads " << threads << ", wire " << jobs[k].options.wire_name);
+        check_same(together[k], alone[k]);
+      }
+    }
+  }
+  CHECK(optimize_target_shapes({}, 2).empty());
+}
+
+TEST_CASE("target shapes: progress is asked on the calling thread only, and it cancels every wire", "[target]") {
+  const std::vector<TargetShapeJob> jobs = round_of_wires();
+  const std::thread::id caller = std::this_thread::get_id();
+  std::mutex seen_mutex;
+  std::set<std::thread::id> seen;
+  int calls = 0;
+  const ProgressFn count = [&](std::string_view, double f) {
+    const std::lock_guard<std::mutex> lock(seen_mutex);
+    seen.insert(std::this_thread::get_id());
+    ++calls;
+    CHECK(f >= 0.0);
+    CHECK(f <= 1.0);
+    return true;
+  };
+  optimize_target_shapes(jobs, 2, count);
+  CHECK(calls > 0);
+  CHECK(seen == std::set<std::thread::id>{caller});
+
+  // Stopped at the third question: both threads stop, and the call ends in Cancelled.
+  int asked = 0;
+  const ProgressFn stop = [&](std::string_view, double) { return ++asked < 3; };
+  CHECK_THROWS_AS(optimize_target_shapes(jobs, 2, stop), Cancelled);
+  CHECK(asked == 3);  // never asked again once it said stop
+}
+
+TEST_CASE("target shapes: the first bad wire in the jobs' order is the error, after every thread stopped",
+          "[target]") {
+  std::vector<TargetShapeJob> jobs = round_of_wires();
+  jobs[3].crossings = {{5000, Vec2(1, 0), 2.0, true}};  // past the contour's 200 points
+  jobs[4].crossings = {{1, Vec2(0, 0), 2.0, true}};     // a zero bisector
+  for (int threads : {1, 2}) {
+    INFO("threads " << threads);
+    CHECK_THROWS_AS(optimize_target_shapes(jobs, threads), InputError);
+    CHECK_THROWS_WITH(optimize_target_shapes(jobs, threads), Contains("Delta") && !Contains("Echo"));
+  }
+  CHECK_THROWS_WITH(optimize_target_shapes(jobs, 0), Contains("threads must be 1 or 2"));
+  CHECK_THROWS_WITH(optimize_target_shapes(jobs, 3), Contains("threads must be 1 or 2"));
+}
