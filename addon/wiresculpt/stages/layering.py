@@ -1,10 +1,9 @@
 """Layering and assembly order (Sec. 4.1-4.2): crossings, a hook per crossing, the order."""
 import math
 
-import numpy as np
-
 from .. import native
 from ..core import settings as settings_table
+from ..core.polylines import point_array
 
 
 def knob(settings, key):
@@ -23,11 +22,14 @@ def settings_for(material, settings):
     }
 
 
-def wire_specs(design, key="contour"):
-    """The design's wires as the native network functions take them."""
+def wire_specs(design, key="contour", arrays=None):
+    """The design's wires as the native network functions take them; `arrays`: their `key` points
+    already as float64 arrays, in the wires' order."""
+    if arrays is None:
+        arrays = [point_array(w[key]) for w in design["wires"]]
     return [{"name": w["name"], "origin": w["plane"]["origin"], "normal": w["plane"]["normal"],
-             "points": np.asarray(w[key], dtype=np.float64), "closed": w["closed"]}
-            for w in design["wires"]]
+             "points": a, "closed": w["closed"]}
+            for w, a in zip(design["wires"], arrays)]
 
 
 def run(design, material, settings, native_progress=None, forbidden=(), too_close=None, arrays=False):
@@ -77,20 +79,21 @@ def run(design, material, settings, native_progress=None, forbidden=(), too_clos
             f"({stats['seconds']:.3f} s)")
 
 
-def recheck(design, material, settings, native_progress=None):
+def recheck(design, material, settings, native_progress=None, contours=None):
     """Eq. 1 for every prefix of the design's assembly with its current hooks (after a later
-    stage nulled crossings). Returns the native verdict dict; `native_progress` as for run()."""
+    stage nulled crossings). Returns the native verdict dict; `native_progress` as for run();
+    `contours`: the wires' contours already as float64 arrays (wire_specs)."""
     hooks = [c["hook"] for c in design["crossings"]]
-    return native.check_assembly(wire_specs(design), hooks, design["assembly_steps"],
+    return native.check_assembly(wire_specs(design, arrays=contours), hooks, design["assembly_steps"],
                                  settings_for(material, settings), native_progress)
 
 
-def recheck_verdict(design, material, settings, cause, count, native_progress=None):
+def recheck_verdict(design, material, settings, cause, count, native_progress=None, contours=None):
     """The layering's verdict after a later stage nulled `count` crossings for `cause` (a
     sentence naming them): re-checks the assembly (recheck) and, when it no longer stands, sets
     `stable` false with a `reason` naming the cause and the step that fails. Returns the number
-    of LPs the re-check solved."""
-    verdict = recheck(design, material, settings, native_progress)
+    of LPs the re-check solved. `contours` as for recheck."""
+    verdict = recheck(design, material, settings, native_progress, contours)
     if not verdict["stable"] and design["stable"]:
         step = design["assembly_steps"][verdict["failed_step"]]
         names = " and ".join(design["wires"][w]["name"] for w in step)

@@ -103,7 +103,7 @@ def prepare_wire(design, wire, settings, size, memo=None):
     if limits:  # the coupling's own limits at some points (pipeline._tighten), radians by target index
         options["vertex_max_bend"] = tuple(limits.get(i, 0.0) for i in range(max(limits) + 1))
     key = Memo.key(contour, wire["closed"], specs, options) if memo is not None else None
-    start_key = Memo.key(contour, wire["closed"], specs, options, Memo.LIMITS) if memo is not None else None
+    start_key = Memo.key(contour, wire["closed"], specs, options, Memo.LIMITS, key) if memo is not None else None
     result = memo.reusable(key, options["max_bend"]) if memo is not None else None
     if result is None and memo is not None:  # a coupling round: start from the looser limit's optimum
         start = memo.starts.get(start_key)
@@ -230,11 +230,14 @@ class Memo:
         return entry[1]
 
     @staticmethod
-    def key(contour, closed, specs, options, ignore=("max_bend",)):
+    def key(contour, closed, specs, options, ignore=("max_bend",), like=None):
         """Everything the solve depends on except the bend limit (the options named in `ignore`;
-        a start is never part of it)."""
-        spec_key = tuple((s["vertex"], s["bisector"], s["contact_angle"], s["active"]) for s in specs)
+        a start is never part of it). `like`: a key of the same contour, closed and specs, whose
+        parts for them are taken instead of being built again (the contour's bytes)."""
         other = tuple(sorted((k, v) for k, v in options.items() if k not in ignore and k != "start"))
+        if like is not None:
+            return like[:3] + (other,)
+        spec_key = tuple((s["vertex"], s["bisector"], s["contact_angle"], s["active"]) for s in specs)
         return (np.ascontiguousarray(contour, dtype=np.float64).tobytes(), bool(closed), spec_key, other)
 
     LIMITS = ("vertex_max_bend",)
@@ -383,7 +386,8 @@ def run(design, material, settings, native_progress=None, memo=None):
         memo.nulled = [dict(n) for n in nulled]
     if nulled:  # the verdict is the layering's: it re-checks the assembly without them
         design["stages"]["target_shape"]["recheck_lp_solves"] = layering.recheck_verdict(
-            design, material, settings, unrealised_summary(nulled, size), len(nulled), native_progress)
+            design, material, settings, unrealised_summary(nulled, size), len(nulled), native_progress,
+            [memo.array(w) for w in design["wires"]] if memo is not None else None)
     worst = max(w["max_distance"] for w in per_wire)
     return (f"{len(per_wire)} wires, largest distance to the contour {worst * 1000:.2f} mm, "
             f"{len(nulled)} crossings nulled, {iterations} iterations ({seconds:.3f} s)")
