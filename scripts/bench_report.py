@@ -304,8 +304,7 @@ def prose(cases, names):
                    f"timed by the bench: building arrays, plane frames, deep copies of the design, copying "
                    f"results into it) is {100 * statistics.median(frac):.1f}% of a solve (median; at most "
                    f"{100 * worst[1] / worst[2]:.1f}%, {worst[0]}, {secs(worst[1])} s): the time is in the native "
-                   "solvers, not in the Python around them. It comes out negative where the target shape solves "
-                   "two wires at once: the native calls' seconds are summed per call, and two calls overlap.")
+                   "solvers, not in the Python around them.")
     capped = [c for c in everything if c.get("target_maxeval_wires")]
     if capped:
         out.append("")

@@ -54,13 +54,23 @@ std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetSh
   std::vector<std::exception_ptr> errors(n);
   std::atomic<std::size_t> next{0}, finished{0};
   std::atomic<bool> stop{false};
-  // The other thread's jobs only look at `stop`; the calling thread's ask `progress` as well.
+  // The other thread's jobs only look at `stop`; the calling thread's ask `progress` as well. An
+  // exception from `progress` stops both (every job still running ends in Cancelled) and is the
+  // one thrown at the end, as optimize_target_shape's callers see it.
+  std::exception_ptr progress_error;  // written by the calling thread only
+  const ProgressFn none;
   const ProgressFn stopped = [&](std::string_view, double) { return !stop.load(); };
   const ProgressFn asked = [&](std::string_view stage, double fraction) {
-    if (!stop && !progress(stage, fraction)) stop = true;
+    if (stop) return false;
+    try {
+      if (!progress(stage, fraction)) stop = true;
+    } catch (...) {
+      progress_error = std::current_exception();
+      stop = true;
+    }
     return !stop.load();
   };
-  auto work = [&](const ProgressFn& fn) {
+  auto work = [&](const ProgressFn& fn) noexcept {
     for (std::size_t i; (i = next++) < n;) {
       const std::size_t k = order[i];
       try {
@@ -75,42 +85,51 @@ std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetSh
 
   std::mutex mutex;
   std::condition_variable worker_ended;
-  bool ended = false;
+  std::atomic<bool> ended{false};
   std::optional<std::thread> worker;
+  // Whatever happens below, the other thread is stopped and joined before this frame goes (a
+  // joinable std::thread destroyed would terminate the process, and Blender with it).
+  struct Joiner {
+    std::optional<std::thread>& thread;
+    std::atomic<bool>& stop;
+    ~Joiner() {
+      if (thread && thread->joinable()) {
+        stop = true;
+        thread->join();
+      }
+    }
+  } joiner{worker, stop};
   if (threads == 2 && n >= 2) {
     try {
-      worker.emplace([&] {
-        work(progress ? stopped : ProgressFn{});
-        const std::lock_guard<std::mutex> lock(mutex);
-        ended = true;
+      worker.emplace([&]() noexcept {
+        work(progress ? stopped : none);
+        try {
+          const std::lock_guard<std::mutex> lock(mutex);
+          ended = true;
+        } catch (...) {  // no lock to be had: the caller's 20 ms wait still sees the flag
+          ended = true;
+        }
         worker_ended.notify_one();
       });
     } catch (const std::system_error&) {  // no thread to be had: the calling thread does them all
     }
   }
-  std::exception_ptr waiting_error;
-  work(progress ? asked : ProgressFn{});
-  if (worker) {
-    // While the other thread ends its last job, `progress` is still asked (Live cancels a solve as
-    // soon as the plane moves again); its own exception stops both and is thrown below.
+  work(progress ? asked : none);
+  if (worker && progress) {
+    // While the other thread ends its last job, `progress` is still asked every 20 ms (Live
+    // cancels a solve as soon as the plane moves again).
     std::unique_lock<std::mutex> lock(mutex);
-    while (!worker_ended.wait_for(lock, std::chrono::milliseconds(20), [&] { return ended; })) {
-      if (!progress || stop || waiting_error) continue;
+    while (!worker_ended.wait_for(lock, std::chrono::milliseconds(20), [&] { return ended.load(); })) {
+      if (stop) continue;
       lock.unlock();
-      try {
-        asked("target_shape", static_cast<double>(finished.load()) / static_cast<double>(n));
-      } catch (...) {
-        waiting_error = std::current_exception();
-        stop = true;
-      }
+      asked("target_shape", static_cast<double>(finished.load()) / static_cast<double>(n));
       lock.lock();
     }
-    lock.unlock();
-    worker->join();
   }
+  if (worker) worker->join();
+  if (progress_error) std::rethrow_exception(progress_error);
   for (std::size_t k = 0; k < n; ++k)
     if (errors[k]) std::rethrow_exception(errors[k]);
-  if (waiting_error) std::rethrow_exception(waiting_error);
   std::vector<TargetShapeResult> out;
   out.reserve(n);
   for (std::optional<TargetShapeResult>& r : results) out.push_back(std::move(*r));

@@ -7,6 +7,7 @@
 #include <mutex>
 #include <numbers>
 #include <set>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -88,26 +89,38 @@ TEST_CASE("target shapes: each result is its wire's alone, in the jobs' order, o
 TEST_CASE("target shapes: progress is asked on the calling thread only, and it cancels every wire", "[target]") {
   const std::vector<TargetShapeJob> jobs = round_of_wires();
   const std::thread::id caller = std::this_thread::get_id();
+  // Recorded in the callback, checked after the call (Catch's assertions are not for threads).
   std::mutex seen_mutex;
   std::set<std::thread::id> seen;
-  int calls = 0;
+  std::vector<double> fractions;
   const ProgressFn count = [&](std::string_view, double f) {
     const std::lock_guard<std::mutex> lock(seen_mutex);
     seen.insert(std::this_thread::get_id());
-    ++calls;
-    CHECK(f >= 0.0);
-    CHECK(f <= 1.0);
+    fractions.push_back(f);
     return true;
   };
   optimize_target_shapes(jobs, 2, count);
-  CHECK(calls > 0);
+  CHECK(!fractions.empty());
   CHECK(seen == std::set<std::thread::id>{caller});
+  for (double f : fractions) {
+    CHECK(f >= 0.0);
+    CHECK(f <= 1.0);
+  }
 
   // Stopped at the third question: both threads stop, and the call ends in Cancelled.
-  int asked = 0;
+  std::atomic<int> asked{0};
   const ProgressFn stop = [&](std::string_view, double) { return ++asked < 3; };
   CHECK_THROWS_AS(optimize_target_shapes(jobs, 2, stop), Cancelled);
   CHECK(asked == 3);  // never asked again once it said stop
+
+  // A callback that throws: its own exception, not Cancelled, once both threads stopped.
+  std::atomic<int> thrown{0};
+  const ProgressFn fails = [&](std::string_view, double) -> bool {
+    if (++thrown == 3) throw std::runtime_error("the callback's own error");
+    return true;
+  };
+  CHECK_THROWS_WITH(optimize_target_shapes(jobs, 2, fails), "the callback's own error");
+  CHECK(thrown == 3);
 }
 
 TEST_CASE("target shapes: the first bad wire in the jobs' order is the error, after every thread stopped",

@@ -97,9 +97,12 @@ def model_size(design, contours=None):
     if contours is None:
         contours = [np.asarray(w["contour"]) for w in design["wires"]]
     points = np.concatenate(contours)
+    if points.ndim != 2:
+        return float(np.max(points.max(axis=0) - points.min(axis=0)))
     # Column by column: the same extremes as points.max(axis=0), whose reduction across the rows of
-    # an (n, 3) array took 0.1 ms on the Duck's 2,500 points against 0.01 ms.
-    return max(float(points[:, k].max() - points[:, k].min()) for k in range(points.shape[1]))
+    # an (n, 3) array took 0.1 ms on the Duck's 2,500 points against 0.01 ms (np.max, not max, so
+    # that a NaN still makes the size NaN).
+    return float(np.max([points[:, k].max() - points[:, k].min() for k in range(points.shape[1])]))
 
 
 def new_design(material, settings):

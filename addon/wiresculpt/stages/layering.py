@@ -29,7 +29,7 @@ def wire_specs(design, key="contour", arrays=None):
         arrays = [point_array(w[key]) for w in design["wires"]]
     return [{"name": w["name"], "origin": w["plane"]["origin"], "normal": w["plane"]["normal"],
              "points": a, "closed": w["closed"]}
-            for w, a in zip(design["wires"], arrays)]
+            for w, a in zip(design["wires"], arrays, strict=True)]
 
 
 def run(design, material, settings, native_progress=None, forbidden=(), too_close=None, arrays=False):

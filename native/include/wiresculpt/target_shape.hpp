@@ -227,9 +227,10 @@ struct TargetShapeJob {
 /// length (only the order of the work, never a result, depends on it). Every result is the one
 /// optimize_target_shape returns for that job alone, and they come back in the jobs' order.
 /// Only the calling thread calls `progress` (with a job's own fractions, and while it waits for
-/// the other thread's last job); when it asks to stop, both threads stop at their next
-/// evaluation. After both threads stopped, throws the error of the first job (in the jobs'
-/// order) that threw one: InputError naming its wire, or Cancelled. threads: 1 or 2.
+/// the other thread's last job); when it asks to stop, both threads stop at their next progress
+/// poll (every 16 evaluations). After both threads stopped, throws the exception `progress` threw
+/// if it threw one, else the error of the first job (in the jobs' order) that threw one:
+/// InputError naming its wire, or Cancelled. threads: 1 or 2.
 std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetShapeJob>& jobs, int threads = 2,
                                                       const ProgressFn& progress = {});
 
