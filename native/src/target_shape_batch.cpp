@@ -70,17 +70,18 @@ std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetSh
     }
     return !stop.load();
   };
-  auto work = [&](const ProgressFn& fn) noexcept {
-    for (std::size_t i; (i = next++) < n;) {
-      const std::size_t k = order[i];
-      try {
-        if (stop) throw Cancelled();
-        results[k].emplace(optimize_target_shape(jobs[k].contour, jobs[k].closed, jobs[k].crossings, jobs[k].options, fn));
-      } catch (...) {
-        errors[k] = std::current_exception();
-      }
-      ++finished;
+  auto solve = [&](std::size_t i, const ProgressFn& fn) noexcept {  // the i-th job in `order`
+    const std::size_t k = order[i];
+    try {
+      if (stop) throw Cancelled();
+      results[k].emplace(optimize_target_shape(jobs[k].contour, jobs[k].closed, jobs[k].crossings, jobs[k].options, fn));
+    } catch (...) {
+      errors[k] = std::current_exception();
     }
+    ++finished;
+  };
+  auto work = [&](const ProgressFn& fn) noexcept {
+    for (std::size_t i; (i = next++) < n;) solve(i, fn);
   };
 
   std::mutex mutex;
@@ -100,8 +101,12 @@ std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetSh
     }
   } joiner{worker, stop};
   if (threads == 2 && n >= 2) {
+    // The dearest job is the other thread's from the start (the calling thread, which answers
+    // `progress` too, takes the next), so who does which does not hang on when the thread starts.
+    const std::size_t first = next++;
     try {
-      worker.emplace([&]() noexcept {
+      worker.emplace([&, first]() noexcept {
+        solve(first, progress ? stopped : none);
         work(progress ? stopped : none);
         try {
           const std::lock_guard<std::mutex> lock(mutex);
@@ -112,6 +117,7 @@ std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetSh
         worker_ended.notify_one();
       });
     } catch (const std::system_error&) {  // no thread to be had: the calling thread does them all
+      solve(first, progress ? asked : none);
     }
   }
   work(progress ? asked : none);

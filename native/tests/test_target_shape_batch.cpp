@@ -123,6 +123,29 @@ TEST_CASE("target shapes: progress is asked on the calling thread only, and it c
   CHECK(thrown == 3);
 }
 
+TEST_CASE("target shapes: progress is still asked while the other thread ends its last wire, and can stop it",
+          "[target]") {
+  // The dearest job (by its length) is the other thread's from the start: a 3 m loop solved the
+  // slow way (SLSQP, sweeps to 1 nm: about a second). The calling thread's only job is bad and
+  // fails at once, so the calling thread then waits, asking progress every 20 ms with the share of
+  // jobs done (1 of 2). Stopping there must stop the long solve: Cancelled, not the bad wire's
+  // InputError that would come once the long solve ended.
+  TargetShapeJob slow = loop("Slow", 0.45, 0.05, 5, 3000, 6);
+  slow.options.algorithm = TargetShapeAlgorithm::slsqp;
+  slow.options.sweep_ftol = 0.0;
+  slow.options.sweep_tol = 1e-9;
+  TargetShapeJob bad = loop("Bad", 0.05, 0.0, 1, 100, 0);
+  bad.crossings = {{500, Vec2(1, 0), 2.0, true}};  // past its 100 points
+  std::vector<double> fractions;  // asked on the calling thread only
+  const ProgressFn stop_when_waiting = [&](std::string_view, double f) {
+    fractions.push_back(f);
+    return f != 0.5;
+  };
+  CHECK_THROWS_AS(optimize_target_shapes({slow, bad}, 2, stop_when_waiting), Cancelled);
+  REQUIRE(!fractions.empty());
+  CHECK(fractions.back() == 0.5);
+}
+
 TEST_CASE("target shapes: the first bad wire in the jobs' order is the error, after every thread stopped",
           "[target]") {
   std::vector<TargetShapeJob> jobs = round_of_wires();
