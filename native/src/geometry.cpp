@@ -25,12 +25,18 @@ Plane Plane::make(const Vec3& origin, const Vec3& normal, const std::string& nam
   return p;
 }
 
-double polyline_length(const Polyline3& points, bool closed) {
+namespace {
+template <class Points>
+double length_of(const Points& points, bool closed) {
   double total = 0.0;
   for (std::size_t i = 1; i < points.size(); ++i) total += (points[i] - points[i - 1]).norm();
   if (closed && points.size() > 1) total += (points.front() - points.back()).norm();
   return total;
 }
+}  // namespace
+
+double polyline_length(const Polyline3& points, bool closed) { return length_of(points, closed); }
+double polyline_length(const Polyline2& points, bool closed) { return length_of(points, closed); }
 
 double signed_area(const Polyline2& points) {
   double twice = 0.0;

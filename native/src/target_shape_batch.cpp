@@ -26,11 +26,9 @@ namespace {
 // one block costs about n² (a dense subproblem per iteration; about 4 µs·n² on the stand-ins), one
 // solved in windows about 12·n of the same units (about 50 µs a point).
 double expected_cost(const TargetShapeJob& job) {
-  const Polyline2& c = job.contour;
   const TargetShapeOptions& o = job.options;
-  double length = 0.0;
-  for (std::size_t i = 1; i < c.size(); ++i) length += (c[i] - c[i - 1]).norm();
-  if (job.closed && c.size() > 2) length += (c.front() - c.back()).norm();
+  const double length = polyline_length(job.contour, job.closed);
+  // optimize_target_shape's own default spacing (TargetShapeProblem): 1.5 x min_segment.
   const double spacing = o.spacing > 0.0 ? o.spacing : 1.5 * o.min_segment;
   const double n = length / spacing + static_cast<double>(job.crossings.size());
   if (!std::isfinite(n) || n <= 0.0) return 0.0;  // bad input: optimize_target_shape says what is wrong

@@ -32,6 +32,7 @@ struct Plane {
 
 /// Sum of edge lengths; `closed` adds the edge from the last point back to the first.
 double polyline_length(const Polyline3& points, bool closed);
+double polyline_length(const Polyline2& points, bool closed);
 
 /// Signed area of a closed 2D polygon (positive when counter-clockwise).
 double signed_area(const Polyline2& points);
