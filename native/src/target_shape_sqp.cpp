@@ -33,10 +33,14 @@ namespace {
 
 // The active constraints' whitened normals ñ_j (columns of Ñ) as Ñ = U R, U with orthonormal
 // columns (modified Gram-Schmidt, twice), R upper triangular: adding a column costs O(n |S|);
-// dropping one rebuilds the factorisation of the rest. Its buffers are allocated once per QP.
+// dropping one rebuilds the factorisation of the rest.
 class ActiveBasis {
  public:
-  explicit ActiveBasis(Eigen::Index n) : U_(n, n), R_(n, n), w_(n), r_(n), q_(n) {}
+  // Empties the basis for vectors of n entries (its buffers are kept when their size is).
+  void reset(Eigen::Index n) {
+    U_.resize(n, n), R_.resize(n, n), w_.resize(n), r_.resize(n), q_.resize(n);
+    k_ = 0;
+  }
   Eigen::Index size() const { return k_; }
   // The part of v orthogonal to the basis (q) and its coefficients in it (w() = Uᵀ v).
   template <typename V>
@@ -79,10 +83,19 @@ class ActiveBasis {
   Eigen::Index k_ = 0;
 };
 
-}  // namespace
+// A QP's buffers, kept by an SQP from one iteration to the next (thousands of small QPs): each
+// QP sets their contents, and their sizes where they changed.
+struct QpBuffers {
+  Eigen::MatrixXd At, Nt;
+  std::vector<char> whitened, in;
+  std::vector<Eigen::Index> active;
+  std::vector<double> u;
+  ActiveBasis basis;
+  Eigen::VectorXd q, z;
+};
 
-bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,
-                     const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, double tol) {
+bool dual_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,
+             const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, double tol, QpBuffers& buffers) {
   const Eigen::Index n = g.size(), m = A.rows();
   const auto L = llt.matrixL();
   const auto U = llt.matrixU();
@@ -90,19 +103,26 @@ bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::Vector
   // ñ_k = L⁻¹ n_k, so that W⁻¹ = L⁻ᵀ L⁻¹ turns every projection into a Euclidean one.
   // A's rows as contiguous columns, for the scans below; ñ_k (columns of Nt) is computed the
   // first time constraint k enters.
-  const Eigen::MatrixXd At = A.transpose();
-  Eigen::MatrixXd Nt(n, m);
-  std::vector<char> whitened(static_cast<std::size_t>(m), 0);
+  buffers.At = A.transpose();
+  const Eigen::MatrixXd& At = buffers.At;
+  Eigen::MatrixXd& Nt = buffers.Nt;
+  Nt.resize(n, m);
+  std::vector<char>& whitened = buffers.whitened;
+  whitened.assign(static_cast<std::size_t>(m), 0);
   d = -g;
   llt.solveInPlace(d);
   lambda = Eigen::VectorXd::Zero(m);
-  std::vector<Eigen::Index> active;
-  active.reserve(static_cast<std::size_t>(n));
-  std::vector<double> u;  // multipliers of `active`
-  u.reserve(static_cast<std::size_t>(n));
-  std::vector<char> in(static_cast<std::size_t>(m), 0);
-  ActiveBasis basis(n);
-  Eigen::VectorXd q(n), z(n);
+  std::vector<Eigen::Index>& active = buffers.active;
+  active.clear();
+  std::vector<double>& u = buffers.u;  // multipliers of `active`
+  u.clear();
+  std::vector<char>& in = buffers.in;
+  in.assign(static_cast<std::size_t>(m), 0);
+  ActiveBasis& basis = buffers.basis;
+  basis.reset(n);
+  Eigen::VectorXd& q = buffers.q;
+  Eigen::VectorXd& z = buffers.z;
+  q.resize(n), z.resize(n);
   const double scale = 1.0 + g.cwiseAbs().maxCoeff();
   const int max_steps = static_cast<int>(10 * (n + m) + 10);
   int step = 0;
@@ -161,6 +181,14 @@ bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::Vector
     }
   }
   return false;
+}
+
+}  // namespace
+
+bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,
+                     const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, double tol) {
+  QpBuffers buffers;
+  return dual_qp(llt, g, A, c, d, lambda, tol, buffers);
 }
 
 bool solve_convex_qp(const Eigen::MatrixXd& W, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,
@@ -233,9 +261,10 @@ class BlockModel {
     return f;
   }
 
-  // The Hessian of f + Σ λ_k c_k over the block's variables.
-  Eigen::MatrixXd hessian(const Polyline2& p, const Eigen::VectorXd& lambda) {
-    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n_, n_);
+  // The Hessian of f + Σ λ_k c_k over the block's variables, into W.
+  void hessian(const Polyline2& p, const Eigen::VectorXd& lambda, Eigen::MatrixXd& W) {
+    Eigen::MatrixXd& H = hessian_;
+    H.setZero(n_, n_);
     const double hs = s_.scale_x * s_.scale_x / s_.scale_f;
     auto add = [&](int a, int b, const Mat2& B, double scale) {  // B = d²/dp_a dp_b
       if (var_[a] < 0 || var_[b] < 0) return;
@@ -332,7 +361,7 @@ class BlockModel {
           add(pts[b], pts[a], B, l * cs);
         }
     }
-    return 0.5 * (H + H.transpose());
+    W = 0.5 * (H + H.transpose());
   }
 
  private:
@@ -345,6 +374,7 @@ class BlockModel {
   int n_ = 0, mc_ = 0;
   std::vector<int> var_;
   Polyline2 grad_, scratch_, work_;
+  Eigen::MatrixXd hessian_;
 };
 
 double violation(const Eigen::VectorXd& c) { return c.size() ? std::max(0.0, c.maxCoeff()) : 0.0; }
@@ -355,7 +385,9 @@ double infeasibility(const Eigen::VectorXd& c) { return c.cwiseMax(0.0).sum(); }
 Eigen::MatrixXd sqp_lagrangian_hessian(const TargetShapeProblem& problem, const SqpBlock& block,
                                        const SqpSettings& settings, const Polyline2& p, const Eigen::VectorXd& lambda) {
   BlockModel model(problem, block, settings, p);
-  return model.hessian(p, lambda);
+  Eigen::MatrixXd W;
+  model.hessian(p, lambda, W);
+  return W;
 }
 
 Eigen::VectorXd sqp_lagrangian_gradient(const TargetShapeProblem& problem, const SqpBlock& block,
@@ -366,6 +398,16 @@ Eigen::VectorXd sqp_lagrangian_gradient(const TargetShapeProblem& problem, const
   model.evaluate(p, &g, c, &A);
   return g + A.transpose() * lambda;
 }
+
+namespace {
+
+// convexify's buffers, kept by an SQP from one iteration to the next: each call sets their
+// contents, and their sizes where they changed.
+struct ShiftBuffers {
+  Eigen::MatrixXd AtA;
+  std::array<Eigen::MatrixXd, 2> Wd;
+  std::array<Eigen::LLT<Eigen::MatrixXd>, 2> llt;
+};
 
 // Adds ρ a_k a_kᵀ for every constraint with λ_k > 0, then δI, until W is positive definite;
 // `factor` gets its Cholesky factor. False when it cannot be made so (not finite).
@@ -378,10 +420,12 @@ Eigen::VectorXd sqp_lagrangian_gradient(const TargetShapeProblem& problem, const
 // instead of one factorisation per shift (the δ of a window far from its contour took 12 of them at
 // every iteration). The shift taken is the same.
 bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::VectorXd& lambda,
-               Eigen::LLT<Eigen::MatrixXd>& factor, std::array<int, 2>& guess, double* delta_taken) {
+               Eigen::LLT<Eigen::MatrixXd>& factor, std::array<int, 2>& guess, double* delta_taken,
+               ShiftBuffers& buffers) {
   constexpr int kShifts = 61;
   const Eigen::Index n = W.rows();
-  Eigen::MatrixXd AtA = Eigen::MatrixXd::Zero(n, n);
+  Eigen::MatrixXd& AtA = buffers.AtA;
+  AtA.setZero(n, n);
   bool any = false;
   for (Eigen::Index k = 0; k < A.rows(); ++k)
     if (lambda[k] > 0.0) {
@@ -401,8 +445,8 @@ bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::Vector
   // Two slots for the shifted matrix and its factor: a shift that works keeps its slot (the next
   // try goes to the other), so the first definite shift, always the last that worked, need not be
   // factored again after a later try failed.
-  std::array<Eigen::MatrixXd, 2> Wd{Eigen::MatrixXd(n, n), Eigen::MatrixXd(n, n)};
-  std::array<Eigen::LLT<Eigen::MatrixXd>, 2> llt{Eigen::LLT<Eigen::MatrixXd>(n), Eigen::LLT<Eigen::MatrixXd>(n)};
+  std::array<Eigen::MatrixXd, 2>& Wd = buffers.Wd;
+  std::array<Eigen::LLT<Eigen::MatrixXd>, 2>& llt = buffers.llt;
   std::array<int, 2> held{-1, -1};  // the shift each slot holds
   int slot = 0;                     // where the next try goes
   auto definite = [&](int i) {
@@ -450,6 +494,14 @@ bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::Vector
   return true;
 }
 
+}  // namespace
+
+bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::VectorXd& lambda,
+               Eigen::LLT<Eigen::MatrixXd>& factor, std::array<int, 2>& guess, double* delta_taken) {
+  ShiftBuffers buffers;
+  return convexify(W, A, lambda, factor, guess, delta_taken, buffers);
+}
+
 SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, Polyline2& p_io,
                      const SqpSettings& settings) {
   SqpOutcome out;
@@ -470,6 +522,9 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
   counted();
   double nu = 1.0;  // ℓ1 penalty of the merit function f + ν Σ max(0, c_k)
   Eigen::LLT<Eigen::MatrixXd> factor(n);
+  Eigen::MatrixXd W;
+  QpBuffers qp;
+  ShiftBuffers shifts;
   std::array<int, 2> own_guess{0, 0};
   std::array<int, 2>& shift = settings.shift_guess ? *settings.shift_guess : own_guess;
   for (int it = 0; it < settings.max_iterations; ++it) {
@@ -481,12 +536,12 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
     // (far from the contour) gets δI.
     // Eigen's Cholesky accepts NaN, so anything not finite ends here (SLSQP decides).
     if (!std::isfinite(f) || !g.allFinite() || !c.allFinite() || !A.allFinite()) return out;
-    Eigen::MatrixXd W = model.hessian(p, lambda);
+    model.hessian(p, lambda, W);
     double delta = 0.0;
-    if (!W.allFinite() || !convexify(W, A, lambda, factor, shift, &delta)) return out;
+    if (!W.allFinite() || !convexify(W, A, lambda, factor, shift, &delta, shifts)) return out;
     // Inconsistent linearised constraints (a kink that cannot be opened from here): the caller's
     // SLSQP decides, as it always did.
-    if (!solve_convex_qp(factor, g, A, c, d, mu)) return out;
+    if (!dual_qp(factor, g, A, c, d, mu, kQpTolerance, qp)) return out;
     // At a KKT point the QP's own step vanishes: converged when it is below step_tol at a feasible
     // point (its line search could not tell so small a step from rounding).
     if (violation(c) <= settings.constraint_tol && d.lpNorm<Eigen::Infinity>() <= settings.step_tol) {
@@ -528,7 +583,7 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
         // point, linearised about x.
         Eigen::VectorXd dc, mc2;
         const Eigen::VectorXd csoc = ct - A * d;
-        if (solve_convex_qp(factor, g, A, csoc, dc, mc2)) {
+        if (dual_qp(factor, g, A, csoc, dc, mc2, kQpTolerance, qp)) {
           xt = x + dc;
           model.to_points(xt, trial);
           ft = model.evaluate(trial, &gt, ct, &At);
@@ -634,6 +689,7 @@ SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& bloc
   if (const int stop = budget()) return finish(stop);
   Eigen::MatrixXd B = Eigen::MatrixXd::Identity(n, n);
   Eigen::LLT<Eigen::MatrixXd> factor(n);
+  QpBuffers qp;
   double f_prev = std::numeric_limits<double>::infinity();
   Eigen::VectorXd x_prev = x;
   int resets = 1;
@@ -645,7 +701,7 @@ SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& bloc
     // Inconsistent linearised constraints: SLSQP would solve its augmented problem (a slack
     // variable relaxing them), which this replica does not model (written out with our QP, its
     // steps left NLopt's within a few evaluations): the caller runs NLopt's SLSQP instead.
-    if (!solve_convex_qp(factor, g, A, c, s, r)) return out;
+    if (!dual_qp(factor, g, A, c, s, r, kQpTolerance, qp)) return out;
     const Eigen::VectorXd v = g + A.transpose() * r;  // ∇L at the start of the step
     const double f0 = f;
     const Eigen::VectorXd x0 = x;

@@ -105,13 +105,16 @@ Eigen::VectorXd sqp_lagrangian_gradient(const TargetShapeProblem& problem, const
 bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::VectorXd& lambda,
                Eigen::LLT<Eigen::MatrixXd>& factor, std::array<int, 2>& guess, double* delta_taken = nullptr);
 
+/// The QP's tolerance on a constraint's violation, relative to 1 + |g|∞.
+inline constexpr double kQpTolerance = 1e-12;
+
 /// Minimises ½ dᵀ W d + gᵀ d subject to A d + c <= 0 (rows of A as a dense matrix), W symmetric
 /// positive definite: the dual active-set method of Goldfarb and Idnani (1983). Returns false when
 /// the constraints are inconsistent (or, never seen, its step budget runs out). `lambda` gets the
 /// multipliers (>= 0). Exposed for its tests.
 bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& W_factor, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,
-                     const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, double tol = 1e-12);
+                     const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, double tol = kQpTolerance);
 bool solve_convex_qp(const Eigen::MatrixXd& W, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,
-                     const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, double tol = 1e-12);
+                     const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, double tol = kQpTolerance);
 
 }  // namespace wiresculpt::detail
