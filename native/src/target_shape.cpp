@@ -517,10 +517,11 @@ double TargetShapeProblem::imls(const Vec2& q, Vec2* grad) const {
   return s * I + (1.0 - s) * g;
 }
 
-double TargetShapeProblem::distance_term(const Polyline2& p, int i, Polyline2* grad) const {
+double TargetShapeProblem::distance_term(const Polyline2& p, int i, Polyline2* grad, ImlsSample* sample) const {
   const int m = static_cast<int>(p.size());
   Vec2 dD;
   const double D = imls(p[i], grad ? &dD : nullptr);
+  if (grad && sample) *sample = {p[i], D, dD};
   // w_i = |p_i - p_{i-1}| + |p_{i+1} - p_i| (one term at an open end).
   double wi = 0.0;
   for (int side : {-1, 1}) {
@@ -575,9 +576,15 @@ double TargetShapeProblem::energy(const Polyline2& p, Polyline2* grad) const {
   return E;
 }
 
-double TargetShapeProblem::energy_terms(const Polyline2& p, const std::vector<int>& terms, Polyline2* grad) const {
+double TargetShapeProblem::energy_terms(const Polyline2& p, const std::vector<int>& terms, Polyline2* grad,
+                                        std::vector<ImlsSample>* samples) const {
   double E = 0.0;
-  for (int i : terms) E += distance_term(p, i, grad) + regularization_term(p, i, options_.regularization, grad);
+  if (grad && samples) samples->resize(terms.size());
+  for (std::size_t k = 0; k < terms.size(); ++k) {
+    const int i = terms[k];
+    E += distance_term(p, i, grad, grad && samples ? &(*samples)[k] : nullptr) +
+         regularization_term(p, i, options_.regularization, grad);
+  }
   return E;
 }
 

@@ -232,7 +232,7 @@ class BlockModel {
     if (g) {
       for (int t : *b_.terms)
         for (int sd : {-1, 0, 1}) grad_[wrap(t + sd)] = Vec2::Zero();
-      f = pr_.energy_terms(p, *b_.terms, &grad_) / s_.scale_f;
+      f = pr_.energy_terms(p, *b_.terms, &grad_, &samples_) / s_.scale_f;
       g->resize(n_);
       const double gs = s_.scale_x / s_.scale_f;
       for (int i : *b_.points) (*g)[var_[i]] = gs * grad_[i].x(), (*g)[var_[i] + 1] = gs * grad_[i].y();
@@ -273,9 +273,18 @@ class BlockModel {
     const bool closed = pr_.closed();
     // E_d: terms w_i D(p_i), w_i = Σ_j |p_i - p_j| over the neighbours j of i.
     const double step = 1e-7 * s_.min_segment;  // differences of the IMLS gradient
-    for (int i : *b_.terms) {
+    for (std::size_t k = 0; k < b_.terms->size(); ++k) {
+      const int i = (*b_.terms)[k];
+      // D and its gradient where the last evaluation with gradients took them (nearly always
+      // these very points: the iterate is the trial point evaluated last), else anew.
       Vec2 dD;
-      const double D = pr_.imls(p[i], &dD);
+      double D;
+      if (k < samples_.size() && samples_[k].q == p[i]) {
+        D = samples_[k].value;
+        dD = samples_[k].gradient;
+      } else {
+        D = pr_.imls(p[i], &dD);
+      }
       Mat2 HD = Mat2::Zero();  // only the (i, i) block needs it
       for (int r = 0; r < 2 && var_[i] >= 0; ++r) {  // forward differences: O(step) is far below what Newton needs
         Vec2 gp, q = p[i];
@@ -374,6 +383,7 @@ class BlockModel {
   int n_ = 0, mc_ = 0;
   std::vector<int> var_;
   Polyline2 grad_, scratch_, work_;
+  std::vector<TargetShapeProblem::ImlsSample> samples_;  // of the last evaluation with gradients
   Eigen::MatrixXd hessian_;
 };
 

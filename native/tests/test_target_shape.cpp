@@ -366,6 +366,36 @@ TEST_CASE("target shape: analytic gradients match central differences", "[target
   }
 }
 
+TEST_CASE("target shape: energy_terms gives each term's IMLS sample, and the same energy and gradient", "[target]") {
+  const Polyline2 contour = wavy(0.1, 0.02, 3, 700);
+  const std::vector<TargetCrossing> xs{{10, Vec2(1, 0), 2 * pi / 3, true}};
+  TargetShapeProblem problem(contour, true, xs);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-2 * problem.kernel_support(), 2 * problem.kernel_support());
+  Polyline2 p = problem.initial();
+  for (Vec2& q : p) q += Vec2(u(rng), u(rng));
+  const std::vector<int> terms{0, 3, 4, 5, static_cast<int>(p.size()) - 1};
+  Polyline2 g0(p.size(), Vec2::Zero()), g1(p.size(), Vec2::Zero());
+  std::vector<TargetShapeProblem::ImlsSample> samples;
+  const double e0 = problem.energy_terms(p, terms, &g0);
+  const double e1 = problem.energy_terms(p, terms, &g1, &samples);
+  CHECK(e1 == e0);  // asking for the samples changes nothing
+  for (std::size_t i = 0; i < p.size(); ++i) CHECK(g1[i] == g0[i]);
+  REQUIRE(samples.size() == terms.size());
+  for (std::size_t k = 0; k < terms.size(); ++k) {
+    const Vec2& q = p[static_cast<std::size_t>(terms[k])];
+    Vec2 dD;
+    const double D = problem.imls(q, &dD);
+    CHECK(samples[k].q == q);
+    CHECK(samples[k].value == D);  // the very numbers imls gives there
+    CHECK(samples[k].gradient == dD);
+  }
+  // Without the gradient nothing is sampled.
+  std::vector<TargetShapeProblem::ImlsSample> none;
+  problem.energy_terms(p, terms, nullptr, &none);
+  CHECK(none.empty());
+}
+
 TEST_CASE("target shape: the distance to the contour is the nearest of all its segments", "[target]") {
   // Brute force over the input contour's segments (the solver's target subdivides them, on the
   // same lines), at random points near it, beyond its bounding box (where the grid's rings start

@@ -269,9 +269,18 @@ class TargetShapeProblem {
   double regularization_energy(const Polyline2& p, Polyline2* grad = nullptr) const;
   /// E = E_d + w_r E_r; adds the gradient when non-null.
   double energy(const Polyline2& p, Polyline2* grad = nullptr) const;
+  /// D at one point and its gradient, as imls gives them.
+  struct ImlsSample {
+    Vec2 q;
+    double value = 0.0;
+    Vec2 gradient;
+  };
   /// Σ over `terms` (vertex indices) of w_i D(p_i) + w_r |Δu_i|²: the part of E that a block of
-  /// points changes. Adds the gradient when non-null (grad must already have #points entries).
-  double energy_terms(const Polyline2& p, const std::vector<int>& terms, Polyline2* grad = nullptr) const;
+  /// points changes. Adds the gradient when non-null (grad must already have #points entries);
+  /// with the gradient, `samples` (when non-null) gets term k's D at p_{terms[k]} in entry k, for a
+  /// caller that needs D there again (the SQP's Hessian).
+  double energy_terms(const Polyline2& p, const std::vector<int>& terms, Polyline2* grad = nullptr,
+                      std::vector<ImlsSample>* samples = nullptr) const;
   /// Value of constraint k; adds its gradient to `grad` when non-null.
   double constraint(std::size_t k, const Polyline2& p, Polyline2* grad = nullptr) const;
   /// Distance (metres) from q to the input contour polyline.
@@ -283,8 +292,9 @@ class TargetShapeProblem {
   friend TargetShapeResult optimize_target_shape(const Polyline2&, bool, const std::vector<TargetCrossing>&,
                                                  const TargetShapeOptions&, const ProgressFn&);
   double nearest_squared(const Vec2& q, Vec2* grad) const;
-  // Term i of E_d (w_i D(p_i)) and of w_r E_r (weight |Δu_i|²); gradients added to grad.
-  double distance_term(const Polyline2& p, int i, Polyline2* grad) const;
+  // Term i of E_d (w_i D(p_i)) and of w_r E_r (weight |Δu_i|²); gradients added to grad. With grad,
+  // `sample` (when non-null) gets D(p_i) and its gradient.
+  double distance_term(const Polyline2& p, int i, Polyline2* grad, ImlsSample* sample = nullptr) const;
   double regularization_term(const Polyline2& p, int i, double weight, Polyline2* grad) const;
 
   TargetShapeOptions options_;
