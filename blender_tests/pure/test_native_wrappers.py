@@ -75,6 +75,46 @@ class Wrappers(unittest.TestCase):
         control.abort()
         self.assertTrue(control.aborted)
 
+    def test_target_shape_results_have_the_documented_keys_and_types(self):
+        # The keys as the module's docstring lists them (the Python side reads them by name).
+        result_keys = {"points", "crossing_vertices", "crossings", "max_distance", "rms_distance",
+                       "min_segment", "max_bend", "max_length_violation", "max_angle_violation", "iterations",
+                       "sweeps", "sqp_blocks", "sqp_fallbacks", "seconds", "nlopt_result", "energy", "feasible",
+                       "warnings"}
+        status_keys = {"status", "realised", "vertex", "bisector", "contact_angle", "contact_violation", "scale",
+                       "message"}
+        angle = np.linspace(0.0, 2.0 * np.pi, 40, endpoint=False)
+        ring = np.column_stack([0.1 * np.cos(angle), 0.1 * np.sin(angle)])
+        crossings = [{"vertex": 0, "bisector": (1.0, 0.0)}, {"vertex": 20, "bisector": (1.0, 0.0)}]
+        one = native.optimize_target_shape(ring, True, crossings, {"wire_name": "R"})
+        both = native.optimize_target_shapes([{"points": ring, "closed": True, "crossings": crossings,
+                                               "options": {"wire_name": "R"}}] * 2)
+        for r in [one] + both:
+            self.assertEqual(set(r), result_keys)
+            self.assertEqual(r["points"].dtype, np.float64)
+            self.assertEqual(r["points"].shape[1], 2)
+            self.assertEqual(len(r["crossings"]), 2)
+            for st in r["crossings"]:
+                self.assertEqual(set(st), status_keys)
+                self.assertIsInstance(st["status"], str)
+                self.assertIsInstance(st["realised"], bool)
+                self.assertIsInstance(st["vertex"], int)
+                self.assertEqual(len(st["bisector"]), 2)
+                self.assertIsInstance(st["message"], str)
+            self.assertIsInstance(r["crossing_vertices"], list)
+            self.assertIsInstance(r["feasible"], bool)
+            self.assertIsInstance(r["nlopt_result"], str)
+            self.assertIsInstance(r["warnings"], list)
+            for key in ("max_distance", "rms_distance", "energy", "seconds"):
+                self.assertIsInstance(r[key], float)
+            for key in ("iterations", "sweeps", "sqp_blocks", "sqp_fallbacks"):
+                self.assertIsInstance(r[key], int)
+        # Solved in a batch, each result is the wire's own (all but the clock).
+        for r in both:
+            np.testing.assert_array_equal(r["points"], one["points"])
+            self.assertEqual({k: v for k, v in r.items() if k not in ("points", "seconds")},
+                             {k: v for k, v in one.items() if k not in ("points", "seconds")})
+
     def test_plane_frame_is_right_handed_and_unit(self):
         n, u, v = native.plane_frame([0.0, 0.0, 2.0])
         np.testing.assert_allclose(n, [0, 0, 1])

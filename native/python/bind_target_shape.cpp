@@ -62,20 +62,15 @@ TargetShapeOptions to_options(py::handle d, const std::string& path) {
 py::dict to_dict(const TargetShapeResult& r) {
   py::list statuses;
   for (const TargetCrossingStatus& s : r.crossings)
-    statuses.append(py::dict(py::arg("status") = s.status, py::arg("realised") = s.realised,
-                             py::arg("vertex") = s.vertex,
-                             py::arg("bisector") = py::make_tuple(s.bisector.x(), s.bisector.y()),
-                             py::arg("contact_angle") = s.contact_angle,
-                             py::arg("contact_violation") = s.contact_violation, py::arg("scale") = s.scale,
-                             py::arg("message") = s.message));
-  return py::dict(py::arg("points") = to_array(r.points), py::arg("crossing_vertices") = r.crossing_vertices,
-                  py::arg("crossings") = statuses, py::arg("max_distance") = r.max_distance,
-                  py::arg("rms_distance") = r.rms_distance, py::arg("min_segment") = r.min_segment,
-                  py::arg("max_bend") = r.max_bend, py::arg("max_length_violation") = r.max_length_violation,
-                  py::arg("max_angle_violation") = r.max_angle_violation, py::arg("iterations") = r.iterations,
-                  py::arg("sweeps") = r.sweeps, py::arg("sqp_blocks") = r.sqp_blocks, py::arg("sqp_fallbacks") = r.sqp_fallbacks, py::arg("seconds") = r.seconds,
-                  py::arg("nlopt_result") = r.nlopt_result, py::arg("energy") = r.energy,
-                  py::arg("feasible") = r.feasible, py::arg("warnings") = r.warnings);
+    statuses.append(make_dict("status", s.status, "realised", s.realised, "vertex", s.vertex, "bisector",
+                              py::make_tuple(s.bisector.x(), s.bisector.y()), "contact_angle", s.contact_angle,
+                              "contact_violation", s.contact_violation, "scale", s.scale, "message", s.message));
+  return make_dict("points", to_array(r.points), "crossing_vertices", r.crossing_vertices, "crossings", statuses,
+                   "max_distance", r.max_distance, "rms_distance", r.rms_distance, "min_segment", r.min_segment,
+                   "max_bend", r.max_bend, "max_length_violation", r.max_length_violation, "max_angle_violation",
+                   r.max_angle_violation, "iterations", r.iterations, "sweeps", r.sweeps, "sqp_blocks", r.sqp_blocks,
+                   "sqp_fallbacks", r.sqp_fallbacks, "seconds", r.seconds, "nlopt_result", r.nlopt_result, "energy",
+                   r.energy, "feasible", r.feasible, "warnings", r.warnings);
 }
 
 py::dict optimize(const py::object& points, const py::object& closed_arg, const py::object& crossings,

@@ -17,6 +17,7 @@
 #include <initializer_list>
 #include <limits>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -241,6 +242,29 @@ Field choice(std::string key, E& out, std::vector<std::pair<std::string, E>> opt
 }  // namespace field
 
 // --- results --------------------------------------------------------------------------------------
+
+/// A dict of the given key, value pairs (`make_dict("a", 1, "b", x)`): each value is cast as
+/// pybind11 casts it and stored with PyDict_SetItemString. py::dict(py::arg("a") = 1, ...) builds
+/// the same dict through a kwargs dict, making and looking up every key string twice: about 3,500
+/// instructions a key, more than the target shape's small solves spent on their results' dicts.
+inline void put_items(py::dict&) {}
+template <class V, class... Rest>
+void put_items(py::dict& d, const char* key, V&& value, Rest&&... rest) {
+  py::object v;
+  if constexpr (std::is_base_of_v<py::handle, std::decay_t<V>>)
+    v = py::reinterpret_borrow<py::object>(value);
+  else
+    v = py::cast(std::forward<V>(value));
+  if (PyDict_SetItemString(d.ptr(), key, v.ptr()) != 0) throw py::error_already_set();
+  put_items(d, std::forward<Rest>(rest)...);
+}
+template <class... Items>
+py::dict make_dict(Items&&... items) {
+  static_assert(sizeof...(Items) % 2 == 0, "make_dict takes key, value pairs");
+  py::dict d;
+  put_items(d, std::forward<Items>(items)...);
+  return d;
+}
 
 /// Points as an (n, K) float64 array.
 template <class Point>
