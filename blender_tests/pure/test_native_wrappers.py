@@ -99,13 +99,17 @@ class Wrappers(unittest.TestCase):
                 self.assertIsInstance(st["status"], str)
                 self.assertIsInstance(st["realised"], bool)
                 self.assertIsInstance(st["vertex"], int)
+                self.assertIsInstance(st["bisector"], tuple)
                 self.assertEqual(len(st["bisector"]), 2)
+                for key in ("contact_angle", "contact_violation", "scale"):
+                    self.assertIsInstance(st[key], float)
                 self.assertIsInstance(st["message"], str)
             self.assertIsInstance(r["crossing_vertices"], list)
             self.assertIsInstance(r["feasible"], bool)
             self.assertIsInstance(r["nlopt_result"], str)
             self.assertIsInstance(r["warnings"], list)
-            for key in ("max_distance", "rms_distance", "energy", "seconds"):
+            for key in ("max_distance", "rms_distance", "min_segment", "max_bend", "max_length_violation",
+                        "max_angle_violation", "energy", "seconds"):
                 self.assertIsInstance(r[key], float)
             for key in ("iterations", "sweeps", "sqp_blocks", "sqp_fallbacks"):
                 self.assertIsInstance(r[key], int)

@@ -571,8 +571,10 @@ double TargetShapeProblem::regularization_energy(const Polyline2& p, Polyline2* 
 double TargetShapeProblem::energy(const Polyline2& p, Polyline2* grad) const {
   if (grad) grad->resize(p.size(), Vec2::Zero());
   double E = 0.0;
-  for (int i = 0; i < static_cast<int>(p.size()); ++i)
-    E += distance_term(p, i, grad) + regularization_term(p, i, options_.regularization, grad);
+  for (int i = 0; i < static_cast<int>(p.size()); ++i) {
+    const double d = distance_term(p, i, grad);  // first: both add into grad, in this order
+    E += d + regularization_term(p, i, options_.regularization, grad);
+  }
   return E;
 }
 
@@ -582,8 +584,8 @@ double TargetShapeProblem::energy_terms(const Polyline2& p, const std::vector<in
   if (grad && samples) samples->resize(terms.size());
   for (std::size_t k = 0; k < terms.size(); ++k) {
     const int i = terms[k];
-    E += distance_term(p, i, grad, grad && samples ? &(*samples)[k] : nullptr) +
-         regularization_term(p, i, options_.regularization, grad);
+    const double d = distance_term(p, i, grad, grad && samples ? &(*samples)[k] : nullptr);  // first, as in energy
+    E += d + regularization_term(p, i, options_.regularization, grad);
   }
   return E;
 }

@@ -29,73 +29,9 @@ std::array<int, 3> constraint_points(const TargetShapeProblem::Constraint& c, in
 // problems: the active constraints' least-squares step is recomputed by a QR factorisation at
 // every change instead of being updated.
 
-namespace {
-
-// The active constraints' whitened normals ñ_j (columns of Ñ) as Ñ = U R, U with orthonormal
-// columns (modified Gram-Schmidt, twice), R upper triangular: adding a column costs O(n |S|);
-// dropping one rebuilds the factorisation of the rest.
-class ActiveBasis {
- public:
-  // Empties the basis for vectors of n entries (its buffers are kept when their size is).
-  void reset(Eigen::Index n) {
-    U_.resize(n, n), R_.resize(n, n), w_.resize(n), r_.resize(n), q_.resize(n);
-    k_ = 0;
-  }
-  Eigen::Index size() const { return k_; }
-  // The part of v orthogonal to the basis (q) and its coefficients in it (w() = Uᵀ v).
-  template <typename V>
-  void project(const V& v, Eigen::VectorXd& q) {
-    q = v;
-    w_.head(k_).setZero();
-    for (int pass = 0; pass < 2; ++pass)
-      for (Eigen::Index j = 0; j < k_; ++j) {
-        const double a = U_.col(j).dot(q);
-        q -= a * U_.col(j);
-        w_[j] += a;
-      }
-  }
-  // Solves R r = w() (the coefficients of the projected vector in the columns of Ñ).
-  const Eigen::VectorXd& coefficients() {
-    r_.head(k_) = w_.head(k_);
-    if (k_ > 0) R_.topLeftCorner(k_, k_).triangularView<Eigen::Upper>().solveInPlace(r_.head(k_));
-    return r_;
-  }
-  // Adds the vector last projected (q its orthogonal part).
-  void add(const Eigen::VectorXd& q) {
-    const double nq = q.norm();
-    U_.col(k_) = q / nq;
-    R_.col(k_).head(k_) = w_.head(k_);
-    R_(k_, k_) = nq;
-    ++k_;
-  }
-  // Rebuilds the basis from the given columns of Ñ, in order.
-  void rebuild(const Eigen::MatrixXd& Nt, const std::vector<Eigen::Index>& columns) {
-    k_ = 0;
-    for (Eigen::Index j : columns) {
-      project(Nt.col(j), q_);
-      add(q_);
-    }
-  }
-
- private:
-  Eigen::MatrixXd U_, R_;
-  Eigen::VectorXd w_, r_, q_;
-  Eigen::Index k_ = 0;
-};
-
-// A QP's buffers, kept by an SQP from one iteration to the next (thousands of small QPs): each
-// QP sets their contents, and their sizes where they changed.
-struct QpBuffers {
-  Eigen::MatrixXd At, Nt;
-  std::vector<char> whitened, in;
-  std::vector<Eigen::Index> active;
-  std::vector<double> u;
-  ActiveBasis basis;
-  Eigen::VectorXd q, z;
-};
-
-bool dual_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,
-             const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, double tol, QpBuffers& buffers) {
+bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,
+                     const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, QpBuffers& buffers,
+                     double tol) {
   const Eigen::Index n = g.size(), m = A.rows();
   const auto L = llt.matrixL();
   const auto U = llt.matrixU();
@@ -183,12 +119,10 @@ bool dual_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::VectorXd& g, c
   return false;
 }
 
-}  // namespace
-
 bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,
                      const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, double tol) {
   QpBuffers buffers;
-  return dual_qp(llt, g, A, c, d, lambda, tol, buffers);
+  return solve_convex_qp(llt, g, A, c, d, lambda, buffers, tol);
 }
 
 bool solve_convex_qp(const Eigen::MatrixXd& W, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,
@@ -393,8 +327,14 @@ double infeasibility(const Eigen::VectorXd& c) { return c.cwiseMax(0.0).sum(); }
 }  // namespace
 
 Eigen::MatrixXd sqp_lagrangian_hessian(const TargetShapeProblem& problem, const SqpBlock& block,
-                                       const SqpSettings& settings, const Polyline2& p, const Eigen::VectorXd& lambda) {
+                                       const SqpSettings& settings, const Polyline2& p, const Eigen::VectorXd& lambda,
+                                       bool after_evaluation) {
   BlockModel model(problem, block, settings, p);
+  if (after_evaluation) {  // as the SQP does: D and its gradient come from this evaluation
+    Eigen::VectorXd g, c;
+    Eigen::MatrixXd A;
+    model.evaluate(p, &g, c, &A);
+  }
   Eigen::MatrixXd W;
   model.hessian(p, lambda, W);
   return W;
@@ -408,16 +348,6 @@ Eigen::VectorXd sqp_lagrangian_gradient(const TargetShapeProblem& problem, const
   model.evaluate(p, &g, c, &A);
   return g + A.transpose() * lambda;
 }
-
-namespace {
-
-// convexify's buffers, kept by an SQP from one iteration to the next: each call sets their
-// contents, and their sizes where they changed.
-struct ShiftBuffers {
-  Eigen::MatrixXd AtA;
-  std::array<Eigen::MatrixXd, 2> Wd;
-  std::array<Eigen::LLT<Eigen::MatrixXd>, 2> llt;
-};
 
 // Adds ρ a_k a_kᵀ for every constraint with λ_k > 0, then δI, until W is positive definite;
 // `factor` gets its Cholesky factor. False when it cannot be made so (not finite).
@@ -504,8 +434,6 @@ bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::Vector
   return true;
 }
 
-}  // namespace
-
 bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::VectorXd& lambda,
                Eigen::LLT<Eigen::MatrixXd>& factor, std::array<int, 2>& guess, double* delta_taken) {
   ShiftBuffers buffers;
@@ -551,7 +479,7 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
     if (!W.allFinite() || !convexify(W, A, lambda, factor, shift, &delta, shifts)) return out;
     // Inconsistent linearised constraints (a kink that cannot be opened from here): the caller's
     // SLSQP decides, as it always did.
-    if (!dual_qp(factor, g, A, c, d, mu, kQpTolerance, qp)) return out;
+    if (!solve_convex_qp(factor, g, A, c, d, mu, qp)) return out;
     // At a KKT point the QP's own step vanishes: converged when it is below step_tol at a feasible
     // point (its line search could not tell so small a step from rounding).
     if (violation(c) <= settings.constraint_tol && d.lpNorm<Eigen::Infinity>() <= settings.step_tol) {
@@ -593,7 +521,7 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
         // point, linearised about x.
         Eigen::VectorXd dc, mc2;
         const Eigen::VectorXd csoc = ct - A * d;
-        if (dual_qp(factor, g, A, csoc, dc, mc2, kQpTolerance, qp)) {
+        if (solve_convex_qp(factor, g, A, csoc, dc, mc2, qp)) {
           xt = x + dc;
           model.to_points(xt, trial);
           ft = model.evaluate(trial, &gt, ct, &At);
@@ -711,7 +639,7 @@ SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& bloc
     // Inconsistent linearised constraints: SLSQP would solve its augmented problem (a slack
     // variable relaxing them), which this replica does not model (written out with our QP, its
     // steps left NLopt's within a few evaluations): the caller runs NLopt's SLSQP instead.
-    if (!dual_qp(factor, g, A, c, s, r, kQpTolerance, qp)) return out;
+    if (!solve_convex_qp(factor, g, A, c, s, r, qp)) return out;
     const Eigen::VectorXd v = g + A.transpose() * r;  // ∇L at the start of the step
     const double f0 = f;
     const Eigen::VectorXd x0 = x;

@@ -13,10 +13,82 @@
 #include <vector>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Core>
 
 #include "wiresculpt/target_shape.hpp"
 
 namespace wiresculpt::detail {
+
+// The active constraints' whitened normals ñ_j (columns of Ñ) as Ñ = U R, U with orthonormal
+// columns (modified Gram-Schmidt, twice), R upper triangular: adding a column costs O(n |S|);
+// dropping one rebuilds the factorisation of the rest.
+class ActiveBasis {
+ public:
+  // Empties the basis for vectors of n entries (its buffers are kept when their size is).
+  void reset(Eigen::Index n) {
+    U_.resize(n, n), R_.resize(n, n), w_.resize(n), r_.resize(n), q_.resize(n);
+    k_ = 0;
+  }
+  Eigen::Index size() const { return k_; }
+  // The part of v orthogonal to the basis (q) and its coefficients in it (w() = Uᵀ v).
+  template <typename V>
+  void project(const V& v, Eigen::VectorXd& q) {
+    q = v;
+    w_.head(k_).setZero();
+    for (int pass = 0; pass < 2; ++pass)
+      for (Eigen::Index j = 0; j < k_; ++j) {
+        const double a = U_.col(j).dot(q);
+        q -= a * U_.col(j);
+        w_[j] += a;
+      }
+  }
+  // Solves R r = w() (the coefficients of the projected vector in the columns of Ñ).
+  const Eigen::VectorXd& coefficients() {
+    r_.head(k_) = w_.head(k_);
+    if (k_ > 0) R_.topLeftCorner(k_, k_).triangularView<Eigen::Upper>().solveInPlace(r_.head(k_));
+    return r_;
+  }
+  // Adds the vector last projected (q its orthogonal part).
+  void add(const Eigen::VectorXd& q) {
+    const double nq = q.norm();
+    U_.col(k_) = q / nq;
+    R_.col(k_).head(k_) = w_.head(k_);
+    R_(k_, k_) = nq;
+    ++k_;
+  }
+  // Rebuilds the basis from the given columns of Ñ, in order.
+  void rebuild(const Eigen::MatrixXd& Nt, const std::vector<Eigen::Index>& columns) {
+    k_ = 0;
+    for (Eigen::Index j : columns) {
+      project(Nt.col(j), q_);
+      add(q_);
+    }
+  }
+
+ private:
+  Eigen::MatrixXd U_, R_;
+  Eigen::VectorXd w_, r_, q_;
+  Eigen::Index k_ = 0;
+};
+
+/// A QP's buffers, kept by an SQP from one iteration to the next (thousands of small QPs): each
+/// QP sets their contents, and their sizes where they changed, so a QP solved with them gives what
+/// it gives with fresh ones.
+struct QpBuffers {
+  Eigen::MatrixXd At, Nt;
+  std::vector<char> whitened, in;
+  std::vector<Eigen::Index> active;
+  std::vector<double> u;
+  ActiveBasis basis;
+  Eigen::VectorXd q, z;
+};
+
+/// convexify's buffers, kept the same way.
+struct ShiftBuffers {
+  Eigen::MatrixXd AtA;
+  std::array<Eigen::MatrixXd, 2> Wd;
+  std::array<Eigen::LLT<Eigen::MatrixXd>, 2> llt;
+};
 
 struct SqpBlock {
   const std::vector<int>* points = nullptr;       ///< free points solved for (2 variables each)
@@ -89,9 +161,11 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
 
 /// The Hessian of f + Σ λ_k c_k over the block's variables (scaled as the solver sees them: p =
 /// scale_x x, f = E / scale_f) at p, before convexification, and that function's gradient: what
-/// sqp_block steps with, exposed for its tests.
+/// sqp_block steps with, exposed for its tests. `after_evaluation`: the Hessian as the SQP takes it,
+/// right after an evaluation with gradients at p (D and ∇D from that evaluation's samples).
 Eigen::MatrixXd sqp_lagrangian_hessian(const TargetShapeProblem& problem, const SqpBlock& block,
-                                       const SqpSettings& settings, const Polyline2& p, const Eigen::VectorXd& lambda);
+                                       const SqpSettings& settings, const Polyline2& p, const Eigen::VectorXd& lambda,
+                                       bool after_evaluation = false);
 Eigen::VectorXd sqp_lagrangian_gradient(const TargetShapeProblem& problem, const SqpBlock& block,
                                         const SqpSettings& settings, const Polyline2& p, const Eigen::VectorXd& lambda);
 
@@ -104,6 +178,10 @@ Eigen::VectorXd sqp_lagrangian_gradient(const TargetShapeProblem& problem, const
 /// Lagrangian's along the active constraints, so the step is Newton's). Exposed for its tests.
 bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::VectorXd& lambda,
                Eigen::LLT<Eigen::MatrixXd>& factor, std::array<int, 2>& guess, double* delta_taken = nullptr);
+/// The same with the caller's buffers.
+bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::VectorXd& lambda,
+               Eigen::LLT<Eigen::MatrixXd>& factor, std::array<int, 2>& guess, double* delta_taken,
+               ShiftBuffers& buffers);
 
 /// The QP's tolerance on a constraint's violation, relative to 1 + |g|∞.
 inline constexpr double kQpTolerance = 1e-12;
@@ -114,6 +192,10 @@ inline constexpr double kQpTolerance = 1e-12;
 /// multipliers (>= 0). Exposed for its tests.
 bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& W_factor, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,
                      const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, double tol = kQpTolerance);
+/// The same with the caller's buffers (an SQP's, kept across its QPs).
+bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& W_factor, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,
+                     const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, QpBuffers& buffers,
+                     double tol = kQpTolerance);
 bool solve_convex_qp(const Eigen::MatrixXd& W, const Eigen::VectorXd& g, const Eigen::MatrixXd& A,
                      const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, double tol = kQpTolerance);
 

@@ -117,6 +117,7 @@ TEST_CASE("sqp: the convex QP's answer is the KKT point that brute force over ac
   std::mt19937 rng(17);
   std::normal_distribution<double> N(0.0, 1.0);
   int solved = 0, inconsistent = 0;
+  detail::QpBuffers kept;  // one set for every trial, whose n and m keep changing, as an SQP keeps them
   for (int trial = 0; trial < 400; ++trial) {
     const int n = 1 + trial % 5, m = trial % 7;
     const Eigen::MatrixXd B = gaussian(n, n, rng);
@@ -136,6 +137,14 @@ TEST_CASE("sqp: the convex QP's answer is the KKT point that brute force over ac
     const bool feasible = brute_force_qp(W, g, A, c, d_bf);
     const bool ok = detail::solve_convex_qp(W, g, A, c, d, lambda);
     REQUIRE(ok == feasible);
+    {  // the kept buffers give the same bits as fresh ones
+      Eigen::VectorXd d2, lambda2;
+      REQUIRE(detail::solve_convex_qp(Eigen::LLT<Eigen::MatrixXd>(W), g, A, c, d2, lambda2, kept) == ok);
+      if (ok) {
+        CHECK(d2 == d);
+        CHECK(lambda2 == lambda);
+      }
+    }
     if (!ok) {
       ++inconsistent;
       continue;
@@ -362,6 +371,8 @@ TEST_CASE("sqp: the Hessian of the Lagrangian matches central differences of its
       Polyline2 p = problem.initial();
       for (int i : tb.points) p[i] += Vec2(u(rng), u(rng));
       const Eigen::MatrixXd H = detail::sqp_lagrangian_hessian(problem, block, ss, p, lambda);
+      // As the SQP takes it, D and ∇D from the evaluation just before: the same bits.
+      CHECK(detail::sqp_lagrangian_hessian(problem, block, ss, p, lambda, true) == H);
       const Eigen::Index n = H.rows();
       REQUIRE(n == static_cast<Eigen::Index>(2 * tb.points.size()));
       Eigen::MatrixXd fd(n, n);
@@ -629,6 +640,7 @@ TEST_CASE("sqp: convexify takes the first shift of its sequence that makes W pos
   // its factor, and the δ it reports.
   std::mt19937 rng(11);
   int with_rho = 0, with_delta = 0;
+  detail::ShiftBuffers kept;  // one set for every call, as an SQP keeps them
   for (int trial = 0; trial < 300; ++trial) {
     const int n = 4 + trial % 9, m = trial % 7;
     const Eigen::MatrixXd B = gaussian(n, n, rng), A = gaussian(m, n, rng);
@@ -664,6 +676,15 @@ TEST_CASE("sqp: convexify takes the first shift of its sequence that makes W pos
       REQUIRE(detail::convexify(got, A, lambda, factor, guess, &delta_taken));
       CHECK(got == want);
       CHECK(delta_taken == delta);  // what settle_step asks: was W's curvature shifted by δI
+      std::array<int, 2> guess2{g, g};  // the kept buffers give the same bits as fresh ones
+      Eigen::MatrixXd got2 = W;
+      Eigen::LLT<Eigen::MatrixXd> factor2(n);
+      double delta2 = -1.0;
+      REQUIRE(detail::convexify(got2, A, lambda, factor2, guess2, &delta2, kept));
+      CHECK(got2 == got);
+      CHECK(factor2.matrixLLT() == factor.matrixLLT());
+      CHECK(delta2 == delta_taken);
+      CHECK(guess2 == guess);
       CHECK((factor.matrixL().toDenseMatrix() * factor.matrixU().toDenseMatrix() - want).cwiseAbs().maxCoeff() <=
             1e-9 * want.cwiseAbs().maxCoeff());
     }
