@@ -29,7 +29,6 @@ class ActiveBasis {
     U_.resize(n, n), R_.resize(n, n), w_.resize(n), r_.resize(n), q_.resize(n);
     k_ = 0;
   }
-  Eigen::Index size() const { return k_; }
   // The part of v orthogonal to the basis (q) and its coefficients in it (w() = Uᵀ v).
   template <typename V>
   void project(const V& v, Eigen::VectorXd& q) {
