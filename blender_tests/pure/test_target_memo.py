@@ -9,7 +9,7 @@ import numpy as np
 
 from wiresculpt import native, pipeline
 from wiresculpt.core.materials import PRESETS
-from wiresculpt.core.polylines import point_array
+from wiresculpt.core.polylines import ContourArrays, point_array
 from wiresculpt.core.settings import defaults
 from wiresculpt.stages import layering, target_shape
 
@@ -151,8 +151,9 @@ class Derived(unittest.TestCase):
                 np.testing.assert_array_equal(v, v0)
             for c in self.design["crossings"]:
                 for k in (0, 1):
-                    np.testing.assert_array_equal(memo.bisector(self.design, c, k),
-                                                  target_shape.desired_bisector(self.design, c, k))
+                    h = target_shape.desired_bisector(self.design, c, k)
+                    u, v, _contour = memo.frame(self.design["wires"][c["wires"][k]])
+                    self.assertEqual(memo.bisector_2d(self.design, c, k, u, v), (float(h @ u), float(h @ v)))
             self.assertEqual(memo.model_size(self.design), target_shape.model_size(self.design))
 
     def test_a_new_contour_plane_or_hook_is_computed_again(self):
@@ -169,9 +170,43 @@ class Derived(unittest.TestCase):
         wire["contour"] = [[3 * x, 3 * y, 3 * z] for x, y, z in wire["contour"]]
         self.assertGreater(memo.model_size(design), size)
         c = next(c for c in design["crossings"] if c["hook"] != 0)
-        h = memo.bisector(design, c, 0)
+        u, v, _contour = memo.frame(design["wires"][c["wires"][0]])
+        h = memo.bisector_2d(design, c, 0, u, v)
         c["hook"] = -c["hook"]
-        np.testing.assert_array_equal(memo.bisector(design, c, 0), -h)
+        self.assertEqual(memo.bisector_2d(design, c, 0, u, v), (-h[0], -h[1]))
+        other = design["wires"][c["wires"][1]]
+        other["plane"]["normal"] = [-x for x in other["plane"]["normal"]]  # d = n0 x n1 turns over
+        self.assertEqual(memo.bisector_2d(design, c, 0, u, v), h)
+
+    def test_the_sides_of_each_wire_are_those_a_scan_finds(self):
+        sides = target_shape.sides_by_wire(self.design)
+        for wire in self.design["wires"]:
+            scan = [(c["id"], c["wires"].index(wire["id"])) for c in self.design["crossings"] if wire["id"] in c["wires"]]
+            self.assertEqual([(c["id"], k) for c, k in sides.get(wire["id"], [])], scan)
+        self.assertEqual(sum(map(len, sides.values())), 2 * len(self.design["crossings"]))
+
+    def test_contour_arrays_are_converted_once_per_list(self):
+        contours = ContourArrays()
+        wire = self.design["wires"][0]
+        first = contours.get(wire["contour"])
+        np.testing.assert_array_equal(first, np.asarray(wire["contour"], dtype=np.float64))
+        self.assertIs(contours.get(wire["contour"]), first)
+        other = [list(p) for p in wire["contour"]]  # equal, but another list
+        self.assertIsNot(contours.get(other), first)
+        given = np.zeros((3, 3))
+        contours.remember(other, given)  # what the layering hands over is what is read
+        self.assertIs(contours.get(other), given)
+        self.assertIs(target_shape.Memo(contours=contours).array({"name": "x", "contour": other}), given)
+
+    def test_the_layering_hands_over_its_contours_as_the_same_floats(self):
+        design = copy.deepcopy(self.design)
+        contours = ContourArrays()
+        layering.run(design, PRESETS["steel"], defaults(), contours=contours)
+        for wire in design["wires"]:
+            self.assertIn(id(wire["contour"]), contours._by_id)  # handed over, not converted
+            got = contours.get(wire["contour"])
+            self.assertEqual(got.dtype, np.float64)
+            np.testing.assert_array_equal(got, np.asarray(wire["contour"], dtype=np.float64))
 
 
 class PointArray(unittest.TestCase):

@@ -18,7 +18,7 @@ import numpy as np
 from .. import native
 from ..core.design import crossing_direction, model_size
 from ..core.frames import plane_frame, to_2d, to_3d
-from ..core.polylines import point_array, polyline_length
+from ..core.polylines import ContourArrays, polyline_length
 from . import layering
 
 FAILED = ("too_close", "infeasible", "open_end")
@@ -78,21 +78,36 @@ def solve_wire(design, wire, material, settings, size, native_progress=None, mem
     return finish_wire(job, solve_job(job, native_progress), memo)
 
 
-def prepare_wire(design, wire, settings, size, memo=None):
+def sides_by_wire(design):
+    """{wire id: [(crossing, k)]}: the crossings through each wire in the design's order, k the
+    wire's index in the crossing's `wires` (the first, should both be the wire)."""
+    sides = {}
+    for c in design["crossings"]:
+        for k, w in enumerate(c["wires"]):
+            if k == 0 or w != c["wires"][0]:
+                sides.setdefault(w, []).append((c, k))
+    return sides
+
+
+def prepare_wire(design, wire, settings, size, memo=None, sides=None):
     """Everything one wire's solve needs, read from the design (call on the thread that owns the
     design and the memo): {"contour", "closed", "specs", "options", "refs", "frame", "key",
     "start_key", "result"}, where "result" is the memo's reusable result or None (solve_job
-    computes it) and "start_key" the key of Memo.starts (None without a memo)."""
+    computes it) and "start_key" the key of Memo.starts (None without a memo). `sides`:
+    sides_by_wire(design), when already at hand."""
     origin = wire["plane"]["origin"]
     u, v, contour = memo.frame(wire) if memo is not None else _frame(wire)
     contact = math.radians(settings["contact_angle_deg"])
     specs, refs = [], []
-    for c in design["crossings"]:
-        if wire["id"] not in c["wires"]:
-            continue
-        k = c["wires"].index(wire["id"])
-        h = memo.bisector(design, c, k) if memo is not None else desired_bisector(design, c, k)
-        specs.append({"vertex": c["contour_vertices"][k], "bisector": (float(h @ u), float(h @ v)),
+    if sides is None:
+        sides = sides_by_wire(design)
+    for c, k in sides.get(wire["id"], ()):
+        if memo is not None:
+            bisector = memo.bisector_2d(design, c, k, u, v)
+        else:
+            h = desired_bisector(design, c, k)
+            bisector = (float(h @ u), float(h @ v))
+        specs.append({"vertex": c["contour_vertices"][k], "bisector": bisector,
                       "contact_angle": contact, "active": c["hook"] != 0})
         refs.append((c, k))
     options = {"min_segment": settings["min_segment"], "max_bend": math.radians(settings["max_bend_deg"]),
@@ -175,11 +190,13 @@ class Memo:
 
     CONVERGED = ("NLOPT_SUCCESS", "NLOPT_FTOL_REACHED", "NLOPT_XTOL_REACHED", "SQP_CONVERGED", "none")  # "none": nothing free
 
-    def __init__(self, same=None):
+    def __init__(self, same=None, contours=None):
         """`same`: a dict {(key, max_bend): result} of earlier solves of exactly the same problem,
         shared with other memos (pipeline.relayer hands one to every re-layering round: wires whose
         crossings and hooks the new layering left alone are the same problems). Its results are
-        reused whatever they were: the solve is a deterministic function of its input."""
+        reused whatever they were: the solve is a deterministic function of its input.
+        `contours`: a core.polylines.ContourArrays shared with the solve's other stages (the
+        layering fills it with the arrays of the contours it makes); a memo of its own without."""
         self.nulled = []
         self.vertex_limits = {}
         self.solves = {}  # key -> (max_bend, result)
@@ -190,9 +207,9 @@ class Memo:
         # layering, shared by the rounds' copies of the design): each wire's frame and 2D contour,
         # each crossing's bisector and the model's size, checked against the objects they came from.
         self._frames = {}  # wire name -> (contour, origin, normal, (u, v, 2D contour))
-        self._bisectors = {}  # (the two wires' plane normals, k, hook) -> h
+        self._bisectors = {}  # (the two wires' plane normals, k, hook) -> h in wire k's frame
         self._size = None  # (the contours, size)
-        self._arrays = {}  # wire name -> (contour, the contour as a float64 array)
+        self.contours = ContourArrays() if contours is None else contours
 
     def frame(self, wire):
         """_frame(wire), computed once per contour and plane."""
@@ -204,13 +221,18 @@ class Memo:
             self._frames[wire["name"]] = entry
         return entry[3]
 
-    def bisector(self, design, crossing, k):
-        """desired_bisector(design, crossing, k), computed once per pair of plane normals and hook."""
-        normals = tuple(tuple(design["wires"][w]["plane"]["normal"]) for w in crossing["wires"])
-        key = (normals, k, crossing["hook"])
-        if key not in self._bisectors:
-            self._bisectors[key] = desired_bisector(design, crossing, k)
-        return self._bisectors[key]
+    def bisector_2d(self, design, crossing, k, u, v):
+        """desired_bisector(design, crossing, k) in the frame (u, v) of wire k's plane (Memo.frame),
+        as floats, computed once per pair of plane normals and hook (the frame is a function of
+        the wire's normal)."""
+        w0, w1 = crossing["wires"]
+        key = (tuple(design["wires"][w0]["plane"]["normal"]), tuple(design["wires"][w1]["plane"]["normal"]), k,
+               crossing["hook"])
+        found = self._bisectors.get(key)
+        if found is None:
+            h = desired_bisector(design, crossing, k)
+            found = self._bisectors[key] = (float(h @ u), float(h @ v))
+        return found
 
     def model_size(self, design):
         """core.design.model_size(design), computed once for the same contours."""
@@ -222,12 +244,9 @@ class Memo:
 
     def array(self, wire):
         """The wire's contour as a float64 array, converted once per contour (a long contour's
-        list of lists took ~0.1 ms each time, twice per wire and round)."""
-        entry = self._arrays.get(wire["name"])
-        if entry is None or entry[0] is not wire["contour"]:
-            entry = (wire["contour"], point_array(wire["contour"]))
-            self._arrays[wire["name"]] = entry
-        return entry[1]
+        list of lists took ~0.1 ms each time, twice per wire and round) or handed over by the
+        layering that made it (`contours`)."""
+        return self.contours.get(wire["contour"])
 
     @staticmethod
     def key(contour, closed, specs, options, ignore=("max_bend",), like=None):
@@ -330,7 +349,8 @@ def run(design, material, settings, native_progress=None, memo=None):
     reused = [False] * len(design["wires"])
     pending = range(len(design["wires"]))  # the first round solves every wire
     for _round in range(MAX_ROUNDS):
-        jobs = [prepare_wire(design, design["wires"][i], settings, size, memo) for i in pending]
+        sides = sides_by_wire(design)
+        jobs = [prepare_wire(design, design["wires"][i], settings, size, memo, sides) for i in pending]
         for i, job, result in zip(pending, jobs, solve_all(jobs, native_progress)):
             reused[i] = job["result"] is not None
             solved[i] = finish_wire(job, result, memo)
