@@ -146,7 +146,7 @@ def relayer(design, material, settings, say, native_progress, checkpoint, hook_p
     up_front = target_shape.REALISED_ANGLE if extra_rounds else None  # None: every hook (the old path)
     forbidden, too_close, rounds, start, shaped = set(), set(), [], time.perf_counter(), None
     same_solves = {}  # target-shape solves by exact input, for every round (target_shape.Memo `same`)
-    contours = ContourArrays()  # every round's contours as arrays (layering.run, target_shape.Memo)
+    contour_cache = ContourArrays()  # every round's contours as arrays (layering.run, target_shape.Memo)
     hook_deadline = time.monotonic() + (HOOK_SECONDS if hook_seconds is None else hook_seconds)  # one bound for the hook searches of every round
     round_ = 0
     while True:
@@ -154,7 +154,7 @@ def relayer(design, material, settings, say, native_progress, checkpoint, hook_p
         checkpoint()
         attempt = design if not rounds else _copy_sharing_contours(pristine)
         say("layering", layering.run(attempt, material, settings, native_progress, forbidden=forbidden, too_close=up_front,
-                                     contours=contours))
+                                     contour_cache=contour_cache))
         attempt["pending_stages"].remove("layering")
         # The crossings' spacing is the same every round, and a learnt pair is never a too-close
         # one, so the native lists them all each round.
@@ -182,7 +182,7 @@ def relayer(design, material, settings, say, native_progress, checkpoint, hook_p
             # and when none is, the layering's own pattern is kept, so the round learns from it.
             attempt = hooks_by_forces(attempt, material, settings, say, native_progress, checkpoint,
                                       patterns=hook_patterns, seconds=hook_seconds, forbidden=excluded, deadline=hook_deadline,
-                                      same_solves=same_solves, contours=contours)
+                                      same_solves=same_solves, contour_cache=contour_cache)
             shaped = attempt
         learnt = target_shape.unrealisable(attempt) - excluded
         rounds.append({"forbidden": _pairs(forbidden), "too_close": _pairs(too_close), "stable": attempt["stable"],
@@ -288,7 +288,7 @@ def _tighten(design, memo, machine_limit_deg, floor_deg):
 
 
 def shape_and_rest(design, material, settings, say, native_progress, checkpoint, solves=None, same_solves=None,
-                   contours=None):
+                   contour_cache=None):
     """Target shape, then forces and rest shape, with the coupling of Sec. 4.3: the machine's
     maximum bend limits the rest shape, which is only known after the forces. A rest bend beyond
     it comes from the torque its vertex carries (Eq. 12), so the target shape is solved again with
@@ -302,7 +302,7 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint,
     `solves`: a target_shape.Memo's per-wire solves to share with other calls (hooks_by_forces: a
     wire whose crossings keep their hooks is not solved again; the vertex limits are part of a
     solve's key); `same_solves` (a dict, see target_shape.Memo) carries the solves of identical
-    problems across re-layering rounds; `contours` (a core.polylines.ContourArrays) the contours' arrays."""
+    problems across re-layering rounds; `contour_cache` (a core.polylines.ContourArrays) the contours' arrays."""
     import copy
 
     def fresh(d):
@@ -314,7 +314,7 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint,
     target_limit = machine_limit
     kink = 180.0 - settings["contact_angle_deg"]  # a hooked crossing bends at least this much
     before = fresh(design)
-    memo = target_shape.Memo(same_solves, contours)
+    memo = target_shape.Memo(same_solves, contour_cache)
     if solves is not None:
         memo.solves = solves
     totals = dict.fromkeys(("seconds", "iterations", "wire_solves", "reused_wires"), 0)
@@ -446,7 +446,7 @@ def choose(scores):
 
 
 def hooks_by_forces(design, material, settings, say, native_progress, checkpoint, patterns=None, seconds=None,
-                    forbidden=(), deadline=None, same_solves=None, contours=None):
+                    forbidden=(), deadline=None, same_solves=None, contour_cache=None):
     """shape_and_rest on the layering's hooks and on the other hook patterns of the same Eq. 2
     cost (equal_cost_patterns) whose assembly order stays stable (Eq. 1, layering.recheck), and
     keeps the design whose forces are best (force_score, choose): first the weakest-direction load
@@ -459,7 +459,7 @@ def hooks_by_forces(design, material, settings, say, native_progress, checkpoint
     default to HOOK_PATTERNS and HOOK_SECONDS (read at the call). `forbidden`: (crossing id, hook)
     pairs no pattern may use (relayer's). `deadline` (time.monotonic()): no new pattern after it,
     instead of `seconds` from the call (relayer's, shared by its rounds); `same_solves`: relayer's
-    solves of identical target-shape problems and `contours` its contours' arrays (shape_and_rest). When no pattern
+    solves of identical target-shape problems and `contour_cache` its contours' arrays (shape_and_rest). When no pattern
     ends stable, the layering's own pattern
     is the result (relayer learns from its unrealisable hooks)."""
     patterns = HOOK_PATTERNS if patterns is None else patterns
@@ -490,7 +490,7 @@ def hooks_by_forces(design, material, settings, say, native_progress, checkpoint
                 continue
             stable += 1
             trial = shape_and_rest(trial, material, settings, say if index == 0 else _quiet, native_progress,
-                                   checkpoint, shared, same_solves, contours)
+                                   checkpoint, shared, same_solves, contour_cache)
         except (native.Cancelled, OutOfTime):
             raise
         except (ValueError, RuntimeError):  # another pattern the solver cannot finish: not a better one
@@ -507,7 +507,7 @@ def hooks_by_forces(design, material, settings, say, native_progress, checkpoint
         for index in dict.fromkeys((chosen, 0)):
             checkpoint()
             best = shape_and_rest(_with_hooks(base, candidates[index]), material, settings, _quiet, native_progress,
-                                  checkpoint, shared, same_solves, contours)
+                                  checkpoint, shared, same_solves, contour_cache)
             chosen, best_score = index, force_score(best)
             if best_score is not None:
                 break

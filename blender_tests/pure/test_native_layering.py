@@ -97,6 +97,13 @@ class LayeringBinding(unittest.TestCase):
             self.assertEqual(b["contour"].shape, (len(a["contour"]), 3))
             np.testing.assert_array_equal(b["contour"], np.asarray(a["contour"]))
         self.assertEqual(lists["hook"], arrays["hook"])
+        self.assertNotIn("arrays", lists)  # only on request
+        too = native.layering(wires, {"arrays_too": True})
+        self.assertEqual(len(too["arrays"]), len(too["network"]["wires"]))
+        for a, b in zip(too["network"]["wires"], too["arrays"]):
+            self.assertIsInstance(a["contour"], list)
+            self.assertEqual(b.dtype, np.float64)
+            np.testing.assert_array_equal(b, np.asarray(a["contour"]))
         # Great circles of radius 0.1 m cross pi/2 x 0.1 = 157 mm apart along each wire: nothing is too
         # close for min_segment 15 mm or 75 mm (a free point needs 150 mm).
         for lmin in (0.015, 0.075):
@@ -118,6 +125,7 @@ class LayeringBinding(unittest.TestCase):
             native.layering(wires, {"forbid_too_close": True, "too_close_angle_tolerance": -0.01})
         self.assertIn("too_close_angle_tolerance must be a finite angle >= 0", str(ctx.exception))
         for bad, message in ((({"contour_arrays": 1}), "settings['contour_arrays']: expected True or False, got int"),
+                             (({"arrays_too": 0}), "settings['arrays_too']: expected True or False, got int"),
                              (({"forbid_too_close": "yes"}), "settings['forbid_too_close']: expected True or False, got str")):
             with self.assertRaises(ValueError) as ctx:
                 native.layering(wires, bad)

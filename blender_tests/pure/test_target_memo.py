@@ -130,7 +130,7 @@ class AgainstColdSolves(unittest.TestCase):
 
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)
 class Derived(unittest.TestCase):
-    """What a memo keeps of the contours and planes between rounds (Memo.frame, bisector,
+    """What a memo keeps of the contours and planes between rounds (Memo.frame, bisector_2d,
     model_size) is what the stage computes without it, and is computed again when they change."""
 
     @classmethod
@@ -153,7 +153,7 @@ class Derived(unittest.TestCase):
                 for k in (0, 1):
                     h = target_shape.desired_bisector(self.design, c, k)
                     u, v, _contour = memo.frame(self.design["wires"][c["wires"][k]])
-                    self.assertEqual(memo.bisector_2d(self.design, c, k, u, v), (float(h @ u), float(h @ v)))
+                    self.assertEqual(memo.bisector_2d(self.design, c, k), (float(h @ u), float(h @ v)))
             self.assertEqual(memo.model_size(self.design), target_shape.model_size(self.design))
 
     def test_a_new_contour_plane_or_hook_is_computed_again(self):
@@ -170,13 +170,12 @@ class Derived(unittest.TestCase):
         wire["contour"] = [[3 * x, 3 * y, 3 * z] for x, y, z in wire["contour"]]
         self.assertGreater(memo.model_size(design), size)
         c = next(c for c in design["crossings"] if c["hook"] != 0)
-        u, v, _contour = memo.frame(design["wires"][c["wires"][0]])
-        h = memo.bisector_2d(design, c, 0, u, v)
+        h = memo.bisector_2d(design, c, 0)
         c["hook"] = -c["hook"]
-        self.assertEqual(memo.bisector_2d(design, c, 0, u, v), (-h[0], -h[1]))
+        self.assertEqual(memo.bisector_2d(design, c, 0), (-h[0], -h[1]))
         other = design["wires"][c["wires"][1]]
         other["plane"]["normal"] = [-x for x in other["plane"]["normal"]]  # d = n0 x n1 turns over
-        self.assertEqual(memo.bisector_2d(design, c, 0, u, v), h)
+        self.assertEqual(memo.bisector_2d(design, c, 0), h)
 
     def test_the_sides_of_each_wire_are_those_a_scan_finds(self):
         sides = target_shape.sides_by_wire(self.design)
@@ -196,12 +195,12 @@ class Derived(unittest.TestCase):
         given = np.zeros((3, 3))
         contours.remember(other, given)  # what the layering hands over is what is read
         self.assertIs(contours.get(other), given)
-        self.assertIs(target_shape.Memo(contours=contours).array({"name": "x", "contour": other}), given)
+        self.assertIs(target_shape.Memo(contour_cache=contours).array({"name": "x", "contour": other}), given)
 
     def test_the_layering_hands_over_its_contours_as_the_same_floats(self):
         design = copy.deepcopy(self.design)
         contours = ContourArrays()
-        layering.run(design, PRESETS["steel"], defaults(), contours=contours)
+        layering.run(design, PRESETS["steel"], defaults(), contour_cache=contours)
         for wire in design["wires"]:
             self.assertIn(id(wire["contour"]), contours._by_id)  # handed over, not converted
             got = contours.get(wire["contour"])

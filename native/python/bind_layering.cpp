@@ -47,6 +47,7 @@ std::vector<WireSpec> to_wires(py::handle list) {
 struct Forbidden {
   std::vector<std::vector<int>> pairs;
   bool contour_arrays = false;
+  bool arrays_too = false;  // settings['arrays_too']: the result's `arrays`
 
   /// LayeringOptions::allowed_hooks for a network of `crossings` crossings; InputError names the
   /// entry at fault.
@@ -87,6 +88,10 @@ void read_settings(py::handle d, NetworkOptions& net, LayeringOptions& lay, Forb
                {"contour_arrays", [&](py::handle v, const std::string& at) {
                   if (forbidden == nullptr) throw InputError(at + ": only layering() returns contours");
                   forbidden->contour_arrays = to_bool(v, at);
+                }},
+               {"arrays_too", [&](py::handle v, const std::string& at) {
+                  if (forbidden == nullptr) throw InputError(at + ": only layering() returns contours");
+                  forbidden->arrays_too = to_bool(v, at);
                 }}});
 }
 
@@ -142,15 +147,11 @@ py::dict layering_py(const py::object& wire_list, const py::object& settings, co
     return layering(net, options, fn);
   });
 
-  // The contours again as arrays, for a caller that keeps the network's lists for the design and
-  // computes with arrays (converting the lists back cost Python ~0.1 ms per 1,000 points).
-  py::list contour_arrays;
-  for (const WireSpec& s : net.wires) contour_arrays.append(to_array(s.points));
   py::list warnings;
   for (const auto& w : net.warnings) warnings.append(w);
   for (const auto& g : net.close_crossings) warnings.append(g.message);
   for (const auto& w : r.warnings) warnings.append(w);
-  return py::dict(
+  py::dict out(
       py::arg("network") = network_dict(net, r.hooks, r.metric, options.contact, forbidden.contour_arrays), py::arg("hook") = r.hooks, py::arg("metric") = r.metric,
       py::arg("assembly_order") = r.assembly_order, py::arg("steps") = r.steps,
       py::arg("two_hand_steps") = r.two_hand_steps, py::arg("stable") = r.stable, py::arg("reason") = r.reason,
@@ -159,9 +160,17 @@ py::dict layering_py(const py::object& wire_list, const py::object& settings, co
                                       py::arg("sum_metric") = r.sum_metric,
                                       py::arg("unbalanced_in_plane") = r.unbalanced_in_plane),
       py::arg("complete_search") = r.complete_search, py::arg("in_plane_complete") = r.in_plane_complete,
-      py::arg("too_close_forbidden") = r.too_close_forbidden, py::arg("contour_arrays") = contour_arrays,
+      py::arg("too_close_forbidden") = r.too_close_forbidden,
       py::arg("stats") = py::dict(py::arg("seconds") = r.stats.seconds, py::arg("lp_solves") = r.stats.lp_solves,
                                   py::arg("nodes") = r.stats.nodes));
+  if (forbidden.arrays_too) {
+    // The contours again as arrays, for a caller that keeps the network's lists for the design and
+    // computes with arrays (converting the lists back costs Python about 0.1 ms per 1,000 points).
+    py::list arrays;
+    for (const WireSpec& s : net.wires) arrays.append(to_array(s.points));
+    out["arrays"] = arrays;
+  }
+  return out;
 }
 
 py::dict check_assembly_py(const py::object& wire_list, const py::object& hook_list, const py::object& step_list,
@@ -211,7 +220,8 @@ forbidden_hooks ([[crossing id, hook -1 or 1], ...]: hooks the search may not ch
 forbid_too_close (False: when True, also every hook that the target shape cannot realise for want
 of a free bending point between two crossings, too_close_hooks), too_close_angle_tolerance (rad, 0.1 deg),
 contour_arrays (False: when True the network's contours come back as float64 (n, 3) arrays, not
-lists: fewer Python objects for a caller that reads few of them, the plane search's screen);
+lists: fewer Python objects for a caller that reads few of them, the plane search's screen),
+arrays_too (False: when True the result's "arrays" holds the contours as arrays as well);
 unknown keys raise ValueError.
 progress(stage, fraction) -> False cancels (raises _wiresculpt.Cancelled).
 Returns {"network": {"wires": [{id, name, origin, normal, closed, contour [[x, y, z]] (the points
@@ -221,8 +231,8 @@ the wires' contours), point, hook, metric, hook_metrics (e_c of hook -1 and of h
 "steps": [[ids]], "two_hand_steps": [step indices], "stable": bool, "reason": str,
 "warnings": [str], "objective": {max_metric, null_crossings, sum_metric, unbalanced_in_plane},
 "complete_search": bool, "in_plane_complete": bool, "too_close_forbidden": [[crossing id, hook]] (the hooks
-forbid_too_close forbade), "contour_arrays": [the network's contours as float64 (n, 3) arrays, in
-its wires' order], "stats": {seconds, lp_solves, nodes}}. Bad
+forbid_too_close forbade), "stats": {seconds, lp_solves, nodes}, "arrays": [the network's
+contours as float64 (n, 3) arrays, in its wires' order; only with arrays_too]}. Bad
 input raises ValueError naming the wire or key, e.g. wires[1]['points']: expected an (n, 3) array
 of numbers, got shape (5, 2).)");
 }

@@ -21,10 +21,10 @@ def point_array(points, dim=3):
 
 class ContourArrays:
     """Contours (lists of points) as float64 arrays, by the lists' identity, for the length of one
-    solve: its layering hands over its new contours' arrays (its native result has both) and its
-    later stages read them instead of converting the same lists again (on the Chair, ~2 ms a
-    solve). The lists must not be edited while it is in use: a solve never edits a contour, its
-    layering replaces them."""
+    solve: its layering hands over its new contours' arrays (the native layering's `arrays_too`)
+    and its later stages read them instead of converting the same lists again (a re-layering round
+    makes new contours: docs/method-target-shape.md, issue 17 eleventh round). The lists must not be
+    edited while it is in use: a solve never edits a contour, its layering replaces them."""
 
     def __init__(self):
         self._by_id = {}  # id(list) -> (list, array); the list is held, so its id is not reused

@@ -32,7 +32,8 @@ def wire_specs(design, key="contour", arrays=None):
             for w, a in zip(design["wires"], arrays, strict=True)]
 
 
-def run(design, material, settings, native_progress=None, forbidden=(), too_close=None, arrays=False, contours=None):
+def run(design, material, settings, native_progress=None, forbidden=(), too_close=None, arrays=False,
+        contour_cache=None):
     """Fills crossings, assembly order, stable/reason and stages.layering. Returns a progress line.
     `native_progress(stage, fraction) -> bool` (False cancels) is handed to the solver.
     `forbidden`: (crossing id, hook) pairs the search may not choose (the re-layering loop,
@@ -42,9 +43,9 @@ def run(design, material, settings, native_progress=None, forbidden=(), too_clos
     forbid_too_close; the plane search's screen, and pipeline.relayer's rounds); the pairs it
     forbade go to `too_close_forbidden`, which never reaches a design.json. `arrays`: the wires'
     contours become float64 (n, 3) arrays instead of lists (the screen's probes: a few arrays
-    instead of a list per point for Python's garbage collector to walk). `contours`: a
+    instead of a list per point for Python's garbage collector to walk). `contour_cache`: a
     core.polylines.ContourArrays of the solve: the contours are read from it, and the new ones'
-    arrays go into it, for the later stages."""
+    arrays (the native result's `arrays`) go into it, for the later stages."""
     options = settings_for(material, settings)
     if forbidden:
         options["forbidden_hooks"] = [[int(c), int(h)] for c, h in sorted(forbidden)]
@@ -52,13 +53,16 @@ def run(design, material, settings, native_progress=None, forbidden=(), too_clos
         options.update(forbid_too_close=True, too_close_angle_tolerance=float(too_close))
     if arrays:
         options["contour_arrays"] = True
-    given = None if contours is None else [contours.get(w["contour"]) for w in design["wires"]]
+    elif contour_cache is not None:
+        options["arrays_too"] = True
+    given = None if contour_cache is None else [contour_cache.get(w["contour"]) for w in design["wires"]]
     result = native.layering(wire_specs(design, arrays=given), options, native_progress)
     net = result["network"]
-    for wire, solved, array in zip(design["wires"], net["wires"], result["contour_arrays"]):
+    for wire, solved in zip(design["wires"], net["wires"]):
         wire["contour"] = solved["contour"]  # the sliced contour with its crossing points inserted
-        if contours is not None:
-            contours.remember(solved["contour"], array)
+    if options.get("arrays_too"):
+        for solved, array in zip(net["wires"], result["arrays"], strict=True):
+            contour_cache.remember(solved["contour"], array)
     design["crossings"] = net["crossings"]  # the design's keys (contour_vertices, metric, ...)
     design["assembly_order"] = list(result["assembly_order"])
     design["assembly_steps"] = [list(s) for s in result["steps"]]

@@ -103,7 +103,7 @@ def prepare_wire(design, wire, settings, size, memo=None, sides=None):
         sides = sides_by_wire(design)
     for c, k in sides.get(wire["id"], ()):
         if memo is not None:
-            bisector = memo.bisector_2d(design, c, k, u, v)
+            bisector = memo.bisector_2d(design, c, k)
         else:
             h = desired_bisector(design, c, k)
             bisector = (float(h @ u), float(h @ v))
@@ -190,12 +190,12 @@ class Memo:
 
     CONVERGED = ("NLOPT_SUCCESS", "NLOPT_FTOL_REACHED", "NLOPT_XTOL_REACHED", "SQP_CONVERGED", "none")  # "none": nothing free
 
-    def __init__(self, same=None, contours=None):
+    def __init__(self, same=None, contour_cache=None):
         """`same`: a dict {(key, max_bend): result} of earlier solves of exactly the same problem,
         shared with other memos (pipeline.relayer hands one to every re-layering round: wires whose
         crossings and hooks the new layering left alone are the same problems). Its results are
         reused whatever they were: the solve is a deterministic function of its input.
-        `contours`: a core.polylines.ContourArrays shared with the solve's other stages (the
+        `contour_cache`: a core.polylines.ContourArrays shared with the solve's other stages (the
         layering fills it with the arrays of the contours it makes); a memo of its own without."""
         self.nulled = []
         self.vertex_limits = {}
@@ -209,7 +209,7 @@ class Memo:
         self._frames = {}  # wire name -> (contour, origin, normal, (u, v, 2D contour))
         self._bisectors = {}  # (the two wires' plane normals, k, hook) -> h in wire k's frame
         self._size = None  # (the contours, size)
-        self.contours = ContourArrays() if contours is None else contours
+        self.contour_cache = ContourArrays() if contour_cache is None else contour_cache
 
     def frame(self, wire):
         """_frame(wire), computed once per contour and plane."""
@@ -221,7 +221,7 @@ class Memo:
             self._frames[wire["name"]] = entry
         return entry[3]
 
-    def bisector_2d(self, design, crossing, k, u, v):
+    def bisector_2d(self, design, crossing, k):
         """desired_bisector(design, crossing, k) in the frame (u, v) of wire k's plane (Memo.frame),
         as floats, computed once per pair of plane normals and hook (the frame is a function of
         the wire's normal)."""
@@ -231,6 +231,7 @@ class Memo:
         found = self._bisectors.get(key)
         if found is None:
             h = desired_bisector(design, crossing, k)
+            u, v, _contour = self.frame(design["wires"][crossing["wires"][k]])
             found = self._bisectors[key] = (float(h @ u), float(h @ v))
         return found
 
@@ -245,8 +246,8 @@ class Memo:
     def array(self, wire):
         """The wire's contour as a float64 array, converted once per contour (a long contour's
         list of lists took ~0.1 ms each time, twice per wire and round) or handed over by the
-        layering that made it (`contours`)."""
-        return self.contours.get(wire["contour"])
+        layering that made it (`contour_cache`)."""
+        return self.contour_cache.get(wire["contour"])
 
     @staticmethod
     def key(contour, closed, specs, options, ignore=("max_bend",), like=None):
