@@ -9,6 +9,7 @@
 #include <exception>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -954,23 +955,30 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     const unsigned nvar = static_cast<unsigned>(2 * b.points.size());
     data.block = &b;
     for (std::size_t k = 0; k < b.points.size(); ++k) data.var_of[b.points[k]] = static_cast<int>(2 * k);
-    nlopt::opt opt(nlopt_algorithm(o.algorithm), nvar);
-    if (o.algorithm == TargetShapeAlgorithm::auglag_lbfgs) {
-      nlopt::opt local(nlopt::LD_LBFGS, nvar);
-      local.set_ftol_rel(o.ftol_rel);
-      local.set_xtol_rel(o.xtol_rel);
-      local.set_maxeval(o.max_iterations);
-      local.set_maxtime(o.max_seconds);
-      opt.set_local_optimizer(local);
-    }
-    opt.set_min_objective(objective, &data);
-    if (!b.constraints.empty())
-      opt.add_inequality_mconstraint(constraints_fn, &data, std::vector<double>(b.constraints.size(), o.constraint_tol));
-    opt.set_ftol_rel(o.ftol_rel);
-    opt.set_xtol_rel(o.xtol_rel);
-    opt.set_maxeval(std::max(1, o.max_iterations - data.evaluations));
-    // The wall-clock budget of the whole call (max_seconds), shared by every block.
-    opt.set_maxtime(std::max(1e-3, o.max_seconds - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
+    // NLopt for this block, set up where it first runs (the SQP solves most blocks without it), with
+    // what is left then of the call's evaluation and wall-clock budgets (max_seconds is shared by
+    // every block).
+    std::optional<nlopt::opt> nlopt_opt;
+    auto opt = [&]() -> nlopt::opt& {
+      if (nlopt_opt) return *nlopt_opt;
+      nlopt::opt& op = nlopt_opt.emplace(nlopt_algorithm(o.algorithm), nvar);
+      if (o.algorithm == TargetShapeAlgorithm::auglag_lbfgs) {
+        nlopt::opt local(nlopt::LD_LBFGS, nvar);
+        local.set_ftol_rel(o.ftol_rel);
+        local.set_xtol_rel(o.xtol_rel);
+        local.set_maxeval(o.max_iterations);
+        local.set_maxtime(o.max_seconds);
+        op.set_local_optimizer(local);
+      }
+      op.set_min_objective(objective, &data);
+      if (!b.constraints.empty())
+        op.add_inequality_mconstraint(constraints_fn, &data, std::vector<double>(b.constraints.size(), o.constraint_tol));
+      op.set_ftol_rel(o.ftol_rel);
+      op.set_xtol_rel(o.xtol_rel);
+      op.set_maxeval(std::max(1, o.max_iterations - data.evaluations));
+      op.set_maxtime(std::max(1e-3, o.max_seconds - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
+      return op;
+    };
     std::vector<double> x(nvar);
     for (std::size_t k = 0; k < b.points.size(); ++k) {
       x[2 * k] = data.p[b.points[k]].x() / data.scale_x;
@@ -993,7 +1001,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     // NLopt from x (updated in place), its stops as result codes; a rejected problem is the solver's error.
     auto run_nlopt = [&]() -> nlopt::result {
       try {
-        return opt.optimize(x, f);
+        return opt().optimize(x, f);
       } catch (const nlopt::roundoff_limited&) {
         return nlopt::ROUNDOFF_LIMITED;
       } catch (const nlopt::forced_stop&) {
@@ -1046,7 +1054,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
         lead_in.lead = std::max(1, std::min(lead, o.max_iterations - data.evaluations));
         lead_in.tol = o.constraint_tol;
         lead_in.take_over = sqp_from;
-        opt.set_maxeval(std::max(1, o.max_iterations - data.evaluations));
+        opt().set_maxeval(std::max(1, o.max_iterations - data.evaluations));
         {
           struct Attached {  // the callbacks see the lead-in only during this run
             SolverData& d;
@@ -1066,10 +1074,9 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
       } else if (detail::sqp_block(problem, sb, start, ss).converged) {  // from the replica's point or the block's start
         finish_by_sqp();
       }
-      // The fallback gets what is left of the call's budgets after the lead-in and the SQP (where
-      // NLopt led, its run was the fallback: its budget was what was left before the lead-in).
-      opt.set_maxeval(std::max(1, o.max_iterations - data.evaluations));
-      opt.set_maxtime(std::max(1e-3, o.max_seconds - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
+      // The fallback gets what is left of the call's budgets after the lead-in and the SQP (opt()
+      // sets it up now; where NLopt led, its run was the fallback: its budget was what was left
+      // before the lead-in).
       ++result.sqp_blocks;
       if (!by_sqp) ++result.sqp_fallbacks;
     }

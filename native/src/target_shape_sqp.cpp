@@ -66,9 +66,10 @@ bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::Vector
     // The most violated constraint not yet active.
     Eigen::Index p = -1;
     double worst = -tol * scale;
+    buffers.s.noalias() = A * d;
     for (Eigen::Index k = 0; k < m; ++k) {
       if (in[static_cast<std::size_t>(k)]) continue;
-      const double s = -(At.col(k).dot(d) + c[k]);
+      const double s = -(buffers.s[k] + c[k]);
       if (s < worst) worst = s, p = k;
     }
     if (p < 0) {
@@ -463,6 +464,9 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
   Eigen::MatrixXd W;
   QpBuffers qp;
   ShiftBuffers shifts;
+  // The line search's buffers, kept across iterations (each use sets their contents and sizes).
+  Eigen::VectorXd xt, gt, dc, mc2, csoc;
+  Eigen::MatrixXd At;
   std::array<int, 2> own_guess{0, 0};
   std::array<int, 2>& shift = settings.shift_guess ? *settings.shift_guess : own_guess;
   for (int it = 0; it < settings.max_iterations; ++it) {
@@ -500,8 +504,6 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
     if (!(slope < 0.0)) return out;
     double alpha = 1.0;
     bool accepted = false;
-    Eigen::VectorXd xt, gt;
-    Eigen::MatrixXd At;
     double ft = 0.0;
     // Trial points are evaluated with their gradients: the accepted one (nearly always the first)
     // is the next iterate, whose values the next iteration needs (the same numbers as evaluating it
@@ -519,8 +521,7 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
         // Second-order correction (the full step raised the violation of curved active
         // constraints, the Maratos effect): the same QP with the constraints' values at the trial
         // point, linearised about x.
-        Eigen::VectorXd dc, mc2;
-        const Eigen::VectorXd csoc = ct - A * d;
+        csoc = ct - A * d;
         if (solve_convex_qp(factor, g, A, csoc, dc, mc2, qp)) {
           xt = x + dc;
           model.to_points(xt, trial);
@@ -630,6 +631,8 @@ SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& bloc
   QpBuffers qp;
   double f_prev = std::numeric_limits<double>::infinity();
   Eigen::VectorXd x_prev = x;
+  // Each iteration's vectors, kept across iterations (each use sets their contents and sizes).
+  Eigen::VectorXd v, x0, y, Bs;
   int resets = 1;
   for (;;) {
     factor.compute(B);
@@ -640,9 +643,9 @@ SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& bloc
     // variable relaxing them), which this replica does not model (written out with our QP, its
     // steps left NLopt's within a few evaluations): the caller runs NLopt's SLSQP instead.
     if (!solve_convex_qp(factor, g, A, c, s, r, qp)) return out;
-    const Eigen::VectorXd v = g + A.transpose() * r;  // ∇L at the start of the step
+    v.noalias() = g + A.transpose() * r;  // ∇L at the start of the step
     const double f0 = f;
-    const Eigen::VectorXd x0 = x;
+    x0 = x;
     const double gs = g.dot(s);
     for (int j = 0; j < mc; ++j) mu[j] = std::max(r[j], 0.5 * (mu[j] + r[j]));
     const double h1 = penalty(c, 0.0);
@@ -688,8 +691,8 @@ SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& bloc
     f_prev = f;
     x_prev = x;
     // Powell's damped BFGS update with y = ∇L(x) - ∇L(x0), both with the step's multipliers.
-    Eigen::VectorXd y = g + A.transpose() * r - v;
-    const Eigen::VectorXd Bs = B * s;
+    y.noalias() = g + A.transpose() * r - v;
+    Bs.noalias() = B * s;
     double sy = s.dot(y);
     const double sBs = s.dot(Bs);
     const double damped = sBs * 0.2;

@@ -79,7 +79,7 @@ struct QpBuffers {
   std::vector<Eigen::Index> active;
   std::vector<double> u;
   ActiveBasis basis;
-  Eigen::VectorXd q, z;
+  Eigen::VectorXd q, z, s;
 };
 
 /// convexify's buffers, kept the same way.
