@@ -955,9 +955,9 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
     const unsigned nvar = static_cast<unsigned>(2 * b.points.size());
     data.block = &b;
     for (std::size_t k = 0; k < b.points.size(); ++k) data.var_of[b.points[k]] = static_cast<int>(2 * k);
-    // NLopt for this block, set up where it first runs (the SQP solves most blocks without it), with
-    // what is left then of the call's evaluation and wall-clock budgets (max_seconds is shared by
-    // every block).
+    // NLopt for this block, set up where it first runs, inside run_nlopt (the SQP solves most blocks
+    // without it), with what is left then of the call's evaluation and wall-clock budgets
+    // (max_seconds is shared by every block).
     std::optional<nlopt::opt> nlopt_opt;
     auto opt = [&]() -> nlopt::opt& {
       if (nlopt_opt) return *nlopt_opt;
@@ -1054,7 +1054,6 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
         lead_in.lead = std::max(1, std::min(lead, o.max_iterations - data.evaluations));
         lead_in.tol = o.constraint_tol;
         lead_in.take_over = sqp_from;
-        opt().set_maxeval(std::max(1, o.max_iterations - data.evaluations));
         {
           struct Attached {  // the callbacks see the lead-in only during this run
             SolverData& d;
@@ -1074,9 +1073,9 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
       } else if (detail::sqp_block(problem, sb, start, ss).converged) {  // from the replica's point or the block's start
         finish_by_sqp();
       }
-      // The fallback gets what is left of the call's budgets after the lead-in and the SQP (opt()
-      // sets it up now; where NLopt led, its run was the fallback: its budget was what was left
-      // before the lead-in).
+      // The fallback gets what is left of the call's budgets after the lead-in and the SQP (NLopt
+      // is set up when it runs; where NLopt led, its run was the fallback: its budget was what was
+      // left before its lead-in, after the replica).
       ++result.sqp_blocks;
       if (!by_sqp) ++result.sqp_fallbacks;
     }
