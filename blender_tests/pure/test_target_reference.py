@@ -196,7 +196,7 @@ class Threads(unittest.TestCase):
         jobs[1]["result"] = kept
         jobs.insert(0, jobs.pop())  # another order than the native call's own
         alone = [target_shape.solve_job(job) for job in jobs]
-        with mock.patch.object(target_shape, "MAX_THREADS", 2), mock.patch.object(target_shape.os, "cpu_count", lambda: 2):
+        with mock.patch.object(target_shape, "MAX_THREADS", 2), mock.patch.object(target_shape, "CORES", 2):
             together = target_shape.solve_all(jobs)
         self.assertIs(together[2], kept)
         for a, b in zip(alone, together):

@@ -57,6 +57,9 @@ ONE_BLOCK_POINTS = 28
 # depends only on its own wire, so the order is kept. (Issue 17, ninth round: a Python thread pool
 # per round cost about a millisecond more on the Duck and the Car.)
 MAX_THREADS = 2
+# The machine's cores, read once: os.cpu_count() reads /sys at every call (40-60 us on a VM, about
+# 1.5 % of the globe's stage).
+CORES = os.cpu_count() or 1
 # Blocks by the Newton SQP (led by SLSQP's first evaluations where a kink's arrangement is chosen,
 # SLSQP where it fails): 2-4.5x fewer instructions than SLSQP alone, the same distances and crossings
 # on the stand-ins, the globe and the corpus (docs/method-target-shape.md, issue 17 fifth round).
@@ -155,7 +158,7 @@ def solve_all(jobs, native_progress=None):
     """The results of solve_job for every job, in order: the ones to solve in one native call, on up
     to MAX_THREADS threads."""
     todo = [k for k, job in enumerate(jobs) if job["result"] is None]
-    threads = max(1, min(MAX_THREADS, os.cpu_count() or 1, len(todo)))
+    threads = max(1, min(MAX_THREADS, CORES, len(todo)))
     results = [job["result"] for job in jobs]
     problems = [{"points": jobs[k]["contour"], "closed": jobs[k]["closed"], "crossings": jobs[k]["specs"],
                  "options": jobs[k]["options"]} for k in todo]
