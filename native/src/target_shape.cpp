@@ -119,9 +119,71 @@ Vec2 closest_on_segment(const Vec2& q, const Vec2& a, const Vec2& b) {
   return a + t * d;
 }
 
+
+// The knots of the initial resampling: the crossings in contour order (plus the ends of an open
+// wire, or one canonical vertex of a closed wire without crossings, the lexicographically smallest,
+// so that the result does not depend on where the contour starts or which way it runs). Crossing
+// vertices must be valid contour indices (validate).
+struct Knot {
+  int vertex;
+  int crossing;  // -1 for an end / anchor
+};
+std::vector<Knot> resampling_knots(const Polyline2& contour, bool closed, const std::vector<TargetCrossing>& crossings) {
+  const int n = static_cast<int>(contour.size());
+  std::vector<Knot> knots;
+  std::vector<int> order(crossings.size());
+  for (std::size_t c = 0; c < order.size(); ++c) order[c] = static_cast<int>(c);
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return crossings[a].vertex < crossings[b].vertex; });
+  if (!closed && (order.empty() || crossings[order.front()].vertex != 0)) knots.push_back({0, -1});
+  for (int c : order) knots.push_back({crossings[c].vertex, c});
+  if (!closed && (order.empty() || crossings[order.back()].vertex != n - 1)) knots.push_back({n - 1, -1});
+  if (closed && knots.empty()) {
+    int best = 0;
+    for (int i = 1; i < n; ++i)
+      if (contour[i].x() < contour[best].x() || (contour[i].x() == contour[best].x() && contour[i].y() < contour[best].y()))
+        best = i;
+    knots.push_back({best, -1});
+  }
+  return knots;
+}
+
+// Segments of the initial resampling on the piece of `arc` metres from one knot to the next: arc /
+// spacing rounded, at least one (three on a closed wire's only piece); between two crossings at
+// least two where the arc allows a free point (2 l_min), else one (a gap, reported apart).
+int piece_segments(double arc, double spacing, double lmin, bool between_crossings, std::size_t knots, bool closed) {
+  int segments = std::max(1, static_cast<int>(std::lround(arc / spacing)));
+  if (closed && knots == 1) segments = std::max(3, segments);
+  if (between_crossings && knots > 1) segments = arc >= 2.0 * lmin ? std::max(2, segments) : 1;
+  return segments;
+}
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
+int detail::initial_point_count(const Polyline2& contour, bool closed, const std::vector<TargetCrossing>& crossings,
+                                const TargetShapeOptions& o) {
+  const int n = static_cast<int>(contour.size());
+  if (n < 2) return -1;
+  for (const TargetCrossing& c : crossings)
+    if (c.vertex < 0 || c.vertex >= n) return -1;
+  const double spacing = o.spacing > 0.0 ? o.spacing : 1.5 * o.min_segment;
+  const int n_edges = closed ? n : n - 1;
+  std::vector<double> cum(static_cast<std::size_t>(n_edges) + 1, 0.0);
+  for (int i = 0; i < n_edges; ++i) cum[i + 1] = cum[i] + (contour[(i + 1) % n] - contour[i]).norm();
+  const double total = cum[n_edges];
+  if (!(total > 0.0) || !std::isfinite(total) || !(spacing > 0.0) || total / spacing > kMaxTargetPoints) return -1;
+  const std::vector<Knot> knots = resampling_knots(contour, closed, crossings);
+  const int pieces = closed ? static_cast<int>(knots.size()) : static_cast<int>(knots.size()) - 1;
+  int count = closed ? 0 : 1;
+  for (int k = 0; k < pieces; ++k) {
+    const Knot& ka = knots[k];
+    const Knot& kb = knots[(k + 1) % knots.size()];
+    double arc = cum[kb.vertex] - cum[ka.vertex];
+    if (closed && arc <= 0.0) arc += total;
+    count += piece_segments(arc, spacing, o.min_segment, ka.crossing >= 0 && kb.crossing >= 0, knots.size(), closed);
+  }
+  return count;
+}
+
 // Problem set-up: target, resampling, constraints.
 
 TargetShapeProblem::TargetShapeProblem(const Polyline2& contour, bool closed,
@@ -229,29 +291,7 @@ TargetShapeProblem::TargetShapeProblem(const Polyline2& contour, bool closed,
     for (int k = 0; k < m_edges; ++k) edge_cells(k, [&](int c) { edge_items_[edge_fill[c]++] = k; });
   }
 
-  // Knots: the crossings in contour order (plus the ends of an open wire, or one canonical vertex
-  // of a closed wire without crossings, the lexicographically smallest, so that the result does
-  // not depend on where the contour starts or which way it runs).
-  struct Knot {
-    int vertex;
-    int crossing;  // -1 for an end / anchor
-  };
-  std::vector<Knot> knots;
-  {
-    std::vector<int> order(crossings_.size());
-    for (std::size_t c = 0; c < order.size(); ++c) order[c] = static_cast<int>(c);
-    std::sort(order.begin(), order.end(), [&](int a, int b) { return crossings_[a].vertex < crossings_[b].vertex; });
-    if (!closed && (order.empty() || crossings_[order.front()].vertex != 0)) knots.push_back({0, -1});
-    for (int c : order) knots.push_back({crossings_[c].vertex, c});
-    if (!closed && (order.empty() || crossings_[order.back()].vertex != n - 1)) knots.push_back({n - 1, -1});
-    if (closed && knots.empty()) {
-      int best = 0;
-      for (int i = 1; i < n; ++i)
-        if (contour[i].x() < contour[best].x() || (contour[i].x() == contour[best].x() && contour[i].y() < contour[best].y()))
-          best = i;
-      knots.push_back({best, -1});
-    }
-  }
+  const std::vector<Knot> knots = resampling_knots(contour, closed, crossings_);
   crossing_vertices_.assign(crossings_.size(), -1);
   statuses_.assign(crossings_.size(), TargetCrossingStatus{});
   struct Gap {
@@ -271,16 +311,9 @@ TargetShapeProblem::TargetShapeProblem(const Polyline2& contour, bool closed,
     if (between_crossings && arc <= 0.0 && knots.size() > 1)
       throw InputError("target shape of wire " + w + ": crossings " + std::to_string(ka.crossing) + " and " +
                        std::to_string(kb.crossing) + " are at the same point of the contour");
-    int segments = std::max(1, static_cast<int>(std::lround(arc / spacing)));
-    if (closed && knots.size() == 1) segments = std::max(3, segments);
-    if (between_crossings && knots.size() > 1) {
-      if (arc >= 2.0 * lmin)
-        segments = std::max(2, segments);
-      else {
-        segments = 1;
-        gaps.push_back({ka.crossing, kb.crossing, arc, (contour[kb.vertex] - contour[ka.vertex]).norm()});
-      }
-    }
+    const int segments = piece_segments(arc, spacing, lmin, between_crossings, knots.size(), closed);
+    if (between_crossings && knots.size() > 1 && arc < 2.0 * lmin)
+      gaps.push_back({ka.crossing, kb.crossing, arc, (contour[kb.vertex] - contour[ka.vertex]).norm()});
     if (ka.crossing >= 0) crossing_vertices_[ka.crossing] = static_cast<int>(initial_.size());
     initial_.push_back(contour[ka.vertex]);
     fixed_.push_back(ka.crossing >= 0 ? 1 : 0);

@@ -21,17 +21,17 @@ namespace wiresculpt {
 namespace {
 
 // A guess of what a job costs, only to start the dearest first: two threads end a round sooner
-// when its long jobs do not come last (the Chair's 26-point one-block wire took 14 of the first
-// round's 33 ms, and came last). With n ≈ the contour's length / spacing points, a wire solved as
-// one block costs about n² (a dense subproblem per iteration; about 4 µs·n² on the stand-ins), one
-// solved in windows about 12·n of the same units (about 50 µs a point).
+// when its long jobs do not come last (the Chair's 26-point one-block wire took 12 of the first
+// round's 42 ms of solving, and came last). With n the target's points (as the solver places them:
+// detail::initial_point_count), a wire solved as one block costs about n² (a dense subproblem per
+// iteration; about 4 µs·n² on the stand-ins), one solved in windows about 12·n of the same units
+// (about 50 µs a point). (The guess was the contour's length / spacing + the crossings, which
+// counted the crossings twice: the Chair's backrest and the Car's 24-point wires looked windowed,
+// hence cheap, and came last; issue 17, fourteenth round.)
 double expected_cost(const TargetShapeJob& job) {
   const TargetShapeOptions& o = job.options;
-  const double length = polyline_length(job.contour, job.closed);
-  // optimize_target_shape's own default spacing (TargetShapeProblem): 1.5 x min_segment.
-  const double spacing = o.spacing > 0.0 ? o.spacing : 1.5 * o.min_segment;
-  const double n = length / spacing + static_cast<double>(job.crossings.size());
-  if (!std::isfinite(n) || n <= 0.0) return 0.0;  // bad input: optimize_target_shape says what is wrong
+  const double n = detail::initial_point_count(job.contour, job.closed, job.crossings, o);
+  if (n <= 0.0) return 0.0;  // bad input: optimize_target_shape says what is wrong
   const double one_block = o.one_block_points < 0 ? 4.0 * o.window : o.one_block_points;
   return o.window <= 0 || n <= one_block ? n * n : 12.0 * n;
 }

@@ -159,3 +159,35 @@ TEST_CASE("target shapes: the first bad wire in the jobs' order is the error, af
   CHECK_THROWS_WITH(optimize_target_shapes(jobs, 0), Contains("threads must be 1 or 2"));
   CHECK_THROWS_WITH(optimize_target_shapes(jobs, 3), Contains("threads must be 1 or 2"));
 }
+
+TEST_CASE("target shapes: the dearest-first guess counts a wire's target points as the solver places them",
+          "[target]") {
+  // Wires near the one-block limit with many crossings: the guess must tell one-block wires (a
+  // dense problem, the dearest per point) from windowed ones as the solver does, else a long
+  // one-block solve can come last and run alone on one thread (the Chair's 26-point backrest with
+  // ten crossings did, when the guess added the crossings to length / spacing). The solver's count
+  // is its own problem's points (TargetShapeProblem::initial).
+  int near_limit = 0;
+  for (bool closed : {true, false}) {
+    for (int kinks : {0, 1, 4, 8, 10, 12}) {
+      for (double wanted : {3.0, 18.0, 22.0, 25.0, 26.0, 27.0, 30.0, 32.0, 36.0, 120.0}) {
+        TargetShapeJob job = loop("Wavy", 0.05, 0.004, 3, 240, kinks);
+        job.closed = closed;
+        double length = 0.0;
+        for (std::size_t i = 0; i + 1 < job.contour.size(); ++i) length += (job.contour[i + 1] - job.contour[i]).norm();
+        job.options.min_segment = length / wanted / 1.5;  // the default spacing: 1.5 min_segment
+        const TargetShapeProblem problem(job.contour, job.closed, job.crossings, job.options);
+        const int m = static_cast<int>(problem.initial().size());
+        INFO((closed ? "closed, " : "open, ") << kinks << " crossings, " << wanted << " points wanted");
+        CHECK(detail::initial_point_count(job.contour, job.closed, job.crossings, job.options) == m);
+        near_limit += kinks >= 8 && m >= 24 && m <= 28;
+      }
+    }
+  }
+  CHECK(near_limit >= 2);  // the case that matters was met: one-block wires just under the limit, many crossings
+  // Input the problem refuses is no count (the solve says what is wrong).
+  TargetShapeJob bad = loop("Bad", 0.05, 0.0, 1, 100, 0);
+  bad.crossings = {{500, Vec2(1, 0), 2.0, true}};
+  CHECK(detail::initial_point_count(bad.contour, bad.closed, bad.crossings, bad.options) == -1);
+  CHECK(detail::initial_point_count({Vec2(0, 0)}, false, {}, bad.options) == -1);
+}

@@ -234,6 +234,15 @@ struct TargetShapeJob {
 std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetShapeJob>& jobs, int threads = 2,
                                                       const ProgressFn& progress = {});
 
+namespace detail {
+/// The number of points of the initial resampling that TargetShapeProblem makes of this wire (its
+/// target points, fixed crossing vertices included), without building the problem; -1 where the
+/// input is not valid (the problem would say why). optimize_target_shapes guesses from it which
+/// wires are solved as one block and what each costs, to start the dearest first.
+int initial_point_count(const Polyline2& contour, bool closed, const std::vector<TargetCrossing>& crossings,
+                        const TargetShapeOptions& options);
+}  // namespace detail
+
 /// The optimisation problem of one wire, exposed for tests and diagnostics: the initial
 /// resampled polyline and every term with its analytic gradient with respect to ALL points
 /// (fixed ones included). optimize_target_shape builds one of these.
