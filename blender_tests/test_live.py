@@ -67,7 +67,8 @@ class Live(unittest.TestCase):
 
 
 class LiveRefused(BlenderCase):
-    """The toggle refuses targets over live.MAX_TRIANGLES with a sentence the panel shows."""
+    """The toggle refuses targets over live.MAX_TRIANGLES, counted with their modifiers, with a
+    sentence the panel shows while that target is picked."""
 
     def test_large_mesh_is_refused(self):
         import bpy
@@ -81,12 +82,178 @@ class LiveRefused(BlenderCase):
         ws.live = True
         self.assertFalse(ws.live)
         self.assertFalse(bpy.app.timers.is_registered(live.tick))
-        self.assertIn("204,800 triangles", live.STATE.message)
-        self.assertIn("200,000", live.STATE.message)
+        self.assertIn("204,800 triangles", live.refused_message(ws))
+        self.assertIn("100,000", live.refused_message(ws))
         bpy.ops.mesh.primitive_cube_add()
         ws.target = bpy.context.view_layer.objects.active
+        self.assertEqual(live.refused_message(ws), "")  # it spoke of the grid
         ws.live = True
         self.assertTrue(ws.live)
         self.assertTrue(bpy.app.timers.is_registered(live.tick))
         ws.live = False
         self.assertFalse(bpy.app.timers.is_registered(live.tick))
+
+    def test_modifiers_count(self):
+        import bpy
+
+        from wiresculpt.operators import live
+
+        bpy.ops.mesh.primitive_cube_add()  # 12 triangles of its own
+        cube = bpy.context.view_layer.objects.active
+        subsurf = cube.modifiers.new("Subdivision", 'SUBSURF')
+        subsurf.levels = 7  # 6 · 4⁷ quads: 196,608 triangles
+        ws = bpy.context.scene.wiresculpt
+        ws.target = cube
+        ws.live = True
+        self.assertFalse(ws.live)
+        self.assertIn("196,608 triangles", live.refused_message(ws))
+        subsurf.levels = 2
+        ws.live = True
+        self.assertTrue(ws.live)
+        ws.live = False
+
+
+class LiveFollowsTheScene(BlenderCase):
+    """What Live sees besides moved planes (a maker's trial under Xvfb, issue 17): the panel's
+    settings, the target's geometry and presence, the toggle set without its update (undo, a scene
+    switch), and errors. The timer's steps are run by hand (no timers run in the background)."""
+
+    def setUp(self):
+        super().setUp()
+        from helpers import globe
+
+        self.target = globe()
+        self.ws = self.scene().wiresculpt
+
+    def tearDown(self):
+        self.ws.live = False
+
+    @staticmethod
+    def scene():
+        import bpy
+
+        return bpy.context.scene
+
+    def settle(self, timeout=60.0):
+        """Runs the timer's steps until the verdict of the scene as it is now is shown."""
+        import time
+
+        from wiresculpt.operators import live
+
+        began = time.monotonic()
+        while True:
+            self.assertIsNotNone(live.tick(), "the live timer ended")
+            if live.STATE.job is None and live.STATE.solved == live.snapshot(self.scene()):
+                return live.STATE.verdict
+            if time.monotonic() - began > timeout:
+                self.fail(f"no verdict within {timeout} s: {live.STATE.verdict!r}")
+            time.sleep(0.02)
+
+    def extent(self):
+        """The largest distance of the live preview's points from the target's centre (m)."""
+        import numpy as np
+
+        from wiresculpt.operators import live
+
+        return max(float(np.max(np.linalg.norm(lines - np.asarray(self.target.location), axis=1)))
+                   for _colour, lines in live.STATE.preview)
+
+    def test_settings_are_part_of_the_verdict(self):
+        import math
+
+        import bpy
+
+        from wiresculpt.operators import live
+
+        self.ws.live = True
+        self.assertEqual(self.settle(), "stable")
+        max_bend, min_bend = self.ws.max_bend_deg, self.ws.min_bend_deg
+        # A limit the globe's kinks cannot meet: solved again without a plane moving.
+        self.ws.max_bend_deg = math.radians(30.0)
+        verdict = self.settle()
+        self.assertTrue(verdict.startswith("not stable — "), verdict)
+        # Settings the solver refuses: a verdict that says why, and Live goes on.
+        self.ws.min_bend_deg = math.radians(40.0)
+        verdict = self.settle()
+        self.assertTrue(verdict.startswith("not stable — the smallest bend must be smaller than the largest bend"),
+                        verdict)
+        self.assertEqual(live.STATE.preview, [])
+        self.assertTrue(bpy.app.timers.is_registered(live.tick))
+        self.ws.max_bend_deg, self.ws.min_bend_deg = max_bend, min_bend
+        self.assertEqual(self.settle(), "stable")
+
+    def test_edits_and_modifiers_of_the_target_are_seen(self):
+        import bpy
+        from mathutils import Matrix
+
+        from wiresculpt.operators import live
+
+        self.ws.live = True
+        self.assertEqual(self.settle(), "stable")
+        before, seen = self.extent(), live.STATE.geometry
+        self.assertAlmostEqual(before, 0.125, delta=0.01)  # the wires lie on the globe
+        self.target.data.transform(Matrix.Scale(0.6, 4))  # an edit of the mesh, its matrix unchanged
+        self.target.data.update()
+        bpy.context.view_layer.update()
+        self.assertGreater(live.STATE.geometry, seen)
+        self.settle()
+        self.assertAlmostEqual(self.extent(), 0.6 * 0.125, delta=0.01)
+        seen = live.STATE.geometry
+        self.target.modifiers.new("Subdivision", 'SUBSURF')
+        bpy.context.view_layer.update()
+        self.assertGreater(live.STATE.geometry, seen)
+        seen = live.STATE.geometry
+        self.settle()
+        self.assertEqual(live.STATE.geometry, seen)  # reading the mesh is no edit: no endless re-solving
+
+    def test_a_target_taken_out_of_the_scene(self):
+        from wiresculpt.operators import live
+
+        self.ws.live = True
+        self.assertEqual(self.settle(), "stable")
+        for collection in self.target.users_collection:
+            collection.objects.unlink(self.target)
+        verdict = self.settle()
+        self.assertTrue(verdict.startswith(f"not stable — Target {self.target.name} is not in scene"), verdict)
+        self.assertEqual(live.STATE.preview, [])
+
+    def test_the_toggle_set_without_its_update(self):
+        import bpy
+
+        from wiresculpt.operators import live
+
+        self.ws["live"] = 1  # as undo or a scene switch sets it: no update called
+        self.assertFalse(bpy.app.timers.is_registered(live.tick))
+        live._undo_post()
+        self.assertTrue(bpy.app.timers.is_registered(live.tick))
+        self.assertEqual(self.settle(), "stable")
+        self.ws["live"] = 0
+        bpy.context.view_layer.update()  # any depsgraph update: the handler stops the timer
+        live._depsgraph_post(self.scene(), bpy.context.evaluated_depsgraph_get())
+        self.assertFalse(bpy.app.timers.is_registered(live.tick))
+        self.assertEqual(live.line(), "")
+
+    def test_an_unexpected_error_is_shown_and_live_goes_on(self):
+        import time
+        from unittest import mock
+
+        import bpy
+
+        from wiresculpt.operators import live
+
+        self.ws.live = True
+        failure = RuntimeError("the solver's thread could not start")
+        with mock.patch.object(live, "_start", side_effect=failure) as start:
+            began = time.monotonic()
+            while not start.called and time.monotonic() - began < 10.0:
+                returned = live.tick()  # a timer that raises is unregistered for good
+                time.sleep(0.02)
+            self.assertTrue(start.called)
+            self.assertEqual(returned, live.TICK_SECONDS)
+            time.sleep(0.1)
+            self.assertEqual(live.tick(), live.TICK_SECONDS)
+            self.assertEqual(start.call_count, 1)  # tried again only once something changes
+        self.assertEqual(live.line(), "Live: error — RuntimeError: the solver's thread could not start")
+        self.target.location.x += 0.001
+        bpy.context.view_layer.update()  # matrix_world follows (a window's event loop does it)
+        self.assertEqual(self.settle(), "stable")

@@ -110,6 +110,16 @@ def solver_settings(settings):
     return out
 
 
+def solve_inputs(settings):
+    """Every panel value material_of and solver_settings read, as they stand (not validated): what
+    a Live solve depends on besides the planes and the target, compared at every tick."""
+    return (tuple(getattr(settings, key) for key in SETTING_PROPS + MATERIAL_PROPS + ("use_load_factor",))
+            + (str(settings.id_data.get(MATERIAL_NAME_KEY, "")),))
+
+
+# the material's panel values (material_of)
+MATERIAL_PROPS = ("material_preset", "wire_diameter", "bending_stiffness", "max_torque", "friction", "density",
+                  "shear_modulus")
 # core/settings.py keys shown in the panel (weld_tolerance stays automatic)
 SETTING_PROPS = ("min_segment", "max_bend_deg", "min_bend_deg", "contact_angle_deg", "torque_fraction",
                  "load_factor", "in_plane_tiebreak", "max_nodes", "relayer_rounds")
@@ -223,7 +233,7 @@ class WiresculptSettings(bpy.types.PropertyGroup):
         name="Live", default=False, update=_live_changed,
         description="While a slicing plane or the target moves, re-slice and re-solve in the background "
                     "and show stable / not stable (the layering's own hooks only; Optimize may pick "
-                    "others). Refused for meshes over 200,000 triangles")
+                    "others). Refused for meshes over 100,000 triangles, counted with their modifiers")
 
     # results display
     show_forces: BoolProperty(

@@ -2,8 +2,10 @@
 show the verdict (docs/user-guide.md, Live).
 
 A bpy.app.timers callback (tick, every TICK_SECONDS while nothing changes, every
-ACTIVE_TICK_SECONDS while planes move or a job runs) compares a snapshot of the slicing planes'
-and the target's matrix_world (and the ticked contours) with the last one it saw. A snapshot that
+ACTIVE_TICK_SECONDS while planes move or a job runs) compares a snapshot of what a solve depends on
+(the slicing planes' and the target's matrix_world, the ticked contours, the material and machine
+settings, whether the target is still in the scene, and how often its geometry changed: edits and
+modifiers, counted by a depsgraph handler) with the last one it saw. A snapshot that
 stayed the same for SETTLE_SECONDS and differs from the one solved (or being solved) starts a LiveJob on
 a worker thread: slice_and_pick then pipeline.solve with the hook search limited to the
 layering's own pattern (hook_patterns=1) and the user's relayer_rounds. Latest position wins: a
@@ -17,10 +19,13 @@ undo history. The wire curves themselves are not rewritten (blend/results.write_
 replace the stored design of the last Optimize and its markers and cut handles); Optimize does.
 
 Turning Live off, loading a file (load_pre) or unregistering stops the timer and cancels the job.
-Meshes over MAX_TRIANGLES triangles are refused (the panel says why).
+The timer follows the toggle also where Blender sets it without its update (undo, redo, another
+scene in the window): the depsgraph, undo and redo handlers start or stop it (_sync). Meshes over
+MAX_TRIANGLES triangles, counted with their modifiers, are refused (the panel says why).
 """
 import threading
 import time
+import traceback
 
 import bpy
 import numpy as np
@@ -31,14 +36,17 @@ from ..blend import results as scene_results
 from ..blend.handles import handles, target_problem, ticked_planes
 from ..blend.view import redraw_3d_views
 from ..core.jobs import WorkerJob
-from ..props import LIVE_HOOKS, material_of, solver_settings
+from ..props import LIVE_HOOKS, material_of, solve_inputs, solver_settings
 
 TICK_SECONDS = 0.1  # while nothing changes
 ACTIVE_TICK_SECONDS = 0.02  # while a plane moves or a job runs: the verdict is seen sooner
 SETTLE_SECONDS = 0.05  # a position unchanged this long is solved (a drag's every frame is not)
-MAX_TRIANGLES = 200_000  # Live is refused on larger targets (re-slicing alone would lag)
+# Live is refused on larger targets (with their modifiers): reading the mesh on Blender's thread when
+# Live starts or the target changes took 63-81 ms at 190,000-250,000 triangles, over the 50 ms a
+# tick may take (issue 17).
+MAX_TRIANGLES = 100_000
 LIVE_HOOK_PATTERNS = 1  # the layering's own hook pattern only: Optimize may pick other hooks
-REASON_WORDS = 8  # words of the reason the panel shows
+REASON_WORDS = 30  # words of the reason the panel shows (wrapped): enough for its numbers and units
 DURATIONS_KEPT = 10_000
 
 
@@ -46,6 +54,7 @@ class LiveState:
     def __init__(self):
         self.reset()
         self.message = ""  # why Live was refused or stopped; kept across resets
+        self.message_target = ""  # the name of the target `message` speaks of
 
     def reset(self):
         self.running = False  # the timer is registered
@@ -55,7 +64,9 @@ class LiveState:
         self.job = None  # the LiveJob of the current snapshot, while it runs
         self.verdict = ""  # "stable", "not stable — …", "solving…" (the panel adds "Live: ")
         self.preview = []  # [(RGBA, (2k, 3) float32 segment end points)], one per wire of the shown verdict
-        self.mesh_key = None  # the target's matrix the cached triangles belong to
+        self.mesh_key = None  # the target's name, matrix and geometry count the cached triangles belong to
+        self.geometry = 0  # changes of the target's geometry seen by the depsgraph handler (edits, modifiers)
+        self.failed = ""  # the last unexpected error's text, printed once
         self.mesh = None  # (V, F) world coordinates
         self.durations = []  # seconds of each tick (the test reads them)
         self.results = []  # the verdicts shown, in order
@@ -68,22 +79,35 @@ class LiveState:
 STATE = LiveState()
 
 
-def triangle_count(obj):
-    """Triangles of the mesh `obj` (its own data: modifiers not counted), from its polygons."""
-    polygons = obj.data.polygons
+def triangle_count(obj, depsgraph=None):
+    """Triangles of the mesh `obj` from its polygons: as evaluated in `depsgraph` (its modifiers
+    applied), else its own data."""
+    polygons = (obj.evaluated_get(depsgraph) if depsgraph is not None else obj).data.polygons
     totals = np.empty(len(polygons), dtype=np.int32)
     polygons.foreach_get("loop_total", totals)
     return int((totals - 2).sum())
 
 
-def refusal(target):
-    """Why Live cannot run on `target`, or ""."""
+def refusal(target, depsgraph=None):
+    """Why Live cannot run on `target` (its triangles counted as evaluated in `depsgraph`), or ""."""
     if target is not None and target.type == 'MESH':
-        n = triangle_count(target)
+        n = triangle_count(target, depsgraph)
         if n > MAX_TRIANGLES:
-            return (f"Live is off: {target.name} has {n:,} triangles, over the {MAX_TRIANGLES:,} Live "
-                    f"re-slices as a plane moves; use Optimize")
+            return (f"Live is off: {target.name} has {n:,} triangles with its modifiers; Live takes at most "
+                    f"{MAX_TRIANGLES:,}, since it reads the mesh again whenever it changes. Use Optimize")
     return ""
+
+
+def refuse(settings, message):
+    """Turns Live off with `message` for the panel (shown while the same target is picked)."""
+    STATE.message, STATE.message_target = message, settings.target.name if settings.target else ""
+    settings.live = False  # its update stops the timer
+
+
+def refused_message(settings):
+    """Why Live was refused, while the target it speaks of is still the picked one, or ""."""
+    target = settings.target
+    return STATE.message if STATE.message and target is not None and target.name == STATE.message_target else ""
 
 
 def _rounded(matrix):
@@ -91,13 +115,15 @@ def _rounded(matrix):
 
 
 def snapshot(scene):
-    """What a live solve depends on that moves in the viewport: the planes' and the target's
-    matrix_world, and the ticked contours."""
+    """What a live solve depends on: the target's name and matrix_world, the planes' matrix_world,
+    the ticked contours, the panel's material and machine values, whether the target is in the
+    scene, and the count of its geometry's changes (STATE.geometry)."""
     ws = scene.wiresculpt
     target = ws.target
     return (target.name if target else "", _rounded(target.matrix_world) if target else (),
             tuple((h.name, _rounded(h.matrix_world)) for h in handles(scene)),
-            tuple((item.plane, item.index) for item in ws.contours if item.use))
+            tuple((item.plane, item.index) for item in ws.contours if item.use),
+            solve_inputs(ws), target is not None and scene.objects.get(target.name) == target, STATE.geometry)
 
 
 def first_words(text, n=REASON_WORDS):
@@ -166,14 +192,14 @@ def _start(scene, key):
     depsgraph = bpy.context.evaluated_depsgraph_get()
     try:
         planes = ticked_planes(scene, depsgraph)
+        material, settings = material_of(ws), solver_settings(ws)  # the panel's values, checked
     except ValueError as exc:
         return "not stable — " + first_words(str(exc))
-    mesh_key = key[:2]
+    mesh_key = (key[0], key[1], key[-1])  # the target's name, matrix and geometry changes
     if STATE.mesh_key != mesh_key:
         STATE.mesh = mesh.object_triangles(ws.target, depsgraph)
         STATE.mesh_key = mesh_key
-    job = LiveJob(key, *STATE.mesh, planes, cut_handles.user_cut_points(scene), material_of(ws),
-                  solver_settings(ws))
+    job = LiveJob(key, *STATE.mesh, planes, cut_handles.user_cut_points(scene), material, settings)
     job.thread.start()
     return job
 
@@ -202,10 +228,9 @@ def _step():
         STATE.seen, STATE.seen_since = key, now
     settled = now - STATE.seen_since >= SETTLE_SECONDS
     if job is None and settled and key != STATE.solved:
-        message = refusal(scene.wiresculpt.target)
+        message = refusal(scene.wiresculpt.target, bpy.context.evaluated_depsgraph_get())
         if message:
-            STATE.message = message
-            scene.wiresculpt.live = False  # its update stops the timer
+            refuse(scene.wiresculpt, message)
             return None
         started = _start(scene, key)
         if isinstance(started, str):
@@ -233,6 +258,13 @@ def tick():
     except (AttributeError, ReferenceError):  # no scene or window (closing, loading)
         stop()
         return None
+    except Exception as exc:  # noqa: BLE001 - a timer that raises is gone for good, leaving the toggle on
+        text = f"{type(exc).__name__}: {exc}"
+        if text != STATE.failed:  # once, not at every tick
+            traceback.print_exc()
+        STATE.failed, STATE.verdict, STATE.preview = text, "error — " + first_words(text), []
+        STATE.solved = STATE.seen  # tried again once something changes
+        return TICK_SECONDS
     finally:
         _TICKING.clear()
         STATE.durations.append(time.perf_counter() - began)
@@ -273,13 +305,57 @@ def live_changed(settings, context):
     if not settings.live:
         stop()
         return
-    message = refusal(settings.target)
+    _turn_on(settings, context.evaluated_depsgraph_get() if context is not None else None)
+
+
+def _turn_on(settings, depsgraph):
+    message = refusal(settings.target, depsgraph)
     if message:
-        STATE.message = message
-        settings.live = False
+        refuse(settings, message)
         return
     STATE.message = ""
     start()
+
+
+def _sync(scene, depsgraph=None):
+    """Starts or stops the timer where the toggle changed without its update (undo, redo, a scene
+    switch); `depsgraph`: the evaluated one at hand (a handler's), else the context's."""
+    if scene is None:
+        return
+    on = bool(scene.wiresculpt.live)
+    if on and not STATE.running:
+        _turn_on(scene.wiresculpt, depsgraph if depsgraph is not None else bpy.context.evaluated_depsgraph_get())
+    elif not on and STATE.running:
+        stop()
+
+
+@bpy.app.handlers.persistent
+def _depsgraph_post(scene=None, depsgraph=None, *_args):
+    """Keeps the timer in step with the toggle, and counts changes of the target's geometry (edits,
+    modifiers) into STATE.geometry, which the snapshot holds."""
+    try:
+        current = bpy.context.scene or scene
+        _sync(current, depsgraph if current == scene else None)
+        if not STATE.running or depsgraph is None or current is None:
+            return
+        target = current.wiresculpt.target
+        if target is None:
+            return
+        watched = (target, target.data)
+        for update in depsgraph.updates:
+            if update.is_updated_geometry and update.id.original in watched:
+                STATE.geometry += 1
+                return
+    except (AttributeError, ReferenceError):  # no scene or window (closing, loading)
+        pass
+
+
+@bpy.app.handlers.persistent
+def _undo_post(*_args):
+    try:
+        _sync(bpy.context.scene)
+    except (AttributeError, ReferenceError):
+        pass
 
 
 @bpy.app.handlers.persistent
@@ -294,16 +370,21 @@ def _load_post(*_args):
         live_changed(scene.wiresculpt, bpy.context)
 
 
+HANDLERS = (("load_pre", "_load_pre"), ("load_post", "_load_post"), ("depsgraph_update_post", "_depsgraph_post"),
+            ("undo_post", "_undo_post"), ("redo_post", "_undo_post"))
+
+
 def register():
     LIVE_HOOKS.append(live_changed)
-    bpy.app.handlers.load_pre.append(_load_pre)
-    bpy.app.handlers.load_post.append(_load_post)
+    for kind, name in HANDLERS:
+        getattr(bpy.app.handlers, kind).append(globals()[name])
 
 
 def unregister():
     stop()
-    for handlers, fn in ((bpy.app.handlers.load_pre, _load_pre), (bpy.app.handlers.load_post, _load_post)):
-        if fn in handlers:
-            handlers.remove(fn)
+    for kind, name in HANDLERS:
+        handlers = getattr(bpy.app.handlers, kind)
+        if globals()[name] in handlers:
+            handlers.remove(globals()[name])
     if live_changed in LIVE_HOOKS:
         LIVE_HOOKS.remove(live_changed)

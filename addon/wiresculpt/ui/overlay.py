@@ -92,15 +92,15 @@ def deflection_whiskers(design, shown=None):
 
 
 def draw_live():
-    """The live verdict's wires (operators/live.py) as thin lines in their colours."""
+    """The live verdict's wires (operators/live.py) as lines in their colours, over everything: the
+    wires lie on the target's surface, where a depth test hid all but their kinks in Solid view."""
     shader = uniform_colour_shader()
-    gpu.state.line_width_set(1.5)
-    gpu.state.depth_test_set('LESS_EQUAL')
+    gpu.state.line_width_set(2.0)
+    gpu.state.depth_test_set('NONE')
     shader.bind()
     for colour, lines in live.STATE.preview:
         shader.uniform_float("color", colour)
         batch_for_shader(shader, 'LINES', {"pos": lines}).draw(shader)
-    gpu.state.depth_test_set('NONE')
     gpu.state.line_width_set(1.0)
     live.STATE.drawn += 1
     live.STATE.drawn_at = time.monotonic()

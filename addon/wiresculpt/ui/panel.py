@@ -103,8 +103,8 @@ class VIEW3D_PT_wiresculpt(bpy.types.Panel):
             wrap_labels(layout, context, live.line(),
                         icon='CHECKMARK' if live.STATE.verdict == "stable" else
                         'SORTTIME' if live.STATE.verdict == "solving…" else 'ERROR')
-        elif live.STATE.message and not settings.live:
-            wrap_labels(layout.box(), context, live.STATE.message, icon='INFO')
+        elif live.refused_message(settings) and not settings.live:
+            wrap_labels(layout.box(), context, live.refused_message(settings), icon='INFO')
         layout.label(text="Contours (ticked: wires)")
         layout.template_list(WIRESCULPT_UL_contours.__name__, "", settings, "contours",
                              settings, "active_contour", rows=4)
