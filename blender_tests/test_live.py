@@ -66,6 +66,21 @@ class Live(unittest.TestCase):
         self.assertEqual(self.seen["load_line"], "")
 
 
+@unittest.skipUnless(shutil.which("xvfb-run"), "xvfb-run is not installed")
+class LiveAcrossScenes(unittest.TestCase):
+    """The window shows another scene and comes back: the timer follows each scene's toggle."""
+
+    def test_timer_follows_the_shown_scene(self):
+        result, seen = run_under_xvfb(os.path.join(ROOT, "blender_tests", "ui_live_scenes.py"), "MODAL ", timeout=180)
+        self.assertIsNotNone(seen, result.stdout[-3000:] + result.stderr[-3000:])
+        self.assertNotIn("error", seen, result.stderr[-3000:])
+        self.assertTrue(seen["on"])
+        self.assertFalse(seen["other_timer"])  # Live is off in the new scene
+        self.assertEqual(seen["other_line"], "")
+        self.assertTrue(seen["back_timer"])  # and on again in the first
+        self.assertTrue(seen["back_line"].startswith("Live: "), seen["back_line"])
+
+
 class LiveRefused(BlenderCase):
     """The toggle refuses targets over live.MAX_TRIANGLES, counted with their modifiers, with a
     sentence the panel shows while that target is picked."""
@@ -214,7 +229,7 @@ class LiveFollowsTheScene(BlenderCase):
         for collection in self.target.users_collection:
             collection.objects.unlink(self.target)
         verdict = self.settle()
-        self.assertTrue(verdict.startswith(f"not stable — Target {self.target.name} is not in scene"), verdict)
+        self.assertTrue(verdict.startswith(f"not stable — Target '{self.target.name}' is not in scene"), verdict)
         self.assertEqual(live.STATE.preview, [])
 
     def test_the_toggle_set_without_its_update(self):

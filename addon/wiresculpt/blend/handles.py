@@ -96,5 +96,6 @@ def target_problem(scene, target):
     if is_handle(target):
         return f"Target {target.name} is a slicing plane; pick the mesh to slice"
     if scene.objects.get(target.name) != target:
-        return f"Target {target.name} is not in scene {scene.name}"
+        return (f"Target '{target.name}' is not in scene '{scene.name}' (deleted or unlinked): put it back, "
+                f"or pick the mesh to slice in the Wire panel (Target)")
     return None

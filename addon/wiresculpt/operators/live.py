@@ -20,7 +20,8 @@ replace the stored design of the last Optimize and its markers and cut handles);
 
 Turning Live off, loading a file (load_pre) or unregistering stops the timer and cancels the job.
 The timer follows the toggle also where Blender sets it without its update (undo, redo, another
-scene in the window): the depsgraph, undo and redo handlers start or stop it (_sync). Meshes over
+scene in the window): the depsgraph, undo and redo handlers and a msgbus subscription to the
+windows' scene start or stop it (_sync). Meshes over
 MAX_TRIANGLES triangles, counted with their modifiers, are refused (the panel says why).
 """
 import threading
@@ -317,16 +318,23 @@ def _turn_on(settings, depsgraph):
     start()
 
 
+_SYNCING = []  # non-empty while _sync runs: the depsgraph it evaluates calls the handler again
+
+
 def _sync(scene, depsgraph=None):
     """Starts or stops the timer where the toggle changed without its update (undo, redo, a scene
     switch); `depsgraph`: the evaluated one at hand (a handler's), else the context's."""
-    if scene is None:
+    if scene is None or _SYNCING:
         return
-    on = bool(scene.wiresculpt.live)
-    if on and not STATE.running:
-        _turn_on(scene.wiresculpt, depsgraph if depsgraph is not None else bpy.context.evaluated_depsgraph_get())
-    elif not on and STATE.running:
-        stop()
+    _SYNCING.append(True)
+    try:
+        on = bool(scene.wiresculpt.live)
+        if on and not STATE.running:
+            _turn_on(scene.wiresculpt, depsgraph if depsgraph is not None else bpy.context.evaluated_depsgraph_get())
+        elif not on and STATE.running:
+            stop()
+    finally:
+        _SYNCING.clear()
 
 
 @bpy.app.handlers.persistent
@@ -352,10 +360,22 @@ def _depsgraph_post(scene=None, depsgraph=None, *_args):
 
 @bpy.app.handlers.persistent
 def _undo_post(*_args):
+    """Undo, redo, and a window switching scenes (a scene evaluated before fires no depsgraph
+    update when it is shown again)."""
     try:
         _sync(bpy.context.scene)
     except (AttributeError, ReferenceError):
         pass
+
+
+_SCENE_SWITCH = object()  # the msgbus owner of the window-scene subscription
+
+
+def _watch_scene_switch():
+    """Subscribes _undo_post to windows switching scenes (load_post again: a load clears msgbus)."""
+    bpy.msgbus.clear_by_owner(_SCENE_SWITCH)
+    bpy.msgbus.subscribe_rna(key=(bpy.types.Window, "scene"), owner=_SCENE_SWITCH, args=(),
+                             notify=_undo_post)
 
 
 @bpy.app.handlers.persistent
@@ -365,6 +385,7 @@ def _load_pre(*_args):
 
 @bpy.app.handlers.persistent
 def _load_post(*_args):
+    _watch_scene_switch()
     scene = bpy.context.scene
     if scene is not None and scene.wiresculpt.live:  # a file saved with Live on resumes it
         live_changed(scene.wiresculpt, bpy.context)
@@ -378,10 +399,12 @@ def register():
     LIVE_HOOKS.append(live_changed)
     for kind, name in HANDLERS:
         getattr(bpy.app.handlers, kind).append(globals()[name])
+    _watch_scene_switch()
 
 
 def unregister():
     stop()
+    bpy.msgbus.clear_by_owner(_SCENE_SWITCH)
     for kind, name in HANDLERS:
         handlers = getattr(bpy.app.handlers, kind)
         if globals()[name] in handlers:
