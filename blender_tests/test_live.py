@@ -243,8 +243,8 @@ class LiveFollowsTheScene(BlenderCase):
         self.assertTrue(bpy.app.timers.is_registered(live.tick))
         self.assertEqual(self.settle(), "stable")
         self.ws["live"] = 0
-        bpy.context.view_layer.update()  # any depsgraph update: the handler stops the timer
-        live._depsgraph_post(self.scene(), bpy.context.evaluated_depsgraph_get())
+        self.scene().update_tag()
+        bpy.context.view_layer.update()  # a depsgraph update: the registered handler stops the timer
         self.assertFalse(bpy.app.timers.is_registered(live.tick))
         self.assertEqual(live.line(), "")
 
@@ -272,3 +272,32 @@ class LiveFollowsTheScene(BlenderCase):
         self.target.location.x += 0.001
         bpy.context.view_layer.update()  # matrix_world follows (a window's event loop does it)
         self.assertEqual(self.settle(), "stable")
+
+    def test_a_mesh_read_over_the_limit_turns_live_off(self):
+        import time
+        from unittest import mock
+
+        import bpy
+
+        from wiresculpt.operators import live
+
+        # As with GPU subdivision, the evaluated mesh the refusal counts is the cage (2,208
+        # triangles); the triangles read for slicing are the subdivided ones, over 100,000.
+        self.target.modifiers.new("Subdivision", 'SUBSURF').levels = 3
+        bpy.context.view_layer.update()
+        with mock.patch.object(live, "triangle_count", return_value=2208):
+            self.ws.live = True
+            self.assertTrue(self.ws.live)
+            for _ in range(500):
+                returned = live.tick()
+                if returned is None:
+                    break
+                time.sleep(0.01)
+        self.assertIsNone(returned)  # the timer that ran this tick ends
+        self.assertFalse(self.ws.live)
+        import re
+
+        found = re.match(r"Live is off: globe has ([0-9,]+) triangles", live.refused_message(self.ws))
+        self.assertIsNotNone(found, live.refused_message(self.ws))
+        self.assertGreater(int(found.group(1).replace(",", "")), live.MAX_TRIANGLES)
+        self.assertEqual(live.line(), "")

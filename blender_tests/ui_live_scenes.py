@@ -1,7 +1,7 @@
 """Driven by test_live.py in a Blender with a window (under Xvfb): the globe with Live on; the
 window switches to a new scene (Live off there: the timer stops) and back (Live on there: the timer
 starts again, although a scene shown again fires no depsgraph update: a msgbus subscription to the
-window's scene). Prints one line `MODAL {json}` with what it saw, then quits."""
+window's scene; without it the timer stayed off there, checked when it was added). Prints one line `MODAL {json}` with what it saw, then quits."""
 import os
 import sys
 

@@ -177,8 +177,10 @@ int detail::initial_point_count(const Polyline2& contour, bool closed, const std
   for (int k = 0; k < pieces; ++k) {
     const Knot& ka = knots[k];
     const Knot& kb = knots[(k + 1) % knots.size()];
-    double arc = cum[kb.vertex] - cum[ka.vertex];
-    if (closed && arc <= 0.0) arc += total;
+    const double s0 = cum[ka.vertex];
+    double s1 = cum[kb.vertex];
+    if (closed && s1 <= s0) s1 += total;  // as the problem computes it, to the last bit
+    const double arc = s1 - s0;
     count += piece_segments(arc, spacing, o.min_segment, ka.crossing >= 0 && kb.crossing >= 0, knots.size(), closed);
   }
   return count;

@@ -21,7 +21,9 @@ replace the stored design of the last Optimize and its markers and cut handles);
 Turning Live off, loading a file (load_pre) or unregistering stops the timer and cancels the job.
 The timer follows the toggle also where Blender sets it without its update (undo, redo, another
 scene in the window): the depsgraph, undo and redo handlers and a msgbus subscription to the
-windows' scene start or stop it (_sync). Meshes over
+windows' scene start or stop it (_sync). (A scene switched to in C, such as from the Outliner,
+publishes no msgbus change: Live there starts with that scene's next depsgraph update. Geometry
+changed only by animation on a frame change is not counted.) Meshes over
 MAX_TRIANGLES triangles, counted with their modifiers, are refused (the panel says why).
 """
 import threading
@@ -43,8 +45,8 @@ TICK_SECONDS = 0.1  # while nothing changes
 ACTIVE_TICK_SECONDS = 0.02  # while a plane moves or a job runs: the verdict is seen sooner
 SETTLE_SECONDS = 0.05  # a position unchanged this long is solved (a drag's every frame is not)
 # Live is refused on larger targets (with their modifiers): reading the mesh on Blender's thread when
-# Live starts or the target changes took 63-81 ms at 190,000-250,000 triangles, over the 50 ms a
-# tick may take (issue 17).
+# Live starts or the target changes (mesh.object_triangles) took 52-56 ms at 199,200 triangles and
+# 24-26 ms at 101,888 (a UV sphere, background Blender), against the 50 ms a tick may take (issue 17).
 MAX_TRIANGLES = 100_000
 LIVE_HOOK_PATTERNS = 1  # the layering's own hook pattern only: Optimize may pick other hooks
 REASON_WORDS = 30  # words of the reason the panel shows (wrapped): enough for its numbers and units
@@ -118,13 +120,17 @@ def _rounded(matrix):
 def snapshot(scene):
     """What a live solve depends on: the target's name and matrix_world, the planes' matrix_world,
     the ticked contours, the panel's material and machine values, whether the target is in the
-    scene, and the count of its geometry's changes (STATE.geometry)."""
+    scene, the cut handles the user moved, and the count of its geometry's changes (STATE.geometry;
+    last)."""
     ws = scene.wiresculpt
     target = ws.target
     return (target.name if target else "", _rounded(target.matrix_world) if target else (),
             tuple((h.name, _rounded(h.matrix_world)) for h in handles(scene)),
             tuple((item.plane, item.index) for item in ws.contours if item.use),
-            solve_inputs(ws), target is not None and scene.objects.get(target.name) == target, STATE.geometry)
+            solve_inputs(ws), target is not None and scene.objects.get(target.name) == target,
+            tuple(sorted((name, tuple(round(x, 9) for x in point))
+                         for name, point in cut_handles.user_cut_points(scene).items())),
+            STATE.geometry)
 
 
 def first_words(text, n=REASON_WORDS):
@@ -181,6 +187,10 @@ class LiveJob(WorkerJob):
         return "not stable — " + first_words(self.design.get("reason") or "")
 
 
+class Refused(str):
+    """_start's answer when the target turned out too large to read at every change."""
+
+
 def _start(scene, key):
     """A LiveJob for snapshot `key` (the scene read here, on Blender's thread); the verdict when
     the scene cannot be solved at all."""
@@ -200,6 +210,11 @@ def _start(scene, key):
     if STATE.mesh_key != mesh_key:
         STATE.mesh = mesh.object_triangles(ws.target, depsgraph)
         STATE.mesh_key = mesh_key
+        triangles = len(STATE.mesh[1])
+        if triangles > MAX_TRIANGLES:  # more than the evaluated mesh counted (GPU subdivision builds it lazily)
+            return Refused(f"Live is off: {ws.target.name} has {triangles:,} triangles with its modifiers; Live "
+                           f"takes at most {MAX_TRIANGLES:,}, since it reads the mesh again whenever it changes. "
+                           f"Use Optimize")
     job = LiveJob(key, *STATE.mesh, planes, cut_handles.user_cut_points(scene), material, settings)
     job.thread.start()
     return job
@@ -234,6 +249,9 @@ def _step():
             refuse(scene.wiresculpt, message)
             return None
         started = _start(scene, key)
+        if isinstance(started, Refused):
+            refuse(scene.wiresculpt, str(started))
+            return None
         if isinstance(started, str):
             STATE.verdict, STATE.solved, STATE.preview = started, key, []
             STATE.results.append(started)
@@ -263,6 +281,8 @@ def tick():
         text = f"{type(exc).__name__}: {exc}"
         if text != STATE.failed:  # once, not at every tick
             traceback.print_exc()
+        if not STATE.running:  # stopped within the step: no timer may outlive it
+            return None
         STATE.failed, STATE.verdict, STATE.preview = text, "error — " + first_words(text), []
         STATE.solved = STATE.seen  # tried again once something changes
         return TICK_SECONDS
