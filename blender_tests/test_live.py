@@ -239,7 +239,7 @@ class LiveFollowsTheScene(BlenderCase):
 
         self.ws["live"] = 1  # as undo or a scene switch sets it: no update called
         self.assertFalse(bpy.app.timers.is_registered(live.tick))
-        live._undo_post()
+        live._sync_shown()
         self.assertTrue(bpy.app.timers.is_registered(live.tick))
         self.assertEqual(self.settle(), "stable")
         self.ws["live"] = 0

@@ -94,11 +94,16 @@ def triangle_count(obj, depsgraph=None):
 def refusal(target, depsgraph=None):
     """Why Live cannot run on `target` (its triangles counted as evaluated in `depsgraph`), or ""."""
     if target is not None and target.type == 'MESH':
-        n = triangle_count(target, depsgraph)
-        if n > MAX_TRIANGLES:
-            return (f"Live is off: {target.name} has {n:,} triangles with its modifiers; Live takes at most "
-                    f"{MAX_TRIANGLES:,}, since it reads the mesh again whenever it changes. Use Optimize")
+        return too_large(target.name, triangle_count(target, depsgraph))
     return ""
+
+
+def too_large(name, triangles):
+    """The refusal of a target `name` of `triangles` triangles, or "" within MAX_TRIANGLES."""
+    if triangles <= MAX_TRIANGLES:
+        return ""
+    return (f"Live is off: {name} has {triangles:,} triangles with its modifiers; Live takes at most "
+            f"{MAX_TRIANGLES:,}, since it reads the mesh again whenever it changes. Use Optimize")
 
 
 def refuse(settings, message):
@@ -210,11 +215,9 @@ def _start(scene, key):
     if STATE.mesh_key != mesh_key:
         STATE.mesh = mesh.object_triangles(ws.target, depsgraph)
         STATE.mesh_key = mesh_key
-        triangles = len(STATE.mesh[1])
-        if triangles > MAX_TRIANGLES:  # more than the evaluated mesh counted (GPU subdivision builds it lazily)
-            return Refused(f"Live is off: {ws.target.name} has {triangles:,} triangles with its modifiers; Live "
-                           f"takes at most {MAX_TRIANGLES:,}, since it reads the mesh again whenever it changes. "
-                           f"Use Optimize")
+        message = too_large(ws.target.name, len(STATE.mesh[1]))  # more than refusal counted (GPU subdivision)
+        if message:
+            return Refused(message)
     job = LiveJob(key, *STATE.mesh, planes, cut_handles.user_cut_points(scene), material, settings)
     job.thread.start()
     return job
@@ -379,9 +382,10 @@ def _depsgraph_post(scene=None, depsgraph=None, *_args):
 
 
 @bpy.app.handlers.persistent
-def _undo_post(*_args):
-    """Undo, redo, and a window switching scenes (a scene evaluated before fires no depsgraph
-    update when it is shown again)."""
+def _sync_shown(*_args):
+    """_sync of the window's scene: after undo, redo, loading a file (a file saved with Live on
+    resumes it), and a window switching scenes (a scene evaluated before fires no depsgraph update
+    when it is shown again)."""
     try:
         _sync(bpy.context.scene)
     except (AttributeError, ReferenceError):
@@ -392,10 +396,10 @@ _SCENE_SWITCH = object()  # the msgbus owner of the window-scene subscription
 
 
 def _watch_scene_switch():
-    """Subscribes _undo_post to windows switching scenes (load_post again: a load clears msgbus)."""
+    """Subscribes _sync_shown to windows switching scenes (load_post again: a load clears msgbus)."""
     bpy.msgbus.clear_by_owner(_SCENE_SWITCH)
     bpy.msgbus.subscribe_rna(key=(bpy.types.Window, "scene"), owner=_SCENE_SWITCH, args=(),
-                             notify=_undo_post)
+                             notify=_sync_shown)
 
 
 @bpy.app.handlers.persistent
@@ -406,13 +410,11 @@ def _load_pre(*_args):
 @bpy.app.handlers.persistent
 def _load_post(*_args):
     _watch_scene_switch()
-    scene = bpy.context.scene
-    if scene is not None and scene.wiresculpt.live:  # a file saved with Live on resumes it
-        live_changed(scene.wiresculpt, bpy.context)
+    _sync_shown()
 
 
 HANDLERS = (("load_pre", "_load_pre"), ("load_post", "_load_post"), ("depsgraph_update_post", "_depsgraph_post"),
-            ("undo_post", "_undo_post"), ("redo_post", "_undo_post"))
+            ("undo_post", "_sync_shown"), ("redo_post", "_sync_shown"))
 
 
 def register():

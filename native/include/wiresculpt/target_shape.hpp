@@ -237,8 +237,9 @@ std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetSh
 namespace detail {
 /// The number of points of the initial resampling that TargetShapeProblem makes of this wire (its
 /// target points, fixed crossing vertices included), without building the problem; -1 where it
-/// cannot count (crossings off the contour, too few points, no length: the problem would say why). optimize_target_shapes guesses from it which
-/// wires are solved as one block and what each costs, to start the dearest first.
+/// cannot count (crossings off the contour, too few points, no length: the problem would say
+/// why). optimize_target_shapes guesses from it which wires are solved as one block and what each
+/// costs, to start the dearest first.
 int initial_point_count(const Polyline2& contour, bool closed, const std::vector<TargetCrossing>& crossings,
                         const TargetShapeOptions& options);
 }  // namespace detail
