@@ -888,7 +888,19 @@ Block make_block(const TargetShapeProblem& problem, const std::vector<int>& rang
 TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
                                         const std::vector<TargetCrossing>& crossings,
                                         const TargetShapeOptions& options, const ProgressFn& progress) {
+  detail::TargetShapeRun run = detail::run_target_shape(contour, closed, crossings, options, progress);
+  while (run.step()) {
+  }
+  return run.take();
+}
+
+detail::TargetShapeRun detail::run_target_shape(const Polyline2& contour, bool closed,
+                                                const std::vector<TargetCrossing>& crossings,
+                                                const TargetShapeOptions& options, const ProgressFn& progress) {
   const auto t0 = std::chrono::steady_clock::now();
+  // Time spent paused between pieces (TargetShapeRun): another wire's, not this one's.
+  std::chrono::steady_clock::duration paused{};
+  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0 - paused).count(); };
   report_progress(progress, "target_shape", 0.0);
   const TargetShapeProblem problem(contour, closed, crossings, options);
   const TargetShapeOptions& o = problem.options_;
@@ -982,7 +994,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
   result.nlopt_result = "none";
   std::string worst_result;
   auto out_of_time = [&] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() >= o.max_seconds;
+    return elapsed() >= o.max_seconds;
   };
   bool choose_basin = false;  // sqp: SLSQP leads the block's first evaluations (see below)
   std::array<int, 2> shift_guess{0, 0};  // sqp: shared by the blocks (SqpSettings::shift_guess)
@@ -1011,7 +1023,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
       op.set_ftol_rel(o.ftol_rel);
       op.set_xtol_rel(o.xtol_rel);
       op.set_maxeval(std::max(1, o.max_iterations - data.evaluations));
-      op.set_maxtime(std::max(1e-3, o.max_seconds - std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()));
+      op.set_maxtime(std::max(1e-3, o.max_seconds - elapsed()));
       return op;
     };
     std::vector<double> x(nvar);
@@ -1183,6 +1195,9 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
             for (int other : watchers[q])
               if (other != static_cast<int>(k)) dirty[other] = 1;
         if (data.evaluations >= o.max_iterations) break;
+        const auto pause = std::chrono::steady_clock::now();
+        co_yield 0;  // a window solved: another thread may run the next one (TargetShapeRun)
+        paused += std::chrono::steady_clock::now() - pause;
       }
       if (!any) break;
       result.sweeps = sweep + 1;
@@ -1324,9 +1339,9 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
   if (!sharp_bends.empty())
     result.warnings.push_back("wire " + w + ": bends at points " + list(sharp_bends) + " exceed " + deg(o.max_bend) + (o.vertex_max_bend.empty() ? "" : " or their own limits (vertex_max_bend)"));
   result.feasible = result.feasible && short_edges.empty() && sharp_bends.empty();
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  result.seconds = elapsed();
   report_progress(progress, "target_shape", 1.0);
-  return result;
+  co_return result;
 }
 
 }  // namespace wiresculpt

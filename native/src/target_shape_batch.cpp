@@ -7,7 +7,6 @@
 #include <cstddef>
 #include <exception>
 #include <mutex>
-#include <numeric>
 #include <optional>
 #include <string_view>
 #include <system_error>
@@ -36,28 +35,41 @@ double expected_cost(const TargetShapeJob& job) {
   return o.window <= 0 || n <= one_block ? n * n : 12.0 * n;
 }
 
+// expected_cost's units in seconds, about (4 µs a unit on the stand-ins; see above).
+constexpr double kSecondsPerCost = 4e-6;
+// A thread hands its wire over for a free one only when that one has this much more work left by
+// the guess: each hand-over moves a wire's working set to the other core, so a wire keeps its
+// thread for a few windows at least.
+constexpr double kHandOverSeconds = 2e-4;
+
+// Guards the jobs' bookkeeping between two pieces (a few comparisons over the jobs): never throws,
+// unlike std::mutex, inside the threads' noexcept loops.
+class SpinLock {
+ public:
+  void lock() noexcept {
+    while (flag_.test_and_set(std::memory_order_acquire)) std::this_thread::yield();
+  }
+  void unlock() noexcept { flag_.clear(std::memory_order_release); }
+
+ private:
+  std::atomic_flag flag_;
+};
+
 }  // namespace
 
 std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetShapeJob>& jobs, int threads,
                                                       const ProgressFn& progress) {
   if (threads < 1 || threads > 2) throw InputError("target shapes: threads must be 1 or 2");
   const std::size_t n = jobs.size();
-  std::vector<double> cost(n);
-  for (std::size_t k = 0; k < n; ++k) cost[k] = expected_cost(jobs[k]);
-  std::vector<std::size_t> order(n);
-  std::iota(order.begin(), order.end(), std::size_t{0});
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return cost[a] > cost[b]; });
+  using Clock = std::chrono::steady_clock;
 
-  std::vector<std::optional<TargetShapeResult>> results(n);
-  std::vector<std::exception_ptr> errors(n);
-  std::atomic<std::size_t> next{0}, finished{0};
-  std::atomic<bool> stop{false};
-  // The other thread's jobs only look at `stop`; the calling thread's ask `progress` as well. An
+  // The calling thread asks `progress`; the other thread's pieces only look at `stop`. An
   // exception from `progress` stops both (every job still running ends in Cancelled) and is the
-  // one thrown at the end, as optimize_target_shape's callers see it.
+  // one thrown at the end, as optimize_target_shape's callers see it. A wire's pieces may run on
+  // either thread, so its progress function asks by the thread it finds itself on.
+  std::atomic<bool> stop{false};
   std::exception_ptr progress_error;  // written by the calling thread only
-  const ProgressFn none;
-  const ProgressFn stopped = [&](std::string_view, double) { return !stop.load(); };
+  const std::thread::id caller = std::this_thread::get_id();
   const ProgressFn asked = [&](std::string_view stage, double fraction) {
     if (stop) return false;
     try {
@@ -68,18 +80,72 @@ std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetSh
     }
     return !stop.load();
   };
-  auto solve = [&](std::size_t i, const ProgressFn& fn) noexcept {  // the i-th job in `order`
-    const std::size_t k = order[i];
-    try {
-      if (stop) throw Cancelled();
-      results[k].emplace(optimize_target_shape(jobs[k].contour, jobs[k].closed, jobs[k].crossings, jobs[k].options, fn));
-    } catch (...) {
-      errors[k] = std::current_exception();
-    }
-    ++finished;
+  const ProgressFn by_thread = [&](std::string_view stage, double fraction) {
+    if (std::this_thread::get_id() == caller) return asked(stage, fraction);
+    return !stop.load();
   };
-  auto work = [&](const ProgressFn& fn) noexcept {
-    for (std::size_t i; (i = next++) < n;) solve(i, fn);
+  const ProgressFn none;
+  const ProgressFn& fn = progress ? by_thread : none;
+
+  // Each job is a run of pieces (detail::TargetShapeRun: a windowed wire's windows, one piece for
+  // a one-block wire). A thread keeps its wire while no free wire has clearly more work left by
+  // the guess (expected_cost less the time it has had), else hands it over between two windows:
+  // three equal wires on two threads then end together instead of in two waves (the globe).
+  struct Slot {
+    std::optional<detail::TargetShapeRun> run;
+    double left = 0.0;  // guessed seconds of work left
+    bool busy = false, done = false;
+    std::exception_ptr error;
+  };
+  std::vector<Slot> slots(n);
+  for (std::size_t k = 0; k < n; ++k) slots[k].left = kSecondsPerCost * expected_cost(jobs[k]);
+  SpinLock book;  // guards slots' left, busy and done
+  std::atomic<std::size_t> finished{0};
+  // The free wire with the most work left (the first of equals), or n.
+  auto dearest_free = [&]() {
+    std::size_t best = n;
+    for (std::size_t k = 0; k < n; ++k)
+      if (!slots[k].busy && !slots[k].done && (best == n || slots[k].left > slots[best].left)) best = k;
+    return best;
+  };
+  auto work = [&](std::size_t mine) noexcept {  // mine: the job it starts with (busy already), or n
+    for (;;) {
+      {
+        const std::lock_guard<SpinLock> lock(book);
+        const std::size_t other = dearest_free();
+        if (mine != n && other != n && slots[other].left > slots[mine].left + kHandOverSeconds) {
+          slots[mine].busy = false;
+          mine = n;
+        }
+        if (mine == n) {
+          if (other == n) return;
+          mine = other;
+          slots[mine].busy = true;
+        }
+      }
+      Slot& slot = slots[mine];
+      const auto began = Clock::now();
+      bool more = false;
+      try {
+        if (stop) throw Cancelled();
+        if (!slot.run) {
+          const TargetShapeJob& job = jobs[mine];
+          slot.run.emplace(detail::run_target_shape(job.contour, job.closed, job.crossings, job.options, fn));
+        }
+        more = slot.run->step();
+      } catch (...) {
+        slot.error = std::current_exception();
+      }
+      const double spent = std::chrono::duration<double>(Clock::now() - began).count();
+      const std::lock_guard<SpinLock> lock(book);
+      slot.left -= spent;
+      if (!more) {
+        slot.done = true;
+        slot.busy = false;
+        ++finished;
+        mine = n;
+      }
+    }
   };
 
   std::mutex mutex;
@@ -100,12 +166,13 @@ std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetSh
   } joiner{worker, stop};
   if (threads == 2 && n >= 2) {
     // The dearest job is the other thread's from the start (the calling thread, which answers
-    // `progress` too, takes the next), so who does which does not hang on when the thread starts.
-    const std::size_t first = next++;
+    // `progress` too, takes the next), so who starts which does not hang on when the thread starts
+    // (40-100 µs on this project's 2-core virtual machine).
+    const std::size_t first = dearest_free();
+    slots[first].busy = true;
     try {
       worker.emplace([&, first]() noexcept {
-        solve(first, progress ? stopped : none);
-        work(progress ? stopped : none);
+        work(first);
         try {
           const std::lock_guard<std::mutex> lock(mutex);
           ended = true;
@@ -115,12 +182,12 @@ std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetSh
         worker_ended.notify_one();
       });
     } catch (const std::system_error&) {  // no thread to be had: the calling thread does them all
-      solve(first, progress ? asked : none);
+      slots[first].busy = false;
     }
   }
-  work(progress ? asked : none);
+  work(n);
   if (worker && progress) {
-    // While the other thread ends its last job, `progress` is still asked every 20 ms (Live
+    // While the other thread ends its last piece, `progress` is still asked every 20 ms (Live
     // cancels a solve as soon as the plane moves again).
     std::unique_lock<std::mutex> lock(mutex);
     while (!worker_ended.wait_for(lock, std::chrono::milliseconds(20), [&] { return ended.load(); })) {
@@ -132,11 +199,12 @@ std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetSh
   }
   if (worker) worker->join();
   if (progress_error) std::rethrow_exception(progress_error);
-  for (std::size_t k = 0; k < n; ++k)
-    if (errors[k]) std::rethrow_exception(errors[k]);
   std::vector<TargetShapeResult> out;
   out.reserve(n);
-  for (std::optional<TargetShapeResult>& r : results) out.push_back(std::move(*r));
+  for (Slot& slot : slots) {
+    if (slot.error) std::rethrow_exception(slot.error);
+    out.push_back(slot.run->take());  // rethrows what the run threw
+  }
   return out;
 }
 

@@ -3,6 +3,7 @@
 // them in; errors and cancellation as one call's.
 #include <catch2/catch.hpp>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <mutex>
 #include <numbers>
@@ -84,6 +85,66 @@ TEST_CASE("target shapes: each result is its wire's alone, in the jobs' order, o
     }
   }
   CHECK(optimize_target_shapes({}, 2).empty());
+}
+
+TEST_CASE("target shapes: a wire run a piece at a time, on any thread and between other wires' pieces, is its wire's alone",
+          "[target]") {
+  // What optimize_target_shapes relies on to hand a wire from one thread to the other between its
+  // windows: a run's pieces depend only on the run. Here every wire of the round advances one
+  // piece in turn, each second piece on a thread of its own.
+  const std::vector<TargetShapeJob> jobs = round_of_wires();
+  std::vector<TargetShapeResult> alone;
+  for (const TargetShapeJob& j : jobs) alone.push_back(optimize_target_shape(j.contour, j.closed, j.crossings, j.options));
+  std::vector<detail::TargetShapeRun> runs;
+  for (const TargetShapeJob& j : jobs) runs.push_back(detail::run_target_shape(j.contour, j.closed, j.crossings, j.options, {}));
+  std::vector<int> pieces(jobs.size(), 0);
+  std::vector<char> more(jobs.size(), 1);
+  for (bool any = true; any;) {
+    any = false;
+    for (std::size_t k = 0; k < jobs.size(); ++k) {
+      if (!more[k]) continue;
+      bool stepped = false;
+      if (pieces[k]++ % 2) {
+        std::thread([&] { stepped = runs[k].step(); }).join();
+      } else {
+        stepped = runs[k].step();
+      }
+      more[k] = stepped;
+      any = any || stepped;
+    }
+  }
+  const int one_block = 4 * TargetShapeOptions{}.window;  // one_block_points -1: 4 windows
+  for (std::size_t k = 0; k < jobs.size(); ++k) {
+    INFO("wire " << jobs[k].options.wire_name << ", " << pieces[k] << " pieces");
+    check_same(runs[k].take(), alone[k]);
+    // One piece for a wire solved as one block; a windowed wire pauses after each window.
+    if (static_cast<int>(alone[k].points.size()) <= one_block)
+      CHECK(pieces[k] == 1);
+    else
+      CHECK(pieces[k] > alone[k].sweeps);
+  }
+  CHECK(!runs[0].step());  // an ended run stays ended
+}
+
+TEST_CASE("target shapes: a run's pauses count neither against its time budget nor in its seconds", "[target]") {
+  // A windowed wire (a few ms alone, 33 pieces) with a budget of 0.25 s, paused 20 ms after every window:
+  // the pauses add up to more than the budget, and the solve must end as it does alone.
+  TargetShapeJob job = loop("Charlie", 0.16, 0.02, 5, 600, 4);
+  job.options.max_seconds = 0.25;
+  const TargetShapeResult alone = optimize_target_shape(job.contour, job.closed, job.crossings, job.options);
+  REQUIRE(alone.nlopt_result != "NLOPT_MAXTIME_REACHED");
+  detail::TargetShapeRun run = detail::run_target_shape(job.contour, job.closed, job.crossings, job.options, {});
+  int pieces = 0;
+  while (run.step()) {
+    ++pieces;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  const double slept = 0.020 * pieces;
+  REQUIRE(slept > job.options.max_seconds);
+  const TargetShapeResult r = run.take();
+  check_same(r, alone);
+  CHECK(r.warnings == alone.warnings);
+  CHECK(r.seconds < slept);
 }
 
 TEST_CASE("target shapes: progress is asked on the calling thread only, and it cancels every wire", "[target]") {

@@ -21,8 +21,12 @@
 // the energy is defined everywhere and continuously differentiable except on the medial axis of
 // the target (where it stays continuous). E_r is Eq. 5 read as a sum of squared norms:
 // Σ_i |u_i - (u_{i-1} + u_{i+1})/2|² over the interior vertices, u = p - p_initial.
+#include <coroutine>
+#include <exception>
 #include <numbers>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "wiresculpt/geometry.hpp"
@@ -189,7 +193,7 @@ struct TargetShapeResult {
   int sweeps = 0;             ///< passes over the windows (1 for a single block)
   int sqp_blocks = 0;         ///< block solves by TargetShapeAlgorithm::sqp
   int sqp_fallbacks = 0;      ///< of them, solved by SLSQP instead (the SQP did not converge)
-  double seconds = 0.0;       ///< wall-clock time of the whole call
+  double seconds = 0.0;       ///< wall-clock time of the whole call (less a run's pauses: detail::TargetShapeRun)
   /// NLopt's result as text, e.g. "NLOPT_FTOL_REACHED" ("SQP_CONVERGED" for a block the SQP
   /// solved): the first failure code of any block, else
   /// the last block's code; "NLOPT_MAXEVAL_REACHED" when max_iterations ran out across windows;
@@ -223,8 +227,10 @@ struct TargetShapeJob {
 };
 
 /// optimize_target_shape of every job, on the calling thread and, with threads = 2, one more
-/// started here: each thread takes the next job, the dearest first by a guess from the contour's
-/// length (only the order of the work, never a result, depends on it). Every result is the one
+/// started here: each thread takes the free job with the most work left by a guess (the dearest
+/// first), and between two windows of a windowed wire hands it over when a free one has clearly
+/// more left, so that three equal wires share two threads (only who runs which piece, never a
+/// result, depends on it: detail::TargetShapeRun). Every result is the one
 /// optimize_target_shape returns for that job alone, and they come back in the jobs' order.
 /// Only the calling thread calls `progress` (with a job's own fractions, and while it waits for
 /// the other thread's last job); when it asks to stop, both threads stop at their next progress
@@ -242,6 +248,60 @@ namespace detail {
 /// costs, to start the dearest first.
 int initial_point_count(const Polyline2& contour, bool closed, const std::vector<TargetCrossing>& crossings,
                         const TargetShapeOptions& options);
+
+/// optimize_target_shape run a piece at a time: each step() solves up to the end of the next
+/// window of a windowed wire's sweeps (the set-up and a one-block wire are one piece), so that
+/// optimize_target_shapes can hand a wire from one thread to the other between its windows. The
+/// arithmetic is optimize_target_shape's, whatever runs which piece: the result is the same.
+/// The arguments are referred to, not copied: they must outlive the run. A run's pauses do not
+/// count against max_seconds, nor in its result's seconds.
+class TargetShapeRun {
+ public:
+  struct promise_type {
+    std::optional<TargetShapeResult> result;
+    std::exception_ptr error;
+    TargetShapeRun get_return_object() {
+      return TargetShapeRun(std::coroutine_handle<promise_type>::from_promise(*this));
+    }
+    std::suspend_always initial_suspend() noexcept { return {}; }
+    std::suspend_always final_suspend() noexcept { return {}; }
+    std::suspend_always yield_value(int) noexcept { return {}; }
+    void return_value(TargetShapeResult r) { result.emplace(std::move(r)); }
+    void unhandled_exception() noexcept { error = std::current_exception(); }
+  };
+  TargetShapeRun(TargetShapeRun&& other) noexcept : handle_(std::exchange(other.handle_, {})) {}
+  TargetShapeRun& operator=(TargetShapeRun&& other) noexcept {
+    if (this != &other) {
+      if (handle_) handle_.destroy();
+      handle_ = std::exchange(other.handle_, {});
+    }
+    return *this;
+  }
+  TargetShapeRun(const TargetShapeRun&) = delete;
+  TargetShapeRun& operator=(const TargetShapeRun&) = delete;
+  ~TargetShapeRun() {
+    if (handle_) handle_.destroy();
+  }
+  /// Runs the next piece; false once the run has ended (with its result or its exception).
+  bool step() {
+    if (!handle_ || handle_.done()) return false;
+    handle_.resume();
+    return !handle_.done();
+  }
+  /// The result of an ended run; rethrows what it threw (InputError, Cancelled, ...).
+  TargetShapeResult take() {
+    promise_type& p = handle_.promise();
+    if (p.error) std::rethrow_exception(p.error);
+    return std::move(*p.result);
+  }
+
+ private:
+  explicit TargetShapeRun(std::coroutine_handle<promise_type> h) : handle_(h) {}
+  std::coroutine_handle<promise_type> handle_;
+};
+
+TargetShapeRun run_target_shape(const Polyline2& contour, bool closed, const std::vector<TargetCrossing>& crossings,
+                                const TargetShapeOptions& options, const ProgressFn& progress);
 }  // namespace detail
 
 /// The optimisation problem of one wire, exposed for tests and diagnostics: the initial
@@ -299,8 +359,8 @@ class TargetShapeProblem {
   double imls(const Vec2& q, Vec2* grad = nullptr) const;
 
  private:
-  friend TargetShapeResult optimize_target_shape(const Polyline2&, bool, const std::vector<TargetCrossing>&,
-                                                 const TargetShapeOptions&, const ProgressFn&);
+  friend detail::TargetShapeRun detail::run_target_shape(const Polyline2&, bool, const std::vector<TargetCrossing>&,
+                                                         const TargetShapeOptions&, const ProgressFn&);
   double nearest_squared(const Vec2& q, Vec2* grad) const;
   // Term i of E_d (w_i D(p_i)) and of w_r E_r (weight |Δu_i|²); gradients added to grad. With grad,
   // `sample` (when non-null) gets D(p_i) and its gradient.
