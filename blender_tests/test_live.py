@@ -267,7 +267,9 @@ class LiveFollowsTheScene(BlenderCase):
         self.assertEqual(live.line(), "Live: cannot solve — No contour is ticked: Slice, then tick the contours "
                                       "that become wires")
         self.assertEqual(live.STATE.preview, [])
+        self.assertEqual(live.whole_reason(), "")  # shown whole: no button for it
         layout = drawn_live()
+        layout.operator.assert_not_called()
         self.assertIs(layout.column.return_value.alert, False)
         labels = layout.column.return_value.label.call_args_list
         self.assertEqual(labels[0].kwargs["icon"], 'INFO')
@@ -334,6 +336,34 @@ class LiveFollowsTheScene(BlenderCase):
         self.target.location.x -= 0.002
         bpy.context.view_layer.update()
         self.assertEqual(self.settle(), "stable")
+
+    def test_a_long_reason_shows_its_first_clause(self):
+        """The globe with Max Bend 30°: the reason repeats "crossing k on wire …" for every crossing; the
+        line shows the first clause up to its deciding figure (30 words ended before it), the button's
+        tooltip the whole reason."""
+        import math
+
+        import bpy
+
+        from wiresculpt.operators import live
+        from wiresculpt.ui import panel
+
+        self.ws.live = True
+        self.assertEqual(self.settle(), "stable")
+        self.addCleanup(setattr, self.ws, "max_bend_deg", self.ws.max_bend_deg)  # the scene's settings stay
+        self.ws.max_bend_deg = math.radians(30.0)
+        verdict = self.settle()
+        reason = live.STATE.reason
+        first = reason[:reason.index(";")]
+        self.assertGreater(len(first.split()), 30)
+        self.assertTrue(first.endswith("but the machine bends at most 30°"), first)
+        self.assertEqual(verdict, "not stable — " + first + "…")
+        self.assertEqual(panel.live_look(verdict), ('ERROR', False))
+        self.assertEqual(live.whole_reason(), reason)
+        self.assertEqual(live.WIRESCULPT_OT_live_reason.description(bpy.context, None), reason)
+        self.assertEqual(bpy.ops.wiresculpt.live_reason(), {'FINISHED'})
+        layout = drawn_live()
+        layout.operator.assert_called_once_with(live.WIRESCULPT_OT_live_reason.bl_idname, icon='COPYDOWN')
 
     def test_the_toggle_set_without_its_update(self):
         import bpy

@@ -14,7 +14,9 @@ for) and a new one starts; a result is shown only when its snapshot is still the
 
 The verdict's words are core/live_verdict's: "not stable — <reason>" only for a solve that ended
 not stable, "cannot solve — <what to do>" when the scene as set up cannot be solved (no target, no
-contour ticked, a panel value or plane the solver refuses), "error — …" for our unexpected error.
+contour ticked, a panel value or plane the solver refuses), "error — …" for our unexpected error; a
+long reason is shown to the end of its first clause, the whole one in WIRESCULPT_OT_live_reason's
+tooltip.
 
 Nothing is written to the scene or the .blend: the verdict and the wires' preview (STATE.preview,
 line segments in each wire's colour, computed on the worker by blend/results.wire_shapes) live in
@@ -41,9 +43,10 @@ from .. import native, pipeline
 from ..blend import cut_handles, mesh
 from ..blend import results as scene_results
 from ..blend.handles import handles, target_problem, ticked_planes
+from ..blend.registration import classes_factory
 from ..blend.view import redraw_3d_views
 from ..core.jobs import WorkerJob
-from ..core.live_verdict import CANNOT_SOLVE, ERROR, NOT_STABLE, SOLVING, STABLE, verdict
+from ..core.live_verdict import CANNOT_SOLVE, ERROR, NOT_STABLE, SOLVING, STABLE, shortened, verdict
 from ..props import LIVE_HOOKS, material_of, solve_inputs, solver_settings
 
 TICK_SECONDS = 0.1  # while nothing changes
@@ -147,6 +150,11 @@ def snapshot(scene):
 def _show(kind, text=""):
     """Sets the verdict of `kind` (core/live_verdict) with its reason, problem or error `text`."""
     STATE.verdict, STATE.reason = verdict(kind, text), text
+
+
+def whole_reason():
+    """The whole reason, problem or error of the shown verdict when the line shows only part of it, else ""."""
+    return STATE.reason if STATE.running and shortened(STATE.reason) else ""
 
 
 def preview_segments(design):
@@ -337,6 +345,31 @@ def line():
     return f"Live: {STATE.verdict}" if STATE.running else ""
 
 
+class WIRESCULPT_OT_live_reason(bpy.types.Operator):
+    """Copy the live verdict's whole reason to the clipboard (the line shows its first clause)"""
+
+    bl_idname = "wiresculpt.live_reason"
+    bl_label = "Copy Whole Reason"
+    bl_options = {'INTERNAL'}  # writes nothing to the scene: no undo step
+
+    @classmethod
+    def description(cls, context, properties):
+        """The tooltip: the whole reason, which the panel's line shortens."""
+        return STATE.reason or cls.__doc__
+
+    @classmethod
+    def poll(cls, context):
+        return bool(STATE.running and STATE.reason)
+
+    def execute(self, context):
+        context.window_manager.clipboard = STATE.reason
+        self.report({'INFO'}, STATE.reason)  # the Info editor keeps it too
+        return {'FINISHED'}
+
+
+_register_classes, _unregister_classes = classes_factory((WIRESCULPT_OT_live_reason,))
+
+
 def live_changed(settings, context):
     """The toggle's update (props.LIVE_HOOKS): start, refuse or stop."""
     if not settings.live:
@@ -431,6 +464,7 @@ HANDLERS = (("load_pre", "_load_pre"), ("load_post", "_load_post"), ("depsgraph_
 
 
 def register():
+    _register_classes()
     LIVE_HOOKS.append(live_changed)
     for kind, name in HANDLERS:
         getattr(bpy.app.handlers, kind).append(globals()[name])
@@ -446,3 +480,4 @@ def unregister():
             handlers.remove(globals()[name])
     if live_changed in LIVE_HOOKS:
         LIVE_HOOKS.remove(live_changed)
+    _unregister_classes()

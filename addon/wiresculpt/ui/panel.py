@@ -93,11 +93,14 @@ def live_look(verdict):
 
 
 def draw_live(layout, context):
-    """The live verdict, wrapped, with the icon of its kind."""
+    """The live verdict, wrapped; under it, when the line shows part of the reason, a button whose
+    tooltip is the whole reason (a click copies it)."""
     icon, alert = live_look(live.STATE.verdict)
     col = layout.column()
     col.alert = alert
     wrap_labels(col, context, live.line(), icon=icon)
+    if live.whole_reason():
+        layout.operator(live.WIRESCULPT_OT_live_reason.bl_idname, icon='COPYDOWN')
 
 
 class VIEW3D_PT_wiresculpt(bpy.types.Panel):
