@@ -1,7 +1,8 @@
 """Live (issue 17 part 2) in a Blender with a window under Xvfb (timers need the event loop): a
-plane moved in steps turns the live verdict stable -> not stable -> stable, the latest position
-wins over a running solve, no tick of the live timer blocks the UI for more than 50 ms, and
-turning Live off or loading a file stops the timer."""
+plane moved in steps turns the live verdict stable -> cannot solve (the plane left the mesh: its
+ticked contour is gone) -> stable, the latest position wins over a running solve, no tick of the
+live timer blocks the UI for more than 50 ms, and turning Live off or loading a file stops the
+timer."""
 import os
 import shutil
 import unittest
@@ -31,8 +32,9 @@ class Live(unittest.TestCase):
         lines = [v["line"] for v in self.seen["verdicts"]]
         self.assertEqual(len(lines), 3, lines)
         self.assertEqual(lines[0], "Live: stable")
-        self.assertTrue(lines[1].startswith("Live: not stable — "), lines)
-        self.assertGreater(len(lines[1]), len("Live: not stable — ") + 3, lines)  # the reason's first words
+        # the plane cuts nothing: its ticked contour does not exist, a setup problem, not a verdict
+        self.assertTrue(lines[1].startswith("Live: cannot solve — plane Slice A: contour index 0 does not exist"),
+                        lines)
         self.assertEqual(lines[2], "Live: stable")
         # the preview: the three wires when stable, none when the plane cuts nothing
         self.assertEqual([v["preview_wires"] for v in self.seen["verdicts"]], [3, 0, 3])
@@ -46,7 +48,7 @@ class Live(unittest.TestCase):
         self.assertTrue(self.seen["first_job_cancelled"])
         self.assertAlmostEqual(self.seen["latest_z_solved"], 0.3)
         self.assertEqual(len(self.seen["latest_results"]), 1, self.seen["latest_results"])
-        self.assertTrue(self.seen["latest_line"].startswith("Live: not stable"), self.seen["latest_line"])
+        self.assertTrue(self.seen["latest_line"].startswith("Live: cannot solve — "), self.seen["latest_line"])
         self.assertEqual(self.seen["results"][-1], self.seen["latest_line"][len("Live: "):])
 
     def test_no_tick_blocks_the_ui(self):
@@ -128,6 +130,18 @@ class LiveRefused(BlenderCase):
         ws.live = False
 
 
+def drawn_live():
+    """A stand-in layout after the Wire panel drew the live line on it (ui/panel.draw_live)."""
+    from types import SimpleNamespace
+    from unittest import mock
+
+    from wiresculpt.ui import panel
+
+    layout = mock.MagicMock()
+    panel.draw_live(layout, SimpleNamespace(region=None))
+    return layout
+
+
 class LiveFollowsTheScene(BlenderCase):
     """What Live sees besides moved planes (a maker's trial under Xvfb, issue 17): the panel's
     settings, the target's geometry and presence, the toggle set without its update (undo, a scene
@@ -183,15 +197,17 @@ class LiveFollowsTheScene(BlenderCase):
         self.ws.live = True
         self.assertEqual(self.settle(), "stable")
         max_bend, min_bend = self.ws.max_bend_deg, self.ws.min_bend_deg
+        self.addCleanup(setattr, self.ws, "min_bend_deg", min_bend)  # also when an assertion fails: the scene's
+        self.addCleanup(setattr, self.ws, "max_bend_deg", max_bend)  # settings outlive the test
         # A limit the globe's kinks cannot meet: solved again without a plane moving.
         self.ws.max_bend_deg = math.radians(30.0)
         verdict = self.settle()
         self.assertTrue(verdict.startswith("not stable — "), verdict)
-        # Settings the solver refuses: a verdict that says why, and Live goes on.
+        # Settings the solver refuses: a setup problem that says why (no verdict on the design), and Live goes on.
         self.ws.min_bend_deg = math.radians(40.0)
         verdict = self.settle()
-        self.assertTrue(verdict.startswith("not stable — the smallest bend must be smaller than the largest bend"),
-                        verdict)
+        self.assertEqual(verdict, "cannot solve — the smallest bend must be smaller than the largest bend "
+                                  "(Machine settings)")
         self.assertEqual(live.STATE.preview, [])
         self.assertTrue(bpy.app.timers.is_registered(live.tick))
         self.ws.max_bend_deg, self.ws.min_bend_deg = max_bend, min_bend
@@ -229,8 +245,125 @@ class LiveFollowsTheScene(BlenderCase):
         for collection in self.target.users_collection:
             collection.objects.unlink(self.target)
         verdict = self.settle()
-        self.assertTrue(verdict.startswith(f"not stable — Target '{self.target.name}' is not in scene"), verdict)
+        self.assertTrue(verdict.startswith(f"cannot solve — Target '{self.target.name}' is not in scene"), verdict)
         self.assertEqual(live.STATE.preview, [])
+
+    def test_setup_problems_cannot_solve(self):
+        """A scene that cannot be solved as set up says so, and never reads as a verdict on the design."""
+        from unittest import mock
+
+        import bpy
+
+        from wiresculpt import native
+        from wiresculpt.operators import live
+        from wiresculpt.ui import panel
+
+        self.ws.live = True
+        self.assertEqual(self.settle(), "stable")
+        for item in self.ws.contours:
+            item.use = False
+        self.assertEqual(self.settle(), "cannot solve — No contour is ticked: Slice, then tick the contours that "
+                                        "become wires")
+        self.assertEqual(live.line(), "Live: cannot solve — No contour is ticked: Slice, then tick the contours "
+                                      "that become wires")
+        self.assertEqual(live.STATE.preview, [])
+        self.assertEqual(live.whole_reason(), "")  # shown whole: no button for it
+        layout = drawn_live()
+        layout.operator.assert_not_called()
+        self.assertIs(layout.column.return_value.alert, False)
+        labels = layout.column.return_value.label.call_args_list
+        self.assertEqual(labels[0].kwargs["icon"], 'INFO')
+        self.assertEqual(" ".join(c.kwargs["text"] for c in labels), live.line())
+        # drawn unlike a verdict: neither the stable tick nor the not-stable warning, not red
+        self.assertEqual(panel.live_look(live.STATE.verdict), ('INFO', False))
+        self.assertNotIn(panel.live_look(live.STATE.verdict)[0],
+                         (panel.live_look("stable")[0], panel.live_look("not stable — crossing 3 pulls")[0]))
+        for item in self.ws.contours:
+            item.use = True
+        self.assertEqual(self.settle(), "stable")
+        with mock.patch.object(native, "available", return_value=False):
+            self.target.location.x += 0.001
+            bpy.context.view_layer.update()
+            self.assertEqual(self.settle(),
+                             "cannot solve — the solver is not loaded (the panel's first box says why)")
+        target, self.ws.target = self.ws.target, None
+        self.assertEqual(self.settle(), "cannot solve — No target mesh: pick one in the Wire panel (Target)")
+        self.ws.target = target
+        self.assertEqual(self.settle(), "stable")
+
+    def test_a_plane_moved_off_the_mesh_cannot_solve(self):
+        """Its ticked contour is gone (the solve's ValueError): what the window test's second step sees."""
+        import bpy
+
+        from wiresculpt.operators import live
+
+        self.ws.live = True
+        self.assertEqual(self.settle(), "stable")
+        plane = self.scene().objects["Slice A"]
+        plane.location.z = 0.3
+        bpy.context.view_layer.update()
+        self.assertEqual(self.settle(), "cannot solve — plane Slice A: contour index 0 does not exist (the plane "
+                                        "cuts 0 contours)")
+        self.assertEqual(live.STATE.preview, [])
+        plane.location.z = 0.0
+        bpy.context.view_layer.update()
+        self.assertEqual(self.settle(), "stable")
+
+    def test_errors_of_a_solve(self):
+        """The solver refusing the input is a setup problem; any other exception is our error, said as such."""
+        from unittest import mock
+
+        import bpy
+
+        from wiresculpt.operators import live
+        from wiresculpt.ui import panel
+
+        self.ws.live = True
+        self.assertEqual(self.settle(), "stable")
+        refused = ValueError("three wires pass through one point: move one of the planes slightly")
+        with mock.patch.object(live.pipeline, "solve", side_effect=refused):
+            self.target.location.x += 0.001
+            bpy.context.view_layer.update()
+            self.assertEqual(self.settle(), "cannot solve — three wires pass through one point: move one of the "
+                                            "planes slightly")
+        with mock.patch.object(live.pipeline, "solve", side_effect=KeyError("hook")):
+            self.target.location.x += 0.001
+            bpy.context.view_layer.update()
+            verdict = self.settle()
+        self.assertEqual(verdict, "error — internal error (KeyError: 'hook'); please report it")
+        self.assertEqual(panel.live_look(verdict), ('CANCEL', True))
+        self.assertEqual(live.STATE.preview, [])
+        self.target.location.x -= 0.002
+        bpy.context.view_layer.update()
+        self.assertEqual(self.settle(), "stable")
+
+    def test_a_long_reason_shows_its_first_clause(self):
+        """The globe with Max Bend 30°: the reason repeats "crossing k on wire …" for every crossing; the
+        line shows the first clause up to its deciding figure (30 words ended before it), the button's
+        tooltip the whole reason."""
+        import math
+
+        import bpy
+
+        from wiresculpt.operators import live
+        from wiresculpt.ui import panel
+
+        self.ws.live = True
+        self.assertEqual(self.settle(), "stable")
+        self.addCleanup(setattr, self.ws, "max_bend_deg", self.ws.max_bend_deg)  # the scene's settings stay
+        self.ws.max_bend_deg = math.radians(30.0)
+        verdict = self.settle()
+        reason = live.STATE.reason
+        first = reason[:reason.index(";")]
+        self.assertGreater(len(first.split()), 30)
+        self.assertTrue(first.endswith("but the machine bends at most 30°"), first)
+        self.assertEqual(verdict, "not stable — " + first + "…")
+        self.assertEqual(panel.live_look(verdict), ('ERROR', False))
+        self.assertEqual(live.whole_reason(), reason)
+        self.assertEqual(live.WIRESCULPT_OT_live_reason.description(bpy.context, None), reason)
+        self.assertEqual(bpy.ops.wiresculpt.live_reason(), {'FINISHED'})
+        layout = drawn_live()
+        layout.operator.assert_called_once_with(live.WIRESCULPT_OT_live_reason.bl_idname, icon='COPYDOWN')
 
     def test_the_toggle_set_without_its_update(self):
         import bpy

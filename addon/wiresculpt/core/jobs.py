@@ -12,6 +12,7 @@ class WorkerJob:
 
     def __init__(self):
         self.error = None
+        self.unexpected = False  # `error` is our bug's, not the user's sentence
         self.thread = threading.Thread(target=self.run, name=self.name, daemon=True)
 
     def work(self):
@@ -24,4 +25,5 @@ class WorkerJob:
         except self.expected as exc:
             self.error = str(exc)
         except Exception as exc:  # a bug of ours: reported, never raised into Blender's UI thread
+            self.unexpected = True
             self.error = f"internal error ({type(exc).__name__}: {exc}); please report it"

@@ -12,6 +12,12 @@ layering's own pattern (hook_patterns=1) and the user's relayer_rounds. Latest p
 running job whose snapshot is no longer current is cancelled (its cancel event; it is never waited
 for) and a new one starts; a result is shown only when its snapshot is still the current one.
 
+The verdict's words are core/live_verdict's: "not stable — <reason>" only for a solve that ended
+not stable, "cannot solve — <what to do>" when the scene as set up cannot be solved (no target, no
+contour ticked, a panel value or plane the solver refuses), "error — …" for our unexpected error; a
+long reason is shown to the end of its first clause, the whole one in WIRESCULPT_OT_live_reason's
+tooltip.
+
 Nothing is written to the scene or the .blend: the verdict and the wires' preview (STATE.preview,
 line segments in each wire's colour, computed on the worker by blend/results.wire_shapes) live in
 module state, shown by the Wire panel and drawn by ui/overlay.py, so no live update touches the
@@ -37,8 +43,10 @@ from .. import native, pipeline
 from ..blend import cut_handles, mesh
 from ..blend import results as scene_results
 from ..blend.handles import handles, target_problem, ticked_planes
+from ..blend.registration import classes_factory
 from ..blend.view import redraw_3d_views
 from ..core.jobs import WorkerJob
+from ..core.live_verdict import CANNOT_SOLVE, ERROR, NOT_STABLE, SOLVING, STABLE, shortened, verdict
 from ..props import LIVE_HOOKS, material_of, solve_inputs, solver_settings
 
 TICK_SECONDS = 0.1  # while nothing changes
@@ -49,7 +57,6 @@ SETTLE_SECONDS = 0.05  # a position unchanged this long is solved (a drag's ever
 # 24-26 ms at 101,888 (a UV sphere, background Blender), against the 50 ms a tick may take (issue 17).
 MAX_TRIANGLES = 100_000
 LIVE_HOOK_PATTERNS = 1  # the layering's own hook pattern only: Optimize may pick other hooks
-REASON_WORDS = 30  # words of the reason the panel shows (wrapped): enough for its numbers and units
 DURATIONS_KEPT = 10_000
 
 
@@ -65,7 +72,9 @@ class LiveState:
         self.seen_since = 0.0  # time.monotonic() when `seen` was first seen
         self.solved = None  # the snapshot of the shown verdict
         self.job = None  # the LiveJob of the current snapshot, while it runs
-        self.verdict = ""  # "stable", "not stable — …", "solving…" (the panel adds "Live: ")
+        # core/live_verdict.verdict: "stable", "not stable — …", "cannot solve — …", … (the panel adds "Live: ")
+        self.verdict = ""
+        self.reason = ""  # the whole text behind `verdict` (its reason, problem or error), "" for a word alone
         self.preview = []  # [(RGBA, (2k, 3) float32 segment end points)], one per wire of the shown verdict
         self.mesh_key = None  # the target's name, matrix and geometry count the cached triangles belong to
         self.geometry = 0  # changes of the target's geometry seen by the depsgraph handler (edits, modifiers)
@@ -138,9 +147,14 @@ def snapshot(scene):
             STATE.geometry)
 
 
-def first_words(text, n=REASON_WORDS):
-    words = text.split()
-    return " ".join(words[:n]) + ("…" if len(words) > n else "")
+def _show(kind, text=""):
+    """Sets the verdict of `kind` (core/live_verdict) with its reason, problem or error `text`."""
+    STATE.verdict, STATE.reason = verdict(kind, text), text
+
+
+def whole_reason():
+    """The whole reason, problem or error of the shown verdict when the line shows only part of it, else ""."""
+    return STATE.reason if STATE.running and shortened(STATE.reason) else ""
 
 
 def preview_segments(design):
@@ -185,11 +199,14 @@ class LiveJob(WorkerJob):
             self.seconds = time.monotonic() - began
 
     def verdict(self):
+        """(kind, text) of core/live_verdict: the design's verdict; an error with the user's sentence
+        (the solver refusing the input, a ticked contour the plane no longer cuts, the time budget)
+        cannot solve, any other is our error."""
         if self.error is not None:
-            return "not stable — " + first_words(self.error)
+            return (ERROR if self.unexpected else CANNOT_SOLVE), self.error
         if self.design["stable"]:
-            return "stable"
-        return "not stable — " + first_words(self.design.get("reason") or "")
+            return STABLE, ""
+        return NOT_STABLE, self.design.get("reason") or ""
 
 
 class Refused(str):
@@ -197,20 +214,20 @@ class Refused(str):
 
 
 def _start(scene, key):
-    """A LiveJob for snapshot `key` (the scene read here, on Blender's thread); the verdict when
-    the scene cannot be solved at all."""
+    """A LiveJob for snapshot `key` (the scene read here, on Blender's thread); (CANNOT_SOLVE, why)
+    when the scene as set up cannot be solved at all."""
     ws = scene.wiresculpt
     problem = target_problem(scene, ws.target)
     if problem:
-        return "not stable — " + first_words(problem)
+        return CANNOT_SOLVE, problem
     if not native.available():
-        return "not stable — solver not loaded"
+        return CANNOT_SOLVE, "the solver is not loaded (the panel's first box says why)"
     depsgraph = bpy.context.evaluated_depsgraph_get()
     try:
         planes = ticked_planes(scene, depsgraph)
         material, settings = material_of(ws), solver_settings(ws)  # the panel's values, checked
     except ValueError as exc:
-        return "not stable — " + first_words(str(exc))
+        return CANNOT_SOLVE, str(exc)
     mesh_key = (key[0], key[1], key[-1])  # the target's name, matrix and geometry changes
     if STATE.mesh_key != mesh_key:
         STATE.mesh = mesh.object_triangles(ws.target, depsgraph)
@@ -234,7 +251,8 @@ def _step():
     if job is not None and not job.thread.is_alive():  # finished: shown only if still current
         STATE.job = None
         if job.key == key and not job.cancelled and not job.cancel_event.is_set():
-            STATE.verdict, STATE.solved = job.verdict(), job.key
+            _show(*job.verdict())
+            STATE.solved = job.key
             STATE.preview = job.preview if job.error is None else []
             STATE.results.append(STATE.verdict)
             STATE.shown_at, STATE.job_seconds = time.monotonic(), job.seconds
@@ -255,14 +273,16 @@ def _step():
         if isinstance(started, Refused):
             refuse(scene.wiresculpt, str(started))
             return None
-        if isinstance(started, str):
-            STATE.verdict, STATE.solved, STATE.preview = started, key, []
-            STATE.results.append(started)
+        if isinstance(started, tuple):
+            _show(*started)
+            STATE.solved, STATE.preview = key, []
+            STATE.results.append(STATE.verdict)
             STATE.shown_at = time.monotonic()
         else:
-            STATE.job, STATE.verdict = started, "solving…"
+            STATE.job = started
+            _show(SOLVING)
     elif not settled and key != STATE.solved:
-        STATE.verdict = "solving…"
+        _show(SOLVING)
     if STATE.verdict != shown:
         redraw_3d_views()
     return ACTIVE_TICK_SECONDS if STATE.job is not None or key != STATE.solved else TICK_SECONDS
@@ -286,7 +306,8 @@ def tick():
             traceback.print_exc()
         if not STATE.running:  # stopped within the step: no timer may outlive it
             return None
-        STATE.failed, STATE.verdict, STATE.preview = text, "error — " + first_words(text), []
+        STATE.failed, STATE.preview = text, []
+        _show(ERROR, text)
         STATE.solved = STATE.seen  # tried again once something changes
         return TICK_SECONDS
     finally:
@@ -299,7 +320,7 @@ def start():
     if not STATE.running:
         STATE.reset()
         STATE.running = True
-        STATE.verdict = "solving…"
+        _show(SOLVING)
         bpy.app.timers.register(tick, first_interval=TICK_SECONDS)
 
 
@@ -322,6 +343,31 @@ def stop():
 def line():
     """The panel's line, or "" when Live is off."""
     return f"Live: {STATE.verdict}" if STATE.running else ""
+
+
+class WIRESCULPT_OT_live_reason(bpy.types.Operator):
+    """Copy the live verdict's whole reason to the clipboard (the line shows its first clause)"""
+
+    bl_idname = "wiresculpt.live_reason"
+    bl_label = "Copy Whole Reason"
+    bl_options = {'INTERNAL'}  # writes nothing to the scene: no undo step
+
+    @classmethod
+    def description(cls, context, properties):
+        """The tooltip: the whole reason, which the panel's line shortens."""
+        return STATE.reason or cls.__doc__
+
+    @classmethod
+    def poll(cls, context):
+        return bool(STATE.running and STATE.reason)
+
+    def execute(self, context):
+        context.window_manager.clipboard = STATE.reason
+        self.report({'INFO'}, STATE.reason)  # the Info editor keeps it too
+        return {'FINISHED'}
+
+
+_register_classes, _unregister_classes = classes_factory((WIRESCULPT_OT_live_reason,))
 
 
 def live_changed(settings, context):
@@ -418,6 +464,7 @@ HANDLERS = (("load_pre", "_load_pre"), ("load_post", "_load_post"), ("depsgraph_
 
 
 def register():
+    _register_classes()
     LIVE_HOOKS.append(live_changed)
     for kind, name in HANDLERS:
         getattr(bpy.app.handlers, kind).append(globals()[name])
@@ -433,3 +480,4 @@ def unregister():
             handlers.remove(globals()[name])
     if live_changed in LIVE_HOOKS:
         LIVE_HOOKS.remove(live_changed)
+    _unregister_classes()

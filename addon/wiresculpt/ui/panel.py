@@ -5,6 +5,7 @@ import bpy
 
 from .. import native
 from ..blend.registration import classes_factory
+from ..core import live_verdict
 from ..operators import live
 from ..operators.slicing import WIRESCULPT_OT_add_plane, WIRESCULPT_OT_slice
 
@@ -12,6 +13,10 @@ CHARS_PER_PIXEL = 1 / 7.5  # rough width of a label character, for wrapping long
 BOX_MARGIN = 30  # pixels of a box not available to its text
 ICON_WIDTH = 22  # pixels an icon takes from a label's text
 WIDE_LIST = 280  # pixels of sidebar from which a contour row has room for its length too
+# The live verdict's icon by its kind (core/live_verdict): a setup problem (cannot solve) reads as
+# something to do, not as a verdict on the design; our error stands out in red (live_look).
+LIVE_ICONS = {live_verdict.STABLE: 'CHECKMARK', live_verdict.SOLVING: 'SORTTIME', live_verdict.NOT_STABLE: 'ERROR',
+              live_verdict.CANNOT_SOLVE: 'INFO', live_verdict.ERROR: 'CANCEL'}
 
 
 def length_text(scene, value, precision=4):
@@ -81,6 +86,23 @@ def wrap_labels(layout, context, text, icon='NONE'):
         layout.label(text=line, icon=icon if i == 0 else 'BLANK1' if icon != 'NONE' else 'NONE')
 
 
+def live_look(verdict):
+    """(icon, alert) of the live line showing `verdict` (live.STATE.verdict)."""
+    kind = live_verdict.kind_of(verdict)
+    return LIVE_ICONS.get(kind, 'NONE'), kind == live_verdict.ERROR
+
+
+def draw_live(layout, context):
+    """The live verdict, wrapped; under it, when the line shows part of the reason, a button whose
+    tooltip is the whole reason (a click copies it)."""
+    icon, alert = live_look(live.STATE.verdict)
+    col = layout.column()
+    col.alert = alert
+    wrap_labels(col, context, live.line(), icon=icon)
+    if live.whole_reason():
+        layout.operator(live.WIRESCULPT_OT_live_reason.bl_idname, icon='COPYDOWN')
+
+
 class VIEW3D_PT_wiresculpt(bpy.types.Panel):
     bl_space_type = 'VIEW_3D'
     bl_region_type = 'UI'
@@ -100,9 +122,7 @@ class VIEW3D_PT_wiresculpt(bpy.types.Panel):
         row.enabled = native.available()
         row.prop(settings, "live", toggle=True, icon='REC' if settings.live else 'PLAY')
         if live.line():
-            wrap_labels(layout, context, live.line(),
-                        icon='CHECKMARK' if live.STATE.verdict == "stable" else
-                        'SORTTIME' if live.STATE.verdict == "solving…" else 'ERROR')
+            draw_live(layout, context)
         elif live.refused_message(settings) and not settings.live:
             wrap_labels(layout.box(), context, live.refused_message(settings), icon='INFO')
         layout.label(text="Contours (ticked: wires)")
