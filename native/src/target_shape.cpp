@@ -896,7 +896,7 @@ TargetShapeResult optimize_target_shape(const Polyline2& contour, bool closed,
 
 detail::TargetShapeRun detail::run_target_shape(const Polyline2& contour, bool closed,
                                                 const std::vector<TargetCrossing>& crossings,
-                                                const TargetShapeOptions& options, const ProgressFn& progress) {
+                                                const TargetShapeOptions& options, ProgressFn progress) {
   const auto t0 = std::chrono::steady_clock::now();
   // Time spent paused between pieces (TargetShapeRun): another wire's, not this one's.
   std::chrono::steady_clock::duration paused{};

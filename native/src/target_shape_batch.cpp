@@ -9,7 +9,6 @@
 #include <mutex>
 #include <optional>
 #include <string_view>
-#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -59,6 +58,11 @@ class SpinLock {
 
 std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetShapeJob>& jobs, int threads,
                                                       const ProgressFn& progress) {
+  return detail::optimize_target_shapes(jobs, threads, progress, nullptr);
+}
+
+std::vector<TargetShapeResult> detail::optimize_target_shapes(const std::vector<TargetShapeJob>& jobs, int threads,
+                                                              const ProgressFn& progress, TargetShapesStats* stats) {
   if (threads < 1 || threads > 2) throw InputError("target shapes: threads must be 1 or 2");
   const std::size_t n = jobs.size();
   using Clock = std::chrono::steady_clock;
@@ -101,6 +105,7 @@ std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetSh
   for (std::size_t k = 0; k < n; ++k) slots[k].left = kSecondsPerCost * expected_cost(jobs[k]);
   SpinLock book;  // guards slots' left, busy and done
   std::atomic<std::size_t> finished{0};
+  int hand_overs = 0;  // guarded by book
   // The free wire with the most work left (the first of equals), or n.
   auto dearest_free = [&]() {
     std::size_t best = n;
@@ -116,6 +121,7 @@ std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetSh
         if (mine != n && other != n && slots[other].left > slots[mine].left + kHandOverSeconds) {
           slots[mine].busy = false;
           mine = n;
+          ++hand_overs;
         }
         if (mine == n) {
           if (other == n) return;
@@ -181,7 +187,7 @@ std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetSh
         }
         worker_ended.notify_one();
       });
-    } catch (const std::system_error&) {  // no thread to be had: the calling thread does them all
+    } catch (...) {  // no thread to be had: the calling thread does them all
       slots[first].busy = false;
     }
   }
@@ -198,6 +204,7 @@ std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetSh
     }
   }
   if (worker) worker->join();
+  if (stats) stats->hand_overs = hand_overs;
   if (progress_error) std::rethrow_exception(progress_error);
   std::vector<TargetShapeResult> out;
   out.reserve(n);

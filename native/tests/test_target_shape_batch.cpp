@@ -96,7 +96,7 @@ TEST_CASE("target shapes: a wire run a piece at a time, on any thread and betwee
   std::vector<TargetShapeResult> alone;
   for (const TargetShapeJob& j : jobs) alone.push_back(optimize_target_shape(j.contour, j.closed, j.crossings, j.options));
   std::vector<detail::TargetShapeRun> runs;
-  for (const TargetShapeJob& j : jobs) runs.push_back(detail::run_target_shape(j.contour, j.closed, j.crossings, j.options, {}));
+  for (const TargetShapeJob& j : jobs) runs.push_back(detail::run_target_shape(j.contour, j.closed, j.crossings, j.options, nullptr));
   std::vector<int> pieces(jobs.size(), 0);
   std::vector<char> more(jobs.size(), 1);
   for (bool any = true; any;) {
@@ -133,7 +133,8 @@ TEST_CASE("target shapes: a run's pauses count neither against its time budget n
   job.options.max_seconds = 0.25;
   const TargetShapeResult alone = optimize_target_shape(job.contour, job.closed, job.crossings, job.options);
   REQUIRE(alone.nlopt_result != "NLOPT_MAXTIME_REACHED");
-  detail::TargetShapeRun run = detail::run_target_shape(job.contour, job.closed, job.crossings, job.options, {});
+  detail::TargetShapeRun run = detail::run_target_shape(job.contour, job.closed, job.crossings, job.options, nullptr);
+  CHECK_THROWS_AS(run.take(), std::logic_error);  // not ended yet
   int pieces = 0;
   while (run.step()) {
     ++pieces;
@@ -145,6 +146,45 @@ TEST_CASE("target shapes: a run's pauses count neither against its time budget n
   check_same(r, alone);
   CHECK(r.warnings == alone.warnings);
   CHECK(r.seconds < slept);
+  CHECK_THROWS_AS(run.take(), std::logic_error);  // taken already
+}
+
+TEST_CASE("target shapes: three equal windowed wires on two threads are handed between them, as each alone",
+          "[target]") {
+  // The globe's case: three wires of one cost. A thread hands its wire over between two windows for
+  // one with more work left, so the three share both threads instead of the third waiting for one
+  // of the first two. The results stay each wire's alone; progress is still asked on the calling
+  // thread only, and stopping it stops wires paused between their windows too.
+  std::vector<TargetShapeJob> jobs;
+  for (const char* name : {"North", "East", "West"}) jobs.push_back(loop(name, 0.16, 0.02, 5, 600, 4));
+  std::vector<TargetShapeResult> alone;
+  for (const TargetShapeJob& j : jobs) alone.push_back(optimize_target_shape(j.contour, j.closed, j.crossings, j.options));
+  REQUIRE(alone[0].points.size() > static_cast<std::size_t>(4 * TargetShapeOptions{}.window));  // windowed
+
+  const std::thread::id caller = std::this_thread::get_id();
+  std::mutex seen_mutex;
+  std::set<std::thread::id> seen;
+  const ProgressFn watch = [&](std::string_view, double) {
+    const std::lock_guard<std::mutex> lock(seen_mutex);
+    seen.insert(std::this_thread::get_id());
+    return true;
+  };
+  detail::TargetShapesStats stats;
+  const std::vector<TargetShapeResult> together = detail::optimize_target_shapes(jobs, 2, watch, &stats);
+  CHECK(stats.hand_overs > 0);
+  CHECK(seen == std::set<std::thread::id>{caller});
+  for (std::size_t k = 0; k < jobs.size(); ++k) {
+    INFO("wire " << jobs[k].options.wire_name);
+    check_same(together[k], alone[k]);
+  }
+
+  // Stopped part-way, wires paused between their windows (1 to 7 hand-overs before the stop in
+  // five runs): Cancelled, and the paused runs are let go (the sanitizer build checks their frames).
+  std::atomic<int> asked{0};
+  const ProgressFn stop = [&](std::string_view, double) { return ++asked < 6; };
+  detail::TargetShapesStats stopped;
+  CHECK_THROWS_AS(detail::optimize_target_shapes(jobs, 2, stop, &stopped), Cancelled);
+  CHECK(asked == 6);
 }
 
 TEST_CASE("target shapes: progress is asked on the calling thread only, and it cancels every wire", "[target]") {

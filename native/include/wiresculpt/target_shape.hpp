@@ -25,6 +25,7 @@
 #include <exception>
 #include <numbers>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -253,8 +254,9 @@ int initial_point_count(const Polyline2& contour, bool closed, const std::vector
 /// window of a windowed wire's sweeps (the set-up and a one-block wire are one piece), so that
 /// optimize_target_shapes can hand a wire from one thread to the other between its windows. The
 /// arithmetic is optimize_target_shape's, whatever runs which piece: the result is the same.
-/// The arguments are referred to, not copied: they must outlive the run. A run's pauses do not
-/// count against max_seconds, nor in its result's seconds.
+/// The contour, crossings and options are referred to, not copied: they must outlive the run
+/// (`progress` is copied). A run's pauses do not count against max_seconds, nor in its result's
+/// seconds; a run that reaches max_seconds stops where its own clock says, as optimize_target_shape.
 class TargetShapeRun {
  public:
   struct promise_type {
@@ -288,11 +290,16 @@ class TargetShapeRun {
     handle_.resume();
     return !handle_.done();
   }
-  /// The result of an ended run; rethrows what it threw (InputError, Cancelled, ...).
+  /// The result of an ended run, once; rethrows what it threw (InputError, Cancelled, ...).
+  /// std::logic_error for a run not ended, moved from or already taken.
   TargetShapeResult take() {
+    if (!handle_ || !handle_.done()) throw std::logic_error("target shape: the run has not ended");
     promise_type& p = handle_.promise();
     if (p.error) std::rethrow_exception(p.error);
-    return std::move(*p.result);
+    if (!p.result) throw std::logic_error("target shape: the run's result was already taken");
+    TargetShapeResult r = std::move(*p.result);
+    p.result.reset();
+    return r;
   }
 
  private:
@@ -301,7 +308,16 @@ class TargetShapeRun {
 };
 
 TargetShapeRun run_target_shape(const Polyline2& contour, bool closed, const std::vector<TargetCrossing>& crossings,
-                                const TargetShapeOptions& options, const ProgressFn& progress);
+                                const TargetShapeOptions& options, ProgressFn progress);
+
+/// What optimize_target_shapes did besides its results, for tests: how often a thread handed its
+/// wire over for another between two windows.
+struct TargetShapesStats {
+  int hand_overs = 0;
+};
+/// optimize_target_shapes, counting into `stats` (when non-null).
+std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetShapeJob>& jobs, int threads,
+                                                      const ProgressFn& progress, TargetShapesStats* stats);
 }  // namespace detail
 
 /// The optimisation problem of one wire, exposed for tests and diagnostics: the initial
@@ -360,7 +376,7 @@ class TargetShapeProblem {
 
  private:
   friend detail::TargetShapeRun detail::run_target_shape(const Polyline2&, bool, const std::vector<TargetCrossing>&,
-                                                         const TargetShapeOptions&, const ProgressFn&);
+                                                         const TargetShapeOptions&, ProgressFn);
   double nearest_squared(const Vec2& q, Vec2* grad) const;
   // Term i of E_d (w_i D(p_i)) and of w_r E_r (weight |Δu_i|²); gradients added to grad. With grad,
   // `sample` (when non-null) gets D(p_i) and its gradient.
