@@ -321,6 +321,18 @@ def id_list(numbers):
     return ", ".join(map(str, numbers[:-1])) + f" and {numbers[-1]}" if len(numbers) > 1 else str(numbers[0])
 
 
+def crossing_words(failure):
+    """The solver's words for one failed crossing (`failure`: a nulled entry), naming it by the
+    design's id, which users see: the solver numbers crossings along the wire and starts its
+    message with "crossing k on wire W" followed by ": " or by its predicate ("needs a bend of at
+    least …"): that opening is replaced by the design's ("…: it needs a bend …"), not repeated."""
+    message, head = failure["message"], f"crossing {failure['crossing']} on wire {failure['wire']}: "
+    opening = re.match(rf"crossing \d+ on wire {re.escape(failure['wire'])}(: | )", message)
+    if opening is None:
+        return head + message
+    return head + ("" if opening.group(1) == ": " else "it ") + message[opening.end():]
+
+
 def unrealised_summary(nulled, size):
     """One sentence for the crossings the target shape could not realise: those too close along
     their wires as one group with the size to scale to, the others each with the solver's words."""
@@ -333,9 +345,7 @@ def unrealised_summary(nulled, size):
                      f"bending point between them (the closest: {worst['message']})")
     for n in nulled:
         if n["status"] != "too_close":
-            # The solver numbers crossings along the wire; the design's id is the one users see.
-            message = re.sub(r"^crossing \d+ on wire .*?: ", "", n["message"])
-            parts.append(f"crossing {n['crossing']} on wire {n['wire']}: {message}")
+            parts.append(crossing_words(n))
     return "the target shape cannot realise " + "; ".join(parts)
 
 
