@@ -1,6 +1,6 @@
 """Live (issue 17 part 2) in a Blender with a window under Xvfb (timers need the event loop): a
-plane moved in steps turns the live verdict stable -> cannot solve (the plane left the mesh: its
-ticked contour is gone) -> stable, the latest position wins over a running solve, no tick of the
+plane moved in steps turns the live verdict stable -> not stable (near the top of the mesh) ->
+cannot solve (the plane left the mesh: its ticked contour is gone) -> stable, the latest position wins over a running solve, no tick of the
 live timer blocks the UI for more than 50 ms, and turning Live off or loading a file stops the
 timer."""
 import os
@@ -30,14 +30,16 @@ class Live(unittest.TestCase):
     def test_verdict_follows_the_plane(self):
         self.assertTrue(self.seen["timer_on"])
         lines = [v["line"] for v in self.seen["verdicts"]]
-        self.assertEqual(len(lines), 3, lines)
+        self.assertEqual(len(lines), 4, lines)
         self.assertEqual(lines[0], "Live: stable")
+        # 5 mm below the top of the globe: the design's own verdict, not stable, with the reason
+        self.assertTrue(lines[1].startswith("Live: not stable — the target shape cannot realise crossing "), lines)
         # the plane cuts nothing: its ticked contour does not exist, a setup problem, not a verdict
-        self.assertTrue(lines[1].startswith("Live: cannot solve — plane Slice A: contour index 0 does not exist"),
+        self.assertTrue(lines[2].startswith("Live: cannot solve — plane Slice A: contour index 0 does not exist"),
                         lines)
-        self.assertEqual(lines[2], "Live: stable")
-        # the preview: the three wires when stable, none when the plane cuts nothing
-        self.assertEqual([v["preview_wires"] for v in self.seen["verdicts"]], [3, 0, 3])
+        self.assertEqual(lines[3], "Live: stable")
+        # the preview: the three wires of a solved design (stable or not), none when the plane cuts nothing
+        self.assertEqual([v["preview_wires"] for v in self.seen["verdicts"]], [3, 3, 0, 3])
 
     def test_preview_is_drawn(self):
         self.assertGreater(self.seen["verdicts"][-1]["drawn"], 0)  # the overlay drew the live wires
