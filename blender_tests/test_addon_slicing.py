@@ -14,7 +14,7 @@ import wiresculpt
 from wiresculpt import native
 from wiresculpt.blend import contours as blend_contours
 from wiresculpt.blend import handles as blend_handles
-from wiresculpt.operators import slicing
+from wiresculpt.operators import live, slicing
 from wiresculpt.ui import panel
 
 from helpers import BlenderCase, FakeLayout, clear_scene, draw, register_addon
@@ -221,6 +221,75 @@ class Ticks(AddonCase):
         self.assertEqual([i.use for i in items], [False, True])
         self.assertLengthNear(items[1].length, circle_length(0.5, 0.2))
         self.assertEqual(len(contour_objects()), 2)
+
+    def two_planes(self):
+        """The pair sliced by Slice A (z = 0) and Slice B (y = 0), each cutting both spheres;
+        Slice A's ticks set to its smaller contour only (not the default)."""
+        self.two_spheres()
+        a = add_handle((1.5, 0, 0))
+        b = add_handle((1.5, 0, 0), rotation=(math.pi / 2, 0, 0))
+        slice_scene()
+        self.assertEqual((a.name, b.name), ("Slice A", "Slice B"))
+        items = items_of("Slice A")
+        self.assertEqual(len(items), 2)
+        items[0].use, items[1].use = False, True
+        return a, b
+
+    def ticked(self):
+        """{plane name: ticked indices} of ticked_planes."""
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        return {p.name: p.contours for p in blend_handles.ticked_planes(bpy.context.scene, depsgraph)}
+
+    def test_ticks_follow_a_renamed_plane(self):
+        a, _b = self.two_planes()
+        before = live.snapshot(bpy.context.scene)
+        a.name = "Front"  # as in the Outliner
+        self.assertEqual(self.ticked(), {"Front": [1], "Slice B": [0]})
+        self.assertNotEqual(live.snapshot(bpy.context.scene), before)  # Live solves again
+        self.assertEqual([panel.contour_name(i) for i in bpy.context.scene.wiresculpt.contours][:2],
+                         ["Front #0", "Front #1"])
+        slice_scene()
+        self.assertEqual(items_of("Slice A"), [])
+        self.assertEqual([i.use for i in items_of("Front")], [False, True])
+        self.assertEqual(self.ticked(), {"Front": [1], "Slice B": [0]})
+
+    def test_a_new_plane_does_not_take_a_deleted_planes_ticks(self):
+        a, _b = self.two_planes()
+        bpy.data.objects.remove(a)
+        with self.assertRaisesRegex(ValueError, "slicing plane Slice A of a ticked contour is gone"):
+            self.ticked()
+        c = add_handle((1.5, 0, 0))
+        self.assertEqual(c.name, "Slice A")  # the first unused name
+        with self.assertRaisesRegex(ValueError, "slicing plane Slice A of a ticked contour is gone"):
+            self.ticked()
+        slice_scene()
+        self.assertEqual([i.use for i in items_of("Slice A")], [True, False])  # the default, not the old ticks
+        self.assertEqual(self.ticked(), {"Slice A": [0], "Slice B": [0]})
+
+    def test_a_plane_deleted_in_the_viewport_is_gone(self):
+        a, b = self.two_planes()
+        for obj in bpy.context.selected_objects:
+            obj.select_set(False)
+        a.select_set(True)
+        self.assertEqual(bpy.ops.object.delete(), {'FINISHED'})  # it may linger outside the scene
+        with self.assertRaisesRegex(ValueError, "slicing plane Slice A of a ticked contour is gone"):
+            self.ticked()
+        c = add_handle((1.5, 0, 0))
+        slice_scene()
+        self.assertEqual([i.use for i in items_of(c.name)], [True, False])
+        self.assertEqual(self.ticked(), {b.name: [0], c.name: [0]})
+
+    def test_items_of_older_files_go_by_the_plane_name(self):
+        a, _b = self.two_planes()
+        for item in bpy.context.scene.wiresculpt.contours:  # as a file saved before the pointer
+            item.property_unset("plane_object")
+            item.property_unset("has_plane_object")
+            self.assertIsNone(item.plane_object)  # (this read adds an empty property: harmless)
+        self.assertEqual(self.ticked(), {"Slice A": [1], "Slice B": [0]})
+        a.location.z = 0.2
+        slice_scene()
+        self.assertEqual([i.use for i in items_of("Slice A")], [False, True])
+        self.assertTrue(all(i.plane_object == a and i.has_plane_object for i in items_of("Slice A")))
 
 
 class Refusals(AddonCase):

@@ -57,6 +57,8 @@ def add_handles(scene, planes, design):
     import bpy
     from mathutils import Vector
 
+    from wiresculpt.blend.handles import contour_plane_name
+
     picked = {w["name"] for w in design["wires"]}
     for plane in planes:
         bpy.ops.wiresculpt.add_plane()
@@ -67,7 +69,7 @@ def add_handles(scene, planes, design):
     bpy.context.view_layer.update()
     bpy.ops.wiresculpt.slice()
     for item in scene.wiresculpt.contours:
-        item.use = f"{item.plane}/{item.index}" in picked
+        item.use = f"{contour_plane_name(item)}/{item.index}" in picked
 
 
 def write_scene_outputs(design, objects, planes, factor, out, say, overlap=0.0):

@@ -160,7 +160,16 @@ def _wire_items(_settings, _context):
 
 class WiresculptContour(bpy.types.PropertyGroup):
     plane: StringProperty(
-        name="Plane", description="Name of the slicing plane that cut this contour")
+        name="Plane", description="Name of the slicing plane that cut this contour, at the Slice "
+                                  "that made it (the plane's current name is plane_object's)")
+    plane_object: PointerProperty(
+        name="Plane Object", type=bpy.types.Object,
+        description="Slicing plane that cut this contour: the tick follows this object through "
+                    "renames; None once that object is deleted")
+    has_plane_object: BoolProperty(
+        name="Has Plane Object", default=False, options={'HIDDEN'},
+        description="Plane Object was set by the Slice that made this contour; False on contours "
+                    "saved before it existed, which go by the Plane name instead")
     index: IntProperty(
         name="Index", min=0,
         description="Position of this contour among its plane's contours, longest first (0)")

@@ -4,6 +4,7 @@ import bpy
 from mathutils import Matrix
 
 from ..core.contours import pick
+from .handles import contour_plane
 from .objects import remove_object, scene_collection, tagged, write_polyline
 
 CONTOUR_KEY = "wiresculpt_contour"  # custom property {"plane": name, "index": k} on curve objects
@@ -38,13 +39,20 @@ def contour_curve(scene, existing, plane, index):
     return obj
 
 
-def apply_slice(scene, settings, names, per_plane):
-    """Make the scene's curves and the settings' list match the sliced `per_plane` contours,
-    keeping the user's ticks. Returns (contour count, ticked count, removed curve count)."""
-    ticks = {(item.plane, item.index): item.use for item in settings.contours}
+def apply_slice(scene, settings, planes, per_plane):
+    """Make the scene's curves and the settings' list match the contours `per_plane` cut by the
+    handle objects `planes`, keeping the user's ticks: a tick stays with its plane object (renamed
+    or not) and its index; the ticks of a plane that is gone are dropped, even when a new plane
+    has taken its name. Returns (contour count, ticked count, removed curve count)."""
+    ticks = {}  # (handle object, index) -> tick
+    for item in settings.contours:
+        handle = contour_plane(scene, item)
+        if handle is not None:
+            ticks[handle, item.index] = item.use
     existing = existing_curves(scene)
     settings.contours.clear()
-    for plane, contours in zip(names, per_plane):
+    for handle, contours in zip(planes, per_plane):
+        plane = handle.name
         longest = set(pick(contours, "largest", plane))
         for index, contour in enumerate(contours):
             obj = contour_curve(scene, existing, plane, index)
@@ -54,8 +62,9 @@ def apply_slice(scene, settings, names, per_plane):
             item = settings.contours.add()
             item.name = f"{plane} #{index}"
             item.plane, item.index, item.curve = plane, index, obj
+            item.plane_object, item.has_plane_object = handle, True
             item.length, item.closed = contour["length"], contour["closed"]
-            item.use = ticks.get((plane, index), index in longest)
+            item.use = ticks.get((handle, index), index in longest)
     for obj in existing.values():  # contours that disappeared
         remove_object(obj)
     count = len(settings.contours)

@@ -46,20 +46,46 @@ def handle_plane(handle, depsgraph):
     return handle.name, tuple(M.translation), tuple(normal.normalized())
 
 
+def contour_plane(scene, item):
+    """The slicing handle that cut contour list item `item`, or None when that plane is gone.
+    Items follow the plane object itself (item.plane_object), so a renamed plane keeps its
+    contours and a new plane that takes a deleted one's name does not; the object is gone when
+    it was deleted (the pointer reads None), unlinked from `scene` (an object deleted in the
+    viewport lingers outside every scene) or no longer tagged as a handle. Items of files saved
+    before the pointer existed (has_plane_object False) resolve by their stored plane name.
+    (has_plane_object, not is_property_set: reading an unset ID PointerProperty adds an empty
+    property in Blender 3.4, so is_property_set changes under a mere read.)"""
+    if item.has_plane_object:
+        obj = item.plane_object
+    else:
+        obj = scene.objects.get(item.plane)
+    if obj is None or not is_handle(obj) or scene.objects.get(obj.name) != obj:
+        return None
+    return obj
+
+
+def contour_plane_name(item):
+    """The current name of the plane of contour list item `item`, for messages and wire names:
+    its object's name while the item points at one, else the name stored at the Slice."""
+    obj = item.plane_object if item.has_plane_object else None
+    return item.plane if obj is None else obj.name
+
+
 def ticked_planes(scene, depsgraph):
     """The slicing planes of the ticked contours, as PlaneSpecs whose contour rule is the ticked
     indices (in the list's order): what Optimize and Live slice with. ValueError when no contour
     is ticked or the plane of one is gone."""
-    ticked = [(item.plane, item.index) for item in scene.wiresculpt.contours if item.use]
+    ticked = [item for item in scene.wiresculpt.contours if item.use]
     if not ticked:
         raise ValueError("No contour is ticked: Slice, then tick the contours that become wires")
-    by_name = {h.name: h for h in handles(scene)}
-    rules = {}  # plane name -> its ticked contour indices, in the list's order
-    for plane, index in ticked:
-        if plane not in by_name:
-            raise ValueError(f"slicing plane {plane} of a ticked contour is gone: Slice again")
-        rules.setdefault(plane, []).append(index)
-    return [PlaneSpec(*handle_plane(by_name[name], depsgraph), contours=indices) for name, indices in rules.items()]
+    rules = {}  # handle object -> its ticked contour indices, in the list's order
+    for item in ticked:
+        handle = contour_plane(scene, item)
+        if handle is None:
+            raise ValueError(f"slicing plane {contour_plane_name(item)} of a ticked contour is gone: "
+                             "Slice again")
+        rules.setdefault(handle, []).append(item.index)
+    return [PlaneSpec(*handle_plane(handle, depsgraph), contours=indices) for handle, indices in rules.items()]
 
 
 def add_handle(context, low, high):

@@ -42,7 +42,7 @@ import numpy as np
 from .. import native, pipeline
 from ..blend import cut_handles, mesh
 from ..blend import results as scene_results
-from ..blend.handles import handles, target_problem, ticked_planes
+from ..blend.handles import contour_plane_name, handles, target_problem, ticked_planes
 from ..blend.registration import classes_factory
 from ..blend.view import redraw_3d_views
 from ..core.jobs import WorkerJob
@@ -140,7 +140,7 @@ def snapshot(scene):
     target = ws.target
     return (target.name if target else "", _rounded(target.matrix_world) if target else (),
             tuple((h.name, _rounded(h.matrix_world)) for h in handles(scene)),
-            tuple((item.plane, item.index) for item in ws.contours if item.use),
+            tuple((contour_plane_name(item), item.index) for item in ws.contours if item.use),
             solve_inputs(ws), target is not None and scene.objects.get(target.name) == target,
             tuple(sorted((name, tuple(round(x, 9) for x in point))
                          for name, point in cut_handles.user_cut_points(scene).items())),

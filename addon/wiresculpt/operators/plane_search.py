@@ -21,7 +21,8 @@ from mathutils import Matrix, Vector
 from .. import native, pipeline, plane_search
 from ..blend import mesh
 from ..blend import results as scene_results
-from ..blend.handles import PLANE_MARGIN, add_handle, handle_plane, handles, target_problem
+from ..blend.handles import (PLANE_MARGIN, add_handle, contour_plane, contour_plane_name, handle_plane, handles,
+                             target_problem)
 from ..blend.registration import classes_factory
 from ..blend.view import redraw_3d_views
 from ..core.jobs import WorkerJob
@@ -52,11 +53,11 @@ def gather(context, need_planes=True):
     if not native.available():
         raise RuntimeError(native.LOAD_ERROR)
     depsgraph = context.evaluated_depsgraph_get()
-    ticked = {}
+    ticked = {}  # handle object -> its ticked contour indices (the ticks of a gone plane: none)
     for item in ws.contours:
         if item.use:
-            ticked.setdefault(item.plane, []).append(item.index)
-    planes = [PlaneSpec(*handle_plane(h, depsgraph), contours=ticked.get(h.name, "largest")) for h in handles(scene)]
+            ticked.setdefault(contour_plane(scene, item), []).append(item.index)
+    planes = [PlaneSpec(*handle_plane(h, depsgraph), contours=ticked.get(h, "largest")) for h in handles(scene)]
     if need_planes and not planes:
         raise ValueError("No slicing plane: add planes first, or use Suggest Planes")
     V, F = mesh.object_triangles(ws.target, depsgraph)
@@ -308,7 +309,7 @@ def apply_candidate(context, index):
     bpy.ops.wiresculpt.slice()
     picked = {w["name"] for w in design["wires"]}
     for item in scene.wiresculpt.contours:
-        item.use = f"{item.plane}/{item.index}" in picked
+        item.use = f"{contour_plane_name(item)}/{item.index}" in picked
     scene_results.write_results(scene, design)
     clear_preview()  # the candidate is now the scene's own
     return candidate

@@ -64,7 +64,7 @@ class WIRESCULPT_OT_slice(bpy.types.Operator):
             self.report({'ERROR'}, f"Cannot slice {target.name}: {exc}")
             return {'CANCELLED'}
         names = [name for name, _o, _n in specs]
-        count, ticked, removed = apply_slice(scene, settings, names, result["contours"])
+        count, ticked, removed = apply_slice(scene, settings, planes, result["contours"])
         missed = [name for name, contours in zip(names, result["contours"]) if not contours]
         message = (f"Sliced {target.name} with {len(names)} plane{'s' * (len(names) != 1)}: "
                    f"{count} contour{'s' * (count != 1)}, {ticked} used as wires")

@@ -4,6 +4,7 @@ import textwrap
 import bpy
 
 from .. import native
+from ..blend.handles import contour_plane_name
 from ..blend.registration import classes_factory
 from ..core import live_verdict
 from ..operators import live
@@ -62,14 +63,15 @@ class WIRESCULPT_UL_contours(bpy.types.UIList):
 
 
 def contour_name(item):
-    return f"{item.plane} #{item.index}"
+    """The plane's current name (renaming the plane renames its contours' lines) and the index."""
+    return f"{contour_plane_name(item)} #{item.index}"
 
 
 def contour_details(scene, item):
     """The active contour in full, one sentence (wrapped by the panel)."""
     shape = "closed loop" if item.closed else "open curve (the mesh has a hole there)"
     role = "ticked: it becomes a wire" if item.use else "not ticked: not a wire"
-    return (f"Plane \"{item.plane}\", contour {item.index} (longest first): a {shape}, "
+    return (f"Plane \"{contour_plane_name(item)}\", contour {item.index} (longest first): a {shape}, "
             f"{length_text(scene, item.length)}; {role}")
 
 
