@@ -18,7 +18,8 @@ def to_2d(points, origin, u, v):
 
 def to_3d(points2, origin, u, v):
     q = np.asarray(points2, dtype=np.float64)
-    return np.asarray(origin, dtype=np.float64) + np.outer(q[:, 0], u) + np.outer(q[:, 1], v)
+    # origin + outer(q[:, 0], u) + outer(q[:, 1], v), broadcast: the same products and sums
+    return np.asarray(origin, dtype=np.float64) + q[:, 0:1] * u + q[:, 1:2] * v
 
 
 def rigid_fit_2d(src, dst):
