@@ -63,6 +63,7 @@ class StaleTest(unittest.TestCase):
         ticked = {t for t in TICKED if t[0] != "Slice C"}
         self.assertEqual(changes(p, ticked), ["plane Slice C removed"])
         self.assertEqual(changes(p, None), ["plane Slice C removed"])  # ticks unreadable: the plane says it
+        self.assertEqual(changes(p, TICKED), ["plane Slice C removed"])  # its contour still ticked
         p = planes()
         p["Slice D"] = ((0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
         self.assertEqual(changes(p), [])  # a new plane none of whose contours is ticked changes nothing
@@ -85,6 +86,8 @@ class StaleTest(unittest.TestCase):
                          ["contours ticked differently (Slice A #0 unticked, Slice B #0 unticked, "
                           "Slice B #1 unticked, 1 more)"])
         self.assertEqual(changes(ticked=None), ["contours ticked differently"])
+        # a ticked contour of a plane that is gone and was never in the design
+        self.assertEqual(changes(ticked=TICKED | {("Slice Z", 0)}), ["contours ticked differently (Slice Z #0 ticked)"])
 
     def test_target_settings_and_material(self):
         self.assertEqual(changes(target="Duck"), ["target changed"])

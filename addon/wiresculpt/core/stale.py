@@ -85,21 +85,24 @@ def changed_keys(recorded, now):
     return [k for k in keys if k not in recorded or k not in now or not _same_value(recorded[k], now[k])]
 
 
-def changes(design, planes, ticked, inputs=None, target=None, settings=None, material=None, labels=None):
+def changes(design, planes, ticked, inputs=None, target=None, settings=None, material=None, labels=None,
+            recorded=None):
     """What changed since `design` was optimized, as short phrases ("plane Slice B moved", "plane
     Slice C removed", "plane Slice D added", "contours ticked differently (Slice A #1 unticked)",
     "target changed", "settings changed (Max Bend)"); [] while it is current.
 
-    planes: {handle name: (origin, normal) or None (no normal)} of every slicing handle now.
-    ticked: {(plane name, contour index)} ticked now, or None when they cannot be read (a ticked
-    contour's plane is gone).
+    planes: {handle name: (origin, normal) or None (no normal)} of the slicing handles now: at
+    least those named by the design's wires and by the ticks (a name missing is a plane gone).
+    ticked: {(plane name, contour index)} ticked now (a plane name may be one that is gone), or
+    None when they cannot be read.
     inputs: what Optimize recorded ({"target", "settings", "material"}), or None: then target,
     settings and material are not compared. target: the target's name now ("" for none);
     settings / material: the dicts props.solver_settings / material_of give now (settings None:
     the panel's values are not valid, e.g. the smallest bend above the largest).
-    labels: {setting or material key: the name the panel shows} for the phrase."""
+    labels: {setting or material key: the name the panel shows} for the phrase.
+    recorded: recorded_planes(design) when the caller keeps it (a panel redraws often)."""
     said = []
-    before, ticks_before = recorded_planes(design)
+    before, ticks_before = recorded or recorded_planes(design)
     removed, added = set(), set()
     for name, plane in before.items():
         if name not in planes:
@@ -111,10 +114,11 @@ def changes(design, planes, ticked, inputs=None, target=None, settings=None, mat
             said.append(f"plane {name} {how}")
     if ticked is not None:
         for name in sorted({p for p, _i in ticked} - set(before)):
-            added.add(name)
-            said.append(f"plane {name} added")
+            if name in planes:  # a tick whose plane is gone is not a plane added (the ticks differ)
+                added.add(name)
+                said.append(f"plane {name} added")
         old = {t for t in ticks_before if t[0] not in removed}
-        new = {t for t in ticked if t[0] not in added}
+        new = {t for t in ticked if t[0] not in added and t[0] not in removed}
         if old != new:
             named = [f"{p} #{i} unticked" for p, i in sorted(old - new)] + [f"{p} #{i} ticked" for p, i in sorted(new - old)]
             more = f", {len(named) - MAX_NAMED} more" if len(named) > MAX_NAMED else ""
