@@ -94,8 +94,13 @@ class StaleTest(unittest.TestCase):
         self.assertEqual(changes(settings=dict(SETTINGS, max_bend_deg=90.0)), ["settings changed (Max Bend)"])
         self.assertEqual(changes(settings=dict(SETTINGS, torque_fraction=0.5)), ["settings changed (torque_fraction)"])
         self.assertEqual(changes(settings=None), ["settings changed"])
-        self.assertEqual(changes(material=dict(MATERIAL, wire_diameter=0.002, name="brass")),
-                         ["settings changed (Material, Wire Diameter)"])
+        self.assertEqual(changes(material=dict(MATERIAL, wire_diameter=0.002, name="brass", bending_stiffness=0.2)),
+                         ["settings changed (Material, Wire Diameter)"])  # another material's numbers are its own
+        # a preset scaled to another diameter: the diameter, not the numbers that follow it
+        self.assertEqual(changes(material=dict(MATERIAL, wire_diameter=0.002, bending_stiffness=0.14)),
+                         ["settings changed (Wire Diameter)"])
+        self.assertEqual(changes(material=dict(MATERIAL, bending_stiffness=0.5)),
+                         ["settings changed (bending_stiffness)"])
         self.assertEqual(changes(settings=dict(SETTINGS, in_plane_tiebreak=True)),
                          ["settings changed (in_plane_tiebreak)"])
         # a design without recorded inputs is compared by its planes and ticks only

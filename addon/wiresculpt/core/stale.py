@@ -23,6 +23,9 @@ import math
 ORIGIN_TOLERANCE = 1e-6  # m: the distance of the new origin from the recorded plane
 NORMAL_TOLERANCE = 1e-6  # per component of the unit normals
 VALUE_TOLERANCE = 1e-9  # relative, for a setting's or the material's number
+# a material's numbers that change with its wire diameter (a preset scaled to it, props.material_of):
+# not named beside it, the maker changed the diameter
+SCALED = ("bending_stiffness", "max_torque")
 MAX_NAMED = 3  # contours named after "contours ticked differently"
 
 PREFIX = "From an earlier Optimize: "
@@ -134,7 +137,12 @@ def changes(design, planes, ticked, inputs=None, target=None, settings=None, mat
         elif isinstance(inputs.get("settings"), dict):
             keys += changed_keys(inputs["settings"], settings)
         if material is not None and isinstance(inputs.get("material"), dict):
-            keys += changed_keys(inputs["material"], material)
+            changed = changed_keys(inputs["material"], material)
+            if "name" in changed:  # another material: its numbers are its own, the name says it
+                changed = [k for k in changed if k in ("name", "wire_diameter")]
+            elif "wire_diameter" in changed:  # a preset's numbers follow the diameter
+                changed = [k for k in changed if k not in SCALED]
+            keys += changed
         if keys:
             words = []
             for key in keys:
