@@ -380,6 +380,18 @@ class StaleReport(Case):
         bpy.context.view_layer.update()
         self.assert_stale("plane Slice A rotated")
 
+    def test_live_hint_when_live_disagrees_with_a_current_optimize(self):
+        from wiresculpt.core import live_verdict
+        from wiresculpt.ui import stale as stale_ui
+        self.optimize()  # stable
+        self.assertEqual(stale_ui.live_hint(bpy.context, live_verdict.STABLE), "")
+        disagree = live_verdict.verdict(live_verdict.NOT_STABLE, "crossing 2 slips")
+        self.assertIn("Optimize found these planes stable", stale_ui.live_hint(bpy.context, disagree))
+        self.assertEqual(stale_ui.live_hint(bpy.context, live_verdict.SOLVING), "")
+        bpy.data.objects["Slice A"].location.z += 0.01
+        bpy.context.view_layer.update()
+        self.assertEqual(stale_ui.live_hint(bpy.context, disagree), "")  # an earlier Optimize says nothing of these planes
+
     def test_removing_a_plane(self):
         self.optimize()
         bpy.data.objects.remove(bpy.data.objects["Slice C"], do_unlink=True)

@@ -9,6 +9,7 @@ from .. import native, props
 from ..blend import results as scene_results
 from ..blend.registration import classes_factory
 from ..core import closure, stale
+from .stale import report_changes
 from ..operators import optimize
 from ..operators.results import WIRESCULPT_OT_assembly_guide, WIRESCULPT_OT_clear_results
 from .panel import VIEW3D_PT_wiresculpt, length_text, wrap_labels
@@ -100,40 +101,6 @@ def assembly_rows(design):
 
 
 _wrap = wrap_labels
-
-
-def setting_labels():
-    """{solver setting or material key: the name the panel shows it by}, for core/stale's phrase."""
-    rna = props.WiresculptSettings.bl_rna.properties
-    labels = {key: rna[key].name for key in props.SETTING_PROPS + props.MATERIAL_PROPS if key in rna}
-    labels["name"] = rna["material_preset"].name  # the material's name: a preset or a calibrated one
-    return labels
-
-
-# core/stale.recorded_planes of the stored design and the setting labels, kept while
-# stored_design() returns the same dict (it does until the text changes): read at every redraw
-_recorded = {"design": None, "planes": None, "labels": None}
-
-
-def report_changes(context):
-    """What changed in the scene since the stored design was optimized (core/stale.changes), [] while
-    it is current or there is none. Reads the handles as last evaluated (the view layer's depsgraph,
-    not evaluated again from a panel's draw)."""
-    design = scene_results.stored_design()
-    if design is None:
-        return []
-    if _recorded["design"] is not design:
-        _recorded.update(design=design, planes=stale.recorded_planes(design), labels=setting_labels())
-    scene = context.scene
-    ws = scene.wiresculpt
-    planes, ticked = scene_results.scene_planes(scene, context.view_layer.depsgraph, _recorded["planes"][0])
-    try:
-        settings = props.solver_settings(ws)
-    except ValueError:  # the panel's values cannot be solved (smallest bend above the largest)
-        settings = None
-    return stale.changes(design, planes, ticked, scene_results.stored_inputs(),
-                         ws.target.name if ws.target is not None else "", settings, props.material_of(ws),
-                         _recorded["labels"], _recorded["planes"])
 
 
 # --- panels -------------------------------------------------------------------------------------
