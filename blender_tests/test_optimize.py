@@ -48,7 +48,7 @@ def run(operator_class, context=None):
     """(result, reports) of the operator's execute with a recording report."""
     reports = []
     fake = types.SimpleNamespace(report=lambda kind, message: reports.append((kind, message)),
-                                 _finish=lambda c, d: operator_class._finish(fake, c, d))
+                                 _finish=lambda c, d, *a, **k: operator_class._finish(fake, c, d, *a, **k))
     result = operator_class.execute(fake, context or bpy.context)
     return result, reports
 
@@ -329,6 +329,135 @@ class Failing(Case):
         self.assertIn("Not stable", shown)
 
 
+def report_text():
+    """The Stability box's labels joined (the panel wraps a long line over several labels)."""
+    return " ".join(labels(draw(results_ui.VIEW3D_PT_wiresculpt_report)))
+
+
+EARLIER = "From an earlier Optimize: "
+
+
+@unittest.skipUnless(native.available(), "the native module is not built")
+class StaleReport(Case):
+    """The Stability box says when the scene no longer matches the design it shows (core/stale.py),
+    names what changed, and shows no green "Stable" for it."""
+
+    def optimize(self):
+        globe()
+        self.assertEqual(bpy.ops.wiresculpt.optimize(), {'FINISHED'})
+        self.assertTrue(scene_results.stored_design()["stable"])
+        self.assertEqual(results_ui.report_changes(bpy.context), [])
+        shown = labels(draw(results_ui.VIEW3D_PT_wiresculpt_report))
+        self.assertIn("Stable", shown)
+        self.assertNotIn(EARLIER, report_text())
+
+    def assert_stale(self, phrase):
+        said = results_ui.report_changes(bpy.context)
+        self.assertTrue(any(s.startswith(phrase) for s in said), said)
+        text = report_text()
+        self.assertIn(EARLIER, text)
+        self.assertIn(phrase, text)
+        self.assertIn("Optimize again", text)
+        shown = labels(draw(results_ui.VIEW3D_PT_wiresculpt_report))
+        self.assertNotIn("Stable", shown)  # no green tick beside a design that no longer holds
+        self.assertIn("Was stable", shown)
+
+    def assert_current(self):
+        self.assertEqual(results_ui.report_changes(bpy.context), [])
+        self.assertIn("Stable", labels(draw(results_ui.VIEW3D_PT_wiresculpt_report)))
+
+    def test_moving_a_plane_and_back(self):
+        self.optimize()
+        handle = bpy.data.objects["Slice A"]
+        z = handle.location.z
+        handle.location.z = z + 0.01  # 1 cm along its normal
+        bpy.context.view_layer.update()
+        self.assert_stale("plane Slice A moved")
+        handle.location.z = z
+        bpy.context.view_layer.update()
+        self.assert_current()
+        handle.rotation_euler.x = 0.05
+        bpy.context.view_layer.update()
+        self.assert_stale("plane Slice A rotated")
+
+    def test_live_hint_when_live_disagrees_with_a_current_optimize(self):
+        from wiresculpt.core import live_verdict
+        from wiresculpt.ui import stale as stale_ui
+        self.optimize()  # stable
+        self.assertEqual(stale_ui.live_hint(bpy.context, live_verdict.STABLE), "")
+        disagree = live_verdict.verdict(live_verdict.NOT_STABLE, "crossing 2 slips")
+        self.assertIn("Optimize found these planes stable", stale_ui.live_hint(bpy.context, disagree))
+        self.assertEqual(stale_ui.live_hint(bpy.context, live_verdict.SOLVING), "")
+        bpy.data.objects["Slice A"].location.z += 0.01
+        bpy.context.view_layer.update()
+        self.assertEqual(stale_ui.live_hint(bpy.context, disagree), "")  # an earlier Optimize says nothing of these planes
+
+    def test_removing_a_plane(self):
+        self.optimize()
+        bpy.data.objects.remove(bpy.data.objects["Slice C"], do_unlink=True)
+        bpy.context.view_layer.update()
+        self.assert_stale("plane Slice C removed")
+
+    def test_unticking_a_contour(self):
+        self.optimize()
+        ws = bpy.context.scene.wiresculpt
+        item = next(i for i in ws.contours if i.use)
+        item.use = False
+        self.assert_stale(f"contours ticked differently ({item.plane} #{item.index} unticked)")
+        item.use = True
+        self.assert_current()
+
+    def test_changing_max_bend_and_the_target(self):
+        self.optimize()
+        ws = bpy.context.scene.wiresculpt
+        before = ws.max_bend_deg
+        ws.max_bend_deg = before - math.radians(10)
+        self.assert_stale("settings changed (Max Bend)")
+        ws.max_bend_deg = before
+        self.assert_current()
+        ws.wire_diameter = 0.002
+        self.assert_stale("settings changed (Wire Diameter)")  # not the preset's numbers scaled with it
+        ws.property_unset("wire_diameter")
+        self.assert_current()
+        ws.material_preset = "brass"
+        self.assert_stale("settings changed (Material)")
+        ws.property_unset("material_preset")
+        self.assert_current()
+        target = ws.target
+        other = target.copy()
+        other.data = target.data.copy()
+        bpy.context.scene.collection.objects.link(other)
+        ws.target = other
+        self.assert_stale("target changed")
+        ws.target = target
+        self.assert_current()
+
+    def test_a_reloaded_file_is_current(self):
+        self.optimize()
+        with tempfile.TemporaryDirectory() as folder:
+            path = os.path.join(folder, "sculpture.blend")
+            bpy.ops.wm.save_as_mainfile(filepath=path)
+            bpy.ops.wm.read_homefile(use_empty=True)
+            bpy.ops.wm.open_mainfile(filepath=path)
+            self.assertIsNotNone(scene_results.stored_inputs())
+            self.assert_current()
+            bpy.data.objects["Slice B"].location.x += 0.01
+            bpy.context.view_layer.update()
+            self.assert_stale("plane Slice B moved")
+
+    def test_a_design_without_recorded_inputs_is_compared_by_its_planes(self):
+        self.optimize()
+        scene_results.write_results(bpy.context.scene, scene_results.stored_design())  # as the batch writes it
+        self.assertIsNone(scene_results.stored_inputs())
+        ws = bpy.context.scene.wiresculpt
+        ws.max_bend_deg -= math.radians(10)
+        self.assert_current()  # the settings it was solved with are not known
+        ws.property_unset("max_bend_deg")
+        bpy.data.objects["Slice A"].location.z += 0.01
+        bpy.context.view_layer.update()
+        self.assert_stale("plane Slice A moved")
+
+
 class ReportText(unittest.TestCase):
     """The report's pure parts, on hand-made designs (future keys included)."""
 
@@ -437,7 +566,15 @@ class Panels(Case):
         self.assertFalse(design["stable"])
         self.assertTrue(design.get("search_incomplete"))
         self.assertTrue(design["reason"].startswith("search incomplete"), design["reason"])
+        # the budget is back to its default: the box says the design is from an earlier Optimize
         shown = labels(draw(results_ui.VIEW3D_PT_wiresculpt_report))
+        self.assertIn("Search was incomplete", shown)
+        self.assertIn("settings changed (Max Search Nodes)", results_ui.report_changes(bpy.context))
+        ws.max_nodes = 1  # as it was solved: current
+        try:
+            shown = labels(draw(results_ui.VIEW3D_PT_wiresculpt_report))
+        finally:
+            ws.property_unset("max_nodes")
         self.assertIn("Search incomplete", shown)
         self.assertNotIn("Not stable", shown)
 

@@ -27,6 +27,8 @@ class ModalOptimize(unittest.TestCase):
         self.assertTrue(self.seen["stable"])
         self.assertEqual(self.seen["wires"], 3)
         self.assertTrue(self.seen["shader"])
+        self.assertTrue(self.seen["inputs_recorded"])
+        self.assertEqual(self.seen["report_changes"], [])  # the Stability box: current, not "From an earlier…"
 
     def test_one_undo_removes_the_result(self):
         self.assertTrue(self.seen["undo_restores"])

@@ -19,6 +19,7 @@ import wiresculpt  # noqa: E402
 wiresculpt.register()
 from wiresculpt.blend import results as scene_results  # noqa: E402
 from wiresculpt.ui import overlay  # noqa: E402
+from wiresculpt.ui import results as results_ui  # noqa: E402
 from wiresculpt.operators import optimize  # noqa: E402
 from ui_steps import globe_scene as setup, guarded, report, start_watchdog  # noqa: E402
 from wiresculpt.stages import forces as forces_stage  # noqa: E402
@@ -145,7 +146,10 @@ def check_full():
     seen["wires"] = len([o for o in bpy.context.scene.objects if scene_results.WIRE_KEY in o])
     win = bpy.context.window_manager.windows[0]
     area = next(a for a in win.screen.areas if a.type == 'VIEW_3D')
+    # the modal path records what it solved with: the Stability box reads the result as current
+    seen["inputs_recorded"] = scene_results.stored_inputs() is not None
     with bpy.context.temp_override(window=win, area=area):
+        seen["report_changes"] = results_ui.report_changes(bpy.context)
         bpy.ops.ed.undo()  # one step takes the whole result away
     after = state()
     seen["undo_restores"] = after == seen["before_full"]

@@ -12,9 +12,15 @@ import numpy as np
 
 from ..core.design import crossing_direction, dumps
 from . import cut_handles, preview
+from . import handles as handles_module
+from .handles import handle_plane, is_handle
 from .objects import remove_object, scene_collection, tagged, write_polyline
 
 DESIGN_TEXT = "wiresculpt_design.json"  # Text datablock holding the last design
+# custom property of that Text: JSON of what Optimize solved it with besides the design's own keys
+# ({"target": name, "settings": solver settings, "material": material}; core/stale.py compares
+# it with the panel). Kept beside the design, not in it, so design.json stays as FORMATS.md says.
+INPUTS_KEY = "wiresculpt_inputs"
 WIRE_KEY = "wiresculpt_wire"  # custom property on wire curves: the wire's name
 WIRE_ID_KEY = "wiresculpt_wire_id"  # custom property on wire curves: the wire's id this run
 CROSSING_KEY = "wiresculpt_crossing"  # custom property on crossing markers: the crossing's id
@@ -53,6 +59,52 @@ def store_design(design):
     text = bpy.data.texts.get(DESIGN_TEXT) or bpy.data.texts.new(DESIGN_TEXT)
     text.from_string(dumps(design))
     return text
+
+
+def store_inputs(inputs):
+    """Records `inputs` (a JSON-able dict, or None: unknown) beside the stored design."""
+    text = bpy.data.texts.get(DESIGN_TEXT)
+    if text is None:
+        return
+    if inputs is None:
+        if INPUTS_KEY in text:
+            del text[INPUTS_KEY]
+    else:
+        text[INPUTS_KEY] = json.dumps(inputs)
+
+
+def stored_inputs():
+    """What the stored design was solved with (store_inputs), or None when not recorded."""
+    text = bpy.data.texts.get(DESIGN_TEXT)
+    string = text.get(INPUTS_KEY) if text is not None else None
+    if not isinstance(string, str):
+        return None
+    try:
+        inputs = json.loads(string)
+    except ValueError:
+        return None
+    return inputs if isinstance(inputs, dict) else None
+
+
+def scene_planes(scene, depsgraph, names):
+    """({plane name: (origin, unit normal), or None when it has no normal}, {(plane name, contour
+    index)} ticked): the scene's side of core/stale.changes. `names`: the planes to read (the
+    design's); the ticked contours' planes are read too. By name lookups, not a pass over every
+    object of the scene: a panel draws this at every redraw."""
+    # a ticked contour's plane by its name now where blend/handles.py can say it (items that follow
+    # their plane object), else by the name stored at the Slice
+    name_of = getattr(handles_module, "contour_plane_name", None) or (lambda item: item.plane)
+    ticked = {(name_of(item), item.index) for item in scene.wiresculpt.contours if item.use}
+    planes = {}
+    for name in set(names) | {p for p, _i in ticked}:
+        handle = scene.objects.get(name)
+        if handle is None or not is_handle(handle):
+            continue
+        try:
+            planes[name] = handle_plane(handle, depsgraph)[1:]
+        except ValueError:
+            planes[name] = None
+    return planes, ticked
 
 
 def stored_design():
@@ -171,10 +223,12 @@ def _marker_mesh():
     return mesh
 
 
-def write_results(scene, design):
+def write_results(scene, design, inputs=None):
     """Makes the scene show `design`: wire curves in "Wires", markers in "Crossings", the Text
-    datablock. Returns (wires written, wire objects removed)."""
+    datablock with `inputs` (store_inputs: what it was solved with; None: not known). Returns
+    (wires written, wire objects removed)."""
     store_design(design)
+    store_inputs(inputs)
     preview.clear_ghosts(scene)  # they showed the programs of the design before this one
     radius = 0.5 * design["material"]["wire_diameter"]
     existing = tagged(scene, WIRE_KEY)

@@ -57,6 +57,15 @@ def build_design(context):
     return design, material, settings
 
 
+def solve_record(scene, material, settings):
+    """What a solve reads besides the planes and ticks, as Optimize starts it: kept beside the
+    stored design (blend/results.store_inputs) so the Stability box can tell when the panel has
+    changed since (core/stale.py)."""
+    target = scene.wiresculpt.target
+    return {"target": target.name if target is not None else "", "settings": dict(settings),
+            "material": dict(material)}
+
+
 def summary(design):
     """(report type, sentence) for the finished design."""
     wires = len(design["wires"])
@@ -72,8 +81,9 @@ def run_optimize(context, progress=None, cancel=None):
     """Builds, solves and writes the design into the scene (the synchronous path). Raises
     pipeline.Cancelled (the scene untouched), ValueError or RuntimeError (untouched too)."""
     design, material, settings = build_design(context)
+    inputs = solve_record(context.scene, material, settings)
     design = pipeline.solve(design, material, settings, progress, cancel)  # a new dict after re-layering
-    scene_results.write_results(context.scene, design)
+    scene_results.write_results(context.scene, design, inputs)
     return design
 
 
@@ -91,6 +101,7 @@ class Job(WorkerJob):
         self.cancelled = False
         self.cancel_event = threading.Event()
         self.scene_name = ""  # set by the operator: the scene the results go to
+        self.inputs = None  # set by the operator: solve_record of the scene as the solve started
         self.started = time.perf_counter()
 
     def _progress(self, stage, message):
@@ -174,8 +185,8 @@ class WIRESCULPT_OT_optimize(WorkerModal, bpy.types.Operator):
     def poll(cls, context):
         return not running()
 
-    def _finish(self, context, design, scene=None):
-        scene_results.write_results(scene or context.scene, design)
+    def _finish(self, context, design, scene=None, inputs=None):
+        scene_results.write_results(scene or context.scene, design, inputs)
         kind, message = summary(design)
         self.report(kind, message)
         return {'FINISHED'}
@@ -183,6 +194,7 @@ class WIRESCULPT_OT_optimize(WorkerModal, bpy.types.Operator):
     def execute(self, context):
         try:
             design, material, settings = build_design(context)
+            inputs = solve_record(context.scene, material, settings)
             design = pipeline.solve(design, material, settings)
         except pipeline.Cancelled:
             self.report({'WARNING'}, "Optimize cancelled; the scene is unchanged")
@@ -190,7 +202,7 @@ class WIRESCULPT_OT_optimize(WorkerModal, bpy.types.Operator):
         except (ValueError, RuntimeError) as exc:
             self.report({'ERROR'}, f"Cannot optimize: {exc}")
             return {'CANCELLED'}
-        return self._finish(context, design)
+        return self._finish(context, design, inputs=inputs)
 
     def invoke(self, context, event):
         global JOB
@@ -203,6 +215,7 @@ class WIRESCULPT_OT_optimize(WorkerModal, bpy.types.Operator):
             return {'CANCELLED'}
         JOB = Job(design, material, settings)
         JOB.scene_name = context.scene.name  # the results belong to the scene that was optimized
+        JOB.inputs = solve_record(context.scene, material, settings)
         JOB.thread.start()
         self.begin_watch(context, len(pipeline.ALL_STAGES))
         self._show(context)
@@ -251,7 +264,7 @@ class WIRESCULPT_OT_optimize(WorkerModal, bpy.types.Operator):
             self.report({'WARNING'}, f"The scene '{job.scene_name}' was removed while optimizing; "
                                      "nothing was written")
             return {'CANCELLED'}
-        return self._finish(context, job.design, scene)
+        return self._finish(context, job.design, scene, job.inputs)
 
     def cancel(self, context):  # Blender closes the window or the file under the modal
         job = JOB

@@ -9,6 +9,7 @@ from ..blend.registration import classes_factory
 from ..core import live_verdict
 from ..operators import live
 from ..operators.slicing import WIRESCULPT_OT_add_plane, WIRESCULPT_OT_slice
+from .stale import live_hint
 
 CHARS_PER_PIXEL = 1 / 7.5  # rough width of a label character, for wrapping long messages
 BOX_MARGIN = 30  # pixels of a box not available to its text
@@ -101,6 +102,9 @@ def draw_live(layout, context):
     col = layout.column()
     col.alert = alert
     wrap_labels(col, context, live.line(), icon=icon)
+    hint = live_hint(context, live.STATE.verdict)
+    if hint:  # Live keeps the layering's own hooks; a current Optimize that says otherwise wins
+        wrap_labels(layout, context, hint, icon='INFO')
     if live.whole_reason():
         layout.operator(live.WIRESCULPT_OT_live_reason.bl_idname, icon='COPYDOWN')
 

@@ -8,7 +8,8 @@ import bpy
 from .. import native, props
 from ..blend import results as scene_results
 from ..blend.registration import classes_factory
-from ..core import closure
+from ..core import closure, stale
+from .stale import report_changes
 from ..operators import optimize
 from ..operators.results import WIRESCULPT_OT_assembly_guide, WIRESCULPT_OT_clear_results
 from .panel import VIEW3D_PT_wiresculpt, length_text, wrap_labels
@@ -176,13 +177,24 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
     def draw(self, context):
         layout = self.layout
         design = scene_results.stored_design()
+        said = report_changes(context)
+        if said:  # the scene moved on: the design below is an earlier one's, greyed, and no green tick
+            _wrap(layout, context, stale.stale_text(said), icon='TIME')
+            layout = layout.column()
+            layout.active = False
         box = layout.box()
         if design["stable"]:
-            box.label(text="Stable", icon='CHECKMARK')
+            if said:
+                box.label(text="Was stable", icon='BLANK1')
+            else:
+                box.label(text="Stable", icon='CHECKMARK')
         else:
-            box.alert = True
+            box.alert = not said
             # max_nodes stopped the layering: a stable design may exist (the reason says how to go on)
-            box.label(text="Search incomplete" if design.get("search_incomplete") else "Not stable", icon='ERROR')
+            if design.get("search_incomplete"):
+                box.label(text="Search was incomplete" if said else "Search incomplete", icon='ERROR')
+            else:
+                box.label(text="Was not stable" if said else "Not stable", icon='ERROR')
             _wrap(box, context, design.get("reason") or "no reason given")
         rows = assembly_rows(design)
         if rows:

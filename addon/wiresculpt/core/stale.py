@@ -1,0 +1,158 @@
+"""Does the stored design still match the scene? What changed since the Optimize that made it, in
+words a maker acts on ("plane Slice B moved", "contours ticked differently"), for the Stability
+box (ui/results.py). bpy-free: the add-on gathers the scene's planes, ticks and settings, this
+module compares them with what the design recorded.
+
+What is compared:
+- the planes: each wire's `plane` (origin, normal) in the design, by its plane's name (a wire's
+  name is "<plane name>/<contour index>"), against the handle of that name now. A plane counts as
+  the same when its unit normal is within NORMAL_TOLERANCE (each component) and the new origin
+  lies within ORIGIN_TOLERANCE of the recorded plane: sliding or spinning a handle within its own
+  plane cuts the same contours, so it does not make the design stale.
+- the ticked contours: the (plane, index) pairs of the design's wires against the ticked ones.
+- the inputs Optimize recorded besides the design (`inputs`, see blend/results.py
+  store_inputs): the target's name, the solver settings and the material it was solved with,
+  against the panel's values now. A design without that record (the batch's, the plane
+  assistant's, an older add-on's) is compared by its planes and ticks only.
+
+The tolerances are far below any edit a maker makes (a nudge is 0.1 mm at least) and far above
+the float round trips of a handle's matrix and of the design's JSON.
+"""
+import math
+
+ORIGIN_TOLERANCE = 1e-6  # m: the distance of the new origin from the recorded plane
+NORMAL_TOLERANCE = 1e-6  # per component of the unit normals
+VALUE_TOLERANCE = 1e-9  # relative, for a setting's or the material's number
+# a material's numbers that change with its wire diameter (a preset scaled to it, props.material_of):
+# not named beside it, the maker changed the diameter
+SCALED = ("bending_stiffness", "max_torque")
+MAX_NAMED = 3  # contours named after "contours ticked differently"
+
+PREFIX = "From an earlier Optimize: "
+SUFFIX = "; Optimize again"
+
+
+def wire_contour(name):
+    """(plane name, contour index) of a wire named "<plane name>/<index>", or None."""
+    plane, sep, index = str(name).rpartition("/")
+    if not sep:
+        return None
+    try:
+        return plane, int(index)
+    except ValueError:
+        return None
+
+
+def recorded_planes(design):
+    """({plane name: (origin, normal)}, {(plane name, contour index)}) of the design's wires."""
+    planes, ticks = {}, set()
+    for wire in design.get("wires") or []:
+        key = wire_contour(wire.get("name", ""))
+        plane = wire.get("plane")
+        if key is None or not isinstance(plane, dict):
+            continue
+        ticks.add(key)
+        planes.setdefault(key[0], (tuple(plane["origin"]), tuple(plane["normal"])))
+    return planes, ticks
+
+
+def _unit(v):
+    length = math.sqrt(sum(float(x) * float(x) for x in v))
+    return tuple(float(x) / length for x in v) if length > 0 else tuple(float(x) for x in v)
+
+
+def plane_change(recorded, now):
+    """"rotated" (the normal turned), "moved" (the plane moved along its normal) or None (the same
+    plane) between two (origin, normal) pairs; `now` None: the handle has no normal ("rotated")."""
+    if now is None:
+        return "rotated"
+    (o0, n0), (o1, n1) = recorded, now
+    n0, n1 = _unit(n0), _unit(n1)
+    if any(abs(a - b) > NORMAL_TOLERANCE for a, b in zip(n0, n1)):
+        return "rotated"
+    offset = sum((float(b) - float(a)) * n for a, b, n in zip(o0, o1, n0))
+    return "moved" if abs(offset) > ORIGIN_TOLERANCE else None
+
+
+def _same_value(a, b):
+    if isinstance(a, bool) or isinstance(b, bool) or not isinstance(a, (int, float)) \
+            or not isinstance(b, (int, float)):
+        return a == b
+    return abs(float(a) - float(b)) <= VALUE_TOLERANCE * max(abs(float(a)), abs(float(b)), 1e-12)
+
+
+def changed_keys(recorded, now):
+    """The keys whose values differ between two flat dicts (a key in one only differs), in the
+    recorded dict's order, then the new ones."""
+    keys = list(recorded) + [k for k in now if k not in recorded]
+    return [k for k in keys if k not in recorded or k not in now or not _same_value(recorded[k], now[k])]
+
+
+def changes(design, planes, ticked, inputs=None, target=None, settings=None, material=None, labels=None,
+            recorded=None):
+    """What changed since `design` was optimized, as short phrases ("plane Slice B moved", "plane
+    Slice C removed", "plane Slice D added", "contours ticked differently (Slice A #1 unticked)",
+    "target changed", "settings changed (Max Bend)"); [] while it is current.
+
+    planes: {handle name: (origin, normal) or None (no normal)} of the slicing handles now: at
+    least those named by the design's wires and by the ticks (a name missing is a plane gone).
+    ticked: {(plane name, contour index)} ticked now (a plane name may be one that is gone), or
+    None when they cannot be read.
+    inputs: what Optimize recorded ({"target", "settings", "material"}), or None: then target,
+    settings and material are not compared. target: the target's name now ("" for none);
+    settings / material: the dicts props.solver_settings / material_of give now (settings None:
+    the panel's values are not valid, e.g. the smallest bend above the largest).
+    labels: {setting or material key: the name the panel shows} for the phrase.
+    recorded: recorded_planes(design) when the caller keeps it (a panel redraws often)."""
+    said = []
+    before, ticks_before = recorded or recorded_planes(design)
+    removed, added = set(), set()
+    for name, plane in before.items():
+        if name not in planes:
+            removed.add(name)
+            said.append(f"plane {name} removed")
+            continue
+        how = plane_change(plane, planes[name])
+        if how:
+            said.append(f"plane {name} {how}")
+    if ticked is not None:
+        for name in sorted({p for p, _i in ticked} - set(before)):
+            if name in planes:  # a tick whose plane is gone is not a plane added (the ticks differ)
+                added.add(name)
+                said.append(f"plane {name} added")
+        old = {t for t in ticks_before if t[0] not in removed}
+        new = {t for t in ticked if t[0] not in added and t[0] not in removed}
+        if old != new:
+            named = [f"{p} #{i} unticked" for p, i in sorted(old - new)] + [f"{p} #{i} ticked" for p, i in sorted(new - old)]
+            more = f", {len(named) - MAX_NAMED} more" if len(named) > MAX_NAMED else ""
+            said.append(f"contours ticked differently ({', '.join(named[:MAX_NAMED])}{more})")
+    elif not said:  # the ticks cannot be read and no plane explains it
+        said.append("contours ticked differently")
+    if inputs:
+        if target is not None and inputs.get("target") is not None and str(inputs["target"]) != str(target):
+            said.append("target changed")
+        keys = []
+        if settings is None:
+            keys.append(None)
+        elif isinstance(inputs.get("settings"), dict):
+            keys += changed_keys(inputs["settings"], settings)
+        if material is not None and isinstance(inputs.get("material"), dict):
+            changed = changed_keys(inputs["material"], material)
+            if "name" in changed:  # another material: its numbers are its own, the name says it
+                changed = [k for k in changed if k in ("name", "wire_diameter")]
+            elif "wire_diameter" in changed:  # a preset's numbers follow the diameter
+                changed = [k for k in changed if k not in SCALED]
+            keys += changed
+        if keys:
+            words = []
+            for key in keys:
+                word = (labels or {}).get(key, key) if key is not None else None
+                if word and word not in words:
+                    words.append(word)
+            said.append("settings changed" + (f" ({', '.join(words)})" if words else ""))
+    return said
+
+
+def stale_text(said):
+    """The Stability box's first line for the phrases of changes(), or "" while current."""
+    return f"{PREFIX}{', '.join(said)}{SUFFIX}" if said else ""

@@ -1,0 +1,124 @@
+"""Whether a stored design still matches the scene (core/stale.py), on hand-made designs: planes
+moved, rotated, removed and added, ticks, the recorded target, settings and material, and the
+float round trips that must not count as a change."""
+import json
+import math
+import unittest
+
+from wiresculpt.core import stale
+
+
+def design():
+    return {"wires": [
+        {"id": 0, "name": "Slice A/0", "plane": {"origin": [0.0, 0.0, 0.01], "normal": [0.0, 0.0, 1.0]}},
+        {"id": 1, "name": "Slice B/0", "plane": {"origin": [0.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]}},
+        {"id": 2, "name": "Slice B/1", "plane": {"origin": [0.0, 0.0, 0.0], "normal": [1.0, 0.0, 0.0]}},
+        {"id": 3, "name": "Slice C/0", "plane": {"origin": [0.0, 0.0, 0.0], "normal": [0.0, 1.0, 0.0]}},
+    ]}
+
+
+def planes():
+    return {"Slice A": ((0.0, 0.0, 0.01), (0.0, 0.0, 1.0)), "Slice B": ((0.0, 0.0, 0.0), (1.0, 0.0, 0.0)),
+            "Slice C": ((0.0, 0.0, 0.0), (0.0, 1.0, 0.0))}
+
+
+TICKED = {("Slice A", 0), ("Slice B", 0), ("Slice B", 1), ("Slice C", 0)}
+SETTINGS = {"min_segment": 0.015, "max_bend_deg": 120.0, "torque_fraction": None, "in_plane_tiebreak": False,
+            "max_nodes": 200000}
+MATERIAL = {"name": "steel", "wire_diameter": 0.003, "bending_stiffness": 0.73}
+INPUTS = {"target": "Globe", "settings": SETTINGS, "material": MATERIAL}
+LABELS = {"max_bend_deg": "Max Bend", "wire_diameter": "Wire Diameter", "name": "Material"}
+
+
+def changes(p=None, ticked=TICKED, inputs=INPUTS, target="Globe", settings=SETTINGS, material=MATERIAL, d=None):
+    return stale.changes(d or design(), planes() if p is None else p, ticked, inputs, target, settings, material,
+                         LABELS)
+
+
+class StaleTest(unittest.TestCase):
+    def test_unchanged_scene_is_current(self):
+        self.assertEqual(changes(), [])
+        self.assertEqual(stale.stale_text([]), "")
+
+    def test_json_and_float32_round_trips_are_not_changes(self):
+        # the design as read back from its JSON; the handles' normals from a float32 matrix
+        d = json.loads(json.dumps(design()))
+        p = planes()
+        c = math.cos(1e-7)
+        p["Slice B"] = ((3e-8, 0.0, -2e-8), (c, math.sin(1e-7), 0.0))
+        self.assertEqual(changes(p, d=d), [])
+        self.assertEqual(changes(inputs=json.loads(json.dumps(INPUTS))), [])
+
+    def test_moved_rotated_removed_and_added_planes_are_named(self):
+        p = planes()
+        p["Slice B"] = ((0.01, 0.0, 0.0), (1.0, 0.0, 0.0))  # 1 cm along its normal
+        self.assertEqual(changes(p), ["plane Slice B moved"])
+        self.assertEqual(stale.stale_text(changes(p)),
+                         "From an earlier Optimize: plane Slice B moved; Optimize again")
+        p = planes()
+        p["Slice A"] = ((0.0, 0.0, 0.01), (0.0, math.sin(0.01), math.cos(0.01)))
+        self.assertEqual(changes(p), ["plane Slice A rotated"])
+        p = planes()
+        del p["Slice C"]
+        ticked = {t for t in TICKED if t[0] != "Slice C"}
+        self.assertEqual(changes(p, ticked), ["plane Slice C removed"])
+        self.assertEqual(changes(p, None), ["plane Slice C removed"])  # ticks unreadable: the plane says it
+        self.assertEqual(changes(p, TICKED), ["plane Slice C removed"])  # its contour still ticked
+        p = planes()
+        p["Slice D"] = ((0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+        self.assertEqual(changes(p), [])  # a new plane none of whose contours is ticked changes nothing
+        self.assertEqual(changes(p, TICKED | {("Slice D", 0)}), ["plane Slice D added"])
+        p = planes()
+        p["Slice A"] = None  # flattened: no normal
+        self.assertEqual(changes(p), ["plane Slice A rotated"])
+
+    def test_sliding_or_spinning_within_its_plane_is_the_same_plane(self):
+        p = planes()
+        p["Slice A"] = ((0.05, -0.02, 0.01), (0.0, 0.0, 1.0))
+        self.assertEqual(changes(p), [])
+
+    def test_ticks(self):
+        self.assertEqual(changes(ticked=TICKED - {("Slice B", 1)}),
+                         ["contours ticked differently (Slice B #1 unticked)"])
+        self.assertEqual(changes(ticked=TICKED | {("Slice C", 1)}),
+                         ["contours ticked differently (Slice C #1 ticked)"])
+        self.assertEqual(changes(ticked=set()),
+                         ["contours ticked differently (Slice A #0 unticked, Slice B #0 unticked, "
+                          "Slice B #1 unticked, 1 more)"])
+        self.assertEqual(changes(ticked=None), ["contours ticked differently"])
+        # a ticked contour of a plane that is gone and was never in the design
+        self.assertEqual(changes(ticked=TICKED | {("Slice Z", 0)}), ["contours ticked differently (Slice Z #0 ticked)"])
+
+    def test_target_settings_and_material(self):
+        self.assertEqual(changes(target="Duck"), ["target changed"])
+        self.assertEqual(changes(settings=dict(SETTINGS, max_bend_deg=90.0)), ["settings changed (Max Bend)"])
+        self.assertEqual(changes(settings=dict(SETTINGS, torque_fraction=0.5)), ["settings changed (torque_fraction)"])
+        self.assertEqual(changes(settings=None), ["settings changed"])
+        self.assertEqual(changes(material=dict(MATERIAL, wire_diameter=0.002, name="brass", bending_stiffness=0.2)),
+                         ["settings changed (Material, Wire Diameter)"])  # another material's numbers are its own
+        # a preset scaled to another diameter: the diameter, not the numbers that follow it
+        self.assertEqual(changes(material=dict(MATERIAL, wire_diameter=0.002, bending_stiffness=0.14)),
+                         ["settings changed (Wire Diameter)"])
+        self.assertEqual(changes(material=dict(MATERIAL, bending_stiffness=0.5)),
+                         ["settings changed (bending_stiffness)"])
+        self.assertEqual(changes(settings=dict(SETTINGS, in_plane_tiebreak=True)),
+                         ["settings changed (in_plane_tiebreak)"])
+        # a design without recorded inputs is compared by its planes and ticks only
+        self.assertEqual(changes(inputs=None, target="Duck", settings=None), [])
+
+    def test_several_changes_in_one_line(self):
+        p = planes()
+        p["Slice B"] = ((0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+        said = changes(p, target="Duck", settings=dict(SETTINGS, max_bend_deg=90.0))
+        self.assertEqual(stale.stale_text(said), "From an earlier Optimize: plane Slice B rotated, target changed, "
+                                                 "settings changed (Max Bend); Optimize again")
+
+    def test_wire_names(self):
+        self.assertEqual(stale.wire_contour("Slice A/3"), ("Slice A", 3))
+        self.assertEqual(stale.wire_contour("a/b/12"), ("a/b", 12))
+        self.assertIsNone(stale.wire_contour("no index"))
+        self.assertIsNone(stale.wire_contour("Slice A/x"))
+
+
+if __name__ == "__main__":
+    unittest.main()
