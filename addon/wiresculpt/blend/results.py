@@ -12,8 +12,7 @@ import numpy as np
 
 from ..core.design import crossing_direction, dumps
 from . import cut_handles, preview
-from . import handles as handles_module
-from .handles import handle_plane, is_handle
+from .handles import contour_plane_name, handle_plane, is_handle
 from .objects import remove_object, scene_collection, tagged, write_polyline
 
 DESIGN_TEXT = "wiresculpt_design.json"  # Text datablock holding the last design
@@ -91,10 +90,8 @@ def scene_planes(scene, depsgraph, names):
     index)} ticked): the scene's side of core/stale.changes. `names`: the planes to read (the
     design's); the ticked contours' planes are read too. By name lookups, not a pass over every
     object of the scene: a panel draws this at every redraw."""
-    # a ticked contour's plane by its name now where blend/handles.py can say it (items that follow
-    # their plane object), else by the name stored at the Slice
-    name_of = getattr(handles_module, "contour_plane_name", None) or (lambda item: item.plane)
-    ticked = {(name_of(item), item.index) for item in scene.wiresculpt.contours if item.use}
+    # a ticked contour's plane by its current name (items follow their plane object)
+    ticked = {(contour_plane_name(item), item.index) for item in scene.wiresculpt.contours if item.use}
     planes = {}
     for name in set(names) | {p for p, _i in ticked}:
         handle = scene.objects.get(name)
