@@ -4,9 +4,12 @@ bpy-free (blender_tests/run.py pure). The check against a real design slices and
 case (three great circles of a UV sphere) through the pipeline when the native module is built,
 and is skipped otherwise.
 """
+import math
 import os
 import re
 import unittest
+
+import numpy as np
 
 from wiresculpt import native, pipeline
 from wiresculpt.core import design as vocabulary
@@ -116,6 +119,18 @@ class RealDesign(unittest.TestCase):
             self.assertAlmostEqual(float(d @ d), 1.0, places=12)
             for w in c["wires"]:
                 self.assertAlmostEqual(float(d @ self.design["wires"][w]["plane"]["normal"]), 0.0, places=12)
+
+    def test_crossing_axis_is_numpys_cross_normalised_to_the_bit(self):
+        """Written out without numpy, the target shape's bisectors are the same floats as
+        np.cross / np.linalg.norm gave (every solve depends on them to the last bit)."""
+        rng = np.random.default_rng(7)
+        for _ in range(500):
+            a, b = rng.normal(size=3), rng.normal(size=3) * rng.choice([1e-3, 1.0, 1e3])
+            design = {"wires": [{"plane": {"normal": list(a)}}, {"plane": {"normal": list(b)}}]}
+            d = np.cross(a, b)
+            self.assertEqual(vocabulary.crossing_axis(design, {"wires": [0, 1]}), tuple(d / np.linalg.norm(d)))
+        parallel = {"wires": [{"plane": {"normal": [0, 0, 1]}}, {"plane": {"normal": [0, 0, 2]}}]}
+        self.assertTrue(all(math.isnan(x) for x in vocabulary.crossing_axis(parallel, {"wires": [0, 1]})))
 
     def test_model_size(self):
         self.assertAlmostEqual(vocabulary.model_size(self.design), 0.25, places=3)

@@ -11,6 +11,7 @@ Only stages that ran put values in it: a key a stage owns is absent until that s
 `pending_stages` names the stages that did not run.
 """
 import json
+import math
 import re
 
 import numpy as np
@@ -84,11 +85,19 @@ def written_by(stage):
 def crossing_direction(design, crossing):
     """d = normalize(n0 x n1), n0 and n1 the plane normals of the crossing's wires as written in
     the design (FORMATS.md `hook`: hook 1 opens the kink of wires[0] towards +d)."""
+    return np.array(crossing_axis(design, crossing))
+
+
+def crossing_axis(design, crossing):
+    """crossing_direction as a tuple of three floats. The cross product and its length written out:
+    numpy's np.cross and np.linalg.norm cost ~20x more on one pair of 3-vectors (the target-shape
+    stage asks at every crossing), with the same products and sums in the same order."""
     (a0, a1, a2), (b0, b1, b2) = (map(float, design["wires"][w]["plane"]["normal"]) for w in crossing["wires"])
-    # The cross product written out: numpy's np.cross costs ~20x more on one pair of 3-vectors
-    # (the target-shape stage asks for it at every crossing), with the same arithmetic.
-    d = np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
-    return d / np.linalg.norm(d)
+    x, y, z = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+    length = math.sqrt(x * x + y * y + z * z)
+    if length == 0.0:  # parallel planes: no common line (numpy's 0/0)
+        return (math.nan, math.nan, math.nan)
+    return (x / length, y / length, z / length)
 
 
 def model_size(design, contours=None):

@@ -16,7 +16,7 @@ import time
 import numpy as np
 
 from .. import native
-from ..core.design import crossing_direction, model_size
+from ..core.design import crossing_axis, model_size
 from ..core.frames import plane_frame, to_2d, to_3d
 from ..core.polylines import ContourArrays, polyline_length
 from . import layering
@@ -71,8 +71,22 @@ ALGORITHM = "sqp"
 def desired_bisector(design, crossing, k):
     """The 3D direction wire k (0 or 1) of `crossing` must open towards: hook * d for wires[0],
     -hook * d for wires[1] (d itself for a null crossing, which is not constrained)."""
-    sign = crossing["hook"] if k == 0 else -crossing["hook"]
-    return (sign or 1) * crossing_direction(design, crossing)
+    return np.array(_bisector(design, crossing, k))
+
+
+def _bisector(design, crossing, k):
+    """desired_bisector as a tuple of floats (the same products)."""
+    sign = (crossing["hook"] if k == 0 else -crossing["hook"]) or 1
+    return tuple(sign * x for x in crossing_axis(design, crossing))
+
+
+def bisector_in_frame(design, crossing, k, u, v):
+    """desired_bisector in the plane frame (u, v), as two floats: its dot products with u and v,
+    written out (numpy's per-call cost is most of a 3-vector's dot product; the same sums)."""
+    h = _bisector(design, crossing, k)
+    u0, u1, u2 = map(float, u)
+    v0, v1, v2 = map(float, v)
+    return (h[0] * u0 + h[1] * u1 + h[2] * u2, h[0] * v0 + h[1] * v1 + h[2] * v2)
 
 
 def solve_wire(design, wire, material, settings, size, native_progress=None, memo=None):
@@ -107,11 +121,7 @@ def prepare_wire(design, wire, settings, size, memo=None, sides=None):
     if sides is None:
         sides = sides_by_wire(design)
     for c, k in sides.get(wire["id"], ()):
-        if memo is not None:
-            bisector = memo.bisector_2d(design, c, k)
-        else:
-            h = desired_bisector(design, c, k)
-            bisector = (float(h @ u), float(h @ v))
+        bisector = memo.bisector_2d(design, c, k) if memo is not None else bisector_in_frame(design, c, k, u, v)
         specs.append({"vertex": c["contour_vertices"][k], "bisector": bisector,
                       "contact_angle": contact, "active": c["hook"] != 0})
         refs.append((c, k))
@@ -235,9 +245,8 @@ class Memo:
                crossing["hook"])
         found = self._bisectors.get(key)
         if found is None:
-            h = desired_bisector(design, crossing, k)
             u, v, _contour = self.frame(design["wires"][crossing["wires"][k]])
-            found = self._bisectors[key] = (float(h @ u), float(h @ v))
+            found = self._bisectors[key] = bisector_in_frame(design, crossing, k, u, v)
         return found
 
     def model_size(self, design):
