@@ -86,5 +86,45 @@ class Kinds(unittest.TestCase):
         self.assertNotIn("not stable", lv.verdict(lv.CANNOT_SOLVE, "the solver is not loaded"))
 
 
+class SetupProblems(unittest.TestCase):
+    """Fewer than two wires: the pipeline stops with stable false and a reason that says what to set
+    up. Live calls that "cannot solve", as its other setup problems, not a verdict on a design."""
+
+    def solved(self, wires):
+        from wiresculpt import pipeline
+        from wiresculpt.core.materials import PRESETS
+        from wiresculpt.core.settings import defaults
+
+        from helpers import PLANES, sphere
+
+        V, F = sphere()
+        design = pipeline.slice_and_pick(V, F, PLANES[:wires], PRESETS["steel"], defaults())
+        self.assertEqual(len(design["wires"]), wires)  # a great circle per plane
+        return pipeline.solve(design, PRESETS["steel"], defaults())
+
+    def test_one_wire_cannot_solve(self):
+        design = self.solved(1)
+        # design.json as before: not stable, the pipeline's own sentence
+        self.assertIs(design["stable"], False)
+        self.assertEqual(design["reason"], "a sculpture needs at least two wires: add a plane or pick more contours")
+        kind, text = lv.of_design(design)
+        self.assertEqual(lv.verdict(kind, text),
+                         "cannot solve — a sculpture needs at least two wires: add a plane or pick more contours")
+
+    def test_no_wire_cannot_solve(self):
+        design = self.solved(0)
+        self.assertEqual(design["reason"], "no plane cuts the mesh: move the planes through the mesh")
+        self.assertEqual(lv.verdict(*lv.of_design(design)),
+                         "cannot solve — no plane cuts the mesh: move the planes through the mesh")
+
+    def test_a_design_found_not_stable_is_not_stable(self):
+        reason = "wire 'B/0' crosses no other wire, so nothing can hold it"
+        self.assertEqual(lv.of_design({"stable": False, "reason": reason, "wires": [{}, {}]}), (lv.NOT_STABLE, reason))
+        # the setup sentence inside a longer reason is some other verdict's words
+        longer = "a sculpture needs at least two wires: add a plane or pick more contours; and more"
+        self.assertEqual(lv.of_design({"stable": False, "reason": longer})[0], lv.NOT_STABLE)
+        self.assertEqual(lv.of_design({"stable": True, "reason": ""}), (lv.STABLE, ""))
+
+
 if __name__ == "__main__":
     unittest.main()
