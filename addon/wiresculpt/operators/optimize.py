@@ -23,7 +23,9 @@ from ..blend import results as scene_results
 from ..blend.handles import target_problem, ticked_planes
 from ..blend.view import redraw_3d_views
 from ..blend.registration import classes_factory
+from ..core.design import setup_problem
 from ..core.jobs import WorkerJob
+from ..core.live_verdict import CANNOT_SOLVE
 from ..props import material_of, solver_settings
 from .progress import TIMER_SECONDS, WorkerModal
 
@@ -67,13 +69,16 @@ def solve_record(scene, material, settings):
 
 
 def summary(design):
-    """(report type, sentence) for the finished design."""
+    """(report type, sentence) for the finished design: a setup problem (core/design.setup_problem:
+    fewer than two wires) says it cannot be solved, as Live does, rather than "Not stable"."""
     wires = len(design["wires"])
     crossings = len(design.get("crossings", []))
     if design["stable"]:
         names = [design["wires"][w]["name"] for w in design.get("assembly_order", [])]
         return {'INFO'}, (f"Stable: {wires} wires, {crossings} crossings; assemble "
                           f"{', '.join(names)}")
+    if setup_problem(design):
+        return {'WARNING'}, f"{CANNOT_SOLVE.capitalize()}: {design['reason']}"
     return {'WARNING'}, f"Not stable: {design['reason']}"
 
 
