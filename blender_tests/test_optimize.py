@@ -457,6 +457,27 @@ class StaleReport(Case):
         ws.target = target
         self.assert_current()
 
+    def test_the_target_s_name_is_read_one_way(self):
+        """blend/handles.target_name: the record Optimize keeps, Live's snapshot and the stale check
+        read the picked target's name, "" without one, alike."""
+        from wiresculpt.blend.handles import target_name
+        from wiresculpt.operators import live
+
+        self.optimize()
+        scene = bpy.context.scene
+        ws = scene.wiresculpt
+        target = ws.target
+        self.assertEqual(target_name(ws), target.name)
+        self.assertEqual(scene_results.stored_inputs()["target"], target.name)
+        self.assertEqual(live.snapshot(scene)[0], target.name)
+        ws.target = None
+        self.assertEqual(target_name(ws), "")
+        self.assertEqual(optimize.solve_record(scene, {}, {})["target"], "")
+        self.assertEqual(live.snapshot(scene)[0], "")
+        self.assertIn("target changed", results_ui.report_changes(bpy.context))
+        ws.target = target
+        self.assert_current()
+
     def test_a_reloaded_file_is_current(self):
         self.optimize()
         with tempfile.TemporaryDirectory() as folder:

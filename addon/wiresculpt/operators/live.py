@@ -42,7 +42,7 @@ import numpy as np
 from .. import native, pipeline
 from ..blend import cut_handles, mesh
 from ..blend import results as scene_results
-from ..blend.handles import contour_plane_name, handles, target_problem, ticked_planes
+from ..blend.handles import contour_plane_name, handles, target_name, target_problem, ticked_planes
 from ..blend.registration import classes_factory
 from ..blend.view import redraw_3d_views
 from ..core.jobs import WorkerJob
@@ -117,7 +117,7 @@ def too_large(name, triangles):
 
 def refuse(settings, message):
     """Turns Live off with `message` for the panel (shown while the same target is picked)."""
-    STATE.message, STATE.message_target = message, settings.target.name if settings.target else ""
+    STATE.message, STATE.message_target = message, target_name(settings)
     settings.live = False  # its update stops the timer
 
 
@@ -138,7 +138,7 @@ def snapshot(scene):
     last)."""
     ws = scene.wiresculpt
     target = ws.target
-    return (target.name if target else "", _rounded(target.matrix_world) if target else (),
+    return (target_name(ws), _rounded(target.matrix_world) if target else (),
             tuple((h.name, _rounded(h.matrix_world)) for h in handles(scene)),
             tuple((contour_plane_name(item), item.index) for item in ws.contours if item.use),
             solve_inputs(ws), target is not None and scene.objects.get(target.name) == target,

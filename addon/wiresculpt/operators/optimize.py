@@ -20,7 +20,7 @@ import bpy
 from .. import native, pipeline
 from ..blend import cut_handles, mesh
 from ..blend import results as scene_results
-from ..blend.handles import target_problem, ticked_planes
+from ..blend.handles import target_name, target_problem, ticked_planes
 from ..blend.view import redraw_3d_views
 from ..blend.registration import classes_factory
 from ..core.design import setup_problem
@@ -63,9 +63,7 @@ def solve_record(scene, material, settings):
     """What a solve reads besides the planes and ticks, as Optimize starts it: kept beside the
     stored design (blend/results.store_inputs) so the Stability box can tell when the panel has
     changed since (core/stale.py)."""
-    target = scene.wiresculpt.target
-    return {"target": target.name if target is not None else "", "settings": dict(settings),
-            "material": dict(material)}
+    return {"target": target_name(scene.wiresculpt), "settings": dict(settings), "material": dict(material)}
 
 
 def summary(design):
