@@ -374,6 +374,10 @@ class LiveFollowsTheScene(BlenderCase):
         verdict = self.settle()
         reason = live.STATE.reason
         first = reason[:reason.index(";")]
+        # each crossing named once ("crossing 0 on wire Slice A/0: it needs …", not "…: crossing 0 on wire
+        # Slice A/0 needs …")
+        self.assertRegex(first, r"^the target shape cannot realise crossing \d+ on wire Slice [A-C]/0: it needs a bend")
+        self.assertEqual(first.count(" on wire "), 1, first)
         self.assertGreater(len(first.split()), 30)
         self.assertTrue(first.endswith("but the machine bends at most 30°"), first)
         self.assertEqual(verdict, "not stable — " + first + "…")

@@ -5,14 +5,16 @@ import unittest
 
 from wiresculpt.core import live_verdict as lv
 
-# A Live solve of the bundled globe with Max Bend 30° (hook_patterns=1), its reason as the solver
-# wrote it (226 words; only its first two clauses here, the others repeat them for crossings 2-5).
+# A Live solve of the bundled globe with Max Bend 30° (hook_patterns=1), its reason as the pipeline
+# writes it (only its first two clauses here, the others repeat them for crossings 2-5; before
+# stages/target_shape.crossing_words each crossing was named twice, "…Equator/0: crossing 0 on wire
+# Equator/0 needs…").
 GLOBE_BEND_30 = (
-    "the target shape cannot realise crossing 0 on wire Equator/0: crossing 0 on wire Equator/0 needs a "
-    "bend of at least 60° (contact angle 120° minus twice the friction angle) but the machine bends at "
-    "most 30°; crossing 1 on wire Equator/0: crossing 1 on wire Equator/0 needs a bend of at least 60° "
-    "(contact angle 120° minus twice the friction angle) but the machine bends at most 30°; without them "
-    "the assembly is no longer stable when adding Meridian0/0")
+    "the target shape cannot realise crossing 0 on wire Equator/0: it needs a bend of at least 60° "
+    "(contact angle 120° minus twice the friction angle) but the machine bends at most 30°; crossing 1 "
+    "on wire Equator/0: it needs a bend of at least 60° (contact angle 120° minus twice the friction "
+    "angle) but the machine bends at most 30°; without them the assembly is no longer stable when adding "
+    "Equator/0 and Meridian0/0")
 # Hand-written in the solver's form of a too-close clause: its ";" inside brackets is not the end.
 TOO_CLOSE = (
     "the target shape cannot realise crossings 2, 3 and 4, too close to their neighbours along the wires "
