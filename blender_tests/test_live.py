@@ -293,6 +293,23 @@ class LiveFollowsTheScene(BlenderCase):
         self.ws.target = target
         self.assertEqual(self.settle(), "stable")
 
+    def test_one_wire_cannot_solve(self):
+        """One contour ticked: the solve ends with the pipeline's "at least two wires", a setup problem
+        drawn as the others (info icon, not red), not "not stable"."""
+        from wiresculpt.operators import live
+        from wiresculpt.ui import panel
+
+        self.ws.live = True
+        self.assertEqual(self.settle(), "stable")
+        for item in list(self.ws.contours)[1:]:
+            item.use = False
+        self.assertEqual(self.settle(), "cannot solve — a sculpture needs at least two wires: add a plane or pick "
+                                        "more contours")
+        self.assertEqual(panel.live_look(live.STATE.verdict), ('INFO', False))
+        for item in self.ws.contours:
+            item.use = True
+        self.assertEqual(self.settle(), "stable")
+
     def test_a_plane_moved_off_the_mesh_cannot_solve(self):
         """Its ticked contour is gone (the solve's ValueError): what the window test's second step sees."""
         import bpy
@@ -357,6 +374,10 @@ class LiveFollowsTheScene(BlenderCase):
         verdict = self.settle()
         reason = live.STATE.reason
         first = reason[:reason.index(";")]
+        # each crossing named once ("crossing 0 on wire Slice A/0: it needs …", not "…: crossing 0 on wire
+        # Slice A/0 needs …")
+        self.assertRegex(first, r"^the target shape cannot realise crossing \d+ on wire Slice [A-C]/0: it needs a bend")
+        self.assertEqual(first.count(" on wire "), 1, first)
         self.assertGreater(len(first.split()), 30)
         self.assertTrue(first.endswith("but the machine bends at most 30°"), first)
         self.assertEqual(verdict, "not stable — " + first + "…")

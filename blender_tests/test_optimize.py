@@ -328,6 +328,31 @@ class Failing(Case):
         shown = labels(draw(results_ui.VIEW3D_PT_wiresculpt_report))
         self.assertIn("Not stable", shown)
 
+    def test_one_wire_is_a_setup_problem_not_a_verdict(self):
+        """One contour ticked: the pipeline's "at least two wires" (design.json as ever: stable false,
+        its sentence), which the report and the Stability box say cannot be solved, as Live does."""
+        from unittest import mock
+
+        globe()
+        for item in list(bpy.context.scene.wiresculpt.contours)[1:]:
+            item.use = False
+        result, reports = run(optimize.WIRESCULPT_OT_optimize)
+        design = scene_results.stored_design()
+        self.assertEqual(result, {'FINISHED'})
+        self.assertIs(design["stable"], False)
+        self.assertEqual(design["reason"], "a sculpture needs at least two wires: add a plane or pick more contours")
+        self.assertEqual(reports[-1], ({'WARNING'}, "Cannot solve: a sculpture needs at least two wires: add a plane "
+                                                    "or pick more contours"))
+        log = draw(results_ui.VIEW3D_PT_wiresculpt_report)
+        shown = labels(log)
+        self.assertIn("Cannot solve", shown)
+        self.assertNotIn("Not stable", shown)
+        icons = {kw.get("text"): kw.get("icon") for name, _a, kw in log if name == "label"}
+        self.assertEqual(icons["Cannot solve"], 'INFO')
+        layout = mock.MagicMock()  # the box is not drawn red (a verdict that failed is)
+        results_ui.VIEW3D_PT_wiresculpt_report.draw(types.SimpleNamespace(layout=layout), bpy.context)
+        self.assertIsNot(layout.box.return_value.alert, True)
+
 
 def report_text():
     """The Stability box's labels joined (the panel wraps a long line over several labels)."""
@@ -429,6 +454,27 @@ class StaleReport(Case):
         bpy.context.scene.collection.objects.link(other)
         ws.target = other
         self.assert_stale("target changed")
+        ws.target = target
+        self.assert_current()
+
+    def test_the_target_s_name_is_read_one_way(self):
+        """blend/handles.target_name: the record Optimize keeps, Live's snapshot and the stale check
+        read the picked target's name, "" without one, alike."""
+        from wiresculpt.blend.handles import target_name
+        from wiresculpt.operators import live
+
+        self.optimize()
+        scene = bpy.context.scene
+        ws = scene.wiresculpt
+        target = ws.target
+        self.assertEqual(target_name(ws), target.name)
+        self.assertEqual(scene_results.stored_inputs()["target"], target.name)
+        self.assertEqual(live.snapshot(scene)[0], target.name)
+        ws.target = None
+        self.assertEqual(target_name(ws), "")
+        self.assertEqual(optimize.solve_record(scene, {}, {})["target"], "")
+        self.assertEqual(live.snapshot(scene)[0], "")
+        self.assertIn("target changed", results_ui.report_changes(bpy.context))
         ws.target = target
         self.assert_current()
 

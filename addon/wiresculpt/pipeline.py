@@ -9,7 +9,7 @@ import time
 
 from . import native
 from .core import settings as settings_table
-from .core.design import new_design
+from .core.design import NO_WIRES, ONE_WIRE, new_design
 from .core.polylines import ContourArrays
 from .core.sizes import size_warnings
 from .fab import buildability
@@ -91,8 +91,7 @@ def solve(design, material, settings, progress=None, cancel=None, stock=None, ho
     design["pending_stages"] = list(ALL_STAGES)
     if len(design["wires"]) < 2:
         design["stable"] = False
-        design["reason"] = ("no plane cuts the mesh: move the planes through the mesh" if not design["wires"]
-                            else "a sculpture needs at least two wires: add a plane or pick more contours")
+        design["reason"] = NO_WIRES if not design["wires"] else ONE_WIRE  # setup problems (core/design.py)
         return design
     apply_cuts(design, settings.get("cuts"))
     for warning in size_warnings(design, *(stock or ())):  # before the long work: the figure, at once

@@ -19,6 +19,16 @@ class ExportMessageTest(unittest.TestCase):
         self.assertIn("crossing 3", text)
         self.assertNotIn("optimize until", text)
 
+    def test_a_setup_problem_is_not_called_unstable(self):
+        # fewer than two wires: the pipeline's sentence, a scene to set up (as Live's "cannot solve")
+        design = {"stable": False, "reason": "a sculpture needs at least two wires: add a plane or pick more contours",
+                  "pending_stages": ["layering", "target_shape", "forces", "rest_shape"], "wires": [{"name": "A/0"}]}
+        level, text = export.summary(empty_result(design), "/tmp/out")
+        self.assertEqual(level, "ERROR")
+        self.assertIn("the design cannot be solved as set up: see Stability (a sculpture needs at least two wires: "
+                      "add a plane or pick more contours)", text)
+        self.assertNotIn("not stable", text)
+
     def test_unfinished_design_points_at_optimize(self):
         design = {"stable": True, "reason": "", "pending_stages": ["rest_shape"], "wires": [{"name": "A/0"}]}
         level, text = export.summary(empty_result(design), "/tmp/out")

@@ -5,14 +5,16 @@ import unittest
 
 from wiresculpt.core import live_verdict as lv
 
-# A Live solve of the bundled globe with Max Bend 30° (hook_patterns=1), its reason as the solver
-# wrote it (226 words; only its first two clauses here, the others repeat them for crossings 2-5).
+# A Live solve of the bundled globe with Max Bend 30° (hook_patterns=1), its reason as the pipeline
+# writes it (only its first two clauses here, the others repeat them for crossings 2-5; before
+# stages/target_shape.crossing_words each crossing was named twice, "…Equator/0: crossing 0 on wire
+# Equator/0 needs…").
 GLOBE_BEND_30 = (
-    "the target shape cannot realise crossing 0 on wire Equator/0: crossing 0 on wire Equator/0 needs a "
-    "bend of at least 60° (contact angle 120° minus twice the friction angle) but the machine bends at "
-    "most 30°; crossing 1 on wire Equator/0: crossing 1 on wire Equator/0 needs a bend of at least 60° "
-    "(contact angle 120° minus twice the friction angle) but the machine bends at most 30°; without them "
-    "the assembly is no longer stable when adding Meridian0/0")
+    "the target shape cannot realise crossing 0 on wire Equator/0: it needs a bend of at least 60° "
+    "(contact angle 120° minus twice the friction angle) but the machine bends at most 30°; crossing 1 "
+    "on wire Equator/0: it needs a bend of at least 60° (contact angle 120° minus twice the friction "
+    "angle) but the machine bends at most 30°; without them the assembly is no longer stable when adding "
+    "Equator/0 and Meridian0/0")
 # Hand-written in the solver's form of a too-close clause: its ";" inside brackets is not the end.
 TOO_CLOSE = (
     "the target shape cannot realise crossings 2, 3 and 4, too close to their neighbours along the wires "
@@ -84,6 +86,46 @@ class Kinds(unittest.TestCase):
         self.assertEqual(lv.kind_of(""), "")
         self.assertEqual(lv.kind_of(lv.verdict(lv.CANNOT_SOLVE, "the solver is not loaded")), lv.CANNOT_SOLVE)
         self.assertNotIn("not stable", lv.verdict(lv.CANNOT_SOLVE, "the solver is not loaded"))
+
+
+class SetupProblems(unittest.TestCase):
+    """Fewer than two wires: the pipeline stops with stable false and a reason that says what to set
+    up. Live calls that "cannot solve", as its other setup problems, not a verdict on a design."""
+
+    def solved(self, wires):
+        from wiresculpt import pipeline
+        from wiresculpt.core.materials import PRESETS
+        from wiresculpt.core.settings import defaults
+
+        from helpers import PLANES, sphere
+
+        V, F = sphere()
+        design = pipeline.slice_and_pick(V, F, PLANES[:wires], PRESETS["steel"], defaults())
+        self.assertEqual(len(design["wires"]), wires)  # a great circle per plane
+        return pipeline.solve(design, PRESETS["steel"], defaults())
+
+    def test_one_wire_cannot_solve(self):
+        design = self.solved(1)
+        # design.json as before: not stable, the pipeline's own sentence
+        self.assertIs(design["stable"], False)
+        self.assertEqual(design["reason"], "a sculpture needs at least two wires: add a plane or pick more contours")
+        kind, text = lv.of_design(design)
+        self.assertEqual(lv.verdict(kind, text),
+                         "cannot solve — a sculpture needs at least two wires: add a plane or pick more contours")
+
+    def test_no_wire_cannot_solve(self):
+        design = self.solved(0)
+        self.assertEqual(design["reason"], "no plane cuts the mesh: move the planes through the mesh")
+        self.assertEqual(lv.verdict(*lv.of_design(design)),
+                         "cannot solve — no plane cuts the mesh: move the planes through the mesh")
+
+    def test_a_design_found_not_stable_is_not_stable(self):
+        reason = "wire 'B/0' crosses no other wire, so nothing can hold it"
+        self.assertEqual(lv.of_design({"stable": False, "reason": reason, "wires": [{}, {}]}), (lv.NOT_STABLE, reason))
+        # the setup sentence inside a longer reason is some other verdict's words
+        longer = "a sculpture needs at least two wires: add a plane or pick more contours; and more"
+        self.assertEqual(lv.of_design({"stable": False, "reason": longer})[0], lv.NOT_STABLE)
+        self.assertEqual(lv.of_design({"stable": True, "reason": ""}), (lv.STABLE, ""))
 
 
 if __name__ == "__main__":

@@ -30,7 +30,7 @@ class SizeTest(unittest.TestCase):
         perimeter = 64 * 2 * 1.35 * math.sin(math.pi / 64)  # the closed 64-gon, by hand
         found = sizes.size_warnings(d)
         self.assertEqual(len(found), 4)
-        self.assertIn("2.70 m across, over 1.5 m", found[0])
+        self.assertIn("2.70 m across, over 1.50 m", found[0])
         for k, text in enumerate(found[1:]):
             self.assertIn(f"wire {'ABC'[k]}/0 is {perimeter * 1000:.0f} mm long", text)
             self.assertIn("1000 mm stock", text)

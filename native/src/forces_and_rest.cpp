@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "figures.hpp"
 #include "wiresculpt/error.hpp"
 
 namespace wiresculpt {
@@ -83,13 +84,10 @@ ForcesAndRestResult forces_and_rest(const Network& net, const std::vector<int>& 
       out.deflections.push_back(wire_deflection(net.wires[w], out.cuts[w], wire_loads(net, hooks, out.forces.forces, wi), d));
       const double m = out.deflections.back().max_out_of_plane;
       if (m > options.deflection_limit) {
-        char text[64];
-        std::snprintf(text, sizeof text, "%.2f mm", 1000.0 * m);
-        char limit[32];
-        std::snprintf(limit, sizeof limit, "%g mm", 1000.0 * options.deflection_limit);
-        out.warnings.push_back("wire '" + net.wires[w].name + "' deflects " + text + " out of its plane under its contact forces (at target vertex " +
+        const auto [text, limit] = detail::versus(1000.0 * m, 1000.0 * options.deflection_limit, 2);
+        out.warnings.push_back("wire '" + net.wires[w].name + "' deflects " + text + " mm out of its plane under its contact forces (at target vertex " +
                                std::to_string(out.deflections.back().max_out_of_plane_vertex) + "), more than " + limit +
-                               ": lower the torque fraction or the load factor");
+                               " mm: lower the torque fraction or the load factor");
       }
     }
     out.deflection_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - d0).count();

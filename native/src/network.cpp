@@ -6,6 +6,7 @@
 #include <map>
 #include <set>
 
+#include "figures.hpp"
 #include "wiresculpt/error.hpp"
 
 namespace wiresculpt {
@@ -39,9 +40,11 @@ WireSpec clean_wire(const WireSpec& in, double tolerance) {
     const Vec3& p = in.points[k];
     if (!p.allFinite()) throw InputError(who + ": point " + std::to_string(k) + " has a non-finite coordinate");
     const double off = in.plane.signed_distance(p);
-    if (std::abs(off) > tolerance)
-      throw InputError(who + ": point " + std::to_string(k) + " is " + fmt_len(std::abs(off)) +
-                       " off the wire's plane (more than the tolerance " + fmt_len(tolerance) + ")");
+    if (std::abs(off) > tolerance) {
+      const auto [shown, limit] = detail::versus(std::abs(off), tolerance, 4, 'g');
+      throw InputError(who + ": point " + std::to_string(k) + " is " + shown + " m off the wire's plane (more than the "
+                       "tolerance " + limit + " m)");
+    }
     const Vec3 q = p - off * in.plane.normal;
     if (!out.points.empty() && (q - out.points.back()).norm() <= 1e-12) continue;
     out.points.push_back(q);
@@ -428,9 +431,10 @@ Network build_network(const std::vector<WireSpec>& input, const NetworkOptions& 
       g.scale = dist > 0 ? options.min_segment / dist : 1e300;
       char buf[64];
       std::snprintf(buf, sizeof buf, "%.2f", g.scale);
+      const auto [apart, least] = detail::versus(dist, options.min_segment, 4, 'g');
       g.message = "wire " + quoted(wire.name) + ": crossings " + std::to_string(ca) + " and " + std::to_string(cb) +
-                  " are " + fmt_len(dist) + " apart along the wire, less than the machine's minimum segment " +
-                  fmt_len(options.min_segment) + "; scale the model up at least " + buf + " times (largest side " +
+                  " are " + apart + " m apart along the wire, less than the machine's minimum segment " + least +
+                  " m; scale the model up at least " + buf + " times (largest side " +
                   fmt_len(net.size) + " -> " + fmt_len(net.size * g.scale) + ")";
       net.min_scale = std::max(net.min_scale, g.scale);
       net.close_crossings.push_back(g);

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "figures.hpp"
 #include "nlopt_text.hpp"
 #include "target_shape_sqp.hpp"
 #include "wiresculpt/error.hpp"
@@ -1331,10 +1332,13 @@ detail::TargetShapeRun detail::run_target_shape(const Polyline2& contour, bool c
       result.feasible = false;
       s.status = "infeasible";
       s.realised = false;
+      // the figure and the limit it breaks with the same decimals, enough to tell them apart
+      const auto [shown, limit] = bend > 0.0 ? detail::versus(bend * 180.0 / pi, bend_limit(o, k) * 180.0 / pi, 1)
+                                             : detail::versus(len * 1000.0, o.min_segment * 1000.0, 2);
       s.message = "crossing " + std::to_string(c) + " on wire " + w +
                   ": its kink cannot be made within the machine's limits: next to it, at point " + std::to_string(k) +
-                  ", the wire " + (bend > 0.0 ? "bends " + deg(bend) + ", more than " + deg(bend_limit(o, k))
-                                                : "has a segment of " + mm(len) + ", less than " + mm(o.min_segment));
+                  ", the wire " + (bend > 0.0 ? "bends " + shown + "°, more than " + limit + "°"
+                                                : "has a segment of " + shown + " mm, less than " + limit + " mm");
       break;
     }
   }

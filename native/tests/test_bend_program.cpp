@@ -221,6 +221,19 @@ TEST_CASE("bend program: limits are refused with messages naming the bend or ste
     CHECK(bend_program_problems(walk({0, 0}, 0, {0.02, 0.02}, {119.9 * deg}), m).empty());
     CHECK_NOTHROW(make_bend_program(walk({0, 0}, 0, {0.02, 0.02}, {119.9 * deg}), m));
   }
+  SECTION("a bend or a feed just past its limit reads past it: the same decimals, enough of them") {
+    // 120.001 deg and 120 deg both read 120.00 with two decimals, the limit 120.0 with one
+    CHECK_THROWS_WITH(make_bend_program(walk({0, 0}, 0, {0.02, 0.02}, {120.001 * deg}), m),
+                      Contains("turns 120.001 deg, more than the machine's maximum reliable bend of 120.000 deg"));
+    CHECK_THROWS_WITH(make_bend_program(walk({0, 0}, 0, {0.02, 0.02}, {-120.001 * deg}), m),
+                      Contains("turns -120.001 deg, more than the machine's maximum reliable bend of 120.000 deg"));
+    CHECK_THROWS_WITH(make_bend_program(walk({0, 0}, 0, {0.02, 0.02}, {120.1 * deg}), m),
+                      Contains("turns 120.10 deg, more than the machine's maximum reliable bend of 120.00 deg"));
+    // 14.9999 mm and 15 mm both read 15.000 with three decimals
+    CHECK_THROWS_WITH(make_bend_program(walk({0, 0}, 0, {0.02, 0.0149999, 0.02}, {30 * deg, 30 * deg}), m),
+                      Contains("step 2 feeds 14.9999 mm") &&
+                          Contains("shorter than the machine's minimum feed between bends of 15.0000 mm"));
+  }
   SECTION("every problem is listed, with the numbers of make_bend_program's message") {
     // bends 1..4 at 20, 40, 45, 65 mm: bend 2 over, the feed between bends 2 and 3 5 mm, bend 4 over
     const Polyline2 p = walk({0, 0}, 0, {0.02, 0.02, 0.005, 0.02, 0.02},

@@ -192,6 +192,11 @@ TEST_CASE("network: bad wires are input errors naming the wire") {
   WireSpec w = plain_circle("bent", Vec3::UnitZ(), 0.0, 16, 0.0);
   w.points[3].z() += 0.001;
   CHECK_THROWS_WITH(build_network({w}), Contains("'bent'") && Contains("point 3") && Contains("off"));
+  // just off, by 0.1 nm more than the 10 um tolerance: both read 1e-05 m with four significant digits
+  WireSpec just = plain_circle("just", Vec3::UnitZ(), 0.0, 16, 0.0);
+  just.points[3].z() = 1.00000001e-5;
+  CHECK_THROWS_WITH(build_network({just}),
+                    Contains("point 3 is 1.00000001e-05 m off the wire's plane (more than the tolerance 1e-05 m)"));
   WireSpec few;
   few.name = "stub";
   few.plane = Plane::make({0, 0, 0}, {0, 0, 1});

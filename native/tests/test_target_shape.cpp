@@ -621,6 +621,8 @@ TEST_CASE("target shape: a kink whose neighbour breaks the bend limit is not rea
   CHECK(r.crossings[0].status == "infeasible");
   CHECK_FALSE(r.crossings[0].realised);
   CHECK_THAT(r.crossings[0].message, Contains("its kink cannot be made") && Contains("point " + std::to_string(at)));
+  // the bend and the limit with one decimal each (the bend is over by more than 0.1°), not "121°, more than 120°"
+  CHECK_THAT(r.crossings[0].message, Contains("°, more than 120.0°"));
   CHECK_FALSE(r.feasible);
   CHECK(r.crossings[1].status == "inactive");
 }

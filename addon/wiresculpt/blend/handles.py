@@ -113,6 +113,13 @@ def add_handle(context, low, high):
     return obj
 
 
+def target_name(settings):
+    """The name of the target picked in the Wire panel (`settings`: a scene's wiresculpt), "" when
+    none is: what a solve's record, Live's snapshot and the stale check compare."""
+    target = settings.target
+    return target.name if target is not None else ""
+
+
 def target_problem(scene, target):
     """Why `target` cannot be sliced, or None."""
     if target is None:

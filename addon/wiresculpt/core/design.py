@@ -77,6 +77,21 @@ OPTIONAL = {
 }
 
 
+# The pipeline's reasons when slicing gave fewer than two wires (pipeline.solve stops before any
+# stage): a scene still to set up, not a verdict on a design. Written here once, so that the add-on
+# (Live's "cannot solve", the Stability box, Optimize's report: setup_problem) knows them by these
+# very words; design.json keeps them as written (`stable` false, `reason` one of these).
+NO_WIRES = "no plane cuts the mesh: move the planes through the mesh"
+ONE_WIRE = "a sculpture needs at least two wires: add a plane or pick more contours"
+SETUP_REASONS = (NO_WIRES, ONE_WIRE)
+
+
+def setup_problem(design):
+    """Whether `design` is not stable for a setup problem (its reason one of SETUP_REASONS): nothing
+    was solved, so it says what to set up rather than that a design does not stand."""
+    return not design.get("stable") and design.get("reason") in SETUP_REASONS
+
+
 def written_by(stage):
     """{"top": [...], "wire": [...], "crossing": [...], "stages": [...]}: the keys `stage` writes."""
     return {part: [k for k, owner in table.items() if owner == stage] for part, table in KEYS.items()}

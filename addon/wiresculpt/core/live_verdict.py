@@ -4,8 +4,9 @@ each said with one prefix, and the part of a long reason the line shows.
 - "stable", "solving…": a word alone;
 - "not stable — <reason>": a solve that ended with the design not stable (design["reason"]);
 - "cannot solve — <problem>": the scene as it is set up cannot be solved at all (no target, no
-  contour ticked, a panel value the solver refuses, a ticked contour the plane no longer cuts):
-  no verdict on the design, something to set up;
+  contour ticked, a panel value the solver refuses, a ticked contour the plane no longer cuts,
+  fewer than two wires: the pipeline's setup reasons, core/design.setup_problem): no verdict on
+  the design, something to set up;
 - "error — <text>": an unexpected exception (a bug of ours), said as such.
 
 A reason is shown whole up to REASON_WORDS words. The solver's reasons repeat a prefix per
@@ -14,6 +15,8 @@ shows its first clause (up to the first ";" or full stop outside brackets) whole
 deciding figure (the angle, the length, the scale) comes last, up to CLAUSE_WORDS words. The reason
 itself is never reworded (design.json keeps it; FORMATS.md). bpy-free.
 """
+from .design import setup_problem
+
 STABLE = "stable"
 SOLVING = "solving…"
 NOT_STABLE = "not stable"
@@ -66,6 +69,15 @@ def verdict(kind, text=""):
     """The line's verdict (without "Live: ") of `kind` (one of the kinds above) and its reason,
     problem or error `text` (shown_reason of it); the kind alone when `text` is empty."""
     return kind + DASH + shown_reason(text) if text.strip() else kind
+
+
+def of_design(design):
+    """(kind, text) of a solved `design`: STABLE alone; CANNOT_SOLVE with its reason when that is a
+    setup problem (core/design.setup_problem: fewer than two wires, nothing was solved); else
+    NOT_STABLE with its reason."""
+    if design["stable"]:
+        return STABLE, ""
+    return (CANNOT_SOLVE if setup_problem(design) else NOT_STABLE), design.get("reason") or ""
 
 
 def kind_of(line):

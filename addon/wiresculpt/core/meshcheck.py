@@ -8,6 +8,8 @@ import os
 
 import numpy as np
 
+from .figures import versus
+
 MAX_MESH_COORDINATE = 1e9  # any unit: beyond it the numbers are garbage, not a model
 MAX_UNSCALED_EXTENT = 10.0  # metres: a larger model without "size" is almost surely in millimetres
 MAX_FILE_BYTES = 2 * 1024 ** 3
@@ -128,12 +130,14 @@ def check_vertices(V, path, size):
         far = np.flatnonzero(np.abs(V).max(axis=1) > MAX_MESH_COORDINATE)
         if far.size:
             i = int(far[0])
-            raise ValueError(f"mesh vertex {i} is at {float(np.abs(V[i]).max()):g} from the origin, beyond "
-                             f"{MAX_MESH_COORDINATE:g}: mesh file {path} does not hold a model's coordinates")
+            at, most = versus(float(np.abs(V[i]).max()), MAX_MESH_COORDINATE, 6, "g")
+            raise ValueError(f"mesh vertex {i} is at {at} from the origin, beyond {most}: mesh file {path} does "
+                             f"not hold a model's coordinates")
         extent = float(np.max(V.max(axis=0) - V.min(axis=0)))
         if size is None and extent > MAX_UNSCALED_EXTENT:
-            raise ValueError(f"your mesh looks like millimetres: mesh file {path} is {extent:g} units across, "
-                             f'read as metres that is over {MAX_UNSCALED_EXTENT:g} m; set "size" to the '
+            across, most = versus(extent, MAX_UNSCALED_EXTENT, 6, "g")
+            raise ValueError(f"your mesh looks like millimetres: mesh file {path} is {across} units across, "
+                             f'read as metres that is over {most} m; set "size" to the '
                              "sculpture's size in metres")
     return True
 

@@ -9,6 +9,7 @@ import os
 from dataclasses import dataclass, field
 
 from . import materials, settings as settings_table
+from .figures import versus
 
 TOP_KEYS = {"mesh", "size", "material", "planes", "settings", "machine_profile"}
 PLANE_KEYS = {"name", "origin", "normal", "contours"}
@@ -43,9 +44,11 @@ def _number(value, key, low=None, high=None, low_open=False):
     if not math.isfinite(value):
         raise ValueError(f'scene key "{key}" must be a finite number, got {value}')
     if low is not None and (value <= low if low_open else value < low):
-        raise ValueError(f'scene key "{key}" must be {"greater than" if low_open else "at least"} {low:g}, got {value:g}')
+        got, least = versus(value, low, 6, "g")
+        raise ValueError(f'scene key "{key}" must be {"greater than" if low_open else "at least"} {least}, got {got}')
     if high is not None and value > high:
-        raise ValueError(f'scene key "{key}" must be at most {high:g}, got {value:g}')
+        got, most = versus(value, high, 6, "g")
+        raise ValueError(f'scene key "{key}" must be at most {most}, got {got}')
     return value
 
 

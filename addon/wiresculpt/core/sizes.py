@@ -3,6 +3,8 @@ of this kind, is a warning with the figure, said before the long optimization st
 import math
 from operator import itemgetter
 
+from .figures import versus
+
 STOCK_LENGTH = 1.0   # m: the default machine profile's straight wire stock (profile key stock_length)
 LARGEST_MODEL = 1.5  # m: beyond this a sculpture of stiff planar wires sags and is hard to build
 
@@ -41,11 +43,13 @@ def size_warnings(design, stock_length=STOCK_LENGTH, profile_name="the default m
     out = []
     size = model_size(design)
     if size > LARGEST_MODEL:
-        out.append(f"the model is {size:.2f} m across, over {LARGEST_MODEL:g} m: check the mesh's units or "
+        shown, largest = versus(size, LARGEST_MODEL, 2)
+        out.append(f"the model is {shown} m across, over {largest} m: check the mesh's units or "
                    f"the scene's size (a wire sculpture this large sags and needs very long wires)")
     for w in design["wires"]:
         length = wire_length(w)
         if length > stock_length:
-            out.append(f"wire {w['name']} is {length * 1000:.0f} mm long, longer than the {stock_length * 1000:.0f} mm "
+            shown, stock_mm = versus(length * 1000, stock_length * 1000, 0)
+            out.append(f"wire {w['name']} is {shown} mm long, longer than the {stock_mm} mm "
                        f"stock of {profile_name}: it needs a longer stock or a joint")
     return out

@@ -22,6 +22,7 @@ import numpy as np
 from .. import native
 from . import bendlist, tiles
 from ..core.calibration import closed_overlap, machine_dict
+from ..core.design import setup_problem
 from ..core import sizes
 from ..core.sizes import size_warnings
 from ..core.polylines import self_crossings
@@ -101,8 +102,11 @@ def crossing_indices(design, wire):
 
 
 def no_rest_reason(design):
-    """Why no wire has a rest shape, matching the design's state: an unstable result points at the
-    Stability report, an unfinished one at Optimize."""
+    """Why no wire has a rest shape, matching the design's state: a setup problem (fewer than two
+    wires, core/design.setup_problem) and an unstable result point at the Stability report, an
+    unfinished one at Optimize."""
+    if setup_problem(design):
+        return f"the design cannot be solved as set up: see Stability ({design['reason']})"
     if design.get("stable") is False and design.get("reason"):
         return f"the design is not stable: see Stability ({design['reason']})"
     return "no wire has a rest shape yet: optimize until the rest shape stage has run"

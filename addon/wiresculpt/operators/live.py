@@ -14,9 +14,9 @@ for) and a new one starts; a result is shown only when its snapshot is still the
 
 The verdict's words are core/live_verdict's: "not stable — <reason>" only for a solve that ended
 not stable, "cannot solve — <what to do>" when the scene as set up cannot be solved (no target, no
-contour ticked, a panel value or plane the solver refuses), "error — …" for our unexpected error; a
-long reason is shown to the end of its first clause, the whole one in WIRESCULPT_OT_live_reason's
-tooltip.
+contour ticked, a panel value or plane the solver refuses, fewer than two wires), "error — …" for our
+unexpected error; a long reason is shown to the end of its first clause, the whole one in
+WIRESCULPT_OT_live_reason's tooltip.
 
 Nothing is written to the scene or the .blend: the verdict and the wires' preview (STATE.preview,
 line segments in each wire's colour, computed on the worker by blend/results.wire_shapes) live in
@@ -42,11 +42,11 @@ import numpy as np
 from .. import native, pipeline
 from ..blend import cut_handles, mesh
 from ..blend import results as scene_results
-from ..blend.handles import contour_plane_name, handles, target_problem, ticked_planes
+from ..blend.handles import contour_plane_name, handles, target_name, target_problem, ticked_planes
 from ..blend.registration import classes_factory
 from ..blend.view import redraw_3d_views
 from ..core.jobs import WorkerJob
-from ..core.live_verdict import CANNOT_SOLVE, ERROR, NOT_STABLE, SOLVING, STABLE, shortened, verdict
+from ..core.live_verdict import CANNOT_SOLVE, ERROR, SOLVING, of_design, shortened, verdict
 from ..props import LIVE_HOOKS, material_of, solve_inputs, solver_settings
 
 TICK_SECONDS = 0.1  # while nothing changes
@@ -117,7 +117,7 @@ def too_large(name, triangles):
 
 def refuse(settings, message):
     """Turns Live off with `message` for the panel (shown while the same target is picked)."""
-    STATE.message, STATE.message_target = message, settings.target.name if settings.target else ""
+    STATE.message, STATE.message_target = message, target_name(settings)
     settings.live = False  # its update stops the timer
 
 
@@ -138,7 +138,7 @@ def snapshot(scene):
     last)."""
     ws = scene.wiresculpt
     target = ws.target
-    return (target.name if target else "", _rounded(target.matrix_world) if target else (),
+    return (target_name(ws), _rounded(target.matrix_world) if target else (),
             tuple((h.name, _rounded(h.matrix_world)) for h in handles(scene)),
             tuple((contour_plane_name(item), item.index) for item in ws.contours if item.use),
             solve_inputs(ws), target is not None and scene.objects.get(target.name) == target,
@@ -199,14 +199,12 @@ class LiveJob(WorkerJob):
             self.seconds = time.monotonic() - began
 
     def verdict(self):
-        """(kind, text) of core/live_verdict: the design's verdict; an error with the user's sentence
-        (the solver refusing the input, a ticked contour the plane no longer cuts, the time budget)
-        cannot solve, any other is our error."""
+        """(kind, text) of core/live_verdict: the design's verdict (of_design: fewer than two wires
+        cannot solve); an error with the user's sentence (the solver refusing the input, a ticked
+        contour the plane no longer cuts, the time budget) cannot solve, any other is our error."""
         if self.error is not None:
             return (ERROR if self.unexpected else CANNOT_SOLVE), self.error
-        if self.design["stable"]:
-            return STABLE, ""
-        return NOT_STABLE, self.design.get("reason") or ""
+        return of_design(self.design)
 
 
 class Refused(str):

@@ -20,10 +20,12 @@ import bpy
 from .. import native, pipeline
 from ..blend import cut_handles, mesh
 from ..blend import results as scene_results
-from ..blend.handles import target_problem, ticked_planes
+from ..blend.handles import target_name, target_problem, ticked_planes
 from ..blend.view import redraw_3d_views
 from ..blend.registration import classes_factory
+from ..core.design import setup_problem
 from ..core.jobs import WorkerJob
+from ..core.live_verdict import CANNOT_SOLVE
 from ..props import material_of, solver_settings
 from .progress import TIMER_SECONDS, WorkerModal
 
@@ -61,19 +63,20 @@ def solve_record(scene, material, settings):
     """What a solve reads besides the planes and ticks, as Optimize starts it: kept beside the
     stored design (blend/results.store_inputs) so the Stability box can tell when the panel has
     changed since (core/stale.py)."""
-    target = scene.wiresculpt.target
-    return {"target": target.name if target is not None else "", "settings": dict(settings),
-            "material": dict(material)}
+    return {"target": target_name(scene.wiresculpt), "settings": dict(settings), "material": dict(material)}
 
 
 def summary(design):
-    """(report type, sentence) for the finished design."""
+    """(report type, sentence) for the finished design: a setup problem (core/design.setup_problem:
+    fewer than two wires) says it cannot be solved, as Live does, rather than "Not stable"."""
     wires = len(design["wires"])
     crossings = len(design.get("crossings", []))
     if design["stable"]:
         names = [design["wires"][w]["name"] for w in design.get("assembly_order", [])]
         return {'INFO'}, (f"Stable: {wires} wires, {crossings} crossings; assemble "
                           f"{', '.join(names)}")
+    if setup_problem(design):
+        return {'WARNING'}, f"{CANNOT_SOLVE.capitalize()}: {design['reason']}"
     return {'WARNING'}, f"Not stable: {design['reason']}"
 
 

@@ -9,6 +9,7 @@ from .. import native, props
 from ..blend import results as scene_results
 from ..blend.registration import classes_factory
 from ..core import closure, stale
+from ..core.design import setup_problem
 from .stale import report_changes
 from ..operators import optimize
 from ..operators.results import WIRESCULPT_OT_assembly_guide, WIRESCULPT_OT_clear_results
@@ -188,6 +189,9 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
                 box.label(text="Was stable", icon='BLANK1')
             else:
                 box.label(text="Stable", icon='CHECKMARK')
+        elif setup_problem(design):  # fewer than two wires: something to set up, as Live's "cannot solve"
+            box.label(text="Could not solve" if said else "Cannot solve", icon='INFO')
+            _wrap(box, context, design["reason"])
         else:
             box.alert = not said
             # max_nodes stopped the layering: a stable design may exist (the reason says how to go on)

@@ -3,6 +3,7 @@ scene's planes, ticks and panel values) and the Live line's hint when Live and a
 disagree. Shared by ui/results.py and ui/panel.py; no panel here."""
 from .. import props
 from ..blend import results as scene_results
+from ..blend.handles import target_name
 from ..core import live_verdict, stale
 
 
@@ -36,7 +37,7 @@ def report_changes(context):
     except ValueError:  # the panel's values cannot be solved (smallest bend above the largest)
         settings = None
     return stale.changes(design, planes, ticked, scene_results.stored_inputs(),
-                         ws.target.name if ws.target is not None else "", settings, props.material_of(ws),
+                         target_name(ws), settings, props.material_of(ws),
                          _recorded["labels"], _recorded["planes"])
 
 

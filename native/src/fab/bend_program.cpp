@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <string>
 
+#include "../figures.hpp"
 #include "wiresculpt/error.hpp"
 
 namespace wiresculpt::fab {
@@ -111,11 +112,11 @@ BendProgram build(const Polyline2& points, const MachineProfile& profile, std::v
       } else if (at > profile.max_bend + kAngleSlack) {
         if (std::abs(theta) > profile.max_bend + kAngleSlack) {
           const int bend = static_cast<int>(prog.steps.size()) + 1;
+          const auto [turn, most] = detail::versus(to_deg(theta), to_deg(profile.max_bend), 2);
           problems.push_back({BendProblem::Kind::over_bend, bend, static_cast<int>(j), static_cast<int>(j),
                               s_at[j], std::abs(theta), profile.max_bend,
-                              "bend " + std::to_string(bend) + " (" + from_cut(s_at[j]) + ") turns " +
-                                  fmt(to_deg(theta), 2) + " deg, more than the machine's maximum reliable bend of " +
-                                  fmt(to_deg(profile.max_bend), 1) + " deg"});
+                              "bend " + std::to_string(bend) + " (" + from_cut(s_at[j]) + ") turns " + turn +
+                                  " deg, more than the machine's maximum reliable bend of " + most + " deg"});
           carry = 0.0;  // made as asked, to go on listing what else keeps the wire from being made
         } else {
           made = theta;  // keep the carry for the next point rather than overbend here
@@ -157,12 +158,12 @@ BendProgram build(const Polyline2& points, const MachineProfile& profile, std::v
                                 : s.vertex < 0 ? "after bend " + std::to_string(bends) + ", to the end"
                                                : "between bends " + std::to_string(step - 1) + " and " +
                                                      std::to_string(step);
+      const auto [fed, least] = detail::versus(to_mm(s.feed), to_mm(profile.min_feed), 3);
       problems.push_back({BendProblem::Kind::short_feed, step, static_cast<int>(feed_start[k]), static_cast<int>(to),
                           s_at[feed_start[k]], s.feed, profile.min_feed,
-                          "step " + std::to_string(step) + " feeds " + fmt(to_mm(s.feed), 3) + " mm (" + where +
-                              ", " + from_cut(s_at[feed_start[k]]) +
-                              "), shorter than the machine's minimum feed between bends of " +
-                              fmt(to_mm(profile.min_feed), 3) + " mm"});
+                          "step " + std::to_string(step) + " feeds " + fed + " mm (" + where + ", " +
+                              from_cut(s_at[feed_start[k]]) +
+                              "), shorter than the machine's minimum feed between bends of " + least + " mm"});
     }
   }
 
