@@ -193,7 +193,7 @@ TEST_CASE("bend program: limits are refused with messages naming the bend or ste
     const Polyline2 p = walk({0, 0}, 0, {0.02, 0.02, 0.02}, {40 * deg, 130 * deg});
     CHECK_THROWS_WITH(make_bend_program(p, m), Contains("bend 2") && Contains("40.0 mm from the cut") &&
                                                    Contains("130.00 deg") &&
-                                                   Contains("120.0 deg"));
+                                                   Contains("120.00 deg"));
   }
   SECTION("a commanded angle beyond the head's range") {
     MachineProfile soft = m;
