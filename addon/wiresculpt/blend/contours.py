@@ -4,7 +4,7 @@ import bpy
 from mathutils import Matrix
 
 from ..core.contours import pick
-from .handles import contour_plane
+from .handles import contour_plane, drop_copied_ids
 from .objects import remove_object, scene_collection, tagged, write_polyline
 
 CONTOUR_KEY = "wiresculpt_contour"  # custom property {"plane": name, "index": k} on curve objects
@@ -43,12 +43,14 @@ def apply_slice(scene, settings, planes, per_plane):
     """Make the scene's curves and the settings' list match the contours `per_plane` cut by the
     handle objects `planes`, keeping the user's ticks: a tick stays with its plane object (renamed
     or not) and its index; the ticks of a plane that is gone are dropped, even when a new plane
-    has taken its name. Returns (contour count, ticked count, removed curve count)."""
+    has taken its name. A copy of a listed plane loses the id it copied (handles.drop_copied_ids).
+    Returns (contour count, ticked count, removed curve count)."""
     ticks = {}  # (handle object, index) -> tick
     for item in settings.contours:
         handle = contour_plane(scene, item)
         if handle is not None:
             ticks[handle, item.index] = item.use
+    drop_copied_ids(planes, {handle for handle, _index in ticks})
     existing = existing_curves(scene)
     settings.contours.clear()
     for handle, contours in zip(planes, per_plane):

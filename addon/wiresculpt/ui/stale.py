@@ -30,14 +30,15 @@ def report_changes(context):
         _recorded.update(design=design, planes=stale.recorded_planes(design), labels=setting_labels())
     scene = context.scene
     ws = scene.wiresculpt
-    planes, ticked = scene_results.scene_planes(scene, context.view_layer.depsgraph, _recorded["planes"][0])
+    inputs = scene_results.stored_inputs()
+    planes, ticked, names = scene_results.scene_planes(scene, context.view_layer.depsgraph, _recorded["planes"][0],
+                                                       (inputs or {}).get("planes"))
     try:
         settings = props.solver_settings(ws)
     except ValueError:  # the panel's values cannot be solved (smallest bend above the largest)
         settings = None
-    return stale.changes(design, planes, ticked, scene_results.stored_inputs(),
-                         ws.target.name if ws.target is not None else "", settings, props.material_of(ws),
-                         _recorded["labels"], _recorded["planes"])
+    return stale.changes(design, planes, ticked, inputs, ws.target.name if ws.target is not None else "",
+                         settings, props.material_of(ws), _recorded["labels"], _recorded["planes"], names)
 
 
 def live_hint(context, verdict):
