@@ -450,6 +450,13 @@ class StaleReport(Case):
         handle = bpy.data.objects["Slice A"]
         handle.name = "Front"  # as in the Outliner: the same object in the same place
         self.assert_current()
+        text = report_text()  # the wires of Slice A are named by their plane's name now
+        self.assertIn("Front/0", text)
+        self.assertNotIn("Slice A/", text)
+        bpy.context.scene.wiresculpt.assembly_step = 3
+        shown = " ".join(labels(draw(results_ui.VIEW3D_PT_wiresculpt_display)))
+        self.assertIn("Front/0", shown)
+        self.assertNotIn("Slice A/", shown)
         handle.location.z += 0.01
         bpy.context.view_layer.update()
         self.assert_stale("plane Front moved")  # named as it is called now

@@ -163,6 +163,21 @@ class StaleTest(unittest.TestCase):
         self.assertEqual(stale.current_names(["Slice B"], ids, {"Front": "b", "Slice B.001": "b"}),
                          {"Slice B": None})
 
+    def test_wire_names_with_their_planes_names_now(self):
+        names = {"Slice A": "Slice A", "Slice B": "Front", "Slice C": None}
+        self.assertEqual(stale.renamed_wire("Slice B/1", names), "Front/1")
+        self.assertEqual(stale.renamed_wire("Slice A/0", names), "Slice A/0")
+        self.assertEqual(stale.renamed_wire("Slice C/0", names), "Slice C/0")  # gone: its last known name
+        self.assertEqual(stale.renamed_wire("Slice B/1", None), "Slice B/1")
+        self.assertEqual(stale.renamed_wire("no index", names), "no index")
+        d = {"wires": [{"name": n} for n in ("A/0", "A/1", "A/10", "Slice A/0", "B/2")]}
+        names = {"A": "Top", "Slice A": "Slice A", "B": "B"}
+        self.assertEqual(stale.renamed_text("crossing 3 on wire A/1: it needs a bend; A/10 and Slice A/0 hold, "
+                                            "A/0 slips", d, names),
+                         "crossing 3 on wire Top/1: it needs a bend; Top/10 and Slice A/0 hold, Top/0 slips")
+        self.assertEqual(stale.renamed_text("wire A/0", d, {"A": "A"}), "wire A/0")
+        self.assertEqual(stale.renamed_text("", d, names), "")
+
     def test_wire_names(self):
         self.assertEqual(stale.wire_contour("Slice A/3"), ("Slice A", 3))
         self.assertEqual(stale.wire_contour("a/b/12"), ("a/b", 12))

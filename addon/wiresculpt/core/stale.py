@@ -20,8 +20,13 @@ What is compared:
 
 The tolerances are far below any edit a maker makes (a nudge is 0.1 mm at least) and far above
 the float round trips of a handle's matrix and of the design's JSON.
+
+The design's wire names keep the plane names they were solved with (design.json is written then);
+renamed_wire / renamed_text show them with the planes' names now (current_names) where the panel
+prints them.
 """
 import math
+import re
 
 ORIGIN_TOLERANCE = 1e-6  # m: the distance of the new origin from the recorded plane
 NORMAL_TOLERANCE = 1e-6  # per component of the unit normals
@@ -85,6 +90,27 @@ def current_names(recorded, ids, handles):
             found = holders.get(uid, [])
             names[name] = found[0] if len(found) == 1 else None
     return names
+
+
+def renamed_wire(name, names):
+    """Wire `name` ("<plane name>/<index>") with its plane's name now (`names`: current_names), or
+    as it is when that plane is not renamed (kept, gone, or not a wire name)."""
+    key = wire_contour(name)
+    now = (names or {}).get(key[0]) if key else None
+    return f"{now}/{key[1]}" if now and now != key[0] else name
+
+
+def renamed_text(text, design, names):
+    """`text` (a reason, a warning) with the names of `design`'s wires whose plane was renamed
+    (renamed_wire) written as they are called now. Every wire name is matched, longest first, and
+    not followed by a digit, so neither "A/0" inside "Slice A/0" nor "Slice A/1" inside
+    "Slice A/10" is taken for another wire."""
+    wires = [str(w.get("name", "")) for w in design.get("wires") or []]
+    now = {name: renamed_wire(name, names) for name in wires if name}
+    if not text or all(a == b for a, b in now.items()):
+        return text
+    pattern = "|".join(re.escape(name) for name in sorted(now, key=len, reverse=True))
+    return re.sub(f"(?:{pattern})(?![0-9])", lambda m: now[m.group(0)], text)
 
 
 def _unit(v):
