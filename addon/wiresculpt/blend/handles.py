@@ -56,7 +56,8 @@ def contour_plane(scene, item):
     Items follow the plane object itself (item.plane_object), so a renamed plane keeps its
     contours and a new plane that takes a deleted one's name does not; the object is gone when
     it was deleted (the pointer reads None), unlinked from `scene` (an object deleted in the
-    viewport lingers outside every scene) or no longer tagged as a handle. Items of files saved
+    viewport lingers outside every scene until contours.release_deleted lets it go) or no longer
+    tagged as a handle. Items of files saved
     before the pointer existed (has_plane_object False) resolve by their stored plane name.
     (has_plane_object, not is_property_set: reading an unset ID PointerProperty adds an empty
     property in Blender 3.4, so is_property_set changes under a mere read.)"""
