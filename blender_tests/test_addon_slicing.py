@@ -2,9 +2,8 @@
 
     blender --background --factory-startup --python-exit-code 1 --python blender_tests/run.py -- addon_slicing
 """
+import contextlib
 import math
-import os
-import tempfile
 import types
 import unittest
 
@@ -19,7 +18,7 @@ from wiresculpt.blend import handles as blend_handles
 from wiresculpt.operators import live, slicing
 from wiresculpt.ui import panel
 
-from helpers import BlenderCase, FakeLayout, clear_scene, draw, register_addon
+from helpers import BlenderCase, FakeLayout, clear_scene, draw, register_addon, save_and_reload
 
 
 def uv_sphere(radius=1.0, location=(0, 0, 0)):
@@ -281,6 +280,15 @@ class Ticks(AddonCase):
         self.assertEqual([i.use for i in items_of(c.name)], [True, False])
         self.assertEqual(self.ticked(), {b.name: [0], c.name: [0]})
 
+    @contextlib.contextmanager
+    def not_released_at_once(self):
+        """Without the depsgraph handler that lets a deleted object go (operators/slicing.py)."""
+        bpy.app.handlers.depsgraph_update_post.remove(slicing._release_deleted)
+        try:
+            yield
+        finally:
+            bpy.app.handlers.depsgraph_update_post.append(slicing._release_deleted)
+
     def delete_in_viewport(self, obj):
         for other in bpy.context.selected_objects:
             other.select_set(False)
@@ -301,10 +309,7 @@ class Ticks(AddonCase):
         self.assertEqual(bpy.data.objects["Front"].users, 0)  # nothing holds it: not saved
         with self.assertRaisesRegex(ValueError, "slicing plane Front of a ticked contour is gone"):
             self.ticked()
-        with tempfile.TemporaryDirectory() as folder:
-            path = os.path.join(folder, "deleted.blend")
-            bpy.ops.wm.save_as_mainfile(filepath=path)
-            bpy.ops.wm.open_mainfile(filepath=path)
+        save_and_reload()
         self.assertNotIn("Front", bpy.data.objects)
         self.assertNotIn(curve_name, bpy.data.objects)
         self.assertEqual([i.use for i in items_of("Front")], [False, True])
@@ -313,32 +318,21 @@ class Ticks(AddonCase):
 
     def test_a_file_saved_with_a_deleted_plane_lets_it_go_on_loading(self):
         a, _b = self.two_planes()
-        bpy.app.handlers.depsgraph_update_post.remove(slicing._release_deleted)  # as an earlier add-on
-        try:
+        with self.not_released_at_once():  # as an earlier add-on
             self.delete_in_viewport(a)
             self.assertTrue(all(i.plane_object == a for i in items_of("Slice A")))
-        finally:
-            bpy.app.handlers.depsgraph_update_post.append(slicing._release_deleted)
-        with tempfile.TemporaryDirectory() as folder:
-            path = os.path.join(folder, "deleted.blend")
-            bpy.ops.wm.save_as_mainfile(filepath=path)
-            bpy.ops.wm.open_mainfile(filepath=path)
-            self.assertEqual(bpy.data.objects["Slice A"].users, 0)
-            self.assertTrue(all(i.plane_object is None for i in items_of("Slice A")))
-            bpy.ops.wm.save_as_mainfile(filepath=path)
-            bpy.ops.wm.open_mainfile(filepath=path)
+        save_and_reload()  # the file held it; loading lets it go
+        self.assertEqual(bpy.data.objects["Slice A"].users, 0)
+        self.assertTrue(all(i.plane_object is None for i in items_of("Slice A")))
+        save_and_reload()
         self.assertNotIn("Slice A", bpy.data.objects)
 
     def test_undo_brings_a_deleted_plane_back_with_its_ticks(self):
         a, _b = self.two_planes()
         bpy.ops.ed.undo_push(message="two planes")
-        # as in the viewport: the Delete's undo step is saved before the depsgraph handler runs
-        bpy.app.handlers.depsgraph_update_post.remove(slicing._release_deleted)
-        try:
+        with self.not_released_at_once():  # as in the viewport: the Delete's undo step comes first
             self.delete_in_viewport(a)
             bpy.ops.ed.undo_push(message="Delete")
-        finally:
-            bpy.app.handlers.depsgraph_update_post.append(slicing._release_deleted)
         self.assertEqual(bpy.ops.ed.undo(), {'FINISHED'})
         a = bpy.data.objects["Slice A"]  # undo made the objects anew
         self.assertEqual(bpy.context.scene.objects.get("Slice A"), a)

@@ -22,7 +22,7 @@ from wiresculpt.operators import optimize
 from wiresculpt.ui import overlay
 from wiresculpt.ui import results as results_ui
 
-from helpers import GLOBE_OBJ, GLOBE_RADIUS, ROOT, add_handle, clear_scene, globe, register_addon
+from helpers import GLOBE_OBJ, GLOBE_RADIUS, ROOT, add_handle, clear_scene, globe, register_addon, save_and_reload
 from helpers import BlenderCase as Case
 from helpers import draw as helpers_draw
 
@@ -434,16 +434,12 @@ class StaleReport(Case):
 
     def test_a_reloaded_file_is_current(self):
         self.optimize()
-        with tempfile.TemporaryDirectory() as folder:
-            path = os.path.join(folder, "sculpture.blend")
-            bpy.ops.wm.save_as_mainfile(filepath=path)
-            bpy.ops.wm.read_homefile(use_empty=True)
-            bpy.ops.wm.open_mainfile(filepath=path)
-            self.assertIsNotNone(scene_results.stored_inputs())
-            self.assert_current()
-            bpy.data.objects["Slice B"].location.x += 0.01
-            bpy.context.view_layer.update()
-            self.assert_stale("plane Slice B moved")
+        save_and_reload()
+        self.assertIsNotNone(scene_results.stored_inputs())
+        self.assert_current()
+        bpy.data.objects["Slice B"].location.x += 0.01
+        bpy.context.view_layer.update()
+        self.assert_stale("plane Slice B moved")
 
     def test_renaming_a_plane_keeps_the_design_current(self):
         self.optimize()
@@ -463,11 +459,7 @@ class StaleReport(Case):
 
     def test_a_plane_renamed_after_reloading_is_the_same_plane(self):
         self.optimize()
-        with tempfile.TemporaryDirectory() as folder:
-            path = os.path.join(folder, "sculpture.blend")
-            bpy.ops.wm.save_as_mainfile(filepath=path)
-            bpy.ops.wm.read_homefile(use_empty=True)
-            bpy.ops.wm.open_mainfile(filepath=path)
+        save_and_reload()
         bpy.data.objects["Slice B"].name = "Side"
         bpy.data.objects["Slice C"].name = "Slice B"  # a name another recorded plane had
         self.assert_current()
