@@ -8,6 +8,7 @@ import select
 import signal
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 import tty
@@ -337,6 +338,18 @@ def add_handle(rotation=(0.0, 0.0, 0.0), location=(0.0, 0.0, 0.0)):
     handle.location = location
     handle.rotation_euler = rotation
     return handle
+
+
+def save_and_reload(name="sculpture.blend"):
+    """Saves the open file into a temporary folder, opens an empty file, then the saved one again
+    (a maker closing and reopening it); the folder is removed afterwards."""
+    import bpy
+
+    with tempfile.TemporaryDirectory() as folder:
+        path = os.path.join(folder, name)
+        bpy.ops.wm.save_as_mainfile(filepath=path)
+        bpy.ops.wm.read_homefile(use_empty=True)
+        bpy.ops.wm.open_mainfile(filepath=path)
 
 
 def globe(rotations=((0, 0, 0), (0, math.pi / 2, 0), (math.pi / 2, 0, 0))):

@@ -2,6 +2,7 @@
 
     blender --background --factory-startup --python-exit-code 1 --python blender_tests/run.py -- addon_slicing
 """
+import contextlib
 import math
 import types
 import unittest
@@ -17,7 +18,7 @@ from wiresculpt.blend import handles as blend_handles
 from wiresculpt.operators import live, slicing
 from wiresculpt.ui import panel
 
-from helpers import BlenderCase, FakeLayout, clear_scene, draw, register_addon
+from helpers import BlenderCase, FakeLayout, clear_scene, draw, register_addon, save_and_reload
 
 
 def uv_sphere(radius=1.0, location=(0, 0, 0)):
@@ -278,6 +279,76 @@ class Ticks(AddonCase):
         slice_scene()
         self.assertEqual([i.use for i in items_of(c.name)], [True, False])
         self.assertEqual(self.ticked(), {b.name: [0], c.name: [0]})
+
+    @contextlib.contextmanager
+    def not_released_at_once(self):
+        """Without the depsgraph handler that lets a deleted object go (operators/slicing.py)."""
+        bpy.app.handlers.depsgraph_update_post.remove(slicing._release_deleted)
+        try:
+            yield
+        finally:
+            bpy.app.handlers.depsgraph_update_post.append(slicing._release_deleted)
+
+    def delete_in_viewport(self, obj):
+        for other in bpy.context.selected_objects:
+            other.select_set(False)
+        obj.select_set(True)
+        self.assertEqual(bpy.ops.object.delete(), {'FINISHED'})
+
+    def test_a_plane_deleted_in_the_viewport_does_not_stay_in_the_file(self):
+        a, _b = self.two_planes()
+        a.name = "Front"
+        curve = items_of("Slice A")[1].curve
+        curve_name = curve.name
+        self.delete_in_viewport(a)
+        self.delete_in_viewport(curve)
+        items = items_of("Front")  # a deleted plane's items keep its last name, for the messages
+        self.assertEqual(len(items), 2)
+        self.assertTrue(all(i.plane_object is None and i.has_plane_object for i in items))
+        self.assertIsNone(items[1].curve)
+        self.assertEqual(bpy.data.objects["Front"].users, 0)  # nothing holds it: not saved
+        with self.assertRaisesRegex(ValueError, "slicing plane Front of a ticked contour is gone"):
+            self.ticked()
+        save_and_reload()
+        self.assertNotIn("Front", bpy.data.objects)
+        self.assertNotIn(curve_name, bpy.data.objects)
+        self.assertEqual([i.use for i in items_of("Front")], [False, True])
+        with self.assertRaisesRegex(ValueError, "slicing plane Front of a ticked contour is gone"):
+            self.ticked()
+
+    def test_a_file_saved_with_a_deleted_plane_lets_it_go_on_loading(self):
+        a, _b = self.two_planes()
+        with self.not_released_at_once():  # as an earlier add-on
+            self.delete_in_viewport(a)
+            self.assertTrue(all(i.plane_object == a for i in items_of("Slice A")))
+        save_and_reload()  # the file held it; loading lets it go
+        self.assertEqual(bpy.data.objects["Slice A"].users, 0)
+        self.assertTrue(all(i.plane_object is None for i in items_of("Slice A")))
+        save_and_reload()
+        self.assertNotIn("Slice A", bpy.data.objects)
+
+    def test_undo_brings_a_deleted_plane_back_with_its_ticks(self):
+        a, _b = self.two_planes()
+        bpy.ops.ed.undo_push(message="two planes")
+        with self.not_released_at_once():  # as in the viewport: the Delete's undo step comes first
+            self.delete_in_viewport(a)
+            bpy.ops.ed.undo_push(message="Delete")
+        self.assertEqual(bpy.ops.ed.undo(), {'FINISHED'})
+        a = bpy.data.objects["Slice A"]  # undo made the objects anew
+        self.assertEqual(bpy.context.scene.objects.get("Slice A"), a)
+        self.assertTrue(all(i.plane_object == a for i in items_of("Slice A")))
+        self.assertEqual(self.ticked(), {"Slice A": [1], "Slice B": [0]})
+        self.assertEqual(bpy.ops.ed.redo(), {'FINISHED'})
+        self.assertNotIn("Slice A", bpy.context.scene.objects)
+        self.assertTrue(all(i.plane_object is None for i in items_of("Slice A")))  # let go again
+        self.assertEqual(bpy.data.objects["Slice A"].users, 0)
+
+    def test_a_plane_linked_elsewhere_or_kept_is_not_released(self):
+        a, _b = self.two_planes()
+        a.use_fake_user = True  # the maker keeps it on purpose
+        self.delete_in_viewport(a)
+        self.assertTrue(all(i.plane_object == a for i in items_of("Slice A")))
+        self.assertEqual(blend_contours.release_deleted(bpy.data.scenes), 0)
 
     def test_items_of_older_files_go_by_the_plane_name(self):
         a, _b = self.two_planes()

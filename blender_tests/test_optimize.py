@@ -22,7 +22,7 @@ from wiresculpt.operators import optimize
 from wiresculpt.ui import overlay
 from wiresculpt.ui import results as results_ui
 
-from helpers import GLOBE_OBJ, GLOBE_RADIUS, ROOT, add_handle, clear_scene, globe, register_addon
+from helpers import GLOBE_OBJ, GLOBE_RADIUS, ROOT, add_handle, clear_scene, globe, register_addon, save_and_reload
 from helpers import BlenderCase as Case
 from helpers import draw as helpers_draw
 
@@ -480,16 +480,63 @@ class StaleReport(Case):
 
     def test_a_reloaded_file_is_current(self):
         self.optimize()
-        with tempfile.TemporaryDirectory() as folder:
-            path = os.path.join(folder, "sculpture.blend")
-            bpy.ops.wm.save_as_mainfile(filepath=path)
-            bpy.ops.wm.read_homefile(use_empty=True)
-            bpy.ops.wm.open_mainfile(filepath=path)
-            self.assertIsNotNone(scene_results.stored_inputs())
-            self.assert_current()
-            bpy.data.objects["Slice B"].location.x += 0.01
-            bpy.context.view_layer.update()
-            self.assert_stale("plane Slice B moved")
+        save_and_reload()
+        self.assertIsNotNone(scene_results.stored_inputs())
+        self.assert_current()
+        bpy.data.objects["Slice B"].location.x += 0.01
+        bpy.context.view_layer.update()
+        self.assert_stale("plane Slice B moved")
+
+    def test_renaming_a_plane_keeps_the_design_current(self):
+        self.optimize()
+        handle = bpy.data.objects["Slice A"]
+        handle.name = "Front"  # as in the Outliner: the same object in the same place
+        self.assert_current()
+        text = report_text()  # the wires of Slice A are named by their plane's name now
+        self.assertIn("Front/0", text)
+        self.assertNotIn("Slice A/", text)
+        bpy.context.scene.wiresculpt.assembly_step = 3
+        shown = " ".join(labels(draw(results_ui.VIEW3D_PT_wiresculpt_display)))
+        self.assertIn("Front/0", shown)
+        self.assertNotIn("Slice A/", shown)
+        handle.location.z += 0.01
+        bpy.context.view_layer.update()
+        self.assert_stale("plane Front moved")  # named as it is called now
+
+    def test_a_plane_renamed_after_reloading_is_the_same_plane(self):
+        self.optimize()
+        save_and_reload()
+        bpy.data.objects["Slice B"].name = "Side"
+        bpy.data.objects["Slice C"].name = "Slice B"  # a name another recorded plane had
+        self.assert_current()
+
+    def test_a_copy_of_a_plane_is_another_plane(self):
+        self.optimize()
+        original = bpy.data.objects["Slice A"]
+        for obj in bpy.context.selected_objects:
+            obj.select_set(False)
+        original.select_set(True)
+        bpy.context.view_layer.objects.active = original
+        bpy.ops.object.duplicate()  # Shift+D: the copy takes the custom properties along
+        copy = bpy.context.view_layer.objects.active
+        self.assertNotEqual(copy, original)
+        original.name = "Front"
+        self.assertEqual(bpy.ops.wiresculpt.slice(), {'FINISHED'})
+        for item in bpy.context.scene.wiresculpt.contours:
+            if item.plane_object == copy:
+                item.use = False
+        self.assert_current()
+
+    def test_a_record_without_plane_ids_goes_by_name(self):
+        self.optimize()
+        text = bpy.data.texts[scene_results.DESIGN_TEXT]
+        inputs = scene_results.stored_inputs()
+        del inputs["planes"]  # as an earlier add-on recorded it
+        scene_results.store_inputs(inputs)
+        self.assert_current()
+        bpy.data.objects["Slice A"].name = "Front"
+        self.assert_stale("plane Slice A removed")
+        self.assertIn(scene_results.INPUTS_KEY, text)
 
     def test_a_design_without_recorded_inputs_is_compared_by_its_planes(self):
         self.optimize()

@@ -161,7 +161,8 @@ def _wire_items(_settings, _context):
 class WiresculptContour(bpy.types.PropertyGroup):
     plane: StringProperty(
         name="Plane", description="Name of the slicing plane that cut this contour, at the Slice "
-                                  "that made it (the plane's current name is plane_object's)")
+                                  "that made it (the plane's current name is plane_object's), or its "
+                                  "last name once it is deleted")
     plane_object: PointerProperty(
         name="Plane Object", type=bpy.types.Object,
         description="Slicing plane that cut this contour: the tick follows this object through "

@@ -30,9 +30,16 @@ INPUTS = {"target": "Globe", "settings": SETTINGS, "material": MATERIAL}
 LABELS = {"max_bend_deg": "Max Bend", "wire_diameter": "Wire Diameter", "name": "Material"}
 
 
-def changes(p=None, ticked=TICKED, inputs=INPUTS, target="Globe", settings=SETTINGS, material=MATERIAL, d=None):
+def changes(p=None, ticked=TICKED, inputs=INPUTS, target="Globe", settings=SETTINGS, material=MATERIAL, d=None,
+            names=None):
     return stale.changes(d or design(), planes() if p is None else p, ticked, inputs, target, settings, material,
-                         LABELS)
+                         LABELS, names=names)
+
+
+def renamed(mapping, p=None, ticked=TICKED):
+    """(planes, ticked) of the scene after renaming its handles by `mapping` {old: new}."""
+    p = planes() if p is None else p
+    return ({mapping.get(n, n): v for n, v in p.items()}, {(mapping.get(n, n), i) for n, i in ticked})
 
 
 class StaleTest(unittest.TestCase):
@@ -112,6 +119,64 @@ class StaleTest(unittest.TestCase):
         said = changes(p, target="Duck", settings=dict(SETTINGS, max_bend_deg=90.0))
         self.assertEqual(stale.stale_text(said), "From an earlier Optimize: plane Slice B rotated, target changed, "
                                                  "settings changed (Max Bend); Optimize again")
+
+    def test_a_renamed_plane_is_the_same_plane_under_its_new_name(self):
+        p, ticked = renamed({"Slice B": "Front"})
+        names = {"Slice A": "Slice A", "Slice B": "Front", "Slice C": "Slice C"}
+        self.assertEqual(changes(p, ticked, names=names), [])
+        # by name alone (a record without ids) it reads as one plane gone and another added
+        self.assertEqual(changes(p, ticked), ["plane Slice B removed", "plane Front added"])
+        p["Front"] = ((0.01, 0.0, 0.0), (1.0, 0.0, 0.0))
+        self.assertEqual(changes(p, ticked, names=names), ["plane Front moved"])
+        self.assertEqual(changes(renamed({"Slice B": "Front"})[0], ticked - {("Front", 1)}, names=names),
+                         ["contours ticked differently (Front #1 unticked)"])
+
+    def test_swapped_names_and_a_name_taken_by_another_plane(self):
+        p, ticked = renamed({"Slice A": "Slice B", "Slice B": "Slice A"})
+        names = {"Slice A": "Slice B", "Slice B": "Slice A", "Slice C": "Slice C"}
+        self.assertEqual(changes(p, ticked, names=names), [])
+        # Slice C deleted, Slice B renamed Slice C: one plane gone, the other compared under its new name
+        p, ticked = renamed({"Slice B": "Slice C"}, {n: v for n, v in planes().items() if n != "Slice C"},
+                            TICKED - {("Slice C", 0)})
+        names = {"Slice A": "Slice A", "Slice B": "Slice C", "Slice C": None}
+        self.assertEqual(changes(p, ticked, names=names), ["plane Slice C removed"])
+        # a new plane that took a deleted plane's name is another plane
+        names = {"Slice A": "Slice A", "Slice B": "Slice B", "Slice C": None}
+        self.assertEqual(changes(names=names), ["plane Slice C removed", "plane Slice C added"])
+
+    def test_current_names_by_recorded_id(self):
+        recorded = ["Slice A", "Slice B", "Slice C"]
+        ids = {"Slice A": "a", "Slice B": "b", "Slice C": "c"}
+        handles = {"Slice A": "a", "Front": "b", "Slice C": "x"}
+        self.assertEqual(stale.current_names(recorded, ids, handles),
+                         {"Slice A": "Slice A", "Slice B": "Front", "Slice C": None})
+        # no ids recorded (an older record, or a plane without one): by name
+        self.assertEqual(stale.current_names(recorded, None, handles),
+                         {"Slice A": "Slice A", "Slice B": None, "Slice C": "Slice C"})
+        self.assertEqual(stale.current_names(recorded, {"Slice B": "b"}, {"Slice A": None, "Front": "b"}),
+                         {"Slice A": "Slice A", "Slice B": "Front", "Slice C": None})
+        self.assertEqual(stale.current_names(recorded, "not a dict", handles)["Slice C"], "Slice C")
+        # a copy kept the id (Shift+D copies custom properties): the one of the recorded name is it,
+        # and two copies neither of that name tell nothing
+        self.assertEqual(stale.current_names(["Slice B"], ids, {"Slice B": "b", "Slice B.001": "b"}),
+                         {"Slice B": "Slice B"})
+        self.assertEqual(stale.current_names(["Slice B"], ids, {"Front": "b", "Slice B.001": "b"}),
+                         {"Slice B": None})
+
+    def test_wire_names_with_their_planes_names_now(self):
+        names = {"Slice A": "Slice A", "Slice B": "Front", "Slice C": None}
+        self.assertEqual(stale.renamed_wire("Slice B/1", names), "Front/1")
+        self.assertEqual(stale.renamed_wire("Slice A/0", names), "Slice A/0")
+        self.assertEqual(stale.renamed_wire("Slice C/0", names), "Slice C/0")  # gone: its last known name
+        self.assertEqual(stale.renamed_wire("Slice B/1", None), "Slice B/1")
+        self.assertEqual(stale.renamed_wire("no index", names), "no index")
+        d = {"wires": [{"name": n} for n in ("A/0", "A/1", "A/10", "Slice A/0", "B/2")]}
+        names = {"A": "Top", "Slice A": "Slice A", "B": "B"}
+        self.assertEqual(stale.renamed_text("crossing 3 on wire A/1: it needs a bend; A/10 and Slice A/0 hold, "
+                                            "A/0 slips", d, names),
+                         "crossing 3 on wire Top/1: it needs a bend; Top/10 and Slice A/0 hold, Top/0 slips")
+        self.assertEqual(stale.renamed_text("wire A/0", d, {"A": "A"}), "wire A/0")
+        self.assertEqual(stale.renamed_text("", d, names), "")
 
     def test_wire_names(self):
         self.assertEqual(stale.wire_contour("Slice A/3"), ("Slice A", 3))

@@ -4,7 +4,7 @@ import bpy
 from mathutils import Matrix
 
 from ..core.contours import pick
-from .handles import contour_plane
+from .handles import contour_plane, drop_copied_ids
 from .objects import remove_object, scene_collection, tagged, write_polyline
 
 CONTOUR_KEY = "wiresculpt_contour"  # custom property {"plane": name, "index": k} on curve objects
@@ -39,16 +39,45 @@ def contour_curve(scene, existing, plane, index):
     return obj
 
 
+def release_deleted(scenes):
+    """Clears the contour lists' pointers (plane_object, curve) to objects that nothing else holds:
+    an object deleted in the viewport leaves every scene but stays in the file while a pointer
+    is a user of it, and would be saved and reloaded for ever. Each pointer is a user, so an
+    object with no more users than the lists' pointers to it is in no collection, hence in no
+    scene. A cleared plane's items keep its last name (plane) and stay gone (has_plane_object,
+    handles.contour_plane). Returns how many pointers were cleared. Writes ID data: call it from
+    an operator or a handler, never from a draw."""
+    items = [item for scene in scenes for item in scene.wiresculpt.contours]
+    pointers = {}  # object -> how many of the lists' pointers hold it
+    for item in items:
+        # (has_plane_object first: reading an unset ID pointer adds an empty property in Blender 3.4)
+        for obj in (item.plane_object if item.has_plane_object else None, item.curve):
+            if obj is not None:
+                pointers[obj] = pointers.get(obj, 0) + 1
+    gone = {obj for obj, count in pointers.items() if obj.users <= count}
+    cleared = 0
+    for item in items:
+        if item.has_plane_object and item.plane_object in gone:
+            item.plane, item.plane_object = item.plane_object.name, None
+            cleared += 1
+        if item.curve in gone:
+            item.curve = None
+            cleared += 1
+    return cleared
+
+
 def apply_slice(scene, settings, planes, per_plane):
     """Make the scene's curves and the settings' list match the contours `per_plane` cut by the
     handle objects `planes`, keeping the user's ticks: a tick stays with its plane object (renamed
     or not) and its index; the ticks of a plane that is gone are dropped, even when a new plane
-    has taken its name. Returns (contour count, ticked count, removed curve count)."""
+    has taken its name. A copy of a listed plane loses the id it copied (handles.drop_copied_ids).
+    Returns (contour count, ticked count, removed curve count)."""
     ticks = {}  # (handle object, index) -> tick
     for item in settings.contours:
         handle = contour_plane(scene, item)
         if handle is not None:
             ticks[handle, item.index] = item.use
+    drop_copied_ids(planes, {handle for handle, _index in ticks})
     existing = existing_curves(scene)
     settings.contours.clear()
     for handle, contours in zip(planes, per_plane):

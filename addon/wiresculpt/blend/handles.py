@@ -1,11 +1,16 @@
 """Slicing handles: ordinary plane objects, tagged, whose world position and Z axis are a slicing
 plane; and the target mesh they cut."""
+import uuid
+
 import bpy
 
 from ..core.scene import PlaneSpec
 from .objects import scene_collection
 
 HANDLE_KEY = "wiresculpt_handle"  # custom property that marks an object as a slicing handle
+# custom property: a handle's persistent id (plane_ids), saved with the file (an object's
+# session_uid is not); Optimize records it beside the design, so a renamed plane stays the same plane
+HANDLE_ID_KEY = "wiresculpt_handle_id"
 PLANES_COLLECTION = "Slicing Planes"
 PLANE_MARGIN = 1.2  # a new handle is this much wider than the target's largest extent
 
@@ -51,7 +56,8 @@ def contour_plane(scene, item):
     Items follow the plane object itself (item.plane_object), so a renamed plane keeps its
     contours and a new plane that takes a deleted one's name does not; the object is gone when
     it was deleted (the pointer reads None), unlinked from `scene` (an object deleted in the
-    viewport lingers outside every scene) or no longer tagged as a handle. Items of files saved
+    viewport lingers outside every scene until contours.release_deleted lets it go) or no longer
+    tagged as a handle. Items of files saved
     before the pointer existed (has_plane_object False) resolve by their stored plane name.
     (has_plane_object, not is_property_set: reading an unset ID PointerProperty adds an empty
     property in Blender 3.4, so is_property_set changes under a mere read.)"""
@@ -69,6 +75,50 @@ def contour_plane_name(item):
     its object's name while the item points at one, else the name stored at the Slice."""
     obj = item.plane_object if item.has_plane_object else None
     return item.plane if obj is None else obj.name
+
+
+def contour_planes(scene):
+    """{name: handle} of the contour list's planes still in `scene` (contour_plane), each looked
+    up once (a lookup in the scene's objects walks them)."""
+    found = {}
+    for item in scene.wiresculpt.contours:
+        key = item.plane_object if item.has_plane_object else item.plane
+        if key not in found:
+            found[key] = contour_plane(scene, item)
+    return {handle.name: handle for handle in found.values() if handle is not None}
+
+
+def handle_id(obj):
+    """The handle's persistent id (plane_ids), or None when it has none."""
+    uid = obj.get(HANDLE_ID_KEY)
+    return uid if isinstance(uid, str) and uid else None
+
+
+def plane_ids(scene):
+    """{name: persistent id} of the ticked contours' planes, those an Optimize solves with, each
+    given a new id first where it has none or shares it with another of them. Writes to the
+    handles: call it from an operator. A linked (library) handle cannot be written and goes by
+    its name."""
+    ids = {}
+    for item in scene.wiresculpt.contours:
+        handle = contour_plane(scene, item) if item.use else None
+        if handle is None or handle.name in ids or handle.library is not None:
+            continue
+        uid = handle_id(handle)
+        if uid is None or uid in ids.values():
+            uid = handle[HANDLE_ID_KEY] = uuid.uuid4().hex
+        ids[handle.name] = uid
+    return ids
+
+
+def drop_copied_ids(planes, known):
+    """Takes the id from each handle of `planes` that is not in `known` (the contour list's planes
+    before this Slice) and shares it with one that is: a copy (Shift+D copies custom
+    properties), which is another plane. Writes to the handles: call it from an operator."""
+    held = {handle_id(h) for h in planes if h in known} - {None}
+    for handle in planes:
+        if handle not in known and handle.library is None and handle_id(handle) in held:
+            del handle[HANDLE_ID_KEY]
 
 
 def ticked_planes(scene, depsgraph):

@@ -10,15 +10,17 @@ import bmesh
 import bpy
 import numpy as np
 
+from ..core import stale
 from ..core.design import crossing_direction, dumps
 from . import cut_handles, preview
-from .handles import contour_plane_name, handle_plane, is_handle
+from .handles import contour_plane_name, contour_planes, handle_id, handle_plane, is_handle
 from .objects import remove_object, scene_collection, tagged, write_polyline
 
 DESIGN_TEXT = "wiresculpt_design.json"  # Text datablock holding the last design
 # custom property of that Text: JSON of what Optimize solved it with besides the design's own keys
-# ({"target": name, "settings": solver settings, "material": material}; core/stale.py compares
-# it with the panel). Kept beside the design, not in it, so design.json stays as FORMATS.md says.
+# ({"target": name, "settings": solver settings, "material": material, "planes": {plane name:
+# persistent id, handles.plane_ids}}; core/stale.py compares it with the panel and finds renamed
+# planes by it). Kept beside the design, not in it, so design.json stays as FORMATS.md says.
 INPUTS_KEY = "wiresculpt_inputs"
 WIRE_KEY = "wiresculpt_wire"  # custom property on wire curves: the wire's name
 WIRE_ID_KEY = "wiresculpt_wire_id"  # custom property on wire curves: the wire's id this run
@@ -85,23 +87,32 @@ def stored_inputs():
     return inputs if isinstance(inputs, dict) else None
 
 
-def scene_planes(scene, depsgraph, names):
-    """({plane name: (origin, unit normal), or None when it has no normal}, {(plane name, contour
-    index)} ticked): the scene's side of core/stale.changes. `names`: the planes to read (the
-    design's); the ticked contours' planes are read too. By name lookups, not a pass over every
-    object of the scene: a panel draws this at every redraw."""
+def scene_planes(scene, depsgraph, names, ids=None):
+    """({plane name now: (origin, unit normal), or None when it has no normal}, {(plane name,
+    contour index)} ticked, {recorded plane name: its name now, or None when gone}): the scene's
+    side of core/stale.changes. `names`: the design's plane names; `ids`: the persistent ids
+    Optimize recorded for them (stored_inputs()["planes"]; None: by name), which find a renamed
+    plane (core/stale.current_names) among the contour list's planes and those of a recorded
+    name. By those lookups, not a pass over every object of the scene: a panel draws this at
+    every redraw."""
     # a ticked contour's plane by its current name (items follow their plane object)
     ticked = {(contour_plane_name(item), item.index) for item in scene.wiresculpt.contours if item.use}
+    found = contour_planes(scene)
+    for name in names:
+        handle = None if name in found else scene.objects.get(name)
+        if handle is not None and is_handle(handle):
+            found[name] = handle
+    current = stale.current_names(names, ids, {name: handle_id(h) for name, h in found.items()})
     planes = {}
-    for name in set(names) | {p for p, _i in ticked}:
-        handle = scene.objects.get(name)
+    for name in {n for n in current.values() if n is not None} | {p for p, _i in ticked}:
+        handle = found.get(name) or scene.objects.get(name)
         if handle is None or not is_handle(handle):
             continue
         try:
             planes[name] = handle_plane(handle, depsgraph)[1:]
         except ValueError:
             planes[name] = None
-    return planes, ticked
+    return planes, ticked, current
 
 
 def stored_design():

@@ -4,8 +4,11 @@ box (ui/results.py). bpy-free: the add-on gathers the scene's planes, ticks and 
 module compares them with what the design recorded.
 
 What is compared:
-- the planes: each wire's `plane` (origin, normal) in the design, by its plane's name (a wire's
-  name is "<plane name>/<contour index>"), against the handle of that name now. A plane counts as
+- the planes: each wire's `plane` (origin, normal) in the design (a wire's name is "<plane
+  name>/<contour index>") against that plane's handle now. A plane is its object, not its name:
+  Optimize records a persistent id per plane beside the design (current_names), so a renamed
+  handle is the same plane, named by its new name; a record without ids (an older add-on's)
+  goes by the names. A plane counts as
   the same when its unit normal is within NORMAL_TOLERANCE (each component) and the new origin
   lies within ORIGIN_TOLERANCE of the recorded plane: sliding or spinning a handle within its own
   plane cuts the same contours, so it does not make the design stale.
@@ -17,8 +20,13 @@ What is compared:
 
 The tolerances are far below any edit a maker makes (a nudge is 0.1 mm at least) and far above
 the float round trips of a handle's matrix and of the design's JSON.
+
+The design's wire names keep the plane names they were solved with (design.json is written then);
+renamed_wire / renamed_text show them with the planes' names now (current_names) where the panel
+prints them.
 """
 import math
+import re
 
 ORIGIN_TOLERANCE = 1e-6  # m: the distance of the new origin from the recorded plane
 NORMAL_TOLERANCE = 1e-6  # per component of the unit normals
@@ -56,6 +64,55 @@ def recorded_planes(design):
     return planes, ticks
 
 
+def current_names(recorded, ids, handles):
+    """{recorded plane name: the name of that plane's handle now, or None when it is gone}.
+
+    recorded: the design's plane names. ids: {plane name: persistent id} as Optimize recorded them
+    (blend/results.store_inputs, "planes"); None, or a name without one: that plane goes by its
+    name, as records before ids did. handles: {name: id or None} of the scene's slicing handles
+    that may be the recorded ones (those of the contour list and those of a recorded name).
+    A recorded id names the handle that has it now: the one still of its name, else the only
+    one (a renamed plane); none, or several and none of them of its name (a copy that kept the
+    id), is a plane gone."""
+    ids = ids if isinstance(ids, dict) else {}
+    holders = {}
+    for name, uid in handles.items():
+        if uid is not None:
+            holders.setdefault(uid, []).append(name)
+    names = {}
+    for name in recorded:
+        uid = ids.get(name)
+        if uid is None:
+            names[name] = name if name in handles else None
+        elif handles.get(name) == uid:
+            names[name] = name
+        else:
+            found = holders.get(uid, [])
+            names[name] = found[0] if len(found) == 1 else None
+    return names
+
+
+def renamed_wire(name, names):
+    """Wire `name` ("<plane name>/<index>") with its plane's name now (`names`: current_names), or
+    as it is when that plane is not renamed (kept, gone, or not a wire name)."""
+    key = wire_contour(name)
+    now = (names or {}).get(key[0]) if key else None
+    return f"{now}/{key[1]}" if now and now != key[0] else name
+
+
+def renamed_text(text, design, names):
+    """`text` (a reason, a warning) with the names of `design`'s wires whose plane was renamed
+    (renamed_wire) written as they are called now. Every wire name is matched, longest first, and
+    not followed by a digit, so neither "A/0" inside "Slice A/0" nor "Slice A/1" inside
+    "Slice A/10" is taken for another wire."""
+    wires = [str(w.get("name", "")) for w in design.get("wires") or []]
+    now = {name: renamed_wire(name, names) for name in wires if name}
+    if not text or all(a == b for a, b in now.items()):
+        return text
+    pattern = "|".join(re.escape(name) for name in sorted(now, key=len, reverse=True))
+    return re.sub(f"(?:{pattern})(?![0-9])", lambda m: now[m.group(0)], text)
+
+
 def _unit(v):
     length = math.sqrt(sum(float(x) * float(x) for x in v))
     return tuple(float(x) / length for x in v) if length > 0 else tuple(float(x) for x in v)
@@ -89,15 +146,18 @@ def changed_keys(recorded, now):
 
 
 def changes(design, planes, ticked, inputs=None, target=None, settings=None, material=None, labels=None,
-            recorded=None):
+            recorded=None, names=None):
     """What changed since `design` was optimized, as short phrases ("plane Slice B moved", "plane
     Slice C removed", "plane Slice D added", "contours ticked differently (Slice A #1 unticked)",
     "target changed", "settings changed (Max Bend)"); [] while it is current.
 
     planes: {handle name: (origin, normal) or None (no normal)} of the slicing handles now: at
-    least those named by the design's wires and by the ticks (a name missing is a plane gone).
+    least those the design's planes have now (`names`) and those named by the ticks (a name
+    missing is a plane gone).
     ticked: {(plane name, contour index)} ticked now (a plane name may be one that is gone), or
     None when they cannot be read.
+    names: current_names of the design's planes: a renamed plane is compared, and named, by its
+    name now; None: each plane by its recorded name.
     inputs: what Optimize recorded ({"target", "settings", "material"}), or None: then target,
     settings and material are not compared. target: the target's name now ("" for none);
     settings / material: the dicts props.solver_settings / material_of give now (settings None:
@@ -106,22 +166,25 @@ def changes(design, planes, ticked, inputs=None, target=None, settings=None, mat
     recorded: recorded_planes(design) when the caller keeps it (a panel redraws often)."""
     said = []
     before, ticks_before = recorded or recorded_planes(design)
-    removed, added = set(), set()
+    now = {name: (names or {}).get(name, name) for name in before}
+    removed, present = set(), set()  # recorded names of the planes gone; names now of those kept
     for name, plane in before.items():
-        if name not in planes:
+        if now[name] not in planes:
             removed.add(name)
             said.append(f"plane {name} removed")
             continue
-        how = plane_change(plane, planes[name])
+        present.add(now[name])
+        how = plane_change(plane, planes[now[name]])
         if how:
-            said.append(f"plane {name} {how}")
+            said.append(f"plane {now[name]} {how}")
     if ticked is not None:
-        for name in sorted({p for p, _i in ticked} - set(before)):
+        added = set()
+        for name in sorted({p for p, _i in ticked} - present):
             if name in planes:  # a tick whose plane is gone is not a plane added (the ticks differ)
                 added.add(name)
                 said.append(f"plane {name} added")
-        old = {t for t in ticks_before if t[0] not in removed}
-        new = {t for t in ticked if t[0] not in added and t[0] not in removed}
+        old = {(now[p], i) for p, i in ticks_before if p not in removed}
+        new = {t for t in ticked if t[0] not in added and (t[0] in present or t[0] not in removed)}
         if old != new:
             named = [f"{p} #{i} unticked" for p, i in sorted(old - new)] + [f"{p} #{i} ticked" for p, i in sorted(new - old)]
             more = f", {len(named) - MAX_NAMED} more" if len(named) > MAX_NAMED else ""

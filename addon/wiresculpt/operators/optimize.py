@@ -20,7 +20,7 @@ import bpy
 from .. import native, pipeline
 from ..blend import cut_handles, mesh
 from ..blend import results as scene_results
-from ..blend.handles import target_name, target_problem, ticked_planes
+from ..blend.handles import plane_ids, target_name, target_problem, ticked_planes
 from ..blend.view import redraw_3d_views
 from ..blend.registration import classes_factory
 from ..core.design import setup_problem
@@ -60,10 +60,12 @@ def build_design(context):
 
 
 def solve_record(scene, material, settings):
-    """What a solve reads besides the planes and ticks, as Optimize starts it: kept beside the
-    stored design (blend/results.store_inputs) so the Stability box can tell when the panel has
-    changed since (core/stale.py)."""
-    return {"target": target_name(scene.wiresculpt), "settings": dict(settings), "material": dict(material)}
+    """What a solve reads besides the planes and ticks, as Optimize starts it, and the planes' ids
+    (handles.plane_ids: gives those missing): kept beside the stored design
+    (blend/results.store_inputs) so the Stability box can tell when the panel has changed since
+    and which handle a renamed plane is (core/stale.py)."""
+    return {"target": target_name(scene.wiresculpt), "settings": dict(settings), "material": dict(material),
+            "planes": plane_ids(scene)}
 
 
 def summary(design):

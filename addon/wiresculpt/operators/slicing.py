@@ -3,7 +3,7 @@ import bpy
 
 from .. import native
 from ..blend import mesh
-from ..blend.contours import apply_slice
+from ..blend.contours import apply_slice, release_deleted
 from ..blend.handles import add_handle, handle_plane, handles, target_problem
 from ..blend.registration import classes_factory
 
@@ -77,4 +77,33 @@ class WIRESCULPT_OT_slice(bpy.types.Operator):
         return {'FINISHED'}
 
 
-register, unregister = classes_factory((WIRESCULPT_OT_add_plane, WIRESCULPT_OT_slice))
+_register, _unregister = classes_factory((WIRESCULPT_OT_add_plane, WIRESCULPT_OT_slice))
+
+
+@bpy.app.handlers.persistent
+def _release_deleted(*_args):
+    """After every depsgraph update (a delete is one) and on loading a file (one saved before
+    this): a plane or contour curve deleted in the viewport is not kept in the file by the contour
+    list (contours.release_deleted). Not from a panel's draw, which may not write ID data; undo
+    brings a deleted plane back with its pointer, as the undo step saved it."""
+    try:
+        release_deleted(bpy.data.scenes)
+    except (AttributeError, ReferenceError):  # the add-on half unregistered, a scene being freed
+        pass
+
+
+HANDLERS = ("depsgraph_update_post", "load_post")
+
+
+def register():
+    _register()
+    for kind in HANDLERS:
+        getattr(bpy.app.handlers, kind).append(_release_deleted)
+
+
+def unregister():
+    for kind in HANDLERS:
+        handlers = getattr(bpy.app.handlers, kind)
+        if _release_deleted in handlers:
+            handlers.remove(_release_deleted)
+    _unregister()

@@ -10,7 +10,7 @@ from ..blend import results as scene_results
 from ..blend.registration import classes_factory
 from ..core import closure, stale
 from ..core.design import setup_problem
-from .stale import report_changes
+from .stale import report, report_changes  # noqa: F401 (report_changes: read here by the tests)
 from ..operators import optimize
 from ..operators.results import WIRESCULPT_OT_assembly_guide, WIRESCULPT_OT_clear_results
 from .panel import VIEW3D_PT_wiresculpt, length_text, wrap_labels
@@ -57,16 +57,18 @@ def load_capacity_rows(design):
     return rows
 
 
-def wire_rows(design):
+def wire_rows(design, names=None):
     """[(wire name, closure gap text or None, out-of-plane deflection text or None)] per wire that
     has either figure: the gap in mm and % of the wire's length (core/closure.py), the deflection
-    in mm (the 3D check, `out_of_plane_deflection`)."""
+    in mm (the 3D check, `out_of_plane_deflection`). names: core/stale.current_names, for the wires
+    of renamed planes (core/stale.renamed_wire)."""
     rows = []
     for w in design.get("wires", []):
         gap = closure.closure_text(w)
         bend = w.get("out_of_plane_deflection")
         if gap is not None or bend is not None:
-            rows.append((w["name"], gap, f"{bend * 1000:.2f} mm" if bend is not None else None))
+            rows.append((stale.renamed_wire(w["name"], names), gap,
+                         f"{bend * 1000:.2f} mm" if bend is not None else None))
     return rows
 
 
@@ -84,9 +86,10 @@ def torque_text(design):
     return text
 
 
-def assembly_rows(design):
+def assembly_rows(design, names=None):
     """One row per wire in assembly order: "1. Equator/0", "   + Meridian0/0" for a wire added in
-    the same step, "(two hands)" after a step that adds two wires at once beyond the first pair."""
+    the same step, "(two hands)" after a step that adds two wires at once beyond the first pair.
+    names: as wire_rows'."""
     steps = design.get("assembly_steps")
     if not steps:
         order = design.get("assembly_order") or []
@@ -94,10 +97,10 @@ def assembly_rows(design):
     two_hands = set(design.get("two_hand_steps") or [])
     rows = []
     for k, step in enumerate(steps):
-        names = [design["wires"][w]["name"] for w in step]
+        wires = [stale.renamed_wire(design["wires"][w]["name"], names) for w in step]
         note = " (two hands)" if k in two_hands else ""
-        rows.append(f"{k + 1}. {names[0]}" + (note if len(names) == 1 else ""))
-        rows += [f"    + {name}" + (note if i == len(names) - 2 else "") for i, name in enumerate(names[1:])]
+        rows.append(f"{k + 1}. {wires[0]}" + (note if len(wires) == 1 else ""))
+        rows += [f"    + {name}" + (note if i == len(wires) - 2 else "") for i, name in enumerate(wires[1:])]
     return rows
 
 
@@ -178,7 +181,7 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
     def draw(self, context):
         layout = self.layout
         design = scene_results.stored_design()
-        said = report_changes(context)
+        said, names = report(context)
         if said:  # the scene moved on: the design below is an earlier one's, greyed, and no green tick
             _wrap(layout, context, stale.stale_text(said), icon='TIME')
             layout = layout.column()
@@ -199,8 +202,8 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
                 box.label(text="Search was incomplete" if said else "Search incomplete", icon='ERROR')
             else:
                 box.label(text="Was not stable" if said else "Not stable", icon='ERROR')
-            _wrap(box, context, design.get("reason") or "no reason given")
-        rows = assembly_rows(design)
+            _wrap(box, context, stale.renamed_text(design.get("reason"), design, names) or "no reason given")
+        rows = assembly_rows(design, names)
         if rows:
             col = layout.column(align=True)
             col.label(text="Assembly order:")
@@ -214,7 +217,7 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
         torque = torque_text(design)
         if torque:
             _wrap(layout, context, torque)
-        wires = wire_rows(design)
+        wires = wire_rows(design, names)
         if wires:
             # per wire: how far its rest shape's ends stand apart before assembly, and how far its
             # contact forces bend it out of its plane
@@ -236,12 +239,14 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
         pending = design.get("pending_stages") or []
         if pending:
             _wrap(layout, context, "Pending: " + ", ".join(p.replace("_", " ") for p in pending), icon='INFO')
-        crossing = [c["message"] for c in (design.get("buildability") or {}).get("self_crossings", [])]
+        crossing = [stale.renamed_text(c["message"], design, names)
+                    for c in (design.get("buildability") or {}).get("self_crossings", [])]
         if crossing:  # a rest shape that crosses itself: shown first, the maker must see it before bending
             col = layout.column(align=True)
             for message in crossing:
                 _wrap(col, context, message, icon='ERROR')
-        warnings = [w for w in design.get("warnings") or [] if w not in crossing]
+        warnings = [stale.renamed_text(w, design, names) for w in design.get("warnings") or []]
+        warnings = [w for w in warnings if w not in crossing]
         if warnings:
             col = layout.column(align=True)
             for warning in warnings[:3]:
@@ -268,8 +273,10 @@ class VIEW3D_PT_wiresculpt_display(_Child, bpy.types.Panel):
         if steps:
             layout.prop(ws, "assembly_step", slider=False)
             if ws.assembly_step:
-                names = [design["wires"][w]["name"] for s in steps[:ws.assembly_step] for w in s]
-                _wrap(layout, context, "Shown: " + ", ".join(names))
+                names = report(context)[1]
+                shown = [stale.renamed_wire(design["wires"][w]["name"], names)
+                         for s in steps[:ws.assembly_step] for w in s]
+                _wrap(layout, context, "Shown: " + ", ".join(shown))
             col = layout.column(align=True)
             col.prop(ws, "guide_folder", text="")
             col.operator(WIRESCULPT_OT_assembly_guide.bl_idname, icon='HELP')

@@ -20,25 +20,33 @@ def setting_labels():
 _recorded = {"design": None, "planes": None, "labels": None}
 
 
-def report_changes(context):
-    """What changed in the scene since the stored design was optimized (core/stale.changes), [] while
-    it is current or there is none. Reads the handles as last evaluated (the view layer's depsgraph,
-    not evaluated again from a panel's draw)."""
+def report(context):
+    """(what changed in the scene since the stored design was optimized (core/stale.changes), [] while
+    it is current; {the design's plane names: their names now (core/stale.current_names)}), ([], {})
+    when there is no design. Reads the handles as last evaluated (the view layer's depsgraph, not
+    evaluated again from a panel's draw)."""
     design = scene_results.stored_design()
     if design is None:
-        return []
+        return [], {}
     if _recorded["design"] is not design:
         _recorded.update(design=design, planes=stale.recorded_planes(design), labels=setting_labels())
     scene = context.scene
     ws = scene.wiresculpt
-    planes, ticked = scene_results.scene_planes(scene, context.view_layer.depsgraph, _recorded["planes"][0])
+    inputs = scene_results.stored_inputs()
+    planes, ticked, names = scene_results.scene_planes(scene, context.view_layer.depsgraph, _recorded["planes"][0],
+                                                       (inputs or {}).get("planes"))
     try:
         settings = props.solver_settings(ws)
     except ValueError:  # the panel's values cannot be solved (smallest bend above the largest)
         settings = None
-    return stale.changes(design, planes, ticked, scene_results.stored_inputs(),
-                         target_name(ws), settings, props.material_of(ws),
-                         _recorded["labels"], _recorded["planes"])
+    said = stale.changes(design, planes, ticked, inputs, target_name(ws),
+                         settings, props.material_of(ws), _recorded["labels"], _recorded["planes"], names)
+    return said, names
+
+
+def report_changes(context):
+    """The phrases of report(context): what changed since the stored design was optimized."""
+    return report(context)[0]
 
 
 def live_hint(context, verdict):
