@@ -13,6 +13,13 @@ SCRIPT = os.path.join(ROOT, "blender_tests", "ui_live.py")
 TICK_LIMIT = 0.050  # issue 17: no step blocks the UI for more than 50 ms (the one time assertion)
 
 
+def stands(verdict):
+    """Whether a verdict (without "Live: ") says the design stands: "stable", or "stable, over its
+    limits — …" (Live solves with the layering's own hooks; on the globe those give a stable design
+    that bends its wires out of their planes, core/limits.py)."""
+    return verdict == "stable" or verdict.startswith("stable, over its limits — ")
+
+
 @unittest.skipUnless(shutil.which("xvfb-run"), "xvfb-run is not installed")
 class Live(unittest.TestCase):
     @classmethod
@@ -31,13 +38,13 @@ class Live(unittest.TestCase):
         self.assertTrue(self.seen["timer_on"])
         lines = [v["line"] for v in self.seen["verdicts"]]
         self.assertEqual(len(lines), 4, lines)
-        self.assertEqual(lines[0], "Live: stable")
+        self.assertTrue(stands(lines[0][len("Live: "):]), lines[0])
         # 5 mm below the top of the globe: the design's own verdict, not stable, with the reason
         self.assertTrue(lines[1].startswith("Live: not stable — the target shape cannot realise crossing "), lines)
         # the plane cuts nothing: its ticked contour does not exist, a setup problem, not a verdict
         self.assertTrue(lines[2].startswith("Live: cannot solve — plane Slice A: contour index 0 does not exist"),
                         lines)
-        self.assertEqual(lines[3], "Live: stable")
+        self.assertTrue(stands(lines[3][len("Live: "):]), lines[3])
         # the preview: the three wires of a solved design (stable or not), none when the plane cuts nothing
         self.assertEqual([v["preview_wires"] for v in self.seen["verdicts"]], [3, 3, 0, 3])
 
@@ -165,6 +172,9 @@ class LiveFollowsTheScene(BlenderCase):
 
         return bpy.context.scene
 
+    def assertStands(self, verdict):
+        self.assertTrue(stands(verdict), verdict)
+
     def settle(self, timeout=60.0):
         """Runs the timer's steps until the verdict of the scene as it is now is shown."""
         import time
@@ -197,7 +207,7 @@ class LiveFollowsTheScene(BlenderCase):
         from wiresculpt.operators import live
 
         self.ws.live = True
-        self.assertEqual(self.settle(), "stable")
+        self.assertStands(self.settle())
         max_bend, min_bend = self.ws.max_bend_deg, self.ws.min_bend_deg
         self.addCleanup(setattr, self.ws, "min_bend_deg", min_bend)  # also when an assertion fails: the scene's
         self.addCleanup(setattr, self.ws, "max_bend_deg", max_bend)  # settings outlive the test
@@ -213,7 +223,7 @@ class LiveFollowsTheScene(BlenderCase):
         self.assertEqual(live.STATE.preview, [])
         self.assertTrue(bpy.app.timers.is_registered(live.tick))
         self.ws.max_bend_deg, self.ws.min_bend_deg = max_bend, min_bend
-        self.assertEqual(self.settle(), "stable")
+        self.assertStands(self.settle())
 
     def test_edits_and_modifiers_of_the_target_are_seen(self):
         import bpy
@@ -222,7 +232,7 @@ class LiveFollowsTheScene(BlenderCase):
         from wiresculpt.operators import live
 
         self.ws.live = True
-        self.assertEqual(self.settle(), "stable")
+        self.assertStands(self.settle())
         before, seen = self.extent(), live.STATE.geometry
         self.assertAlmostEqual(before, 0.125, delta=0.01)  # the wires lie on the globe
         self.target.data.transform(Matrix.Scale(0.6, 4))  # an edit of the mesh, its matrix unchanged
@@ -243,7 +253,7 @@ class LiveFollowsTheScene(BlenderCase):
         from wiresculpt.operators import live
 
         self.ws.live = True
-        self.assertEqual(self.settle(), "stable")
+        self.assertStands(self.settle())
         for collection in self.target.users_collection:
             collection.objects.unlink(self.target)
         verdict = self.settle()
@@ -261,7 +271,7 @@ class LiveFollowsTheScene(BlenderCase):
         from wiresculpt.ui import panel
 
         self.ws.live = True
-        self.assertEqual(self.settle(), "stable")
+        self.assertStands(self.settle())
         for item in self.ws.contours:
             item.use = False
         self.assertEqual(self.settle(), "cannot solve — No contour is ticked: Slice, then tick the contours that "
@@ -282,7 +292,7 @@ class LiveFollowsTheScene(BlenderCase):
                          (panel.live_look("stable")[0], panel.live_look("not stable — crossing 3 pulls")[0]))
         for item in self.ws.contours:
             item.use = True
-        self.assertEqual(self.settle(), "stable")
+        self.assertStands(self.settle())
         with mock.patch.object(native, "available", return_value=False):
             self.target.location.x += 0.001
             bpy.context.view_layer.update()
@@ -291,7 +301,7 @@ class LiveFollowsTheScene(BlenderCase):
         target, self.ws.target = self.ws.target, None
         self.assertEqual(self.settle(), "cannot solve — No target mesh: pick one in the Wire panel (Target)")
         self.ws.target = target
-        self.assertEqual(self.settle(), "stable")
+        self.assertStands(self.settle())
 
     def test_one_wire_cannot_solve(self):
         """One contour ticked: the solve ends with the pipeline's "at least two wires", a setup problem
@@ -300,7 +310,7 @@ class LiveFollowsTheScene(BlenderCase):
         from wiresculpt.ui import panel
 
         self.ws.live = True
-        self.assertEqual(self.settle(), "stable")
+        self.assertStands(self.settle())
         for item in list(self.ws.contours)[1:]:
             item.use = False
         self.assertEqual(self.settle(), "cannot solve — a sculpture needs at least two wires: add a plane or pick "
@@ -308,7 +318,7 @@ class LiveFollowsTheScene(BlenderCase):
         self.assertEqual(panel.live_look(live.STATE.verdict), ('INFO', False))
         for item in self.ws.contours:
             item.use = True
-        self.assertEqual(self.settle(), "stable")
+        self.assertStands(self.settle())
 
     def test_a_plane_moved_off_the_mesh_cannot_solve(self):
         """Its ticked contour is gone (the solve's ValueError): what the window test's second step sees."""
@@ -317,7 +327,7 @@ class LiveFollowsTheScene(BlenderCase):
         from wiresculpt.operators import live
 
         self.ws.live = True
-        self.assertEqual(self.settle(), "stable")
+        self.assertStands(self.settle())
         plane = self.scene().objects["Slice A"]
         plane.location.z = 0.3
         bpy.context.view_layer.update()
@@ -326,7 +336,7 @@ class LiveFollowsTheScene(BlenderCase):
         self.assertEqual(live.STATE.preview, [])
         plane.location.z = 0.0
         bpy.context.view_layer.update()
-        self.assertEqual(self.settle(), "stable")
+        self.assertStands(self.settle())
 
     def test_errors_of_a_solve(self):
         """The solver refusing the input is a setup problem; any other exception is our error, said as such."""
@@ -338,7 +348,7 @@ class LiveFollowsTheScene(BlenderCase):
         from wiresculpt.ui import panel
 
         self.ws.live = True
-        self.assertEqual(self.settle(), "stable")
+        self.assertStands(self.settle())
         refused = ValueError("three wires pass through one point: move one of the planes slightly")
         with mock.patch.object(live.pipeline, "solve", side_effect=refused):
             self.target.location.x += 0.001
@@ -354,7 +364,7 @@ class LiveFollowsTheScene(BlenderCase):
         self.assertEqual(live.STATE.preview, [])
         self.target.location.x -= 0.002
         bpy.context.view_layer.update()
-        self.assertEqual(self.settle(), "stable")
+        self.assertStands(self.settle())
 
     def test_a_long_reason_shows_its_first_clause(self):
         """The globe with Max Bend 30°: the reason repeats "crossing k on wire …" for every crossing; the
@@ -368,7 +378,7 @@ class LiveFollowsTheScene(BlenderCase):
         from wiresculpt.ui import panel
 
         self.ws.live = True
-        self.assertEqual(self.settle(), "stable")
+        self.assertStands(self.settle())
         self.addCleanup(setattr, self.ws, "max_bend_deg", self.ws.max_bend_deg)  # the scene's settings stay
         self.ws.max_bend_deg = math.radians(30.0)
         verdict = self.settle()
@@ -397,7 +407,7 @@ class LiveFollowsTheScene(BlenderCase):
         self.assertFalse(bpy.app.timers.is_registered(live.tick))
         live._sync_shown()
         self.assertTrue(bpy.app.timers.is_registered(live.tick))
-        self.assertEqual(self.settle(), "stable")
+        self.assertStands(self.settle())
         self.ws["live"] = 0
         self.scene().update_tag()
         bpy.context.view_layer.update()  # a depsgraph update: the registered handler stops the timer
@@ -427,7 +437,7 @@ class LiveFollowsTheScene(BlenderCase):
         self.assertEqual(live.line(), "Live: error — RuntimeError: the solver's thread could not start")
         self.target.location.x += 0.001
         bpy.context.view_layer.update()  # matrix_world follows (a window's event loop does it)
-        self.assertEqual(self.settle(), "stable")
+        self.assertStands(self.settle())
 
     def test_a_mesh_read_over_the_limit_turns_live_off(self):
         import time

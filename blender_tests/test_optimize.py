@@ -3,6 +3,7 @@ save and reload, the assembly slider, failing designs, the report panel and the 
 
     blender --background --factory-startup --python-exit-code 1 --python blender_tests/run.py -- optimize
 """
+import json
 import math
 import os
 import tempfile
@@ -251,9 +252,41 @@ class OptimizeGlobe(Case):
         globe()
         result, reports = run(optimize.WIRESCULPT_OT_optimize)
         self.assertEqual(result, {'FINISHED'})
+        # the globe of great circles holds its load factor with its wires in their planes (figures
+        # read from the design, the 2 mm limit the solver's): plainly stable
+        design = scene_results.stored_design()
+        self.assertGreaterEqual(design["load_factor"]["reached"], design["load_factor"]["asked"])
+        self.assertTrue(all(w["out_of_plane_deflection"] <= 0.002 for w in design["wires"]))
         self.assertEqual(reports[-1][0], {'INFO'})
-        self.assertIn("Stable", reports[-1][1])
+        self.assertTrue(reports[-1][1].startswith("Stable: "), reports[-1][1])
         self.assertEqual(optimize.WIRESCULPT_OT_optimize.bl_options, {'REGISTER', 'UNDO'})
+
+    def test_no_green_stable_beside_a_broken_limit(self):
+        globe()
+        bpy.ops.wiresculpt.optimize()
+        icons = {kw.get("text"): kw.get("icon") for name, _a, kw in draw(results_ui.VIEW3D_PT_wiresculpt_report)
+                 if name == "label"}
+        self.assertEqual(icons.get("Stable"), 'CHECKMARK')
+        # the same design with a wire bending 2.5 mm out of its plane and its load factor not
+        # reached (its figures edited by hand): the limits first, no green tick, a warning
+        design = scene_results.stored_design()
+        design["load_factor"]["reached"] = 1.5
+        design["wires"][1]["out_of_plane_deflection"] = 0.0025
+        bpy.data.texts[scene_results.DESIGN_TEXT].from_string(json.dumps(design))
+        log = draw(results_ui.VIEW3D_PT_wiresculpt_report)
+        icons = {kw.get("text"): kw.get("icon") for name, _a, kw in log if name == "label"}
+        self.assertEqual(icons.get("Stable, over its limits"), 'ERROR')
+        self.assertNotIn("Stable", icons)
+        self.assertNotIn('CHECKMARK', icons.values())
+        shown = labels(log)
+        wire = design["wires"][1]["name"]
+        first = shown.index("Stable, over its limits")
+        after = " ".join(shown[first + 1:])  # the limits first, wrapped to the sidebar's width
+        self.assertTrue(after.startswith(f"holds 1.50x its weight ({design['load_factor']['weakest']}), not the 3x "
+                                         f"asked wire {wire} bends 2.5 mm out of its plane (limit 2.0 mm)"), after)
+        kind, sentence = optimize.summary(design)
+        self.assertEqual(kind, {'WARNING'})
+        self.assertTrue(sentence.startswith("Stable, over its limits: holds 1.50x its weight"), sentence)
 
     def test_assembly_guide(self):
         globe()
@@ -279,7 +312,16 @@ class OptimizeGlobe(Case):
                 self.assertIn(f"stand {gap * 1000:.1f} mm apart ({100 * gap / w['length']:.1f}% of its length)", text)
                 self.assertIn("with a sleeve" if gap <= 0.05 * w["length"] else "with an overlap", text)
             self.assertFalse([n for n in os.listdir(folder) if n.endswith(".tmp") or n.startswith(".")])
+            self.assertNotIn("over its limits", text)  # the globe holds its load factor, its wires in plane
         self.assertEqual(snapshot(), before, "rendering the guide must put the scene back")
+        # a wire bending 2.5 mm out of its plane (set by hand): the guide says so before the steps
+        design["wires"][0]["out_of_plane_deflection"] = 0.0025
+        with tempfile.TemporaryDirectory() as folder:
+            with open(assembly_guide.write_guide(bpy.context.scene, design, folder), encoding="utf-8") as f:
+                text = f.read()
+        said = f"This design is stable, over its limits: wire {design['wires'][0]['name']} bends 2.5 mm out of its plane"
+        self.assertIn(said, text)
+        self.assertLess(text.index(said), text.index("Step 1: hold"))
 
     def test_crossing_sentence_names_the_side(self):
         design = {"wires": [{"name": "Equator/0", "plane": {"normal": [1, 0, 0]}},
@@ -413,9 +455,13 @@ class StaleReport(Case):
         disagree = live_verdict.verdict(live_verdict.NOT_STABLE, "crossing 2 slips")
         self.assertIn("Optimize found these planes stable", stale_ui.live_hint(bpy.context, disagree))
         self.assertEqual(stale_ui.live_hint(bpy.context, live_verdict.SOLVING), "")
+        # Live's own hook pattern over a limit where Optimize's is within them all
+        over = live_verdict.verdict(live_verdict.OVER_LIMITS, "wire Slice A/0 bends 77.0 mm out of its plane")
+        self.assertIn("Optimize found these planes stable within its limits", stale_ui.live_hint(bpy.context, over))
         bpy.data.objects["Slice A"].location.z += 0.01
         bpy.context.view_layer.update()
         self.assertEqual(stale_ui.live_hint(bpy.context, disagree), "")  # an earlier Optimize says nothing of these planes
+        self.assertEqual(stale_ui.live_hint(bpy.context, over), stale_ui.TRIES_MORE)  # but Optimize may do better
 
     def test_removing_a_plane(self):
         self.optimize()

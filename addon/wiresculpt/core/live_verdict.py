@@ -2,6 +2,8 @@
 each said with one prefix, and the part of a long reason the line shows.
 
 - "stable", "solving…": a word alone;
+- "stable, over its limits — <limits>": stable and buildable but breaking a limit a maker asked
+  for (core/limits.py: the load factor, wires bending out of their planes, the stock, the size);
 - "not stable — <reason>": a solve that ended with the design not stable (design["reason"]);
 - "cannot solve — <problem>": the scene as it is set up cannot be solved at all (no target, no
   contour ticked, a panel value the solver refuses, a ticked contour the plane no longer cuts,
@@ -16,6 +18,7 @@ deciding figure (the angle, the length, the scale) comes last, up to CLAUSE_WORD
 itself is never reworded (design.json keeps it; FORMATS.md). bpy-free.
 """
 from .design import setup_problem
+from .limits import OVER_LIMITS, broken_limits
 
 STABLE = "stable"
 SOLVING = "solving…"
@@ -72,17 +75,19 @@ def verdict(kind, text=""):
 
 
 def of_design(design):
-    """(kind, text) of a solved `design`: STABLE alone; CANNOT_SOLVE with its reason when that is a
-    setup problem (core/design.setup_problem: fewer than two wires, nothing was solved); else
-    NOT_STABLE with its reason."""
+    """(kind, text) of a solved `design`: STABLE alone, or OVER_LIMITS with the limits it breaks
+    (core/limits.broken_limits); CANNOT_SOLVE with its reason when that is a setup problem
+    (core/design.setup_problem: fewer than two wires, nothing was solved); else NOT_STABLE with its
+    reason."""
     if design["stable"]:
-        return STABLE, ""
+        limits = broken_limits(design)
+        return (OVER_LIMITS, "; ".join(limits)) if limits else (STABLE, "")
     return (CANNOT_SOLVE if setup_problem(design) else NOT_STABLE), design.get("reason") or ""
 
 
 def kind_of(line):
     """The kind of a verdict made by `verdict` (the panel picks its icon by it); "" when none."""
-    for kind in (NOT_STABLE, CANNOT_SOLVE, ERROR):
+    for kind in (NOT_STABLE, CANNOT_SOLVE, ERROR, OVER_LIMITS):
         if line == kind or line.startswith(kind + DASH):
             return kind
     return line if line in (STABLE, SOLVING) else ""

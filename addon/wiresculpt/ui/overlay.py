@@ -18,6 +18,7 @@ import numpy as np
 from gpu_extras.batch import batch_for_shader
 
 from ..blend import compat, results
+from ..core.limits import DEFLECTION_LIMIT
 from ..operators import live
 from ..operators import plane_search
 
@@ -25,7 +26,6 @@ ARROW_SHARE = 0.2
 HEAD_SHARE = 0.25  # arrow head length as a share of the arrow
 COLOUR = (1.0, 0.35, 0.05, 1.0)
 DEFLECTION_SCALE = 10.0
-DEFLECTION_LIMIT = 0.002  # m: the forces stage's default deflection_limit (native forces_and_rest)
 DEFLECTION_COLOURS = {False: (0.2, 0.45, 1.0, 1.0), True: (1.0, 0.1, 0.1, 1.0)}
 
 _handle = None

@@ -18,7 +18,7 @@ WIDE_LIST = 280  # pixels of sidebar from which a contour row has room for its l
 # The live verdict's icon by its kind (core/live_verdict): a setup problem (cannot solve) reads as
 # something to do, not as a verdict on the design; our error stands out in red (live_look).
 LIVE_ICONS = {live_verdict.STABLE: 'CHECKMARK', live_verdict.SOLVING: 'SORTTIME', live_verdict.NOT_STABLE: 'ERROR',
-              live_verdict.CANNOT_SOLVE: 'INFO', live_verdict.ERROR: 'CANCEL'}
+              live_verdict.CANNOT_SOLVE: 'INFO', live_verdict.ERROR: 'CANCEL', live_verdict.OVER_LIMITS: 'ERROR'}
 
 
 def length_text(scene, value, precision=4):

@@ -9,8 +9,9 @@ from .. import native, props
 from ..blend import results as scene_results
 from ..blend.registration import classes_factory
 from ..core import closure, stale
+from ..core.limits import OVER_LIMITS
 from ..core.design import setup_problem
-from .stale import report, report_changes  # noqa: F401 (report_changes: read here by the tests)
+from .stale import design_limits, report, report_changes  # noqa: F401 (report_changes: read here by the tests)
 from ..operators import optimize
 from ..operators.results import WIRESCULPT_OT_assembly_guide, WIRESCULPT_OT_clear_results
 from .panel import VIEW3D_PT_wiresculpt, length_text, wrap_labels
@@ -187,7 +188,14 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
             layout = layout.column()
             layout.active = False
         box = layout.box()
-        if design["stable"]:
+        limits = design_limits(design) if design["stable"] else []
+        if limits:  # stable and buildable, but not what a maker asked for: no green tick, the limits first
+            box.alert = not said
+            words = OVER_LIMITS[0].upper() + OVER_LIMITS[1:]
+            box.label(text=f"Was {OVER_LIMITS}" if said else words, icon='ERROR')
+            for limit in limits:
+                _wrap(box, context, limit, icon='DOT')
+        elif design["stable"]:
             if said:
                 box.label(text="Was stable", icon='BLANK1')
             else:

@@ -5,6 +5,7 @@ from .. import props
 from ..blend import results as scene_results
 from ..blend.handles import target_name
 from ..core import live_verdict, stale
+from ..core.limits import broken_limits
 
 
 def setting_labels():
@@ -49,16 +50,38 @@ def report_changes(context):
     return report(context)[0]
 
 
+def design_limits(design):
+    """core/limits.broken_limits(design), computed once per stored design (panels read it at every
+    redraw)."""
+    if _limits["design"] is not design:
+        _limits.update(design=design, said=broken_limits(design))
+    return _limits["said"]
+
+
+_limits = {"design": None, "said": []}
+
+# Live solves with the layering's own hook pattern only; Optimize compares more of them.
+TRIES_MORE = "Live tries the layering's hooks only: Optimize tries more and may keep these planes within the limits"
+
+
 def live_hint(context, verdict):
-    """A short line under the Live line when Live's `verdict` (stable / not stable) disagrees with
-    the stored design while that design is current: Optimize searched more hook patterns on the
-    same planes, its verdict is the one to build from. "" otherwise (no design, an earlier one,
-    Live solving or unable to solve)."""
+    """A short line under the Live line when Live's `verdict` disagrees with the stored design while
+    that design is current: Optimize searched more hook patterns on the same planes, its verdict is
+    the one to build from. Live's "stable, over its limits" without a current Optimize says that
+    Optimize may do better (TRIES_MORE). "" otherwise (no disagreement, Live solving or unable to
+    solve)."""
     kind = live_verdict.kind_of(verdict)
     design = scene_results.stored_design()
-    if kind not in (live_verdict.STABLE, live_verdict.NOT_STABLE) or design is None:
+    if kind == live_verdict.OVER_LIMITS and (design is None or report_changes(context)):
+        return TRIES_MORE
+    if kind not in (live_verdict.STABLE, live_verdict.OVER_LIMITS, live_verdict.NOT_STABLE) or design is None:
         return ""
-    if bool(design.get("stable")) == (kind == live_verdict.STABLE) or report_changes(context):
+    if design.get("stable"):
+        found = live_verdict.OVER_LIMITS if design_limits(design) else live_verdict.STABLE
+    else:
+        found = live_verdict.NOT_STABLE
+    if found == kind or report_changes(context):
         return ""
-    said = "stable" if design.get("stable") else "not stable"
+    said = {live_verdict.STABLE: "stable within its limits", live_verdict.OVER_LIMITS: live_verdict.OVER_LIMITS,
+            live_verdict.NOT_STABLE: "not stable"}[found]
     return f"Optimize found these planes {said} (it tries more hook patterns): build from Optimize's result"

@@ -1,0 +1,56 @@
+"""The limits a stable design can still break, said first and in short: `stable` (FORMATS.md) means
+every segment and bend can be made and the assembly holds, but a maker also needs the sculpture to
+carry the load factor asked for, to keep its wires in their planes, to fit the machine's stock and
+to be of a size such wires make. A design that breaks one of these is never shown as plainly
+"Stable" (the Stability box, Optimize's report, Live): it is "stable, over its limits", with
+these phrases. Computed from the design's own figures, the same ones its warnings give in full.
+bpy-free.
+"""
+from .figures import versus
+from .sizes import LARGEST_MODEL, STOCK_LENGTH, model_size, wire_length
+
+# m: the forces stage's deflection_limit (native forces_and_rest; the add-on never sets another):
+# a wire predicted to bend further out of its plane under its contact forces is warned about.
+DEFLECTION_LIMIT = 0.002
+RELATIVE = 1e-9  # a figure this close to its limit is at it, not over it (the solver's own rounding)
+
+OVER_LIMITS = "stable, over its limits"  # the verdict's words for such a design
+
+
+def _over(value, limit):
+    return value > limit * (1.0 + RELATIVE)
+
+
+def broken_limits(design, stock_length=STOCK_LENGTH):
+    """Short phrases, each a limit `design` breaks with its figure and the limit, most decisive
+    first: the load factor not reached, wires bending out of their planes, wires longer than the
+    stock (`stock_length`, m), a model over LARGEST_MODEL. [] for a design within them all (and for
+    one whose stages did not report these figures)."""
+    said = []
+    factor = design.get("load_factor") or {}
+    asked, reached = factor.get("asked"), factor.get("reached")
+    if isinstance(asked, (int, float)) and isinstance(reached, (int, float)) and reached < asked * (1.0 - RELATIVE):
+        weakest = f" ({factor['weakest']})" if factor.get("weakest") else ""
+        said.append(f"holds {reached:.2f}x its weight{weakest}, not the {asked:g}x asked")
+    wires = design.get("wires") or []
+    bent = [(float(w["out_of_plane_deflection"]), w.get("name", "?")) for w in wires
+            if isinstance(w.get("out_of_plane_deflection"), (int, float))
+            and _over(float(w["out_of_plane_deflection"]), DEFLECTION_LIMIT)]
+    if bent:
+        worst, name = max(bent)
+        shown, limit = versus(worst * 1000, DEFLECTION_LIMIT * 1000, 1)
+        said.append(f"wire {name} bends {shown} mm out of its plane (limit {limit} mm)" if len(bent) == 1 else
+                    f"{len(bent)} wires bend out of their planes, {name} by {shown} mm (limit {limit} mm)")
+    long = [(wire_length(w), w.get("name", "?")) for w in wires if w.get("length") is not None]
+    long = [(length, name) for length, name in long if _over(length, stock_length)]
+    if long:
+        worst, name = max(long)
+        shown, limit = versus(worst * 1000, stock_length * 1000, 0)
+        said.append(f"wire {name} is {shown} mm long, over the {limit} mm stock" if len(long) == 1 else
+                    f"{len(long)} wires are longer than the {limit} mm stock, {name} {shown} mm")
+    if wires:
+        size = model_size(design)
+        if _over(size, LARGEST_MODEL):
+            shown, limit = versus(size, LARGEST_MODEL, 2)
+            said.append(f"{shown} m across, over {limit} m")
+    return said
