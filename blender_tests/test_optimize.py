@@ -433,6 +433,38 @@ class StaleReport(Case):
         self.assertEqual(results_ui.report_changes(bpy.context), [])
         self.assertIn("Stable", labels(draw(results_ui.VIEW3D_PT_wiresculpt_report)))
 
+    def test_editing_or_moving_the_target_and_back(self):
+        """Optimize records a digest of the triangles it sliced; an edit or a move of the target
+        makes the design an earlier one until the mesh is as it was (read again once the changes
+        have settled, blend/target_watch.py)."""
+        from wiresculpt.blend import target_watch
+
+        self.optimize()
+        self.assertIn("mesh", scene_results.stored_inputs())
+        target = bpy.context.scene.wiresculpt.target
+        vertex = target.data.vertices[0]
+        z = vertex.co.z
+        vertex.co.z = z + 0.01
+        target.data.update()
+        bpy.context.view_layer.update()
+        self.assert_stale(f"target {target.name} edited or moved")  # still changing: not read yet
+        target_watch._STATE["changed_at"] = 0.0  # settled
+        self.assert_stale(f"target {target.name} edited or moved")  # read again: another mesh
+        vertex.co.z = z
+        target.data.update()
+        bpy.context.view_layer.update()
+        target_watch._STATE["changed_at"] = 0.0
+        self.assert_current()
+        x = target.location.x
+        target.location.x = x + 0.02  # the same mesh elsewhere: other contours
+        bpy.context.view_layer.update()
+        target_watch._STATE["changed_at"] = 0.0
+        self.assert_stale(f"target {target.name} edited or moved")
+        target.location.x = x
+        bpy.context.view_layer.update()
+        target_watch._STATE["changed_at"] = 0.0
+        self.assert_current()
+
     def test_moving_a_plane_and_back(self):
         self.optimize()
         handle = bpy.data.objects["Slice A"]

@@ -43,6 +43,26 @@ def renamed(mapping, p=None, ticked=TICKED):
 
 
 class StaleTest(unittest.TestCase):
+    def test_the_targets_mesh(self):
+        """An edit or move of the target (another digest of its triangles, or MESH_CHANGED while it
+        is not read again) makes the design an earlier one; not known, nothing is said."""
+        V = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+        digest = stale.mesh_digest(V, [[0, 1, 2]])
+        self.assertEqual(digest, stale.mesh_digest(json.loads(json.dumps(V)), [(0, 1, 2)]))
+        self.assertNotEqual(digest, stale.mesh_digest([V[0], V[1], [0.0, 1.0, 1e-12]], [[0, 1, 2]]))
+        self.assertNotEqual(digest, stale.mesh_digest(V, [[0, 2, 1]]))
+        inputs = dict(INPUTS, mesh=digest)
+        said = stale.changes(design(), planes(), TICKED, inputs, "Globe", SETTINGS, MATERIAL, LABELS, mesh=digest)
+        self.assertEqual(said, [])
+        for now in ("0" * 24, stale.MESH_CHANGED):
+            said = stale.changes(design(), planes(), TICKED, inputs, "Globe", SETTINGS, MATERIAL, LABELS, mesh=now)
+            self.assertEqual(said, ["target Globe edited or moved"])
+        self.assertEqual(stale.changes(design(), planes(), TICKED, inputs, "Globe", SETTINGS, MATERIAL, LABELS), [])
+        # another target: that is what is said; a record without a digest (an older add-on's) says nothing
+        self.assertEqual(stale.changes(design(), planes(), TICKED, inputs, "Cube", SETTINGS, MATERIAL, LABELS,
+                                       mesh="0" * 24), ["target changed"])
+        self.assertEqual(changes(), [])
+
     def test_unchanged_scene_is_current(self):
         self.assertEqual(changes(), [])
         self.assertEqual(stale.stale_text([]), "")

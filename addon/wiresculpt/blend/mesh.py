@@ -33,6 +33,16 @@ def object_triangles(obj, depsgraph):
         evaluated.to_mesh_clear()
 
 
+def triangle_count(obj, depsgraph=None):
+    """Triangles of the mesh `obj` from its polygons: as evaluated in `depsgraph` (its modifiers
+    applied, but for a last subdivision Blender leaves to the GPU), else its own data. Far cheaper
+    than object_triangles: no mesh is copied."""
+    polygons = (obj.evaluated_get(depsgraph) if depsgraph is not None else obj).data.polygons
+    totals = np.empty(len(polygons), dtype=np.int32)
+    polygons.foreach_get("loop_total", totals)
+    return int((totals - 2).sum())
+
+
 def join_triangles(parts):
     """One (V, F) from several, re-indexing faces."""
     Vs, Fs, offset = [], [], 0

@@ -15,7 +15,8 @@ What is compared:
 - the ticked contours: the (plane, index) pairs of the design's wires against the ticked ones.
 - the inputs Optimize recorded besides the design (`inputs`, see blend/results.py
   store_inputs): the target's name, the solver settings and the material it was solved with,
-  against the panel's values now. A design without that record (the batch's, the plane
+  against the panel's values now, and a digest of the target's triangles as sliced (mesh_digest,
+  in world coordinates: an edit, a modifier or a move of the target changes it). A design without that record (the batch's, the plane
   assistant's, an older add-on's) is compared by its planes and ticks only.
 
 The tolerances are far below any edit a maker makes (a nudge is 0.1 mm at least) and far above
@@ -25,7 +26,10 @@ The design's wire names keep the plane names they were solved with (design.json 
 renamed_wire / renamed_text show them with the planes' names now (current_names) where the panel
 prints them.
 """
+import hashlib
 import math
+
+import numpy as np
 import re
 
 ORIGIN_TOLERANCE = 1e-6  # m: the distance of the new origin from the recorded plane
@@ -36,8 +40,21 @@ VALUE_TOLERANCE = 1e-9  # relative, for a setting's or the material's number
 SCALED = ("bending_stiffness", "max_torque")
 MAX_NAMED = 3  # contours named after "contours ticked differently"
 
+MESH_CHANGED = "changed"  # the target's mesh changed since its digest was taken, and is not read again yet
+
 PREFIX = "From an earlier Optimize: "
 SUFFIX = "; Optimize again"
+
+
+def mesh_digest(vertices, faces):
+    """A short digest of a triangle mesh (world coordinates, (n, 3) float64; faces (m, 3) int32) as
+    the solver slices it: any change of a coordinate or a triangle changes it."""
+    h = hashlib.blake2b(digest_size=12)
+    for array, kind in ((vertices, np.float64), (faces, np.int32)):
+        a = np.ascontiguousarray(array, dtype=kind)
+        h.update(str(a.shape).encode())
+        h.update(a.tobytes())
+    return h.hexdigest()
 
 
 def wire_contour(name):
@@ -146,7 +163,7 @@ def changed_keys(recorded, now):
 
 
 def changes(design, planes, ticked, inputs=None, target=None, settings=None, material=None, labels=None,
-            recorded=None, names=None):
+            recorded=None, names=None, mesh=None):
     """What changed since `design` was optimized, as short phrases ("plane Slice B moved", "plane
     Slice C removed", "plane Slice D added", "contours ticked differently (Slice A #1 unticked)",
     "target changed", "settings changed (Max Bend)"); [] while it is current.
@@ -163,6 +180,8 @@ def changes(design, planes, ticked, inputs=None, target=None, settings=None, mat
     settings / material: the dicts props.solver_settings / material_of give now (settings None:
     the panel's values are not valid, e.g. the smallest bend above the largest).
     labels: {setting or material key: the name the panel shows} for the phrase.
+    mesh: the digest of the target's triangles now (mesh_digest), MESH_CHANGED when they changed
+    since the recorded digest but were not read again, None when not known (not compared).
     recorded: recorded_planes(design) when the caller keeps it (a panel redraws often)."""
     said = []
     before, ticks_before = recorded or recorded_planes(design)
@@ -194,6 +213,8 @@ def changes(design, planes, ticked, inputs=None, target=None, settings=None, mat
     if inputs:
         if target is not None and inputs.get("target") is not None and str(inputs["target"]) != str(target):
             said.append("target changed")
+        elif mesh is not None and isinstance(inputs.get("mesh"), str) and mesh != inputs["mesh"]:
+            said.append(f"target {target} edited or moved" if target else "target edited or moved")
         keys = []
         if settings is None:
             keys.append(None)

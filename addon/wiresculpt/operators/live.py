@@ -41,6 +41,7 @@ import numpy as np
 
 from .. import native, pipeline
 from ..blend import cut_handles, mesh
+from ..blend.mesh import triangle_count
 from ..blend import results as scene_results
 from ..blend.handles import contour_plane_name, handles, target_name, target_problem, ticked_planes
 from ..blend.registration import classes_factory
@@ -89,15 +90,6 @@ class LiveState:
 
 
 STATE = LiveState()
-
-
-def triangle_count(obj, depsgraph=None):
-    """Triangles of the mesh `obj` from its polygons: as evaluated in `depsgraph` (its modifiers
-    applied), else its own data."""
-    polygons = (obj.evaluated_get(depsgraph) if depsgraph is not None else obj).data.polygons
-    totals = np.empty(len(polygons), dtype=np.int32)
-    polygons.foreach_get("loop_total", totals)
-    return int((totals - 2).sum())
 
 
 def refusal(target, depsgraph=None):

@@ -18,7 +18,7 @@ import time
 import bpy
 
 from .. import native, pipeline
-from ..blend import cut_handles, mesh
+from ..blend import cut_handles, mesh, target_watch
 from ..blend import results as scene_results
 from ..blend.handles import plane_ids, target_name, target_problem, ticked_planes
 from ..blend.view import redraw_3d_views
@@ -52,6 +52,7 @@ def build_design(context):
     planes = ticked_planes(scene, depsgraph)
     material, settings = material_of(ws), solver_settings(ws)
     V, F = mesh.object_triangles(ws.target, depsgraph)
+    target_watch.remember(ws.target, V, F)  # solve_record's digest of what is sliced here
     try:
         design = pipeline.slice_and_pick(V, F, planes, material, settings)
     except ValueError as exc:  # a ticked contour the planes no longer cut
@@ -65,8 +66,12 @@ def solve_record(scene, material, settings):
     (handles.plane_ids: gives those missing): kept beside the stored design
     (blend/results.store_inputs) so the Stability box can tell when the panel has changed since
     and which handle a renamed plane is (core/stale.py)."""
-    return {"target": target_name(scene.wiresculpt), "settings": dict(settings), "material": dict(material),
-            "planes": plane_ids(scene)}
+    record = {"target": target_name(scene.wiresculpt), "settings": dict(settings), "material": dict(material),
+              "planes": plane_ids(scene)}
+    digest = target_watch.kept_digest(scene.wiresculpt.target) if scene.wiresculpt.target is not None else None
+    if digest is not None:  # the triangles build_design sliced (blend/target_watch.py)
+        record["mesh"] = digest
+    return record
 
 
 def summary(design):

@@ -3,6 +3,7 @@ scene's planes, ticks and panel values) and the Live line's hint when Live and a
 disagree. Shared by ui/results.py and ui/panel.py; no panel here."""
 from .. import props
 from ..blend import results as scene_results
+from ..blend import target_watch
 from ..blend.handles import target_name
 from ..core import live_verdict, stale
 from ..core.limits import broken_limits
@@ -40,8 +41,11 @@ def report(context):
         settings = props.solver_settings(ws)
     except ValueError:  # the panel's values cannot be solved (smallest bend above the largest)
         settings = None
+    mesh = None
+    if inputs and "mesh" in inputs and ws.target is not None and inputs.get("target") == ws.target.name:
+        mesh = target_watch.mesh_state(ws.target, context.view_layer.depsgraph)
     said = stale.changes(design, planes, ticked, inputs, target_name(ws),
-                         settings, props.material_of(ws), _recorded["labels"], _recorded["planes"], names)
+                         settings, props.material_of(ws), _recorded["labels"], _recorded["planes"], names, mesh)
     return said, names
 
 

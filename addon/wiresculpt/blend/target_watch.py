@@ -1,0 +1,90 @@
+"""Is the target's mesh still the one the stored design was solved on? Optimize records a digest of
+the triangles it sliced (core/stale.mesh_digest of blend/mesh.object_triangles: world coordinates,
+modifiers applied), and the Stability box compares the target's now with it (mesh_state).
+
+Reading a mesh at every redraw would cost 25 ms at 100,000 triangles, so it is read again only
+after the depsgraph reported a change of the target's geometry or placement (an edit, a modifier,
+a move, an animated frame; `generation` counts them), at most once per change, and not while the
+changes follow each other (a drag): then, and for a target over MAX_TRIANGLES, a change since the
+digest last taken counts as a change (CHANGED), which the next reading may take back.
+
+Only module state is written here (no ID data: the handler runs after every update and the state
+is asked for from a panel's draw)."""
+import time
+
+import bpy
+
+from ..core.stale import MESH_CHANGED, mesh_digest
+from .mesh import object_triangles, triangle_count
+
+MAX_TRIANGLES = 100_000  # as Live's limit: reading this many took 24-26 ms
+SETTLE_SECONDS = 0.3  # a target changed more recently is still moving: not read yet
+
+# digest: (target name, generation, digest) of the last reading; changed_at: time.monotonic() of
+# the last change counted
+_STATE = {"generation": 0, "digest": None, "changed_at": 0.0}
+
+
+def remember(target, vertices, faces):
+    """The digest of the triangles just read from `target` (Optimize's), kept for the current
+    generation; returned."""
+    digest = mesh_digest(vertices, faces)
+    _STATE["digest"] = (target.name, _STATE["generation"], digest)
+    return digest
+
+
+def kept_digest(target):
+    """The digest taken of `target` since its last change, or None."""
+    kept = _STATE["digest"]
+    return kept[2] if kept is not None and kept[0] == target.name and kept[1] == _STATE["generation"] else None
+
+
+def mesh_state(target, depsgraph):
+    """The digest of `target` as evaluated in `depsgraph`, read again when it changed since the
+    last reading; MESH_CHANGED when it changed since a reading of it but is not read now (still
+    moving, or over MAX_TRIANGLES); None when unknown (never read and not readable now)."""
+    kept = kept_digest(target)
+    if kept is not None:
+        return kept
+    earlier = _STATE["digest"] is not None and _STATE["digest"][0] == target.name
+    if (time.monotonic() - _STATE["changed_at"] < SETTLE_SECONDS
+            or triangle_count(target, depsgraph) > MAX_TRIANGLES):
+        return MESH_CHANGED if earlier else None
+    return remember(target, *object_triangles(target, depsgraph))
+
+
+@bpy.app.handlers.persistent
+def _depsgraph_post(scene=None, depsgraph=None, *_args):
+    """Counts the updates that changed the scene's target's geometry or placement."""
+    try:
+        target = scene.wiresculpt.target if scene is not None else None
+        if target is None or depsgraph is None:
+            return
+        watched = (target, target.data)
+        for update in depsgraph.updates:
+            if (update.is_updated_geometry or update.is_updated_transform) and update.id.original in watched:
+                _STATE["generation"] += 1
+                _STATE["changed_at"] = time.monotonic()
+                return
+    except (AttributeError, ReferenceError):  # closing, loading, the add-on half unregistered
+        pass
+
+
+@bpy.app.handlers.persistent
+def _load_post(*_args):
+    """Another file: no reading of this session holds for its target, even by the same name."""
+    _STATE["digest"] = None
+
+
+HANDLERS = (("depsgraph_update_post", _depsgraph_post), ("load_post", _load_post))
+
+
+def register():
+    for kind, handler in HANDLERS:
+        getattr(bpy.app.handlers, kind).append(handler)
+
+
+def unregister():
+    for kind, handler in HANDLERS:
+        if handler in getattr(bpy.app.handlers, kind):
+            getattr(bpy.app.handlers, kind).remove(handler)
