@@ -389,7 +389,9 @@ class LiveFollowsTheScene(BlenderCase):
         self.assertRegex(first, r"^the target shape cannot realise crossing \d+ on wire Slice [A-C]/0: it needs a bend")
         self.assertEqual(first.count(" on wire "), 1, first)
         self.assertGreater(len(first.split()), 30)
-        self.assertTrue(first.endswith("but the machine bends at most 30°"), first)
+        # its deciding figures, and what to change: 180° - 30° (no friction here) = 150°
+        self.assertTrue(first.endswith("(180° less the contact angle 120°) but the machine bends at most 30°: "
+                                       "a contact angle of at least 150° fits"), first)
         self.assertEqual(verdict, "not stable — " + first + "…")
         self.assertEqual(panel.live_look(verdict), ('ERROR', False))
         self.assertEqual(live.whole_reason(), reason)

@@ -363,9 +363,14 @@ TargetShapeProblem::TargetShapeProblem(const Polyline2& contour, bool closed,
            crossing_name(ci) + " asks for contact angle " + deg(x.contact_angle) +
                ", which is not wider than twice the friction angle atan(μ) = " + deg(friction_angle));
     else if (pi - 2.0 * beta_[c] > o.max_bend + 1e-12)
+      // the bend is 180° less the contact angle, plus twice the friction angle; a contact angle
+      // of at least 180° - max_bend + 2 atan(μ) fits the machine
       mark(ci, "infeasible",
-           crossing_name(ci) + " needs a bend of at least " + deg(pi - 2.0 * beta_[c]) + " (contact angle " +
-               deg(x.contact_angle) + " minus twice the friction angle) but the machine bends at most " + deg(o.max_bend));
+           crossing_name(ci) + " needs a bend of at least " + deg(pi - 2.0 * beta_[c]) + " (180° less the contact angle " +
+               deg(x.contact_angle) +
+               (friction_angle > 0.0 ? ", plus twice the friction angle " + deg(friction_angle) : std::string()) +
+               ") but the machine bends at most " + deg(o.max_bend) + ": a contact angle of at least " +
+               deg(pi - o.max_bend + 2.0 * friction_angle) + " fits");
   }
   auto scale_message = [&](const Gap& g) {
     const double scale = 2.0 * lmin / std::max(g.arc, 1e-300);

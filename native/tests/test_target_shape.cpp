@@ -278,6 +278,10 @@ TEST_CASE("target shape: impossible contact angles and open ends are reported", 
     const TargetShapeResult r = optimize_target_shape(contour, false, {{150, Vec2(0, 1), 50 * pi / 180, true}}, o);
     CHECK(r.crossings[0].status == "infeasible");
     CHECK_THAT(r.crossings[0].message, Contains("bends at most 120"));
+    // the figures add up as written: 180 - 50 + 2 x 17.7 = 165.4; 180 - 120 + 35.5 = 95.5
+    CHECK_THAT(r.crossings[0].message, Contains("needs a bend of at least 165° (180° less the contact angle 50°, plus "
+                                                "twice the friction angle 17.7°) but the machine bends at most 120°: "
+                                                "a contact angle of at least 95.5° fits"));
     CHECK(r.feasible);  // that crossing's constraint was dropped; the wire itself is fine
   }
   SECTION("active crossing at an open end") {
