@@ -42,7 +42,7 @@ class Live(unittest.TestCase):
         # 5 mm below the top of the globe: the design's own verdict, not stable, with the reason
         self.assertTrue(lines[1].startswith("Live: not stable — the target shape cannot realise crossing "), lines)
         # the plane cuts nothing: its ticked contour does not exist, a setup problem, not a verdict
-        self.assertTrue(lines[2].startswith("Live: cannot solve — plane Slice A: contour index 0 does not exist"),
+        self.assertTrue(lines[2].startswith("Live: cannot solve — plane Slice A cuts no contour of the mesh now"),
                         lines)
         self.assertTrue(stands(lines[3][len("Live: "):]), lines[3])
         # the preview: the three wires of a solved design (stable or not), none when the plane cuts nothing
@@ -331,8 +331,8 @@ class LiveFollowsTheScene(BlenderCase):
         plane = self.scene().objects["Slice A"]
         plane.location.z = 0.3
         bpy.context.view_layer.update()
-        self.assertEqual(self.settle(), "cannot solve — plane Slice A: contour index 0 does not exist (the plane "
-                                        "cuts 0 contours)")
+        self.assertEqual(self.settle(), "cannot solve — plane Slice A cuts no contour of the mesh now (contour index 0 "
+                                        "does not exist)")
         self.assertEqual(live.STATE.preview, [])
         plane.location.z = 0.0
         bpy.context.view_layer.update()

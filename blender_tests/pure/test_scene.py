@@ -120,6 +120,9 @@ class PickTest(unittest.TestCase):
         with self.assertRaises(ValueError) as ctx:
             contours.pick(found, [3], "B")
         self.assertIn("plane B: contour index 3 does not exist", str(ctx.exception))
+        with self.assertRaises(ValueError) as ctx:  # the plane moved off the mesh: said as such
+            contours.pick([], [0], "B")
+        self.assertEqual(str(ctx.exception), "plane B cuts no contour of the mesh now (contour index 0 does not exist)")
 
 
 if __name__ == "__main__":

@@ -16,6 +16,8 @@ def pick(contours, rule="largest", plane="plane"):
         for k in rule:
             if isinstance(k, bool) or not isinstance(k, int):
                 raise ValueError(f"plane {plane}: contour index {k!r} is not a whole number")
+            if not count:  # the plane misses the mesh (moved off it since the contour was picked)
+                raise ValueError(f"plane {plane} cuts no contour of the mesh now (contour index {k} does not exist)")
             if not 0 <= k < count:
                 raise ValueError(f"plane {plane}: contour index {k} does not exist "
                                  f"(the plane cuts {count} contour{'s' if count != 1 else ''})")
