@@ -9,7 +9,7 @@ import unittest
 import numpy as np
 
 from wiresculpt.core import meshcheck, sizes
-from wiresculpt.core.figures import versus
+from wiresculpt.core.figures import mass_text, versus
 from wiresculpt.core.scene import parse_scene
 
 
@@ -34,6 +34,15 @@ class Versus(unittest.TestCase):
         self.assertEqual(versus(60.0, 60.0, 1), ("60.0", "60.0"))
         self.assertEqual(versus(float("inf"), 60.0, 1), ("inf", "60.0"))
         self.assertEqual(versus(float("nan"), 60.0, 1), ("nan", "60.0"))
+
+
+class Masses(unittest.TestCase):
+    def test_grams_below_a_kilogram_kilograms_from_one(self):
+        self.assertEqual(mass_text(136.2), "136 g")
+        self.assertEqual(mass_text(999.4), "999 g")
+        self.assertEqual(mass_text(999.6), "1.0 kg")  # not "1000 g"
+        self.assertEqual(mass_text(37692.0), "37.7 kg")
+        self.assertEqual(mass_text(456764.0), "456.8 kg")
 
 
 def ring(radius, n=4):

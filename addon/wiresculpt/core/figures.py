@@ -20,3 +20,11 @@ def versus(value, limit, digits=1, style="f"):
            and f"{abs(value):.{d}{style}}" == f"{abs(limit):.{d}{style}}"):
         d += 1
     return f"{value:.{d}{style}}", f"{limit:.{d}{style}}"
+
+
+def mass_text(grams):
+    """A mass a maker reads: "136 g" below a kilogram, "37.7 kg" from one (a load capacity or a
+    sculpture's weight can be either)."""
+    if abs(grams) >= 999.5:  # would round to "1000 g"
+        return f"{grams / 1000:.1f} kg"
+    return f"{grams:.0f} g"

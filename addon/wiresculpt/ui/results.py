@@ -9,8 +9,9 @@ from .. import native, props
 from ..blend import results as scene_results
 from ..blend.registration import classes_factory
 from ..core import closure, stale
-from ..core.limits import OVER_LIMITS
 from ..core.design import setup_problem
+from ..core.figures import mass_text
+from ..core.limits import OVER_LIMITS
 from .stale import design_limits, report, report_changes  # noqa: F401 (report_changes: read here by the tests)
 from ..operators import optimize
 from ..operators.results import WIRESCULPT_OT_assembly_guide, WIRESCULPT_OT_clear_results
@@ -239,11 +240,11 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
         if capacity:
             col = layout.column(align=True)
             weight = sculpture_weight(design)
-            col.label(text=f"Load capacity (weighs {weight / GRAVITY * 1000:.0f} g):")
+            col.label(text=f"Load capacity (weighs {mass_text(weight / GRAVITY * 1000)}):")
             for direction, grams in capacity:
                 row = col.row()
                 row.label(text=direction)
-                row.label(text=f"{grams:.0f} g" if grams is not None else "no limit found")
+                row.label(text=mass_text(grams) if grams is not None else "no limit found")
         pending = design.get("pending_stages") or []
         if pending:
             _wrap(layout, context, "Pending: " + ", ".join(p.replace("_", " ") for p in pending), icon='INFO')
