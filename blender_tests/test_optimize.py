@@ -465,6 +465,17 @@ class StaleReport(Case):
         target_watch._STATE["changed_at"] = 0.0
         self.assert_current()
 
+    def test_fabrication_says_its_files_follow_the_earlier_design(self):
+        from wiresculpt.ui import fabrication as fabrication_ui
+
+        self.optimize()
+        said = " ".join(labels(draw(fabrication_ui.VIEW3D_PT_wiresculpt_fabrication)))
+        self.assertNotIn("earlier Optimize", said)
+        bpy.data.objects["Slice A"].location.z += 0.01
+        bpy.context.view_layer.update()
+        said = " ".join(labels(draw(fabrication_ui.VIEW3D_PT_wiresculpt_fabrication)))
+        self.assertIn("These files follow the earlier Optimize the Stability box shows", said)
+
     def test_moving_a_plane_and_back(self):
         self.optimize()
         handle = bpy.data.objects["Slice A"]

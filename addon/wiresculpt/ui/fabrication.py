@@ -9,6 +9,10 @@ from ..blend.registration import classes_factory
 from ..fab import streaming
 from ..operators import fabrication as ops
 from .results import _Child, _wrap
+from .stale import report_changes
+
+# above Export and Send when the Stability box says "From an earlier Optimize: …"
+EARLIER_DESIGN = "These files follow the earlier Optimize the Stability box shows, not the scene now: Optimize again first"
 
 
 class VIEW3D_PT_wiresculpt_fabrication(_Child, bpy.types.Panel):
@@ -23,6 +27,8 @@ class VIEW3D_PT_wiresculpt_fabrication(_Child, bpy.types.Panel):
         layout.enabled = native.available()
         ws = context.scene.wiresculpt
         layout.prop(ws, "machine_profile", text="Profile")
+        if report_changes(context):  # the files would follow a design the scene no longer matches
+            _wrap(layout, context, EARLIER_DESIGN, icon='ERROR')
         layout.operator(ops.WIRESCULPT_OT_export_fabrication.bl_idname, text="Export…", icon='EXPORT')
         rows, model = preview.figures(context.scene)
         if rows:  # the last export's machine preview: how far each predicted wire is from its rest shape
