@@ -4,7 +4,7 @@ each figure just over, at, or under its limit; the expected phrases written out.
 import unittest
 
 from wiresculpt.core import live_verdict as lv
-from wiresculpt.core.limits import DEFLECTION_LIMIT, OVER_LIMITS, broken_limits
+from wiresculpt.core.limits import DEFLECTION_LIMIT, OVER_LIMITS, broken_limits, hooks_may_help
 
 
 def wire(name, length=0.5, deflection=0.0, side=0.2):
@@ -24,7 +24,7 @@ class Limits(unittest.TestCase):
 
     def test_the_load_factor_not_reached(self):
         self.assertEqual(broken_limits(design(wire("A/0"), reached=1.8726)),
-                         ["holds 1.87x its weight (-z), not the 3x asked"])
+                         ["holds 1.87x its weight (-z), not the 3.00x asked"])
 
     def test_wires_bending_out_of_their_planes(self):
         self.assertEqual(broken_limits(design(wire("A/0", deflection=0.0025), wire("B/0"))),
@@ -51,6 +51,16 @@ class Limits(unittest.TestCase):
 
     def test_a_design_without_these_figures_breaks_none(self):
         self.assertEqual(broken_limits({"stable": True, "wires": [{"name": "A/0"}]}), [])
+        # a hand-edited design with figures of the wrong kind is not a crash at every redraw
+        self.assertEqual(broken_limits({"stable": True, "load_factor": 3, "wires": [7, {"name": "A/0"}]}), [])
+
+    def test_a_factor_just_short_reads_short(self):
+        self.assertEqual(broken_limits(design(wire("A/0"), reached=2.999)), ["holds 2.999x its weight (-z), not the 3.000x asked"])
+
+    def test_which_limits_another_hook_pattern_may_keep(self):
+        self.assertTrue(hooks_may_help(broken_limits(design(wire("A/0"), reached=2.0))))
+        self.assertTrue(hooks_may_help(broken_limits(design(wire("A/0", deflection=0.01)))))
+        self.assertFalse(hooks_may_help(broken_limits(design(wire("A/0", length=1.5), wire("B/0", side=2.0)))))
 
 
 class Verdict(unittest.TestCase):

@@ -241,9 +241,8 @@ def page_html(design, pictures, overlap=0.0):
                  "The green beads in the pictures mark the crossings that close at that step.</p>")
     if not design.get("stable"):
         parts.append(f'<p class="warn">This design is not stable: {html.escape(design.get("reason", ""))}</p>')
-    elif broken_limits(design):  # it stands, but not as asked (core/limits.py): said before the steps
-        parts.append(f'<p class="warn">This design is {OVER_LIMITS}: '
-                     f'{html.escape("; ".join(broken_limits(design)))}.</p>')
+    elif limits := broken_limits(design):  # it stands, but not as asked (core/limits.py): said before the steps
+        parts.append(f'<p class="warn">This design is {OVER_LIMITS}: {html.escape("; ".join(limits))}.</p>')
     items = []
     for w in design["wires"]:
         text = _wire_html(design, w["id"])

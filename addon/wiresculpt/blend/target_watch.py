@@ -3,10 +3,14 @@ the triangles it sliced (core/stale.mesh_digest of blend/mesh.object_triangles: 
 modifiers applied), and the Stability box compares the target's now with it (mesh_state).
 
 Reading a mesh at every redraw would cost 25 ms at 100,000 triangles, so it is read again only
-after the depsgraph reported a change of the target's geometry or placement (an edit, a modifier,
-a move, an animated frame; `generation` counts them), at most once per change, and not while the
-changes follow each other (a drag): then, and for a target over MAX_TRIANGLES, a change since the
-digest last taken counts as a change (CHANGED), which the next reading may take back.
+after a change that may have moved it (`generation` counts them): the depsgraph reporting the
+target's geometry or placement changed (an edit, a modifier, a move), a frame change (animation
+reports no update), an undo or a redo; at most once per change, and not while the changes follow
+each other (a drag): then, and for a target over MAX_TRIANGLES, a change since the digest last
+taken counts as one (MESH_CHANGED), and the 3D views are asked to redraw once the changes have
+settled, when the next reading may take it back. A target the depsgraph does not evaluate (hidden
+from viewports, in an excluded collection) is not read: without its modifiers it would not be
+the mesh Optimize sliced.
 
 Only module state is written here (no ID data: the handler runs after every update and the state
 is asked for from a panel's draw)."""
@@ -16,6 +20,7 @@ import bpy
 
 from ..core.stale import MESH_CHANGED, mesh_digest
 from .mesh import object_triangles, triangle_count
+from .view import redraw_3d_views
 
 MAX_TRIANGLES = 100_000  # as Live's limit: reading this many took 24-26 ms
 SETTLE_SECONDS = 0.3  # a target changed more recently is still moving: not read yet
@@ -47,10 +52,29 @@ def mesh_state(target, depsgraph):
     if kept is not None:
         return kept
     earlier = _STATE["digest"] is not None and _STATE["digest"][0] == target.name
-    if (time.monotonic() - _STATE["changed_at"] < SETTLE_SECONDS
-            or triangle_count(target, depsgraph) > MAX_TRIANGLES):
+    if time.monotonic() - _STATE["changed_at"] < SETTLE_SECONDS:
+        if not bpy.app.timers.is_registered(_settled):
+            bpy.app.timers.register(_settled, first_interval=SETTLE_SECONDS)
+        return MESH_CHANGED if earlier else None
+    if not target.evaluated_get(depsgraph).is_evaluated:
+        return None
+    if triangle_count(target, depsgraph) > MAX_TRIANGLES:
         return MESH_CHANGED if earlier else None
     return remember(target, *object_triangles(target, depsgraph))
+
+
+def _settled():
+    """Once the changes have settled: the panels read the target again at their next redraw."""
+    try:
+        redraw_3d_views()
+    except (AttributeError, ReferenceError):  # no window (closing, background)
+        pass
+    return None
+
+
+def _changed():
+    _STATE["generation"] += 1
+    _STATE["changed_at"] = time.monotonic()
 
 
 @bpy.app.handlers.persistent
@@ -63,11 +87,16 @@ def _depsgraph_post(scene=None, depsgraph=None, *_args):
         watched = (target, target.data)
         for update in depsgraph.updates:
             if (update.is_updated_geometry or update.is_updated_transform) and update.id.original in watched:
-                _STATE["generation"] += 1
-                _STATE["changed_at"] = time.monotonic()
+                _changed()
                 return
     except (AttributeError, ReferenceError):  # closing, loading, the add-on half unregistered
         pass
+
+
+@bpy.app.handlers.persistent
+def _maybe_changed(*_args):
+    """A frame change (animation moves a mesh without a depsgraph update), an undo or a redo."""
+    _changed()
 
 
 @bpy.app.handlers.persistent
@@ -76,7 +105,8 @@ def _load_post(*_args):
     _STATE["digest"] = None
 
 
-HANDLERS = (("depsgraph_update_post", _depsgraph_post), ("load_post", _load_post))
+HANDLERS = (("depsgraph_update_post", _depsgraph_post), ("frame_change_post", _maybe_changed),
+            ("undo_post", _maybe_changed), ("redo_post", _maybe_changed), ("load_post", _load_post))
 
 
 def register():
@@ -85,6 +115,8 @@ def register():
 
 
 def unregister():
+    if bpy.app.timers.is_registered(_settled):
+        bpy.app.timers.unregister(_settled)
     for kind, handler in HANDLERS:
         if handler in getattr(bpy.app.handlers, kind):
             getattr(bpy.app.handlers, kind).remove(handler)

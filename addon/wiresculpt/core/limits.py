@@ -15,6 +15,9 @@ DEFLECTION_LIMIT = 0.002
 RELATIVE = 1e-9  # a figure this close to its limit is at it, not over it (the solver's own rounding)
 
 OVER_LIMITS = "stable, over its limits"  # the verdict's words for such a design
+OVER_LIMITS_TITLE = "Stable, over its limits"  # the same, heading a box or a report
+# the limits another hook pattern may keep (the pre-stress follows the hooks): not the stock or the size
+HOOK_LIMITS = ("holds ", "out of its plane", "out of their planes")
 
 
 def _over(value, limit):
@@ -27,12 +30,14 @@ def broken_limits(design, stock_length=STOCK_LENGTH):
     stock (`stock_length`, m), a model over LARGEST_MODEL. [] for a design within them all (and for
     one whose stages did not report these figures)."""
     said = []
-    factor = design.get("load_factor") or {}
+    factor = design.get("load_factor")
+    factor = factor if isinstance(factor, dict) else {}
     asked, reached = factor.get("asked"), factor.get("reached")
     if isinstance(asked, (int, float)) and isinstance(reached, (int, float)) and reached < asked * (1.0 - RELATIVE):
         weakest = f" ({factor['weakest']})" if factor.get("weakest") else ""
-        said.append(f"holds {reached:.2f}x its weight{weakest}, not the {asked:g}x asked")
-    wires = design.get("wires") or []
+        shown, limit = versus(reached, asked, 2)
+        said.append(f"holds {shown}x its weight{weakest}, not the {limit}x asked")
+    wires = [w for w in design.get("wires") or [] if isinstance(w, dict)]
     bent = [(float(w["out_of_plane_deflection"]), w.get("name", "?")) for w in wires
             if isinstance(w.get("out_of_plane_deflection"), (int, float))
             and _over(float(w["out_of_plane_deflection"]), DEFLECTION_LIMIT)]
@@ -49,8 +54,14 @@ def broken_limits(design, stock_length=STOCK_LENGTH):
         said.append(f"wire {name} is {shown} mm long, over the {limit} mm stock" if len(long) == 1 else
                     f"{len(long)} wires are longer than the {limit} mm stock, {name} {shown} mm")
     if wires:
-        size = model_size(design)
+        size = model_size({"wires": wires})
         if _over(size, LARGEST_MODEL):
             shown, limit = versus(size, LARGEST_MODEL, 2)
             said.append(f"{shown} m across, over {limit} m")
     return said
+
+
+def hooks_may_help(limits):
+    """Whether another hook pattern may keep a design within `limits` (broken_limits' phrases):
+    the load factor and the out-of-plane deflection follow the pre-stress the hooks choose."""
+    return any(words in limit for limit in limits for words in HOOK_LIMITS)

@@ -28,9 +28,9 @@ prints them.
 """
 import hashlib
 import math
+import re
 
 import numpy as np
-import re
 
 ORIGIN_TOLERANCE = 1e-6  # m: the distance of the new origin from the recorded plane
 NORMAL_TOLERANCE = 1e-6  # per component of the unit normals

@@ -37,7 +37,6 @@ import time
 import traceback
 
 import bpy
-import numpy as np
 
 from .. import native, pipeline
 from ..blend import cut_handles, mesh

@@ -25,7 +25,7 @@ from ..blend.view import redraw_3d_views
 from ..blend.registration import classes_factory
 from ..core.design import setup_problem
 from ..core.jobs import WorkerJob
-from ..core.limits import OVER_LIMITS, broken_limits
+from ..core.limits import OVER_LIMITS_TITLE, broken_limits
 from ..core.live_verdict import CANNOT_SOLVE
 from ..props import material_of, solver_settings
 from .progress import TIMER_SECONDS, WorkerModal
@@ -83,7 +83,7 @@ def summary(design):
         names = [design["wires"][w]["name"] for w in design.get("assembly_order", [])]
         limits = broken_limits(design)
         if limits:  # never a plain "Stable" beside a broken limit (core/limits.py)
-            return {'WARNING'}, (f"{OVER_LIMITS[0].upper() + OVER_LIMITS[1:]}: {'; '.join(limits)}; {wires} wires, "
+            return {'WARNING'}, (f"{OVER_LIMITS_TITLE}: {'; '.join(limits)}; {wires} wires, "
                                  f"{crossings} crossings; assemble {', '.join(names)}")
         return {'INFO'}, (f"Stable: {wires} wires, {crossings} crossings; assemble "
                           f"{', '.join(names)}")

@@ -6,7 +6,7 @@ from ..blend import results as scene_results
 from ..blend import target_watch
 from ..blend.handles import target_name
 from ..core import live_verdict, stale
-from ..core.limits import broken_limits
+from ..core.limits import broken_limits, hooks_may_help
 
 
 def setting_labels():
@@ -65,27 +65,30 @@ def design_limits(design):
 _limits = {"design": None, "said": []}
 
 # Live solves with the layering's own hook pattern only; Optimize compares more of them.
-TRIES_MORE = "Live tries the layering's hooks only: Optimize tries more and may keep these planes within the limits"
+TRIES_MORE = "Live tries the layering's hooks only: Optimize tries more and may keep these planes within their limits"
 
 
 def live_hint(context, verdict):
     """A short line under the Live line when Live's `verdict` disagrees with the stored design while
     that design is current: Optimize searched more hook patterns on the same planes, its verdict is
     the one to build from. Live's "stable, over its limits" without a current Optimize says that
-    Optimize may do better (TRIES_MORE). "" otherwise (no disagreement, Live solving or unable to
+    Optimize may do better (TRIES_MORE) when another hook pattern may help (the load factor, the
+    deflection; not the stock or the size). "" otherwise (no disagreement, Live solving or unable to
     solve)."""
     kind = live_verdict.kind_of(verdict)
-    design = scene_results.stored_design()
-    if kind == live_verdict.OVER_LIMITS and (design is None or report_changes(context)):
-        return TRIES_MORE
-    if kind not in (live_verdict.STABLE, live_verdict.OVER_LIMITS, live_verdict.NOT_STABLE) or design is None:
+    if kind not in (live_verdict.STABLE, live_verdict.OVER_LIMITS, live_verdict.NOT_STABLE):
         return ""
+    design = scene_results.stored_design()
+    current = design is not None and not report_changes(context)
+    if not current:
+        helps = kind == live_verdict.OVER_LIMITS and hooks_may_help(verdict.split(live_verdict.DASH, 1)[-1].split("; "))
+        return TRIES_MORE if helps else ""
     if design.get("stable"):
         found = live_verdict.OVER_LIMITS if design_limits(design) else live_verdict.STABLE
     else:
         found = live_verdict.NOT_STABLE
-    if found == kind or report_changes(context):
+    if found == kind:
         return ""
-    said = {live_verdict.STABLE: "stable within its limits", live_verdict.OVER_LIMITS: live_verdict.OVER_LIMITS,
+    said = {live_verdict.STABLE: "stable within their limits", live_verdict.OVER_LIMITS: live_verdict.OVER_LIMITS,
             live_verdict.NOT_STABLE: "not stable"}[found]
     return f"Optimize found these planes {said} (it tries more hook patterns): build from Optimize's result"
