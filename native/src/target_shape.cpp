@@ -363,14 +363,21 @@ TargetShapeProblem::TargetShapeProblem(const Polyline2& contour, bool closed,
            crossing_name(ci) + " asks for contact angle " + deg(x.contact_angle) +
                ", which is not wider than twice the friction angle atan(μ) = " + deg(friction_angle));
     else if (pi - 2.0 * beta_[c] > o.max_bend + 1e-12)
+    {
       // the bend is 180° less the contact angle, plus twice the friction angle; a contact angle
-      // of at least 180° - max_bend + 2 atan(μ) fits the machine
+      // of at least 180° - max_bend + 2 atan(μ) fits the machine (rounded up where it is shown,
+      // so the figure given does fit; none from 180° on: then only a larger bend helps)
+      const double fits = (pi - o.max_bend + 2.0 * friction_angle) * 180.0 / pi;
+      const double step = fits >= 100.0 ? 1.0 : fits >= 10.0 ? 0.1 : 0.01;  // deg()'s 3 digits
+      const std::string advice = fits < 180.0 ? ": a contact angle of at least " +
+                                                    fmt(std::ceil(fits / step - 1e-9) * step, 3) + "° fits"
+                                              : std::string();
       mark(ci, "infeasible",
            crossing_name(ci) + " needs a bend of at least " + deg(pi - 2.0 * beta_[c]) + " (180° less the contact angle " +
                deg(x.contact_angle) +
                (friction_angle > 0.0 ? ", plus twice the friction angle " + deg(friction_angle) : std::string()) +
-               ") but the machine bends at most " + deg(o.max_bend) + ": a contact angle of at least " +
-               deg(pi - o.max_bend + 2.0 * friction_angle) + " fits");
+               ") but the machine bends at most " + deg(o.max_bend) + advice);
+    }
   }
   auto scale_message = [&](const Gap& g) {
     const double scale = 2.0 * lmin / std::max(g.arc, 1e-300);

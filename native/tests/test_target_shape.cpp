@@ -15,6 +15,7 @@
 
 using namespace wiresculpt;
 using Catch::Matchers::Contains;
+using Catch::Matchers::EndsWith;
 
 namespace {
 constexpr double pi = std::numbers::pi;
@@ -283,6 +284,16 @@ TEST_CASE("target shape: impossible contact angles and open ends are reported", 
                                                 "twice the friction angle 17.7°) but the machine bends at most 120°: "
                                                 "a contact angle of at least 95.5° fits"));
     CHECK(r.feasible);  // that crossing's constraint was dropped; the wire itself is fine
+  }
+  SECTION("the contact angle that fits is rounded up, and not offered when none fits") {
+    // 180 - 68.075 + 35.485 = 147.41: shown as 148, which fits (147 would not)
+    o.max_bend = 68.075 * pi / 180;
+    TargetShapeResult r = optimize_target_shape(contour, false, {{150, Vec2(0, 1), 50 * pi / 180, true}}, o);
+    CHECK_THAT(r.crossings[0].message, EndsWith("but the machine bends at most 68.1°: a contact angle of at least 148° fits"));
+    // 180 - 30 + 35.5 = 185.5: no contact angle does
+    o.max_bend = 30 * pi / 180;
+    r = optimize_target_shape(contour, false, {{150, Vec2(0, 1), 50 * pi / 180, true}}, o);
+    CHECK_THAT(r.crossings[0].message, EndsWith("but the machine bends at most 30°"));
   }
   SECTION("active crossing at an open end") {
     const TargetShapeResult r = optimize_target_shape(contour, false, {{0, Vec2(0, 1), 2 * pi / 3, true}}, o);
