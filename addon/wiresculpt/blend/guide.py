@@ -16,7 +16,7 @@ from mathutils import Vector
 from ..core import closure
 from ..core.design import crossing_direction
 from ..core.files import write_atomic
-from ..core.limits import OVER_LIMITS, broken_limits
+from ..core.limits import OVER_LIMITS, broken_limits, recorded_stock
 from . import results
 from .objects import tagged
 
@@ -241,7 +241,7 @@ def page_html(design, pictures, overlap=0.0):
                  "The green beads in the pictures mark the crossings that close at that step.</p>")
     if not design.get("stable"):
         parts.append(f'<p class="warn">This design is not stable: {html.escape(design.get("reason", ""))}</p>')
-    elif limits := broken_limits(design):  # it stands, but not as asked (core/limits.py): said before the steps
+    elif limits := broken_limits(design, recorded_stock(results.stored_inputs())):  # it stands, but not as asked (core/limits.py): said before the steps
         parts.append(f'<p class="warn">This design is {OVER_LIMITS}: {html.escape("; ".join(limits))}.</p>')
     items = []
     for w in design["wires"]:

@@ -7,7 +7,7 @@ these phrases. Computed from the design's own figures, the same ones its warning
 bpy-free.
 """
 from .figures import versus
-from .sizes import LARGEST_MODEL, STOCK_LENGTH, model_size, wire_length
+from .sizes import LARGEST_MODEL, STOCK_LENGTH, model_size, wire_length  # noqa: F401 (STOCK_LENGTH: the default, for callers)
 
 # m: the forces stage's deflection_limit (native forces_and_rest; the add-on never sets another):
 # a wire predicted to bend further out of its plane under its contact forces is warned about.
@@ -18,6 +18,14 @@ OVER_LIMITS = "stable, over its limits"  # the verdict's words for such a design
 OVER_LIMITS_TITLE = "Stable, over its limits"  # the same, heading a box or a report
 # the limits another hook pattern may keep (the pre-stress follows the hooks): not the stock or the size
 HOOK_LIMITS = ("holds ", "out of its plane", "out of their planes")
+
+
+def recorded_stock(inputs):
+    """m: the stock length Optimize solved for (its record's "stock": [length, profile name]), the
+    default profile's when not recorded."""
+    stock = (inputs or {}).get("stock")
+    ok = isinstance(stock, (list, tuple)) and stock and isinstance(stock[0], (int, float)) and stock[0] > 0
+    return float(stock[0]) if ok else STOCK_LENGTH
 
 
 def _over(value, limit):

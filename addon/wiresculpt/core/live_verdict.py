@@ -18,7 +18,7 @@ deciding figure (the angle, the length, the scale) comes last, up to CLAUSE_WORD
 itself is never reworded (design.json keeps it; FORMATS.md). bpy-free.
 """
 from .design import setup_problem
-from .limits import OVER_LIMITS, broken_limits
+from .limits import OVER_LIMITS, STOCK_LENGTH, broken_limits
 
 STABLE = "stable"
 SOLVING = "solving…"
@@ -74,13 +74,13 @@ def verdict(kind, text=""):
     return kind + DASH + shown_reason(text) if text.strip() else kind
 
 
-def of_design(design):
+def of_design(design, stock_length=STOCK_LENGTH):
     """(kind, text) of a solved `design`: STABLE alone, or OVER_LIMITS with the limits it breaks
-    (core/limits.broken_limits); CANNOT_SOLVE with its reason when that is a setup problem
+    (core/limits.broken_limits, with the machine's `stock_length`, m); CANNOT_SOLVE with its reason when that is a setup problem
     (core/design.setup_problem: fewer than two wires, nothing was solved); else NOT_STABLE with its
     reason."""
     if design["stable"]:
-        limits = broken_limits(design)
+        limits = broken_limits(design, stock_length)
         return (OVER_LIMITS, "; ".join(limits)) if limits else (STABLE, "")
     return (CANNOT_SOLVE if setup_problem(design) else NOT_STABLE), design.get("reason") or ""
 

@@ -48,6 +48,7 @@ from ..blend.view import redraw_3d_views
 from ..core.jobs import WorkerJob
 from ..core.live_verdict import CANNOT_SOLVE, ERROR, SOLVING, of_design, shortened, verdict
 from ..props import LIVE_HOOKS, material_of, solve_inputs, solver_settings
+from .optimize import chosen_stock
 
 TICK_SECONDS = 0.1  # while nothing changes
 ACTIVE_TICK_SECONDS = 0.02  # while a plane moves or a job runs: the verdict is seen sooner
@@ -165,8 +166,9 @@ class LiveJob(WorkerJob):
 
     name = "wiresculpt live"
 
-    def __init__(self, key, vertices, faces, planes, cuts, material, settings):
+    def __init__(self, key, vertices, faces, planes, cuts, material, settings, stock=None):
         super().__init__()
+        self.stock = stock  # (m, profile name) the size warnings and limits name (optimize.chosen_stock)
         self.key = key
         self.vertices, self.faces, self.planes, self.cuts = vertices, faces, planes, cuts
         self.material, self.settings = material, settings
@@ -182,7 +184,7 @@ class LiveJob(WorkerJob):
             design = pipeline.slice_and_pick(self.vertices, self.faces, self.planes, self.material, self.settings)
             cut_handles.set_cut_points(design, self.cuts)  # the user's moved cut handles, as build_design gives them
             self.design = pipeline.solve(design, self.material, self.settings, cancel=self.cancel_event.is_set,
-                                         hook_patterns=LIVE_HOOK_PATTERNS)
+                                         stock=self.stock, hook_patterns=LIVE_HOOK_PATTERNS)
             self.preview = preview_segments(self.design)
         except pipeline.Cancelled:
             self.cancelled = True
@@ -195,7 +197,7 @@ class LiveJob(WorkerJob):
         contour the plane no longer cuts, the time budget) cannot solve, any other is our error."""
         if self.error is not None:
             return (ERROR if self.unexpected else CANNOT_SOLVE), self.error
-        return of_design(self.design)
+        return of_design(self.design, *(self.stock[:1] if self.stock else ()))
 
 
 class Refused(str):
@@ -224,7 +226,8 @@ def _start(scene, key):
         message = too_large(ws.target.name, len(STATE.mesh[1]))  # more than refusal counted (GPU subdivision)
         if message:
             return Refused(message)
-    job = LiveJob(key, *STATE.mesh, planes, cut_handles.user_cut_points(scene), material, settings)
+    job = LiveJob(key, *STATE.mesh, planes, cut_handles.user_cut_points(scene), material, settings,
+                  chosen_stock(scene))
     job.thread.start()
     return job
 

@@ -23,11 +23,13 @@ from ..blend import results as scene_results
 from ..blend.handles import plane_ids, target_name, target_problem, ticked_planes
 from ..blend.view import redraw_3d_views
 from ..blend.registration import classes_factory
+from ..core import sizes
 from ..core.design import setup_problem
 from ..core.jobs import WorkerJob
-from ..core.limits import OVER_LIMITS_TITLE, broken_limits
+from ..core.limits import OVER_LIMITS_TITLE, STOCK_LENGTH, broken_limits, recorded_stock
 from ..core.live_verdict import CANNOT_SOLVE
 from ..props import material_of, solver_settings
+from .fabrication import chosen_profile
 from .progress import TIMER_SECONDS, WorkerModal
 
 JOIN_SECONDS = 0.2  # the longest a cancel waits for the worker in Blender's UI thread
@@ -67,21 +69,31 @@ def solve_record(scene, material, settings):
     (blend/results.store_inputs) so the Stability box can tell when the panel has changed since
     and which handle a renamed plane is (core/stale.py)."""
     record = {"target": target_name(scene.wiresculpt), "settings": dict(settings), "material": dict(material),
-              "planes": plane_ids(scene)}
+              "planes": plane_ids(scene), "stock": list(chosen_stock(scene))}
     digest = target_watch.kept_digest(scene.wiresculpt.target) if scene.wiresculpt.target is not None else None
     if digest is not None:  # the triangles build_design sliced (blend/target_watch.py)
         record["mesh"] = digest
     return record
 
 
-def summary(design):
+def chosen_stock(scene):
+    """(m, profile name): the stock of the Fabrication panel's machine profile, which the size
+    warnings and limits name; the default profile's when none is chosen or it cannot be read (the
+    Export then says what is wrong with it)."""
+    try:
+        return sizes.stock(chosen_profile(scene))
+    except ValueError:
+        return sizes.stock(None)
+
+
+def summary(design, stock_length=STOCK_LENGTH):
     """(report type, sentence) for the finished design: a setup problem (core/design.setup_problem:
     fewer than two wires) says it cannot be solved, as Live does, rather than "Not stable"."""
     wires = len(design["wires"])
     crossings = len(design.get("crossings", []))
     if design["stable"]:
         names = [design["wires"][w]["name"] for w in design.get("assembly_order", [])]
-        limits = broken_limits(design)
+        limits = broken_limits(design, stock_length)
         if limits:  # never a plain "Stable" beside a broken limit (core/limits.py)
             return {'WARNING'}, (f"{OVER_LIMITS_TITLE}: {'; '.join(limits)}; {wires} wires, "
                                  f"{crossings} crossings; assemble {', '.join(names)}")
@@ -97,7 +109,7 @@ def run_optimize(context, progress=None, cancel=None):
     pipeline.Cancelled (the scene untouched), ValueError or RuntimeError (untouched too)."""
     design, material, settings = build_design(context)
     inputs = solve_record(context.scene, material, settings)
-    design = pipeline.solve(design, material, settings, progress, cancel)  # a new dict after re-layering
+    design = pipeline.solve(design, material, settings, progress, cancel, stock=tuple(inputs["stock"]))  # a new dict after re-layering
     scene_results.write_results(context.scene, design, inputs)
     return design
 
@@ -117,6 +129,7 @@ class Job(WorkerJob):
         self.cancel_event = threading.Event()
         self.scene_name = ""  # set by the operator: the scene the results go to
         self.inputs = None  # set by the operator: solve_record of the scene as the solve started
+        self.stock = None  # set by the operator: (m, profile name) the size warnings name (chosen_stock)
         self.started = time.perf_counter()
 
     def _progress(self, stage, message):
@@ -132,7 +145,7 @@ class Job(WorkerJob):
     def work(self):
         try:
             self.design = pipeline.solve(self.design, self.material, self.settings, self._progress,
-                                         self.cancel_event.is_set)
+                                         self.cancel_event.is_set, stock=self.stock)
         except pipeline.Cancelled:
             self.cancelled = True
 
@@ -202,7 +215,7 @@ class WIRESCULPT_OT_optimize(WorkerModal, bpy.types.Operator):
 
     def _finish(self, context, design, scene=None, inputs=None):
         scene_results.write_results(scene or context.scene, design, inputs)
-        kind, message = summary(design)
+        kind, message = summary(design, recorded_stock(inputs))
         self.report(kind, message)
         return {'FINISHED'}
 
@@ -210,7 +223,7 @@ class WIRESCULPT_OT_optimize(WorkerModal, bpy.types.Operator):
         try:
             design, material, settings = build_design(context)
             inputs = solve_record(context.scene, material, settings)
-            design = pipeline.solve(design, material, settings)
+            design = pipeline.solve(design, material, settings, stock=tuple(inputs["stock"]))
         except pipeline.Cancelled:
             self.report({'WARNING'}, "Optimize cancelled; the scene is unchanged")
             return {'CANCELLED'}
@@ -231,6 +244,7 @@ class WIRESCULPT_OT_optimize(WorkerModal, bpy.types.Operator):
         JOB = Job(design, material, settings)
         JOB.scene_name = context.scene.name  # the results belong to the scene that was optimized
         JOB.inputs = solve_record(context.scene, material, settings)
+        JOB.stock = tuple(JOB.inputs["stock"])
         JOB.thread.start()
         self.begin_watch(context, len(pipeline.ALL_STAGES))
         self._show(context)

@@ -6,7 +6,7 @@ from ..blend import results as scene_results
 from ..blend import target_watch
 from ..blend.handles import target_name
 from ..core import live_verdict, stale
-from ..core.limits import broken_limits, hooks_may_help
+from ..core.limits import broken_limits, hooks_may_help, recorded_stock
 
 
 def setting_labels():
@@ -58,7 +58,7 @@ def design_limits(design):
     """core/limits.broken_limits(design), computed once per stored design (panels read it at every
     redraw)."""
     if _limits["design"] is not design:
-        _limits.update(design=design, said=broken_limits(design))
+        _limits.update(design=design, said=broken_limits(design, recorded_stock(scene_results.stored_inputs())))
     return _limits["said"]
 
 
