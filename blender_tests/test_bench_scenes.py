@@ -95,8 +95,13 @@ class BenchLiveTest(unittest.TestCase):
         self.assertNotIn("error", record)
         self.assertEqual(record["name"], "globe")
         self.assertEqual(record["wires_ticked"], 3)
-        self.assertEqual(record["first_verdict"], "Live: stable")
-        self.assertEqual(record["verdicts"], ["Live: stable"] * 5)  # 1 mm moves keep the globe stable
+        # the globe stands (with Live's single hook pattern its wires bend out of their planes, so the
+        # verdict may read "stable, over its limits — …", core/limits.py), and 1 mm moves keep it so
+        stands = r"^Live: stable($|, over its limits — )"  # its figures move with the plane
+        self.assertRegex(record["first_verdict"], stands)
+        self.assertEqual(len(record["verdicts"]), 5)
+        for verdict in record["verdicts"]:
+            self.assertRegex(verdict, stands)
         self.assertEqual(len(record["round_trips"]), 5)
         for trip, shown, job in zip(record["round_trips"], record["verdict_set"], record["job_seconds"]):
             self.assertGreater(job, 0)
