@@ -6,9 +6,9 @@ Reading a mesh at every redraw would cost 25 ms at 100,000 triangles, so it is r
 after a change that may have moved it (`generation` counts them): the depsgraph reporting the
 target's geometry or placement changed (an edit, a modifier, a move), a frame change (animation
 reports no update), an undo or a redo; at most once per change, and not while the changes follow
-each other (a drag): then, and for a target over MAX_TRIANGLES, a change since the digest last
-taken counts as one (MESH_CHANGED), and the 3D views are asked to redraw once the changes have
-settled, when the next reading may take it back. A target the depsgraph does not evaluate (hidden
+each other (a drag): then, and for a target over mesh.MAX_REREAD_TRIANGLES, a change since the
+digest last taken counts as one (MESH_CHANGED), and the 3D views are asked to redraw once the
+changes have settled, when the next reading may take it back. A target the depsgraph does not evaluate (hidden
 from viewports, in an excluded collection) is not read: without its modifiers it would not be
 the mesh Optimize sliced.
 
@@ -19,10 +19,9 @@ import time
 import bpy
 
 from ..core.stale import MESH_CHANGED, mesh_digest
-from .mesh import object_triangles, triangle_count
+from .mesh import MAX_REREAD_TRIANGLES, object_triangles, triangle_count
 from .view import redraw_3d_views
 
-MAX_TRIANGLES = 100_000  # as Live's limit: reading this many took 24-26 ms
 SETTLE_SECONDS = 0.3  # a target changed more recently is still moving: not read yet
 
 # digest: (target name, generation, digest) of the last reading; changed_at: time.monotonic() of
@@ -47,7 +46,7 @@ def kept_digest(target):
 def mesh_state(target, depsgraph):
     """The digest of `target` as evaluated in `depsgraph`, read again when it changed since the
     last reading; MESH_CHANGED when it changed since a reading of it but is not read now (still
-    moving, or over MAX_TRIANGLES); None when unknown (never read and not readable now)."""
+    moving, or over MAX_REREAD_TRIANGLES); None when unknown (never read and not readable now)."""
     kept = kept_digest(target)
     if kept is not None:
         return kept
@@ -58,7 +57,7 @@ def mesh_state(target, depsgraph):
         return MESH_CHANGED if earlier else None
     if not target.evaluated_get(depsgraph).is_evaluated:
         return None
-    if triangle_count(target, depsgraph) > MAX_TRIANGLES:
+    if triangle_count(target, depsgraph) > MAX_REREAD_TRIANGLES:
         return MESH_CHANGED if earlier else None
     return remember(target, *object_triangles(target, depsgraph))
 

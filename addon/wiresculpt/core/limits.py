@@ -7,7 +7,8 @@ these phrases. Computed from the design's own figures, the same ones its warning
 bpy-free.
 """
 from .figures import versus
-from .sizes import LARGEST_MODEL, STOCK_LENGTH, model_size, wire_length  # noqa: F401 (STOCK_LENGTH: the default, for callers)
+# STOCK_LENGTH: the default stock, which callers take from here too
+from .sizes import LARGEST_MODEL, STOCK_LENGTH, model_size, wire_length
 
 # m: the forces stage's deflection_limit (native forces_and_rest; the add-on never sets another):
 # a wire predicted to bend further out of its plane under its contact forces is warned about.
@@ -15,7 +16,6 @@ DEFLECTION_LIMIT = 0.002
 RELATIVE = 1e-9  # a figure this close to its limit is at it, not over it (the solver's own rounding)
 
 OVER_LIMITS = "stable, over its limits"  # the verdict's words for such a design
-OVER_LIMITS_TITLE = "Stable, over its limits"  # the same, heading a box or a report
 # the limits another hook pattern may keep (the pre-stress follows the hooks): not the stock or the size
 HOOK_LIMITS = ("holds ", "out of its plane", "out of their planes")
 

@@ -53,10 +53,9 @@ from .optimize import chosen_stock
 TICK_SECONDS = 0.1  # while nothing changes
 ACTIVE_TICK_SECONDS = 0.02  # while a plane moves or a job runs: the verdict is seen sooner
 SETTLE_SECONDS = 0.05  # a position unchanged this long is solved (a drag's every frame is not)
-# Live is refused on larger targets (with their modifiers): reading the mesh on Blender's thread when
-# Live starts or the target changes (mesh.object_triangles) took 52-56 ms at 199,200 triangles and
-# 24-26 ms at 101,888 (a UV sphere, background Blender), against the 50 ms a tick may take (issue 17).
-MAX_TRIANGLES = 100_000
+# Live is refused on larger targets (with their modifiers): it reads the mesh on Blender's thread
+# when Live starts and whenever the target changes (blend/mesh.MAX_REREAD_TRIANGLES says why).
+MAX_TRIANGLES = mesh.MAX_REREAD_TRIANGLES
 LIVE_HOOK_PATTERNS = 1  # the layering's own hook pattern only: Optimize may pick other hooks
 DURATIONS_KEPT = 10_000
 

@@ -24,10 +24,9 @@ from ..blend.handles import plane_ids, target_name, target_problem, ticked_plane
 from ..blend.view import redraw_3d_views
 from ..blend.registration import classes_factory
 from ..core import sizes
-from ..core.design import setup_problem
 from ..core.jobs import WorkerJob
-from ..core.limits import OVER_LIMITS_TITLE, STOCK_LENGTH, broken_limits, recorded_stock
-from ..core.live_verdict import CANNOT_SOLVE
+from ..core.limits import OVER_LIMITS, STOCK_LENGTH, recorded_stock
+from ..core.live_verdict import STABLE, of_design
 from ..props import material_of, solver_settings
 from .fabrication import chosen_profile
 from .progress import TIMER_SECONDS, WorkerModal
@@ -87,21 +86,17 @@ def chosen_stock(scene):
 
 
 def summary(design, stock_length=STOCK_LENGTH):
-    """(report type, sentence) for the finished design: a setup problem (core/design.setup_problem:
-    fewer than two wires) says it cannot be solved, as Live does, rather than "Not stable"."""
-    wires = len(design["wires"])
-    crossings = len(design.get("crossings", []))
-    if design["stable"]:
-        names = [design["wires"][w]["name"] for w in design.get("assembly_order", [])]
-        limits = broken_limits(design, stock_length)
-        if limits:  # never a plain "Stable" beside a broken limit (core/limits.py)
-            return {'WARNING'}, (f"{OVER_LIMITS_TITLE}: {'; '.join(limits)}; {wires} wires, "
-                                 f"{crossings} crossings; assemble {', '.join(names)}")
-        return {'INFO'}, (f"Stable: {wires} wires, {crossings} crossings; assemble "
-                          f"{', '.join(names)}")
-    if setup_problem(design):
-        return {'WARNING'}, f"{CANNOT_SOLVE.capitalize()}: {design['reason']}"
-    return {'WARNING'}, f"Not stable: {design['reason']}"
+    """(report type, sentence) for the finished design, in the words of Live's verdict
+    (core/live_verdict.of_design): stable, stable over its limits (never a plain "Stable" beside a
+    broken limit), cannot solve (a setup problem) or not stable, with the limits or the reason."""
+    kind, text = of_design(design, stock_length)
+    if kind not in (STABLE, OVER_LIMITS):
+        return {'WARNING'}, f"{kind.capitalize()}: {text}"
+    names = [design["wires"][w]["name"] for w in design.get("assembly_order", [])]
+    counts = f"{len(design['wires'])} wires, {len(design.get('crossings', []))} crossings; assemble {', '.join(names)}"
+    if kind == OVER_LIMITS:
+        return {'WARNING'}, f"{OVER_LIMITS.capitalize()}: {text}; {counts}"
+    return {'INFO'}, f"Stable: {counts}"
 
 
 def run_optimize(context, progress=None, cancel=None):
@@ -109,7 +104,8 @@ def run_optimize(context, progress=None, cancel=None):
     pipeline.Cancelled (the scene untouched), ValueError or RuntimeError (untouched too)."""
     design, material, settings = build_design(context)
     inputs = solve_record(context.scene, material, settings)
-    design = pipeline.solve(design, material, settings, progress, cancel, stock=tuple(inputs["stock"]))  # a new dict after re-layering
+    # a new dict after re-layering
+    design = pipeline.solve(design, material, settings, progress, cancel, stock=tuple(inputs["stock"]))
     scene_results.write_results(context.scene, design, inputs)
     return design
 

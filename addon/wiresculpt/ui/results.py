@@ -11,7 +11,7 @@ from ..blend.registration import classes_factory
 from ..core import closure, stale
 from ..core.design import setup_problem
 from ..core.figures import mass_text
-from ..core.limits import OVER_LIMITS, OVER_LIMITS_TITLE
+from ..core.limits import OVER_LIMITS
 from .stale import design_limits, report, report_changes  # noqa: F401 (report_changes: read here by the tests)
 from ..operators import optimize
 from ..operators.results import WIRESCULPT_OT_assembly_guide, WIRESCULPT_OT_clear_results
@@ -192,7 +192,7 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
         limits = design_limits(design) if design["stable"] else []
         if limits:  # stable and buildable, but not what a maker asked for: no green tick, the limits first
             box.alert = not said
-            box.label(text=f"Was {OVER_LIMITS}" if said else OVER_LIMITS_TITLE, icon='ERROR')
+            box.label(text=f"Was {OVER_LIMITS}" if said else OVER_LIMITS.capitalize(), icon='ERROR')
             for limit in limits:
                 _wrap(box, context, stale.renamed_text(limit, design, names), icon='DOT')
         elif design["stable"]:
