@@ -421,6 +421,13 @@ TargetShapeProblem::TargetShapeProblem(const Polyline2& contour, bool closed,
     for (int nb : {(v + m - 1) % m, (v + 1) % m})
       if (!fixed_[nb]) constraints_.push_back({Kind::contact, v, nb, static_cast<int>(c)});
   }
+  // Each bend and contact constraint's cosine, taken once (every evaluation, and a dozen times
+  // for each active one in the SQP's Hessian, reads it).
+  constraint_cos_.reserve(constraints_.size());
+  for (const Constraint& c : constraints_)
+    constraint_cos_.push_back(c.kind == Kind::bend      ? std::cos(bend_limit(options_, c.vertex))
+                              : c.kind == Kind::contact ? std::cos(beta_[c.crossing])
+                                                        : 0.0);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -651,11 +658,11 @@ Vec2 d_unit_dot(const Vec2& u, const Vec2& vhat) {
 double TargetShapeProblem::constraint(std::size_t k, const Polyline2& p, Polyline2* grad) const {
   const Constraint& c = constraints_.at(k);
   const int m = static_cast<int>(p.size());
-  if (grad) grad->resize(m, Vec2::Zero());
-  const double lmin2 = options_.min_segment * options_.min_segment;
+  if (grad && static_cast<int>(grad->size()) != m) grad->resize(m, Vec2::Zero());
   switch (c.kind) {
     case Kind::length: {
-      const int a = c.vertex, b = (c.vertex + 1) % m;
+      const double lmin2 = options_.min_segment * options_.min_segment;
+      const int a = c.vertex, b = c.vertex + 1 < m ? c.vertex + 1 : 0;
       const Vec2 e = p[b] - p[a];
       if (grad) {
         (*grad)[b] -= (2.0 / lmin2) * e;
@@ -664,7 +671,7 @@ double TargetShapeProblem::constraint(std::size_t k, const Polyline2& p, Polylin
       return 1.0 - e.squaredNorm() / lmin2;
     }
     case Kind::bend: {
-      const int i = c.vertex, a = (i + m - 1) % m, b = (i + 1) % m;
+      const int i = c.vertex, a = i > 0 ? i - 1 : m - 1, b = i + 1 < m ? i + 1 : 0;
       const Vec2 u = p[i] - p[a], v = p[b] - p[i];
       const Vec2 uh = u.normalized(), vh = v.normalized();
       if (grad) {
@@ -674,7 +681,7 @@ double TargetShapeProblem::constraint(std::size_t k, const Polyline2& p, Polylin
         (*grad)[i] += dv;
         (*grad)[b] -= dv;
       }
-      return std::cos(bend_limit(options_, i)) - uh.dot(vh);
+      return constraint_cos_[k] - uh.dot(vh);  // cos(bend limit)
     }
     case Kind::contact: {
       const Vec2& h = crossings_[c.crossing].bisector;
@@ -684,7 +691,7 @@ double TargetShapeProblem::constraint(std::size_t k, const Polyline2& p, Polylin
         (*grad)[c.neighbour] -= du;
         (*grad)[c.vertex] += du;
       }
-      return std::cos(beta_[c.crossing]) - u.normalized().dot(h);
+      return constraint_cos_[k] - u.normalized().dot(h);  // cos(β)
     }
   }
   return 0.0;

@@ -14,14 +14,6 @@
 
 namespace wiresculpt::detail {
 
-std::array<int, 3> constraint_points(const TargetShapeProblem::Constraint& c, int np) {
-  switch (c.kind) {
-    case TargetShapeProblem::Kind::length: return {c.vertex, (c.vertex + 1) % np, -1};
-    case TargetShapeProblem::Kind::bend: return {(c.vertex + np - 1) % np, c.vertex, (c.vertex + 1) % np};
-    case TargetShapeProblem::Kind::contact: return {c.vertex, c.neighbour, -1};
-  }
-  return {-1, -1, -1};
-}
 
 // ---------------------------------------------------------------------------------------------
 // The QP: Goldfarb and Idnani's dual method ("A numerically stable dual method for solving
@@ -315,7 +307,8 @@ class BlockModel {
   }
 
  private:
-  int wrap(int j) const { return ((j % m_) + m_) % m_; }
+  // j from -m to 2m - 1 (a term's neighbours: from -1 to m).
+  int wrap(int j) const { return j < 0 ? j + m_ : j >= m_ ? j - m_ : j; }
 
   const TargetShapeProblem& pr_;
   SqpBlock b_;

@@ -151,7 +151,15 @@ SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& bloc
 
 /// The points constraint `c` of a wire of `np` points reads (-1: none): the edge's two ends
 /// (length), the vertex and its neighbours (bend), the crossing and its neighbour (contact).
-std::array<int, 3> constraint_points(const TargetShapeProblem::Constraint& c, int np);
+inline std::array<int, 3> constraint_points(const TargetShapeProblem::Constraint& c, int np) {
+  const int before = c.vertex > 0 ? c.vertex - 1 : np - 1, after = c.vertex + 1 < np ? c.vertex + 1 : 0;
+  switch (c.kind) {
+    case TargetShapeProblem::Kind::length: return {c.vertex, after, -1};
+    case TargetShapeProblem::Kind::bend: return {before, c.vertex, after};
+    case TargetShapeProblem::Kind::contact: return {c.vertex, c.neighbour, -1};
+  }
+  return {-1, -1, -1};
+}
 
 /// Solves the block from `p` (the whole wire's points; only the block's points change). On
 /// success `p` holds the solution; on failure `p` is left as it was.

@@ -403,6 +403,7 @@ class TargetShapeProblem {
   std::vector<char> fixed_;
   std::vector<int> crossing_vertices_;
   std::vector<Constraint> constraints_;
+  std::vector<double> constraint_cos_;  // per constraint: cos of its bend limit or β (0 for a length)
   std::vector<TargetCrossingStatus> statuses_;
   std::vector<double> beta_;  // per crossing: α*/2 - atan μ
 };
