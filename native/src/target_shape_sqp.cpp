@@ -1,5 +1,7 @@
 #include "target_shape_sqp.hpp"
 
+#include "small_triangular.hpp"
+
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
 #include <Eigen/QR>
@@ -25,8 +27,7 @@ bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::Vector
                      const Eigen::VectorXd& c, Eigen::VectorXd& d, Eigen::VectorXd& lambda, QpBuffers& buffers,
                      double tol) {
   const Eigen::Index n = g.size(), m = A.rows();
-  const auto L = llt.matrixL();
-  const auto U = llt.matrixU();
+  const double* L = llt.matrixLLT().data();  // L's lower triangle, column-major (leading dimension n)
   // In Goldfarb-Idnani's form the constraints are n_kᵀ d >= b_k with n_k = -a_k, b_k = c_k;
   // ñ_k = L⁻¹ n_k, so that W⁻¹ = L⁻ᵀ L⁻¹ turns every projection into a Euclidean one.
   // A's rows as contiguous columns, for the scans below; ñ_k (columns of Nt) is computed the
@@ -37,8 +38,9 @@ bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::Vector
   Nt.resize(n, m);
   std::vector<char>& whitened = buffers.whitened;
   whitened.assign(static_cast<std::size_t>(m), 0);
-  d = -g;
-  llt.solveInPlace(d);
+  d = -g;  // -W⁻¹ g, as llt.solveInPlace(d) gives it (small_triangular.hpp)
+  lower_solve_in_place(L, n, n, d.data());
+  lower_transpose_solve_in_place(L, n, n, d.data());
   lambda = Eigen::VectorXd::Zero(m);
   std::vector<Eigen::Index>& active = buffers.active;
   active.clear();
@@ -71,7 +73,7 @@ bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::Vector
     }
     if (!whitened[static_cast<std::size_t>(p)]) {
       Nt.col(p) = -At.col(p);
-      L.solveInPlace(Nt.col(p));
+      lower_solve_in_place(L, n, n, Nt.col(p).data());
       whitened[static_cast<std::size_t>(p)] = 1;
     }
     double up = 0.0;
@@ -81,7 +83,7 @@ bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::Vector
       const Eigen::VectorXd& r = basis.coefficients();
       const double zn = q.squaredNorm();
       z = q;
-      U.solveInPlace(z);
+      lower_transpose_solve_in_place(L, n, n, z.data());
       // Dual step length: the first active multiplier to reach zero.
       double t1 = std::numeric_limits<double>::infinity();
       Eigen::Index drop = -1;
