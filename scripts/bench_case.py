@@ -60,11 +60,14 @@ class TimedModule:
 
         def timed(*args, **kwargs):
             start = time.perf_counter()
+            result = None
             try:
-                return attr(*args, **kwargs)
+                result = attr(*args, **kwargs)
+                return result
             finally:
                 entry = self.calls.setdefault(name, [0, 0.0])
-                entry[0] += len(args[0]) if name == "optimize_target_shapes" else 1
+                # its problems may come from a generator: count the results
+                entry[0] += len(result or ()) if name == "optimize_target_shapes" else 1
                 entry[1] += time.perf_counter() - start
         return timed
 

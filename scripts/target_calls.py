@@ -47,6 +47,7 @@ def record(out, names):
 
         @staticmethod
         def optimize_target_shapes(problems, progress=None, threads=2):
+            problems = list(problems)  # the stage hands a generator over
             calls.extend({"case": current[0], "contour": copy.deepcopy(p["points"]), "closed": p["closed"],
                           "specs": copy.deepcopy(p["crossings"]), "options": copy.deepcopy(p["options"])}
                          for p in problems)

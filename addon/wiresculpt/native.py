@@ -13,6 +13,7 @@ the stages copy them without renaming.
 import os
 import re
 import sys
+from collections.abc import Iterator
 
 import numpy as np
 
@@ -134,14 +135,21 @@ def _list(value, what):
     return value
 
 
+def _point_item(item, i, what, key, columns):
+    """`item` with its `key` (when it is a dict holding one) made an (n, columns) float64 array."""
+    if isinstance(item, dict) and key in item:
+        return dict(item, **{key: as_points(item[key], f"{what}[{i}]['{key}']", columns)})
+    return item
+
+
 def _with_points(items, what, key, columns=3):
     """A list of dicts whose `key` (when present) is made an (n, columns) float64 array."""
-    out = []
-    for i, item in enumerate(_list(items, what)):
-        if isinstance(item, dict) and key in item:
-            item = dict(item, **{key: as_points(item[key], f"{what}[{i}]['{key}']", columns)})
-        out.append(item)
-    return out
+    return [_point_item(item, i, what, key, columns) for i, item in enumerate(_list(items, what))]
+
+
+def _iter_with_points(items, what, key, columns=3):
+    """_with_points of an iterator, one item at a time as it is read."""
+    return (_point_item(item, i, what, key, columns) for i, item in enumerate(items))
 
 
 # --- geometry and slicing --------------------------------------------------------------------------
@@ -193,7 +201,12 @@ def optimize_target_shape(points, closed, crossings, options=None, progress=None
 
 def optimize_target_shapes(problems, progress=None, threads=2):
     """optimize_target_shape of each problem ({"points", "closed", "crossings", "options"}), on up to
-    `threads` (1 or 2) native threads: the results in the problems' order, each as if solved alone."""
+    `threads` (1 or 2) native threads: the results in the problems' order, each as if solved alone.
+    `problems`: a list, or an iterator read one problem at a time (with 2 threads the other thread
+    solves the first while the iterator makes the next: a generator that prepares each wire)."""
+    if isinstance(problems, Iterator):
+        return require().optimize_target_shapes(_iter_with_points(problems, "problems", "points", 2), progress,
+                                                threads)
     return require().optimize_target_shapes(_with_points(problems, "problems", "points", 2), progress, threads)
 
 

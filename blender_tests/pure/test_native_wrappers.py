@@ -75,6 +75,39 @@ class Wrappers(unittest.TestCase):
         control.abort()
         self.assertTrue(control.aborted)
 
+    def test_target_shapes_read_an_iterator_one_problem_at_a_time(self):
+        # The stage hands over a generator that prepares each wire as it is read: the same results
+        # as a list; the points may be lists (converted as each problem is read); an error raised
+        # while making the next problem is the call's, with the other thread stopped.
+        def ring(r, n):
+            angle = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
+            return [[r * np.cos(a), r * np.sin(a)] for a in angle]
+        problems = [{"points": ring(0.05 + 0.02 * k, 40 + 20 * k), "closed": True,
+                     "crossings": [{"vertex": 0, "bisector": (1.0, 0.0)}], "options": {"wire_name": f"W{k}"}}
+                    for k in range(3)]
+        read = []
+
+        def made():
+            for k, p in enumerate(problems):
+                read.append(k)
+                yield p
+        listed = native.optimize_target_shapes(problems)
+        for threads in (1, 2):
+            read.clear()
+            fed = native.optimize_target_shapes(made(), None, threads)
+            self.assertEqual(read, [0, 1, 2])
+            self.assertEqual(len(fed), 3)
+            for a, b in zip(listed, fed):
+                np.testing.assert_array_equal(a["points"], b["points"])
+                self.assertEqual(a["energy"], b["energy"])
+
+        def failing():
+            yield problems[0]
+            raise RuntimeError("the next wire could not be prepared")
+        with self.assertRaisesRegex(RuntimeError, "could not be prepared"):
+            native.optimize_target_shapes(failing())
+        self.assertEqual(len(native.optimize_target_shapes(iter(problems))), 3)  # the other thread is free again
+
     def test_target_shape_results_have_the_documented_keys_and_types(self):
         # The keys as the module's docstring lists them (the Python side reads them by name).
         result_keys = {"points", "crossing_vertices", "crossings", "max_distance", "rms_distance",

@@ -57,6 +57,7 @@ class Coupling(unittest.TestCase):
                     return getattr(module, name)
 
                 def solve(problems, *args):
+                    problems = list(problems)  # the stage hands a generator over
                     self.calls += len(problems)
                     self.starts += sum("start" in p["options"] for p in problems)
                     return module.optimize_target_shapes(problems, *args)

@@ -177,7 +177,8 @@ class AgainstConvergedSweeps(unittest.TestCase):
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)
 class Threads(unittest.TestCase):
     """solve_all: one native call for the wires to solve, on two threads, each result that of its
-    wire solved alone (solve_job), in the jobs' order, with the memo's results handed back untouched."""
+    wire solved alone (solve_job), in the jobs' order, with the memo's results handed back untouched;
+    from a list or from a generator that prepares each job as it is read."""
 
     @classmethod
     def setUpClass(cls):
@@ -197,14 +198,30 @@ class Threads(unittest.TestCase):
         jobs.insert(0, jobs.pop())  # another order than the native call's own
         alone = [target_shape.solve_job(job) for job in jobs]
         with mock.patch.object(target_shape, "MAX_THREADS", 2), mock.patch.object(target_shape, "CORES", 2):
-            together = target_shape.solve_all(jobs)
+            taken, together = target_shape.solve_all(jobs)
+            # as the stage hands them over: a generator that makes each job when it is read
+            made, fed = target_shape.solve_all((job for job in jobs), None, len(jobs))
+        self.assertEqual(taken, jobs)
+        self.assertEqual(made, jobs)
         self.assertIs(together[2], kept)
-        for a, b in zip(alone, together):
+        self.assertIs(fed[2], kept)
+        for a, b, c in zip(alone, together, fed):
             if a is kept:
                 continue
-            self.assertEqual(a["points"].tolist(), b["points"].tolist())
-            self.assertEqual(a["crossings"], b["crossings"])
-            self.assertEqual(a["energy"], b["energy"])
+            for d in (b, c):
+                self.assertEqual(a["points"].tolist(), d["points"].tolist())
+                self.assertEqual(a["crossings"], d["crossings"])
+                self.assertEqual(a["energy"], d["energy"])
+
+    def test_no_native_call_when_every_result_is_kept(self):
+        jobs = self.jobs()
+        for k, job in enumerate(jobs):
+            job["result"] = {"kept": k}
+        with mock.patch.object(target_shape.native, "optimize_target_shapes") as solve:
+            taken, results = target_shape.solve_all(iter(jobs), None, len(jobs))
+        solve.assert_not_called()
+        self.assertEqual(taken, jobs)
+        self.assertEqual(results, [{"kept": k} for k in range(len(jobs))])
 
     def test_a_bad_wire_is_named_and_cancelling_stops_all(self):
         jobs = self.jobs()

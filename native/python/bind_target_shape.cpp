@@ -85,8 +85,14 @@ py::dict optimize(const py::object& points, const py::object& closed_arg, const 
 }
 
 py::list optimize_all(const py::object& problems, const py::object& progress, const py::object& threads_arg) {
-  std::vector<TargetShapeJob> jobs;
-  each_item(problems, "problems", [&](py::handle item, const std::string& where) {
+  const int threads = to_integer(threads_arg, "threads");
+  // A list of fewer than two problems is solved on this thread alone (the other would only wait).
+  const bool iterator = PyIter_Check(problems.ptr());
+  const bool few = !iterator && PySequence_Check(problems.ptr()) && PySequence_Size(problems.ptr()) < 2;
+  TargetShapeBatch batch(few && threads == 2 ? 1 : threads);
+  // Each problem is handed to the batch as soon as it is read: from an iterator (a generator that
+  // prepares the next wire), the other thread solves the first while Python makes the next.
+  auto add = [&](py::handle item, const std::string& where) {
     TargetShapeJob job;
     const auto seen = read_fields(
         item, where,
@@ -95,12 +101,17 @@ py::list optimize_all(const py::object& problems, const py::object& progress, co
          {"crossings", [&](py::handle v, const std::string& at) { job.crossings = to_crossings(v, at); }},
          {"options", [&](py::handle v, const std::string& at) { job.options = to_options(v, at); }}});
     require_keys(seen, where, {"points", "closed"});
-    jobs.push_back(std::move(job));
-  });
-  const int threads = to_integer(threads_arg, "threads");
+    batch.add(std::move(job));
+  };
+  if (iterator) {
+    std::size_t k = 0;
+    for (py::handle item : problems) add(item, index_path("problems", k++));
+  } else {
+    each_item(problems, "problems", add);
+  }
   PythonProgress reporter(progress);
   const ProgressFn fn = reporter.fn();
-  const std::vector<TargetShapeResult> results = reporter.run([&] { return optimize_target_shapes(jobs, threads, fn); });
+  const std::vector<TargetShapeResult> results = reporter.run([&] { return batch.finish(fn); });
   py::list out;
   for (const TargetShapeResult& r : results) out.append(to_dict(r));
   return out;
@@ -133,8 +144,9 @@ Raises ValueError naming the wire and crossing for bad input.)");
         R"(optimize_target_shape of every problem, on this thread and, with threads=2, one more (the
 GIL released throughout).
 
-problems: list of {"points", "closed", "crossings" (default []), "options" (default {})}, each
-as optimize_target_shape's arguments of those names; progress: optional callable(stage, fraction)
+problems: list (or iterator, read one problem at a time: with threads=2 the other thread starts on
+the first while the iterator makes the next) of {"points", "closed", "crossings" (default []),
+"options" (default {})}, each as optimize_target_shape's arguments of those names; progress: optional callable(stage, fraction)
 -> bool, called on this thread only, False cancels every problem (raises Cancelled); threads: 1 or 2.
 Returns the list of optimize_target_shape's results, in the problems' order: each the same as that
 problem solved alone (the problems are taken the dearest first, which changes only how long the

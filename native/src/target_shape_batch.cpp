@@ -5,11 +5,15 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstddef>
+#include <deque>
 #include <exception>
 #include <mutex>
 #include <optional>
+#include <stdexcept>
 #include <string_view>
 #include <thread>
+
+#include <unistd.h>
 #include <vector>
 
 #include "wiresculpt/error.hpp"
@@ -54,7 +58,315 @@ class SpinLock {
   std::atomic_flag flag_;
 };
 
+// The other thread, made once and kept for the process: a thread started for every call cost
+// about 14 % more CPU than the same solves on one thread (its start and end in the kernel, a fresh
+// stack, malloc arena and caches; issue 17, seventeenth round). It serves one batch at a time;
+// a batch that finds it busy (another solve on another thread) runs on its own thread alone. It is
+// never destroyed: parked at exit, it is the operating system's to end (joining it from a static
+// destructor could wait on a batch whose caller the interpreter froze).
+class Helper {
+ public:
+  using Fn = void (*)(void*) noexcept;
+
+  // The process's helper, made at the first call (again in a forked child, which has no thread);
+  // null when no thread can be made.
+  static Helper* instance() {
+    static std::mutex made;
+    static Helper* helper = nullptr;
+    static pid_t owner = 0;
+    const std::lock_guard<std::mutex> lock(made);
+    if (!helper || owner != getpid()) {
+      helper = nullptr;  // a forked child's copy: its thread is the parent's (the object is left)
+      try {
+        helper = new Helper();
+        owner = getpid();
+      } catch (...) {
+        helper = nullptr;
+      }
+    }
+    return helper;
+  }
+
+  // Runs work(arg) and then done(arg) on the helper thread, unless it serves another batch (false).
+  // After done(arg) returns the helper no longer touches arg.
+  bool lend(Fn work, Fn done, void* arg) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (work_) return false;
+    work_ = work, done_ = done, arg_ = arg;
+    wake_.notify_one();
+    return true;
+  }
+
+ private:
+  Helper() { std::thread([this] { loop(); }).detach(); }
+
+  void loop() noexcept {
+    for (;;) {
+      Fn work = nullptr, done = nullptr;
+      void* arg = nullptr;
+      try {
+        std::unique_lock<std::mutex> lock(mutex_);
+        wake_.wait(lock, [&] { return work_ != nullptr; });
+        work = work_, done = done_, arg = arg_;
+      } catch (...) {
+        continue;  // no lock to be had (never seen): wait again
+      }
+      work(arg);
+      try {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        work_ = nullptr;  // free for the next batch before this one hears it ended
+      } catch (...) {
+        work_ = nullptr;
+      }
+      done(arg);
+    }
+  }
+
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  Fn work_ = nullptr, done_ = nullptr;
+  void* arg_ = nullptr;
+};
+
 }  // namespace
+
+struct TargetShapeBatch::State {
+  using Clock = std::chrono::steady_clock;
+  static constexpr std::size_t none = static_cast<std::size_t>(-1);
+
+  explicit State(int t) : threads(t) {}
+
+  // One job's run and bookkeeping. A windowed wire is a run of pieces (detail::TargetShapeRun: its
+  // windows; a one-block wire is one piece). A thread keeps its wire while no free wire has clearly
+  // more work left by the guess (expected_cost less the time it has had), else hands it over
+  // between two windows: three equal wires on two threads then end together instead of in two
+  // waves (the globe).
+  struct Slot {
+    const TargetShapeJob* job = nullptr;
+    std::optional<detail::TargetShapeRun> run;
+    double left = 0.0;  // guessed seconds of work left
+    bool busy = false, done = false;
+    std::exception_ptr error;
+  };
+
+  const int threads;
+  const std::thread::id caller = std::this_thread::get_id();
+  // Stable addresses as jobs are added (a run refers to its job; a thread holds its slot by
+  // pointer outside the lock while add() appends).
+  std::deque<TargetShapeJob> jobs;
+  std::deque<Slot> slots;
+  SpinLock book;  // guards slots (their number, left, busy, done), closed, reserved, started, hand_overs
+  bool closed = false;      // finish() began: the caller works too and no job comes
+  std::size_t reserved = none;  // the job the other thread starts with (finish() before it started)
+  bool started = false;     // the other thread took its first job
+  int hand_overs = 0;
+  std::atomic<unsigned> posted{0};  // bumped at each add and at the close: wakes an idle thread
+  std::atomic<bool> stop{false};
+  std::atomic<std::size_t> finished{0};
+
+  // The calling thread asks finish()'s `progress`; the other thread's pieces only look at `stop`.
+  // An exception from `progress` stops both (every job still running ends in Cancelled) and is
+  // the one thrown at the end, as optimize_target_shape's callers see it. A wire's pieces may run
+  // on either thread, so the function every run polls asks by the thread it finds itself on.
+  const ProgressFn* progress = nullptr;  // finish()'s, read on the calling thread only
+  std::exception_ptr progress_error;     // written by the calling thread only
+  bool asked(std::string_view stage, double fraction) {
+    if (stop) return false;
+    try {
+      if (!(*progress)(stage, fraction)) stop = true;
+    } catch (...) {
+      progress_error = std::current_exception();
+      stop = true;
+    }
+    return !stop.load();
+  }
+  const ProgressFn by_thread = [this](std::string_view stage, double fraction) {
+    if (std::this_thread::get_id() == caller && progress && *progress) return asked(stage, fraction);
+    return !stop.load();
+  };
+
+  bool asked_helper = false;  // add() asked for the helper thread (with threads = 2)
+  bool lent = false;          // the helper thread works on this batch until `ended`
+  std::mutex mutex;
+  std::condition_variable worker_ended;
+  std::atomic<bool> ended{false};
+
+  // The free job with the most work left (the first of equals), or none. Under `book`.
+  std::size_t dearest_free() const {
+    std::size_t best = none;
+    for (std::size_t k = 0; k < slots.size(); ++k)
+      if (!slots[k].busy && !slots[k].done && (best == none || slots[k].left > slots[best].left)) best = k;
+    return best;
+  }
+
+  // A thread's loop: pieces of the jobs until none is left (for the other thread, once the batch
+  // is closed; until then it waits for the next add).
+  void work() noexcept {
+    const bool other_thread = std::this_thread::get_id() != caller;
+    std::size_t mine = none;
+    Slot* slot = nullptr;
+    for (;;) {
+      const unsigned seen = posted.load();
+      {
+        const std::lock_guard<SpinLock> lock(book);
+        if (other_thread && !started && reserved != none) {
+          mine = reserved;
+          started = true;
+        }
+        const std::size_t other = dearest_free();
+        if (closed && mine != none && other != none && slots[other].left > slots[mine].left + kHandOverSeconds) {
+          slots[mine].busy = false;
+          mine = none;
+          ++hand_overs;
+        }
+        if (mine == none) {
+          if (other == none) {
+            if (closed) return;
+          } else {
+            mine = other;
+            slots[mine].busy = true;
+            if (other_thread) started = true;
+          }
+        }
+        slot = mine == none ? nullptr : &slots[mine];
+      }
+      if (!slot) {  // nothing free yet: wait for the next add (or the close)
+        posted.wait(seen);
+        continue;
+      }
+      const auto began = Clock::now();
+      bool more = false;
+      try {
+        if (stop) throw Cancelled();
+        if (!slot->run) {
+          const TargetShapeJob& job = *slot->job;
+          slot->run.emplace(detail::run_target_shape(job.contour, job.closed, job.crossings, job.options, by_thread));
+        }
+        more = slot->run->step();
+      } catch (...) {
+        slot->error = std::current_exception();
+      }
+      const double spent = std::chrono::duration<double>(Clock::now() - began).count();
+      const std::lock_guard<SpinLock> lock(book);
+      slot->left -= spent;
+      if (!more) {
+        slot->done = true;
+        slot->busy = false;
+        ++finished;
+        mine = none;
+      }
+    }
+  }
+
+  void post() {
+    posted.fetch_add(1);
+    posted.notify_all();
+  }
+
+  // The helper thread's part: its loop, then the word that it ended (given under the lock, so
+  // that the batch, free to go once it hears it, is not touched after).
+  static void helper_work(void* state) noexcept { static_cast<State*>(state)->work(); }
+  static void helper_done(void* state) noexcept {
+    State& s = *static_cast<State*>(state);
+    try {
+      const std::lock_guard<std::mutex> lock(s.mutex);
+      s.ended = true;
+      s.worker_ended.notify_one();
+    } catch (...) {  // no lock to be had: the waits below poll the flag every 20 ms
+      s.ended = true;
+    }
+  }
+
+  // Waits until the helper thread, if it works on this batch, is done with it (closing the batch
+  // first, so that it stops waiting for jobs).
+  void join() noexcept {
+    if (!lent) return;
+    {
+      const std::lock_guard<SpinLock> lock(book);
+      closed = true;
+    }
+    post();
+    try {
+      std::unique_lock<std::mutex> lock(mutex);
+      while (!worker_ended.wait_for(lock, std::chrono::milliseconds(20), [&] { return ended.load(); })) {
+      }
+    } catch (...) {
+      while (!ended) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    lent = false;
+  }
+};
+
+TargetShapeBatch::TargetShapeBatch(int threads) {
+  if (threads < 1 || threads > 2) throw InputError("target shapes: threads must be 1 or 2");
+  state_ = std::make_unique<State>(threads);
+}
+
+TargetShapeBatch::~TargetShapeBatch() {
+  if (!state_) return;
+  state_->stop = true;
+  state_->join();
+}
+
+void TargetShapeBatch::add(TargetShapeJob job) {
+  State& s = *state_;
+  if (s.closed) throw std::logic_error("TargetShapeBatch::add after finish");
+  s.jobs.push_back(std::move(job));  // only this thread touches jobs
+  State::Slot slot;
+  slot.job = &s.jobs.back();
+  slot.left = kSecondsPerCost * expected_cost(s.jobs.back());
+  {
+    const std::lock_guard<SpinLock> lock(s.book);
+    s.slots.push_back(std::move(slot));
+  }
+  if (s.threads == 2 && !s.asked_helper) {
+    s.asked_helper = true;  // once: busy now, it stays the other solve's
+    Helper* helper = Helper::instance();
+    s.lent = helper && helper->lend(&State::helper_work, &State::helper_done, &s);
+  }
+  s.post();
+}
+
+std::vector<TargetShapeResult> TargetShapeBatch::finish(const ProgressFn& progress, detail::TargetShapesStats* stats) {
+  State& s = *state_;
+  if (s.closed) throw std::logic_error("TargetShapeBatch::finish called twice");
+  s.progress = &progress;
+  {
+    const std::lock_guard<SpinLock> lock(s.book);
+    s.closed = true;
+    // The dearest job is the other thread's when it has not started yet (the calling thread, which
+    // answers `progress` too, takes the next), so who starts which does not hang on when the
+    // thread starts (40-100 µs on this project's 2-core virtual machine).
+    if (s.lent && !s.started) {
+      s.reserved = s.dearest_free();
+      if (s.reserved != State::none) s.slots[s.reserved].busy = true;
+    }
+  }
+  s.post();
+  s.work();
+  if (s.lent && progress) {
+    // While the other thread ends its last piece, `progress` is still asked every 20 ms (Live
+    // cancels a solve as soon as the plane moves again).
+    std::unique_lock<std::mutex> lock(s.mutex);
+    while (!s.worker_ended.wait_for(lock, std::chrono::milliseconds(20), [&] { return s.ended.load(); })) {
+      if (s.stop) continue;
+      lock.unlock();
+      s.asked("target_shape", static_cast<double>(s.finished.load()) / static_cast<double>(s.slots.size()));
+      lock.lock();
+    }
+  }
+  s.join();
+  s.progress = nullptr;
+  if (stats) stats->hand_overs = s.hand_overs;
+  if (s.progress_error) std::rethrow_exception(s.progress_error);
+  std::vector<TargetShapeResult> out;
+  out.reserve(s.slots.size());
+  for (State::Slot& slot : s.slots) {
+    if (slot.error) std::rethrow_exception(slot.error);
+    out.push_back(slot.run->take());  // rethrows what the run threw
+  }
+  return out;
+}
 
 std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetShapeJob>& jobs, int threads,
                                                       const ProgressFn& progress) {
@@ -63,156 +375,14 @@ std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetSh
 
 std::vector<TargetShapeResult> detail::optimize_target_shapes(const std::vector<TargetShapeJob>& jobs, int threads,
                                                               const ProgressFn& progress, TargetShapesStats* stats) {
-  if (threads < 1 || threads > 2) throw InputError("target shapes: threads must be 1 or 2");
-  const std::size_t n = jobs.size();
-  using Clock = std::chrono::steady_clock;
-
-  // The calling thread asks `progress`; the other thread's pieces only look at `stop`. An
-  // exception from `progress` stops both (every job still running ends in Cancelled) and is the
-  // one thrown at the end, as optimize_target_shape's callers see it. A wire's pieces may run on
-  // either thread, so its progress function asks by the thread it finds itself on.
-  std::atomic<bool> stop{false};
-  std::exception_ptr progress_error;  // written by the calling thread only
-  const std::thread::id caller = std::this_thread::get_id();
-  const ProgressFn asked = [&](std::string_view stage, double fraction) {
-    if (stop) return false;
-    try {
-      if (!progress(stage, fraction)) stop = true;
-    } catch (...) {
-      progress_error = std::current_exception();
-      stop = true;
-    }
-    return !stop.load();
-  };
-  const ProgressFn by_thread = [&](std::string_view stage, double fraction) {
-    if (std::this_thread::get_id() == caller) return asked(stage, fraction);
-    return !stop.load();
-  };
-  const ProgressFn none;
-  const ProgressFn& fn = progress ? by_thread : none;
-
-  // Each job is a run of pieces (detail::TargetShapeRun: a windowed wire's windows, one piece for
-  // a one-block wire). A thread keeps its wire while no free wire has clearly more work left by
-  // the guess (expected_cost less the time it has had), else hands it over between two windows:
-  // three equal wires on two threads then end together instead of in two waves (the globe).
-  struct Slot {
-    std::optional<detail::TargetShapeRun> run;
-    double left = 0.0;  // guessed seconds of work left
-    bool busy = false, done = false;
-    std::exception_ptr error;
-  };
-  std::vector<Slot> slots(n);
-  for (std::size_t k = 0; k < n; ++k) slots[k].left = kSecondsPerCost * expected_cost(jobs[k]);
-  SpinLock book;  // guards slots' left, busy and done
-  std::atomic<std::size_t> finished{0};
-  int hand_overs = 0;  // guarded by book
-  // The free wire with the most work left (the first of equals), or n.
-  auto dearest_free = [&]() {
-    std::size_t best = n;
-    for (std::size_t k = 0; k < n; ++k)
-      if (!slots[k].busy && !slots[k].done && (best == n || slots[k].left > slots[best].left)) best = k;
-    return best;
-  };
-  auto work = [&](std::size_t mine) noexcept {  // mine: the job it starts with (busy already), or n
-    for (;;) {
-      {
-        const std::lock_guard<SpinLock> lock(book);
-        const std::size_t other = dearest_free();
-        if (mine != n && other != n && slots[other].left > slots[mine].left + kHandOverSeconds) {
-          slots[mine].busy = false;
-          mine = n;
-          ++hand_overs;
-        }
-        if (mine == n) {
-          if (other == n) return;
-          mine = other;
-          slots[mine].busy = true;
-        }
-      }
-      Slot& slot = slots[mine];
-      const auto began = Clock::now();
-      bool more = false;
-      try {
-        if (stop) throw Cancelled();
-        if (!slot.run) {
-          const TargetShapeJob& job = jobs[mine];
-          slot.run.emplace(detail::run_target_shape(job.contour, job.closed, job.crossings, job.options, fn));
-        }
-        more = slot.run->step();
-      } catch (...) {
-        slot.error = std::current_exception();
-      }
-      const double spent = std::chrono::duration<double>(Clock::now() - began).count();
-      const std::lock_guard<SpinLock> lock(book);
-      slot.left -= spent;
-      if (!more) {
-        slot.done = true;
-        slot.busy = false;
-        ++finished;
-        mine = n;
-      }
-    }
-  };
-
-  std::mutex mutex;
-  std::condition_variable worker_ended;
-  std::atomic<bool> ended{false};
-  std::optional<std::thread> worker;
-  // Whatever happens below, the other thread is stopped and joined before this frame goes (a
-  // joinable std::thread destroyed would terminate the process, and Blender with it).
-  struct Joiner {
-    std::optional<std::thread>& thread;
-    std::atomic<bool>& stop;
-    ~Joiner() {
-      if (thread && thread->joinable()) {
-        stop = true;
-        thread->join();
-      }
-    }
-  } joiner{worker, stop};
-  if (threads == 2 && n >= 2) {
-    // The dearest job is the other thread's from the start (the calling thread, which answers
-    // `progress` too, takes the next), so who starts which does not hang on when the thread starts
-    // (40-100 µs on this project's 2-core virtual machine).
-    const std::size_t first = dearest_free();
-    slots[first].busy = true;
-    try {
-      worker.emplace([&, first]() noexcept {
-        work(first);
-        try {
-          const std::lock_guard<std::mutex> lock(mutex);
-          ended = true;
-        } catch (...) {  // no lock to be had: the caller's 20 ms wait still sees the flag
-          ended = true;
-        }
-        worker_ended.notify_one();
-      });
-    } catch (...) {  // no thread to be had: the calling thread does them all
-      slots[first].busy = false;
-    }
+  TargetShapeBatch batch(threads);  // checks threads
+  if (jobs.size() < 2) {  // the other thread would only wait for it: the calling thread solves it
+    TargetShapeBatch alone(1);
+    for (const TargetShapeJob& job : jobs) alone.add(job);
+    return alone.finish(progress, stats);
   }
-  work(n);
-  if (worker && progress) {
-    // While the other thread ends its last piece, `progress` is still asked every 20 ms (Live
-    // cancels a solve as soon as the plane moves again).
-    std::unique_lock<std::mutex> lock(mutex);
-    while (!worker_ended.wait_for(lock, std::chrono::milliseconds(20), [&] { return ended.load(); })) {
-      if (stop) continue;
-      lock.unlock();
-      asked("target_shape", static_cast<double>(finished.load()) / static_cast<double>(n));
-      lock.lock();
-    }
-  }
-  if (worker) worker->join();
-  if (stats) stats->hand_overs = hand_overs;
-  if (progress_error) std::rethrow_exception(progress_error);
-  std::vector<TargetShapeResult> out;
-  out.reserve(n);
-  for (Slot& slot : slots) {
-    if (slot.error) std::rethrow_exception(slot.error);
-    out.push_back(slot.run->take());  // rethrows what the run threw
-  }
-  return out;
+  for (const TargetShapeJob& job : jobs) batch.add(job);
+  return batch.finish(progress, stats);
 }
 
 }  // namespace wiresculpt

@@ -261,6 +261,77 @@ TEST_CASE("target shapes: the first bad wire in the jobs' order is the error, af
   CHECK_THROWS_WITH(optimize_target_shapes(jobs, 3), Contains("threads must be 1 or 2"));
 }
 
+TEST_CASE("target shapes: a batch fed one job at a time gives each wire's own result, in the order added",
+          "[target]") {
+  // The other thread starts on the first job while the caller is still adding (here: pausing 2 ms
+  // between adds, as the stage's Python prepares the next wire), then finish() works on both.
+  const std::vector<TargetShapeJob> jobs = round_of_wires();
+  std::vector<TargetShapeResult> alone;
+  for (const TargetShapeJob& j : jobs) alone.push_back(optimize_target_shape(j.contour, j.closed, j.crossings, j.options));
+  for (int threads : {1, 2}) {
+    TargetShapeBatch batch(threads);
+    for (const TargetShapeJob& j : jobs) {
+      batch.add(j);
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    const std::vector<TargetShapeResult> results = batch.finish();
+    REQUIRE(results.size() == jobs.size());
+    for (std::size_t k = 0; k < jobs.size(); ++k) {
+      INFO("threads " << threads << ", wire " << jobs[k].options.wire_name);
+      check_same(results[k], alone[k]);
+    }
+    CHECK_THROWS_AS(batch.add(jobs[0]), std::logic_error);
+    CHECK_THROWS_AS(batch.finish(), std::logic_error);
+  }
+  CHECK(TargetShapeBatch(2).finish().empty());
+  CHECK_THROWS_WITH(TargetShapeBatch(3), Contains("threads must be 1 or 2"));
+}
+
+TEST_CASE("target shapes: two batches at once share the other thread and each gets its wires' own results",
+          "[target]") {
+  // The helper thread serves one batch at a time: the one that finds it busy runs on its own thread.
+  const std::vector<TargetShapeJob> jobs = round_of_wires();
+  std::vector<TargetShapeResult> alone;
+  for (const TargetShapeJob& j : jobs) alone.push_back(optimize_target_shape(j.contour, j.closed, j.crossings, j.options));
+  std::vector<TargetShapeResult> first, second;
+  std::thread other([&] { second = optimize_target_shapes(jobs, 2); });
+  first = optimize_target_shapes(jobs, 2);
+  other.join();
+  REQUIRE(first.size() == jobs.size());
+  REQUIRE(second.size() == jobs.size());
+  for (std::size_t k = 0; k < jobs.size(); ++k) {
+    INFO("wire " << jobs[k].options.wire_name);
+    check_same(first[k], alone[k]);
+    check_same(second[k], alone[k]);
+  }
+}
+
+TEST_CASE("target shapes: a batch dropped before finish stops the other thread's work, which serves the next",
+          "[target]") {
+  // As when the Python that feeds a batch raises: the long job the other thread took is stopped at
+  // its next poll (well before its second of work), and the thread is free for the next batch.
+  TargetShapeJob slow = loop("Slow", 0.45, 0.05, 5, 3000, 6);
+  slow.options.algorithm = TargetShapeAlgorithm::slsqp;
+  slow.options.sweep_ftol = 0.0;
+  slow.options.sweep_tol = 1e-9;
+  const auto began = std::chrono::steady_clock::now();
+  {
+    TargetShapeBatch batch(2);
+    batch.add(slow);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));  // the other thread is on it
+  }
+  const double dropped = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+  const TargetShapeResult whole = optimize_target_shape(slow.contour, slow.closed, slow.crossings, slow.options);
+  const double solved = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count() - dropped;
+  CHECK(dropped < 0.5 * solved);  // stopped, not waited for (no time asserted, only the proportion)
+  const std::vector<TargetShapeJob> jobs = round_of_wires();
+  detail::TargetShapesStats stats;
+  const std::vector<TargetShapeResult> next = detail::optimize_target_shapes(jobs, 2, {}, &stats);
+  REQUIRE(next.size() == jobs.size());
+  check_same(next[0], optimize_target_shape(jobs[0].contour, jobs[0].closed, jobs[0].crossings, jobs[0].options));
+  CHECK(whole.points.size() > 0);
+}
+
 TEST_CASE("target shapes: the dearest-first guess counts a wire's target points as the solver places them",
           "[target]") {
   // Wires near the one-block limit with many crossings: the guess must tell one-block wires (a

@@ -166,17 +166,37 @@ def finish_wire(job, result, memo=None):
     return result, job["refs"], job["frame"]
 
 
-def solve_all(jobs, native_progress=None):
-    """The results of solve_job for every job, in order: the ones to solve in one native call, on up
-    to MAX_THREADS threads."""
-    todo = [k for k, job in enumerate(jobs) if job["result"] is None]
-    threads = max(1, min(MAX_THREADS, CORES, len(todo)))
-    results = [job["result"] for job in jobs]
-    problems = [{"points": jobs[k]["contour"], "closed": jobs[k]["closed"], "crossings": jobs[k]["specs"],
-                 "options": jobs[k]["options"]} for k in todo]
-    for k, result in zip(todo, native.optimize_target_shapes(problems, native_progress, threads) if todo else []):
-        results[k] = result
-    return results
+def solve_all(jobs, native_progress=None, count=None):
+    """(the jobs, their results): solve_job of every job of `jobs`, in order, the ones to solve in
+    one native call on up to MAX_THREADS threads. `jobs` is read once, and may be a generator that
+    prepares each wire as it is read (then `count` says how many it makes): the native call reads
+    its problems one at a time, so the other thread solves the first wire while this one prepares
+    the next."""
+    count = len(jobs) if count is None else count
+    jobs = iter(jobs)
+    taken = []
+    first = None
+    for job in jobs:  # up to the first to solve: no native call when every result is reused
+        taken.append(job)
+        if job["result"] is None:
+            first = job
+            break
+    if first is None:
+        return taken, [job["result"] for job in taken]
+
+    def problems():
+        yield _problem(first)
+        for job in jobs:
+            taken.append(job)
+            if job["result"] is None:
+                yield _problem(job)
+    solved = iter(native.optimize_target_shapes(problems(), native_progress,
+                                                max(1, min(MAX_THREADS, CORES, count))))
+    return taken, [next(solved) if job["result"] is None else job["result"] for job in taken]
+
+
+def _problem(job):
+    return {"points": job["contour"], "closed": job["closed"], "crossings": job["specs"], "options": job["options"]}
 
 
 class Memo:
@@ -375,8 +395,9 @@ def run(design, material, settings, native_progress=None, memo=None):
     pending = range(len(design["wires"]))  # the first round solves every wire
     for _round in range(MAX_ROUNDS):
         sides = sides_by_wire(design)
-        jobs = [prepare_wire(design, design["wires"][i], settings, size, memo, sides) for i in pending]
-        for i, job, result in zip(pending, jobs, solve_all(jobs, native_progress)):
+        jobs, results = solve_all((prepare_wire(design, design["wires"][i], settings, size, memo, sides)
+                                   for i in pending), native_progress, len(pending))
+        for i, job, result in zip(pending, jobs, results):
             reused[i] = job["result"] is not None
             solved[i] = finish_wire(job, result, memo)
             if not reused[i]:

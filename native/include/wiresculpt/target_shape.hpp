@@ -23,6 +23,7 @@
 // Σ_i |u_i - (u_{i-1} + u_{i+1})/2|² over the interior vertices, u = p - p_initial.
 #include <coroutine>
 #include <exception>
+#include <memory>
 #include <numbers>
 #include <optional>
 #include <stdexcept>
@@ -319,6 +320,30 @@ struct TargetShapesStats {
 std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetShapeJob>& jobs, int threads,
                                                       const ProgressFn& progress, TargetShapesStats* stats);
 }  // namespace detail
+
+/// optimize_target_shapes with the jobs handed over one at a time: with two threads, the other
+/// thread is started at the first add() and solves while the caller prepares the next jobs (the
+/// stage's Python reads each wire's frame and crossings; issue 17, seventeenth round); finish()
+/// then works on the calling thread too until every job is solved, exactly as
+/// optimize_target_shapes does (it is this batch with every job added at once). Every result is
+/// the one optimize_target_shape returns for that job alone, in the order added. Before finish()
+/// the other thread polls no `progress` and hands no wire over. Call add() and finish() from the
+/// thread that made the batch; destroying a batch that was not finished stops its other thread
+/// at its next poll and joins it.
+class TargetShapeBatch {
+ public:
+  explicit TargetShapeBatch(int threads);  ///< 1 or 2, else InputError
+  TargetShapeBatch(const TargetShapeBatch&) = delete;
+  TargetShapeBatch& operator=(const TargetShapeBatch&) = delete;
+  ~TargetShapeBatch();
+  void add(TargetShapeJob job);
+  /// The results, as optimize_target_shapes returns them (and throws as it throws). Once only.
+  std::vector<TargetShapeResult> finish(const ProgressFn& progress = {}, detail::TargetShapesStats* stats = nullptr);
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 /// The optimisation problem of one wire, exposed for tests and diagnostics: the initial
 /// resampled polyline and every term with its analytic gradient with respect to ALL points
