@@ -55,9 +55,11 @@ ONE_BLOCK_POINTS = 28
 # Wires are independent problems: a round's are solved in one native call (optimize_target_shapes)
 # on up to this many threads, the dearest first, a windowed wire handed from one thread to the other
 # between its windows when another has more work left (three equal wires end together), with the
-# GIL released throughout; each result depends only on its own wire, so the order is kept. (Issue
-# 17, ninth round: a Python thread pool per round cost about a millisecond more on the Duck and the
-# Car; fifteenth round: the hand-over.)
+# GIL released throughout; each result depends only on its own wire, so the order is kept. The call
+# reads its wires from a generator: the native helper thread (kept for the process) starts on the
+# first while this thread prepares the next. (Issue 17, ninth round: a Python thread pool per round
+# cost about a millisecond more on the Duck and the Car; fifteenth round: the hand-over;
+# seventeenth round: the generator and the kept thread.)
 MAX_THREADS = 2
 # The machine's cores, read once: os.cpu_count() reads /sys at every call (40-60 us on a VM, about
 # 1.5 % of the globe's stage).
