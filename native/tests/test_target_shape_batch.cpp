@@ -49,6 +49,15 @@ std::vector<TargetShapeJob> round_of_wires() {
           loop("Delta", 0.06, 0.0, 1, 200, 0), loop("Echo", 0.1, 0.015, 3, 400, 4)};
 }
 
+// A 3 m loop solved the slow way (SLSQP, sweeps to 1 nm): about a second.
+TargetShapeJob slow_loop() {
+  TargetShapeJob slow = loop("Slow", 0.45, 0.05, 5, 3000, 6);
+  slow.options.algorithm = TargetShapeAlgorithm::slsqp;
+  slow.options.sweep_ftol = 0.0;
+  slow.options.sweep_tol = 1e-9;
+  return slow;
+}
+
 void check_same(const TargetShapeResult& a, const TargetShapeResult& b) {
   REQUIRE(a.points.size() == b.points.size());
   for (std::size_t i = 0; i < a.points.size(); ++i) CHECK(a.points[i] == b.points[i]);
@@ -226,15 +235,11 @@ TEST_CASE("target shapes: progress is asked on the calling thread only, and it c
 
 TEST_CASE("target shapes: progress is still asked while the other thread ends its last wire, and can stop it",
           "[target]") {
-  // The dearest job (by its length) is the other thread's from the start: a 3 m loop solved the
-  // slow way (SLSQP, sweeps to 1 nm: about a second). The calling thread's only job is bad and
-  // fails at once, so the calling thread then waits, asking progress every 20 ms with the share of
-  // jobs done (1 of 2). Stopping there must stop the long solve: Cancelled, not the bad wire's
+  // The dearest job (by its length) is the other thread's from the start: slow_loop, about a
+  // second. The calling thread's only job is bad and fails at once, so the calling thread then
+  // waits, asking progress every 20 ms with the share of jobs done (1 of 2). Stopping there must stop the long solve: Cancelled, not the bad wire's
   // InputError that would come once the long solve ended.
-  TargetShapeJob slow = loop("Slow", 0.45, 0.05, 5, 3000, 6);
-  slow.options.algorithm = TargetShapeAlgorithm::slsqp;
-  slow.options.sweep_ftol = 0.0;
-  slow.options.sweep_tol = 1e-9;
+  const TargetShapeJob slow = slow_loop();
   TargetShapeJob bad = loop("Bad", 0.05, 0.0, 1, 100, 0);
   bad.crossings = {{500, Vec2(1, 0), 2.0, true}};  // past its 100 points
   std::vector<double> fractions;  // asked on the calling thread only
@@ -310,10 +315,7 @@ TEST_CASE("target shapes: a batch dropped before finish stops the other thread's
           "[target]") {
   // As when the Python that feeds a batch raises: the long job the other thread took is stopped at
   // its next poll (well before its second of work), and the thread is free for the next batch.
-  TargetShapeJob slow = loop("Slow", 0.45, 0.05, 5, 3000, 6);
-  slow.options.algorithm = TargetShapeAlgorithm::slsqp;
-  slow.options.sweep_ftol = 0.0;
-  slow.options.sweep_tol = 1e-9;
+  const TargetShapeJob slow = slow_loop();
   const auto began = std::chrono::steady_clock::now();
   {
     TargetShapeBatch batch(2);
