@@ -1029,6 +1029,7 @@ detail::TargetShapeRun detail::run_target_shape(const Polyline2& contour, bool c
   };
   bool choose_basin = false;  // sqp: SLSQP leads the block's first evaluations (see below)
   std::array<int, 2> shift_guess{0, 0};  // sqp: shared by the blocks (SqpSettings::shift_guess)
+  detail::SqpWorkspace workspace;         // sqp: the blocks' buffers (SqpSettings::workspace)
   auto solve_block = [&](const Block& b) {
     const unsigned nvar = static_cast<unsigned>(2 * b.points.size());
     data.block = &b;
@@ -1101,6 +1102,7 @@ detail::TargetShapeRun detail::run_target_shape(const Polyline2& contour, bool c
       ss.constraint_tol = o.constraint_tol;
       ss.ftol_rel = o.ftol_rel;
       ss.shift_guess = &shift_guess;
+      ss.workspace = &workspace;
       ss.on_evaluation = [&] {
         if (!data.count_evaluation()) throw Cancelled();
       };

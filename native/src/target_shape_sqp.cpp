@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include <nlopt.h>
@@ -140,8 +141,11 @@ using Mat2 = Eigen::Matrix2d;
 
 class BlockModel {
  public:
-  BlockModel(const TargetShapeProblem& problem, const SqpBlock& block, const SqpSettings& s, const Polyline2& p)
-      : pr_(problem), b_(block), s_(s), m_(static_cast<int>(p.size())) {
+  BlockModel(const TargetShapeProblem& problem, const SqpBlock& block, const SqpSettings& s, const Polyline2& p,
+             SqpWorkspace& ws)
+      : pr_(problem), b_(block), s_(s), m_(static_cast<int>(p.size())), var_(ws.var), grad_(ws.grad),
+        scratch_(ws.scratch), work_(ws.work), samples_(ws.samples), hessian_(ws.hessian) {
+    samples_.clear();  // the last evaluation with gradients is this model's
     var_.assign(m_, -1);
     for (std::size_t k = 0; k < b_.points->size(); ++k) var_[(*b_.points)[k]] = static_cast<int>(2 * k);
     n_ = static_cast<int>(2 * b_.points->size());
@@ -152,10 +156,9 @@ class BlockModel {
   int variables() const { return n_; }
   int constraints() const { return mc_; }
 
-  Eigen::VectorXd to_x(const Polyline2& p) const {
-    Eigen::VectorXd x(n_);
+  void to_x(const Polyline2& p, Eigen::VectorXd& x) const {
+    x.resize(n_);
     for (int i : *b_.points) x[var_[i]] = p[i].x() / s_.scale_x, x[var_[i] + 1] = p[i].y() / s_.scale_x;
-    return x;
   }
   void to_points(const Eigen::VectorXd& x, Polyline2& p) const {
     for (int i : *b_.points) p[i] = s_.scale_x * Vec2(x[var_[i]], x[var_[i] + 1]);
@@ -317,10 +320,11 @@ class BlockModel {
   SqpSettings s_;
   int m_;
   int n_ = 0, mc_ = 0;
-  std::vector<int> var_;
-  Polyline2 grad_, scratch_, work_;
-  std::vector<TargetShapeProblem::ImlsSample> samples_;  // of the last evaluation with gradients
-  Eigen::MatrixXd hessian_;
+  // The workspace's buffers.
+  std::vector<int>& var_;
+  Polyline2 &grad_, &scratch_, &work_;
+  std::vector<TargetShapeProblem::ImlsSample>& samples_;  // of the last evaluation with gradients
+  Eigen::MatrixXd& hessian_;
 };
 
 double violation(const Eigen::VectorXd& c) { return c.size() ? std::max(0.0, c.maxCoeff()) : 0.0; }
@@ -331,7 +335,8 @@ double infeasibility(const Eigen::VectorXd& c) { return c.cwiseMax(0.0).sum(); }
 Eigen::MatrixXd sqp_lagrangian_hessian(const TargetShapeProblem& problem, const SqpBlock& block,
                                        const SqpSettings& settings, const Polyline2& p, const Eigen::VectorXd& lambda,
                                        bool after_evaluation) {
-  BlockModel model(problem, block, settings, p);
+  SqpWorkspace ws;
+  BlockModel model(problem, block, settings, p, ws);
   if (after_evaluation) {  // as the SQP does: D and its gradient come from this evaluation
     Eigen::VectorXd g, c;
     Eigen::MatrixXd A;
@@ -344,7 +349,8 @@ Eigen::MatrixXd sqp_lagrangian_hessian(const TargetShapeProblem& problem, const 
 
 Eigen::VectorXd sqp_lagrangian_gradient(const TargetShapeProblem& problem, const SqpBlock& block,
                                         const SqpSettings& settings, const Polyline2& p, const Eigen::VectorXd& lambda) {
-  BlockModel model(problem, block, settings, p);
+  SqpWorkspace ws;
+  BlockModel model(problem, block, settings, p, ws);
   Eigen::VectorXd g, c;
   Eigen::MatrixXd A;
   model.evaluate(p, &g, c, &A);
@@ -445,7 +451,9 @@ bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::Vector
 SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, Polyline2& p_io,
                      const SqpSettings& settings) {
   SqpOutcome out;
-  BlockModel model(problem, block, settings, p_io);
+  std::optional<SqpWorkspace> own;
+  SqpWorkspace& ws = settings.workspace ? *settings.workspace : own.emplace();
+  BlockModel model(problem, block, settings, p_io, ws);
   const int n = model.variables(), mc = model.constraints();
   if (n == 0) {
     out.converged = true;
@@ -455,19 +463,23 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
     ++out.evaluations;
     if (settings.on_evaluation) settings.on_evaluation();
   };
-  Polyline2 p = p_io, trial = p_io;
-  Eigen::VectorXd x = model.to_x(p), g, c, ct, lambda = Eigen::VectorXd::Zero(mc), d, mu;
-  Eigen::MatrixXd A;
+  // Every buffer below is set before it is read (the workspace's, kept across blocks).
+  Polyline2 &p = ws.p, &trial = ws.trial;
+  p = p_io, trial = p_io;
+  Eigen::VectorXd &x = ws.x, &g = ws.g, &c = ws.c, &ct = ws.ct, &lambda = ws.lambda, &d = ws.d, &mu = ws.mu;
+  model.to_x(p, x);
+  lambda.setZero(mc);
+  Eigen::MatrixXd& A = ws.A;
   double f = model.evaluate(p, &g, c, &A);
   counted();
   double nu = 1.0;  // ℓ1 penalty of the merit function f + ν Σ max(0, c_k)
-  Eigen::LLT<Eigen::MatrixXd> factor(n);
-  Eigen::MatrixXd W;
-  QpBuffers qp;
-  ShiftBuffers shifts;
-  // The line search's buffers, kept across iterations (each use sets their contents and sizes).
-  Eigen::VectorXd xt, gt, dc, mc2, csoc;
-  Eigen::MatrixXd At;
+  Eigen::LLT<Eigen::MatrixXd>& factor = ws.factor;
+  Eigen::MatrixXd& W = ws.W;
+  QpBuffers& qp = ws.qp;
+  ShiftBuffers& shifts = ws.shifts;
+  // The line search's buffers (each use sets their contents and sizes).
+  Eigen::VectorXd &xt = ws.xt, &gt = ws.gt, &dc = ws.dc, &mc2 = ws.mc2, &csoc = ws.csoc;
+  Eigen::MatrixXd& At = ws.At;
   std::array<int, 2> own_guess{0, 0};
   std::array<int, 2>& shift = settings.shift_guess ? *settings.shift_guess : own_guess;
   for (int it = 0; it < settings.max_iterations; ++it) {
@@ -566,19 +578,27 @@ SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& bloc
                          const SqpSettings& settings, int max_evaluations, double xtol_rel,
                          const std::function<bool()>& out_of_time) {
   SlsqpOutcome out;
-  BlockModel model(problem, block, settings, p_io);
+  std::optional<SqpWorkspace> own;
+  SqpWorkspace& ws = settings.workspace ? *settings.workspace : own.emplace();
+  BlockModel model(problem, block, settings, p_io, ws);
   const int n = model.variables(), mc = model.constraints();
   if (n == 0) {
     out.done = true;
     out.result = NLOPT_SUCCESS;
     return out;
   }
-  Polyline2 p = p_io;
-  Eigen::VectorXd x = model.to_x(p), g, c, r, s, mu = Eigen::VectorXd::Zero(mc);
-  Eigen::MatrixXd A;
+  // Every buffer below is set before it is read (the workspace's, kept across blocks; g and A by
+  // the first evaluation, which takes the gradients).
+  Polyline2& p = ws.p;
+  p = p_io;
+  Eigen::VectorXd &x = ws.x, &g = ws.g, &c = ws.c, &r = ws.r, &s = ws.s, &mu = ws.mu;
+  model.to_x(p, x);
+  mu.setZero(mc);
+  Eigen::MatrixXd& A = ws.A;
   // NLopt keeps the best point seen: lower f where feasible (or nothing feasible yet), else less
   // infeasible while nothing is feasible.
-  Eigen::VectorXd best_x = x;
+  Eigen::VectorXd& best_x = ws.best_x;
+  best_x = x;
   double best_f = std::numeric_limits<double>::infinity(), best_infeasibility = best_f;
   bool best_feasible = false, feasible = false;
   bool finite = true;
@@ -627,13 +647,15 @@ SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& bloc
   double f = evaluate(true);
   if (!finite) return out;
   if (const int stop = budget()) return finish(stop);
-  Eigen::MatrixXd B = Eigen::MatrixXd::Identity(n, n);
-  Eigen::LLT<Eigen::MatrixXd> factor(n);
-  QpBuffers qp;
+  Eigen::MatrixXd& B = ws.B;
+  B.setIdentity(n, n);
+  Eigen::LLT<Eigen::MatrixXd>& factor = ws.factor;
+  QpBuffers& qp = ws.qp;
   double f_prev = std::numeric_limits<double>::infinity();
-  Eigen::VectorXd x_prev = x;
-  // Each iteration's vectors, kept across iterations (each use sets their contents and sizes).
-  Eigen::VectorXd v, x0, y, Bs;
+  Eigen::VectorXd& x_prev = ws.x_prev;
+  x_prev = x;
+  // Each iteration's vectors (each use sets their contents and sizes).
+  Eigen::VectorXd &v = ws.v, &x0 = ws.x0, &y = ws.y, &Bs = ws.Bs;
   int resets = 1;
   for (;;) {
     factor.compute(B);

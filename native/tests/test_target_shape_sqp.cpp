@@ -701,3 +701,45 @@ TEST_CASE("sqp: convexify takes the first shift of its sequence that makes W pos
   CHECK(W(2, 2) == 1.0);
   CHECK(std::isnan(W(1, 1)));
 }
+
+TEST_CASE("sqp: a block solved in a workspace another block used gives a fresh workspace's result", "[target][sqp]") {
+  // SqpWorkspace: a run keeps one across its blocks, whose sizes differ. Here blocks of three
+  // sizes, around the crossing and away from it, solved by the SLSQP replica and by the SQP, in a
+  // shared workspace in turn and each in a fresh one: the same points, to the bit.
+  const TargetShapeOptions o;
+  const double lmin = o.min_segment, spacing = 1.5 * lmin;
+  detail::SqpSettings fresh;
+  fresh.scale_x = lmin;
+  fresh.scale_f = 2.0 * spacing * lmin * lmin;
+  fresh.min_segment = lmin;
+  fresh.regularization = o.regularization;
+  detail::SqpWorkspace shared;
+  detail::SqpSettings reused = fresh;
+  reused.workspace = &shared;
+  Polyline2 contour;
+  for (int k = 0; k < 900; ++k) {
+    const double t = k / 900.0;
+    contour.emplace_back(0.15 * std::cos(2 * pi * t), 0.09 * std::sin(2 * pi * t));
+  }
+  const TargetShapeProblem problem(contour, true, {{450, Vec2(1, 0), 2 * pi / 3, true}}, o);
+  const int v = problem.statuses()[0].vertex;
+  std::vector<TestBlock> blocks{block_of(problem, v - 4, v + 4), block_of(problem, v + 6, v + 10),
+                                block_of(problem, v - 12, v - 1), block_of(problem, v - 4, v + 4)};
+  int solved = 0;
+  for (const TestBlock& tb : blocks) {
+    const detail::SqpBlock block{&tb.points, &tb.terms, &tb.constraints};
+    Polyline2 a = problem.initial(), b = problem.initial();
+    const detail::SlsqpOutcome la = detail::slsqp_block(problem, block, a, fresh, 10, o.xtol_rel);
+    const detail::SlsqpOutcome lb = detail::slsqp_block(problem, block, b, reused, 10, o.xtol_rel);
+    CHECK(la.done == lb.done);
+    CHECK(la.evaluations == lb.evaluations);
+    CHECK(a == b);
+    const detail::SqpOutcome sa = detail::sqp_block(problem, block, a, fresh);
+    const detail::SqpOutcome sb = detail::sqp_block(problem, block, b, reused);
+    CHECK(sa.converged == sb.converged);
+    CHECK(sa.evaluations == sb.evaluations);
+    CHECK(a == b);
+    solved += sa.converged ? 1 : 0;
+  }
+  CHECK(solved > 0);  // the comparison covers solves that moved points
+}
