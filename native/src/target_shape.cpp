@@ -718,6 +718,10 @@ struct SolverData {
   double scale_x = 1.0;     // p = scale_x * x
   double scale_f = 1.0;     // f = E / scale_f
   Polyline2 p, grad, cgrad;
+  // solve_block's buffers, kept across blocks: the block's variables, the points before it, its
+  // start, its answer, and the points before it in the sweep.
+  std::vector<double> x;
+  Polyline2 before, start, after, sweep_before;
   const ProgressFn* progress = nullptr;
   int evaluations = 0;
   int max_evaluations = 1;
@@ -1058,12 +1062,14 @@ detail::TargetShapeRun detail::run_target_shape(const Polyline2& contour, bool c
       op.set_maxtime(std::max(1e-3, o.max_seconds - elapsed()));
       return op;
     };
-    std::vector<double> x(nvar);
+    std::vector<double>& x = data.x;  // the buffers below are the run's, kept across blocks
+    x.assign(nvar, 0.0);
     for (std::size_t k = 0; k < b.points.size(); ++k) {
       x[2 * k] = data.p[b.points[k]].x() / data.scale_x;
       x[2 * k + 1] = data.p[b.points[k]].y() / data.scale_x;
     }
-    const Polyline2 before = data.p;
+    Polyline2& before = data.before;
+    before = data.p;
     double f = 0.0;
     nlopt::result r = nlopt::FAILURE;
     // TargetShapeAlgorithm::sqp: the block by Newton SQP. Where the basin is chosen (a one-block
@@ -1107,7 +1113,8 @@ detail::TargetShapeRun detail::run_target_shape(const Polyline2& contour, bool c
         if (!data.count_evaluation()) throw Cancelled();
       };
       const detail::SqpBlock sb{&b.points, &b.terms, &b.constraints};
-      Polyline2 start = data.p;
+      Polyline2& start = data.start;
+      start = data.p;
       const int lead = std::max(1, std::min(kSqpBasinEvaluations, o.max_iterations - data.evaluations));
       // SLSQP's first steps, replicated with our QP (slsqp_block); NLopt's own SLSQP where the
       // replica stops (inconsistent linearised constraints, a value not finite).
@@ -1174,7 +1181,8 @@ detail::TargetShapeRun detail::run_target_shape(const Polyline2& contour, bool c
     const auto [viol0, e0] = merit(before);
     data.p = before;
     if (finite) {
-      Polyline2 after = before;
+      Polyline2& after = data.after;
+      after = before;
       for (std::size_t k = 0; k < b.points.size(); ++k) after[b.points[k]] = data.scale_x * Vec2(x[2 * k], x[2 * k + 1]);
       const auto [viol1, e1] = merit(after);
       const double tol = o.constraint_tol;
@@ -1220,7 +1228,8 @@ detail::TargetShapeRun detail::run_target_shape(const Polyline2& contour, bool c
         if (!dirty[k]) continue;
         any = true;
         dirty[k] = 0;
-        const Polyline2 before = data.p;
+        Polyline2& before = data.sweep_before;
+        before = data.p;
         choose_basin = sweep == 0 && blocks[k].around_crossing;
         solve_block(blocks[k]);
         for (int q : blocks[k].points)
