@@ -88,7 +88,9 @@ py::list optimize_all(const py::object& problems, const py::object& progress, co
   const int threads = to_integer(threads_arg, "threads");
   // A list of fewer than two problems is solved on this thread alone (the other would only wait).
   const bool iterator = PyIter_Check(problems.ptr());
-  const bool few = !iterator && PySequence_Check(problems.ptr()) && PySequence_Size(problems.ptr()) < 2;
+  const Py_ssize_t size = iterator || !PySequence_Check(problems.ptr()) ? -1 : PySequence_Size(problems.ptr());
+  if (size < 0) PyErr_Clear();  // no length: each_item says what is wrong
+  const bool few = size >= 0 && size < 2;
   TargetShapeBatch batch(few && threads == 2 ? 1 : threads);
   // Each problem is handed to the batch as soon as it is read: from an iterator (a generator that
   // prepares the next wire), the other thread solves the first while Python makes the next.

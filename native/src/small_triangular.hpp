@@ -6,15 +6,21 @@
 // matrix-vector products and the in-panel dot products summed as Eigen sums them), without its
 // dispatch, alignment and blocking logic, which at these sizes cost more than the arithmetic
 // (docs/method-target-shape.md, issue 17, seventeenth round). So every result is Eigen's to the
-// bit. Where Eigen's double packet is not two wide (a build for AVX), or its panel width or version
-// differ, these call Eigen itself. native/tests/test_small_triangular.cpp compares the two.
+// bit. Where Eigen's packets are not SSE2's (a build for AVX or FMA, another processor), or its panel
+// width or version differ, these call Eigen itself. native/tests/test_small_triangular.cpp compares the two.
 
 #include <Eigen/Core>
 
 namespace wiresculpt::detail {
 
 /// Whether the written-out solves below reproduce this build's Eigen (else they call it).
-inline constexpr bool kTriangularReplica = Eigen::internal::packet_traits<double>::size == 2 &&
+inline constexpr bool kTriangularReplica =
+#if defined(EIGEN_VECTORIZE_SSE2) && !defined(EIGEN_VECTORIZE_FMA)  // x86's packets; no fused multiply-add
+    true &&
+#else
+    false &&
+#endif
+    Eigen::internal::packet_traits<double>::size == 2 &&
                                            Eigen::internal::packet_traits<double>::Vectorizable &&
                                            EIGEN_TUNE_TRIANGULAR_PANEL_WIDTH == 8 && EIGEN_WORLD_VERSION == 3 &&
                                            EIGEN_MAJOR_VERSION == 4;

@@ -185,7 +185,6 @@ struct TargetShapeBatch::State {
     return !stop.load();
   };
 
-  bool asked_helper = false;  // add() asked for the helper thread (with threads = 2)
   bool lent = false;          // the helper thread works on this batch until `ended`
   std::mutex mutex;
   std::condition_variable worker_ended;
@@ -263,6 +262,14 @@ struct TargetShapeBatch::State {
     posted.notify_all();
   }
 
+  // Lends the helper thread to this batch (with threads = 2), unless it serves another solve: then
+  // asked again at the next add() and at finish().
+  void borrow_helper() {
+    if (threads != 2 || lent) return;
+    Helper* helper = Helper::instance();
+    lent = helper && helper->lend(&State::helper_work, &State::helper_done, this);
+  }
+
   // The helper thread's part: its loop, then the word that it ended (given under the lock, so
   // that the batch, free to go once it hears it, is not touched after).
   static void helper_work(void* state) noexcept { static_cast<State*>(state)->work(); }
@@ -319,11 +326,7 @@ void TargetShapeBatch::add(TargetShapeJob job) {
     const std::lock_guard<SpinLock> lock(s.book);
     s.slots.push_back(std::move(slot));
   }
-  if (s.threads == 2 && !s.asked_helper) {
-    s.asked_helper = true;  // once: busy now, it stays the other solve's
-    Helper* helper = Helper::instance();
-    s.lent = helper && helper->lend(&State::helper_work, &State::helper_done, &s);
-  }
+  s.borrow_helper();
   s.post();
 }
 
@@ -331,13 +334,15 @@ std::vector<TargetShapeResult> TargetShapeBatch::finish(const ProgressFn& progre
   State& s = *state_;
   if (s.closed) throw std::logic_error("TargetShapeBatch::finish called twice");
   s.progress = &progress;
+  if (s.slots.size() >= 2) s.borrow_helper();
   {
     const std::lock_guard<SpinLock> lock(s.book);
     s.closed = true;
     // The dearest job is the other thread's when it has not started yet (the calling thread, which
     // answers `progress` too, takes the next), so who starts which does not hang on when the
-    // thread starts (40-100 µs on this project's 2-core virtual machine).
-    if (s.lent && !s.started) {
+    // thread starts (40-100 µs on this project's 2-core virtual machine). A lone job is the
+    // calling thread's (it asks `progress` as it goes), unless the helper took it already.
+    if (s.lent && !s.started && s.slots.size() >= 2) {
       s.reserved = s.dearest_free();
       if (s.reserved != State::none) s.slots[s.reserved].busy = true;
     }

@@ -289,6 +289,11 @@ TEST_CASE("target shapes: a batch fed one job at a time gives each wire's own re
     CHECK_THROWS_AS(batch.finish(), std::logic_error);
   }
   CHECK(TargetShapeBatch(2).finish().empty());
+  TargetShapeBatch lone(2);  // one job with two threads: whichever takes it, its own result
+  lone.add(jobs[2]);
+  const std::vector<TargetShapeResult> one = lone.finish();
+  REQUIRE(one.size() == 1);
+  check_same(one[0], alone[2]);
   CHECK_THROWS_WITH(TargetShapeBatch(3), Contains("threads must be 1 or 2"));
 }
 
