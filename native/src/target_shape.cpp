@@ -662,7 +662,8 @@ double TargetShapeProblem::constraint(std::size_t k, const Polyline2& p, Polylin
   switch (c.kind) {
     case Kind::length: {
       const double lmin2 = options_.min_segment * options_.min_segment;
-      const int a = c.vertex, b = c.vertex + 1 < m ? c.vertex + 1 : 0;
+      const auto pts = detail::constraint_points(c, m);
+      const int a = pts[0], b = pts[1];
       const Vec2 e = p[b] - p[a];
       if (grad) {
         (*grad)[b] -= (2.0 / lmin2) * e;
@@ -671,7 +672,7 @@ double TargetShapeProblem::constraint(std::size_t k, const Polyline2& p, Polylin
       return 1.0 - e.squaredNorm() / lmin2;
     }
     case Kind::bend: {
-      const int i = c.vertex, a = i > 0 ? i - 1 : m - 1, b = i + 1 < m ? i + 1 : 0;
+      const auto [a, i, b] = detail::constraint_points(c, m);
       const Vec2 u = p[i] - p[a], v = p[b] - p[i];
       const Vec2 uh = u.normalized(), vh = v.normalized();
       if (grad) {
@@ -720,7 +721,7 @@ struct SolverData {
   Polyline2 p, grad, cgrad;
   // solve_block's buffers, kept across blocks: the block's variables, the points before it, its
   // start, its answer, and the points before it in the sweep.
-  std::vector<double> x;
+  std::vector<double> block_x;
   Polyline2 before, start, after, sweep_before;
   const ProgressFn* progress = nullptr;
   int evaluations = 0;
@@ -1062,7 +1063,7 @@ detail::TargetShapeRun detail::run_target_shape(const Polyline2& contour, bool c
       op.set_maxtime(std::max(1e-3, o.max_seconds - elapsed()));
       return op;
     };
-    std::vector<double>& x = data.x;  // the buffers below are the run's, kept across blocks
+    std::vector<double>& x = data.block_x;  // the buffers below are the run's, kept across blocks
     x.assign(nvar, 0.0);
     for (std::size_t k = 0; k < b.points.size(); ++k) {
       x[2 * k] = data.p[b.points[k]].x() / data.scale_x;

@@ -12,9 +12,9 @@
 #include <stdexcept>
 #include <string_view>
 #include <thread>
+#include <vector>
 
 #include <unistd.h>
-#include <vector>
 
 #include "wiresculpt/error.hpp"
 #include "wiresculpt/target_shape.hpp"
@@ -285,8 +285,10 @@ struct TargetShapeBatch::State {
   }
 
   // Waits until the helper thread, if it works on this batch, is done with it (closing the batch
-  // first, so that it stops waiting for jobs).
-  void join() noexcept {
+  // first, so that it stops waiting for jobs). With `ask_progress`, finish()'s `progress` is still
+  // asked every 20 ms meanwhile, with the share of jobs done (Live cancels a solve as soon as the
+  // plane moves again).
+  void join(bool ask_progress = false) noexcept {
     if (!lent) return;
     {
       const std::lock_guard<SpinLock> lock(book);
@@ -296,6 +298,10 @@ struct TargetShapeBatch::State {
     try {
       std::unique_lock<std::mutex> lock(mutex);
       while (!worker_ended.wait_for(lock, std::chrono::milliseconds(20), [&] { return ended.load(); })) {
+        if (!ask_progress || stop) continue;
+        lock.unlock();
+        asked("target_shape", static_cast<double>(finished.load()) / static_cast<double>(slots.size()));
+        lock.lock();
       }
     } catch (...) {
       while (!ended) std::this_thread::sleep_for(std::chrono::milliseconds(1));
@@ -349,18 +355,7 @@ std::vector<TargetShapeResult> TargetShapeBatch::finish(const ProgressFn& progre
   }
   s.post();
   s.work();
-  if (s.lent && progress) {
-    // While the other thread ends its last piece, `progress` is still asked every 20 ms (Live
-    // cancels a solve as soon as the plane moves again).
-    std::unique_lock<std::mutex> lock(s.mutex);
-    while (!s.worker_ended.wait_for(lock, std::chrono::milliseconds(20), [&] { return s.ended.load(); })) {
-      if (s.stop) continue;
-      lock.unlock();
-      s.asked("target_shape", static_cast<double>(s.finished.load()) / static_cast<double>(s.slots.size()));
-      lock.lock();
-    }
-  }
-  s.join();
+  s.join(static_cast<bool>(progress));  // the other thread's last piece, `progress` asked meanwhile
   s.progress = nullptr;
   if (stats) stats->hand_overs = s.hand_overs;
   if (s.progress_error) std::rethrow_exception(s.progress_error);
@@ -380,12 +375,8 @@ std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetSh
 
 std::vector<TargetShapeResult> detail::optimize_target_shapes(const std::vector<TargetShapeJob>& jobs, int threads,
                                                               const ProgressFn& progress, TargetShapesStats* stats) {
-  TargetShapeBatch batch(threads);  // checks threads
-  if (jobs.size() < 2) {  // the other thread would only wait for it: the calling thread solves it
-    TargetShapeBatch alone(1);
-    for (const TargetShapeJob& job : jobs) alone.add(job);
-    return alone.finish(progress, stats);
-  }
+  // Fewer than two jobs: the other thread would only wait, the calling thread solves it alone.
+  TargetShapeBatch batch(jobs.size() < 2 && threads == 2 ? 1 : threads);
   for (const TargetShapeJob& job : jobs) batch.add(job);
   return batch.finish(progress, stats);
 }

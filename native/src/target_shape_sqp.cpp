@@ -17,7 +17,6 @@
 
 namespace wiresculpt::detail {
 
-
 // ---------------------------------------------------------------------------------------------
 // The QP: Goldfarb and Idnani's dual method ("A numerically stable dual method for solving
 // strictly convex quadratic programs", Math. Programming 27, 1983), written for small dense

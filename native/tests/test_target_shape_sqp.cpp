@@ -707,12 +707,7 @@ TEST_CASE("sqp: a block solved in a workspace another block used gives a fresh w
   // sizes, around the crossing and away from it, solved by the SLSQP replica and by the SQP, in a
   // shared workspace in turn and each in a fresh one: the same points, to the bit.
   const TargetShapeOptions o;
-  const double lmin = o.min_segment, spacing = 1.5 * lmin;
-  detail::SqpSettings fresh;
-  fresh.scale_x = lmin;
-  fresh.scale_f = 2.0 * spacing * lmin * lmin;
-  fresh.min_segment = lmin;
-  fresh.regularization = o.regularization;
+  const detail::SqpSettings fresh = block_settings(o);
   detail::SqpWorkspace shared;
   detail::SqpSettings reused = fresh;
   reused.workspace = &shared;
