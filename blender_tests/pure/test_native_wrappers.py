@@ -108,6 +108,41 @@ class Wrappers(unittest.TestCase):
             native.optimize_target_shapes(failing())
         self.assertEqual(len(native.optimize_target_shapes(iter(problems))), 3)  # the other thread is free again
 
+    def test_a_target_shape_problem_with_a_plane_is_placed_and_measured_as_numpy_does(self):
+        # The stage used to place each result with core.frames.to_3d and measure it with
+        # core.polylines.polyline_length (numpy); the native does it now on the solving thread: the
+        # same numbers to the bit. Wires of fewer than 8 points, of 8-128 and of more than 128 (numpy
+        # sums those in halves), open and closed, in tilted planes.
+        from wiresculpt.core.frames import plane_frame, to_3d
+        from wiresculpt.core.polylines import polyline_length
+
+        def arc(r, n, closed):
+            angle = np.linspace(0.0, (2.0 if closed else 1.2) * np.pi, n, endpoint=not closed)
+            return np.column_stack([r * np.cos(angle), r * np.sin(angle)])
+        cases = [(0.012, 12, True, [0.0, 0.0, 1.0]), (0.1, 60, False, [0.3, -0.5, 0.8]), (0.45, 400, True, [1.0, 2.0, -0.5])]
+        problems, frames = [], []
+        for k, (r, n, closed, normal) in enumerate(cases):
+            _n, u, v = plane_frame(normal)
+            origin = [0.1 * k, -0.37, 1.3]
+            frames.append((origin, u, v))
+            problems.append({"points": arc(r, n, closed), "closed": closed, "options": {"wire_name": f"P{k}", "min_segment": 0.01},
+                             "plane": {"origin": origin, "u": u, "v": v}})
+        for threads in (1, 2):
+            results = native.optimize_target_shapes(iter(problems), None, threads)
+            counts = []
+            for problem, frame, r in zip(problems, frames, results):
+                expected = to_3d(r["points"], *frame)
+                self.assertIsInstance(r["target"], list)
+                self.assertEqual(r["target"], expected.tolist())
+                self.assertEqual(r["length"], polyline_length(expected, problem["closed"]))
+                counts.append(len(r["points"]))
+            self.assertLess(counts[0], 8)
+            self.assertTrue(8 <= counts[1] <= 128 < counts[2], counts)
+        plain = native.optimize_target_shapes([{k: v for k, v in problems[0].items() if k != "plane"}])[0]
+        self.assertNotIn("target", plain)
+        with self.assertRaisesRegex(ValueError, r"problems\[0\]\['plane'\]: the key 'v' is missing"):
+            native.optimize_target_shapes([dict(problems[0], plane={"origin": [0, 0, 0], "u": [1, 0, 0]})])
+
     def test_target_shape_results_have_the_documented_keys_and_types(self):
         # The keys as the module's docstring lists them (the Python side reads them by name).
         result_keys = {"points", "crossing_vertices", "crossings", "max_distance", "rms_distance",

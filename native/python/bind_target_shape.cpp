@@ -65,12 +65,30 @@ py::dict to_dict(const TargetShapeResult& r) {
     statuses.append(make_dict("status", s.status, "realised", s.realised, "vertex", s.vertex, "bisector",
                               py::make_tuple(s.bisector.x(), s.bisector.y()), "contact_angle", s.contact_angle,
                               "contact_violation", s.contact_violation, "scale", s.scale, "message", s.message));
-  return make_dict("points", to_array(r.points), "crossing_vertices", r.crossing_vertices, "crossings", statuses,
+  py::dict d = make_dict("points", to_array(r.points), "crossing_vertices", r.crossing_vertices, "crossings", statuses,
                    "max_distance", r.max_distance, "rms_distance", r.rms_distance, "min_segment", r.min_segment,
                    "max_bend", r.max_bend, "max_length_violation", r.max_length_violation, "max_angle_violation",
                    r.max_angle_violation, "iterations", r.iterations, "sweeps", r.sweeps, "sqp_blocks", r.sqp_blocks,
                    "sqp_fallbacks", r.sqp_fallbacks, "seconds", r.seconds, "nlopt_result", r.nlopt_result, "energy",
                    r.energy, "feasible", r.feasible, "warnings", r.warnings);
+  if (!r.target.empty()) {  // a problem with a "plane"
+    d["target"] = to_lists(r.target);
+    d["length"] = r.length;
+  }
+  return d;
+}
+
+// A problem's "plane": {"origin", "u", "v"}, three 3-vectors (the normal is not needed).
+Plane to_plane(py::handle d, const std::string& path) {
+  Plane plane;
+  const auto seen = read_fields(d, path,
+                                {{"origin", [&](py::handle v, const std::string& at) { plane.origin = to_vector<3>(v, at); }},
+                                 {"u", [&](py::handle v, const std::string& at) { plane.u = to_vector<3>(v, at); }},
+                                 {"v", [&](py::handle v, const std::string& at) { plane.v = to_vector<3>(v, at); }}});
+  require_keys(seen, path, {"origin", "u", "v"});
+  if (!plane.origin.allFinite() || !plane.u.allFinite() || !plane.v.allFinite())
+    throw InputError(path + ": origin, u and v must be finite");
+  return plane;
 }
 
 py::dict optimize(const py::object& points, const py::object& closed_arg, const py::object& crossings,
@@ -101,7 +119,8 @@ py::list optimize_all(const py::object& problems, const py::object& progress, co
         {{"points", [&](py::handle v, const std::string& at) { job.contour = to_points<2>(v, at); }},
          field::boolean("closed", job.closed),
          {"crossings", [&](py::handle v, const std::string& at) { job.crossings = to_crossings(v, at); }},
-         {"options", [&](py::handle v, const std::string& at) { job.options = to_options(v, at); }}});
+         {"options", [&](py::handle v, const std::string& at) { job.options = to_options(v, at); }},
+         {"plane", [&](py::handle v, const std::string& at) { job.plane = to_plane(v, at); }}});
     require_keys(seen, where, {"points", "closed"});
     batch.add(std::move(job));
   };
@@ -148,7 +167,10 @@ GIL released throughout).
 
 problems: list (or iterator, read one problem at a time: with threads=2 the other thread starts on
 the first while the iterator makes the next) of {"points", "closed", "crossings" (default []),
-"options" (default {})}, each as optimize_target_shape's arguments of those names; progress: optional callable(stage, fraction)
+"options" (default {}), "plane" (optional)}, each as optimize_target_shape's arguments of those
+names; "plane": {"origin", "u", "v"} (3-vectors, metres and unit axes) adds to the result "target"
+(the points in space, origin + x u + y v, as a list of [x, y, z]) and "length" (their polyline's,
+metres); progress: optional callable(stage, fraction)
 -> bool, called on this thread only, False cancels every problem (raises Cancelled); threads: 1 or 2.
 Returns the list of optimize_target_shape's results, in the problems' order: each the same as that
 problem solved alone (the problems are taken the dearest first, which changes only how long the

@@ -144,6 +144,7 @@ struct TargetShapeBatch::State {
   struct Slot {
     const TargetShapeJob* job = nullptr;
     std::optional<detail::TargetShapeRun> run;
+    std::optional<TargetShapeResult> result;  // taken from the run on the thread that ended it
     double left = 0.0;  // guessed seconds of work left
     bool busy = false, done = false;
     std::exception_ptr error;
@@ -242,6 +243,10 @@ struct TargetShapeBatch::State {
           slot->run.emplace(detail::run_target_shape(job.contour, job.closed, job.crossings, job.options, by_thread));
         }
         more = slot->run->step();
+        if (!more) {  // the result, placed in its plane here: one thread's work less after the batch
+          slot->result.emplace(slot->run->take());
+          if (slot->job->plane) detail::place_target(*slot->result, *slot->job->plane, slot->job->closed);
+        }
       } catch (...) {
         slot->error = std::current_exception();
       }
@@ -362,8 +367,8 @@ std::vector<TargetShapeResult> TargetShapeBatch::finish(const ProgressFn& progre
   std::vector<TargetShapeResult> out;
   out.reserve(s.slots.size());
   for (State::Slot& slot : s.slots) {
-    if (slot.error) std::rethrow_exception(slot.error);
-    out.push_back(slot.run->take());  // rethrows what the run threw
+    if (slot.error) std::rethrow_exception(slot.error);  // what the run threw, too
+    out.push_back(std::move(*slot.result));
   }
   return out;
 }

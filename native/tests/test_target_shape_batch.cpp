@@ -374,3 +374,34 @@ TEST_CASE("target shapes: the dearest-first guess counts a wire's target points 
   CHECK(detail::initial_point_count(bad.contour, bad.closed, bad.crossings, bad.options) == -1);
   CHECK(detail::initial_point_count({Vec2(0, 0)}, false, {}, bad.options) == -1);
 }
+
+TEST_CASE("target shapes: a job with a plane has its result placed in space and measured", "[target]") {
+  std::vector<TargetShapeJob> jobs = round_of_wires();
+  jobs.resize(3);
+  const Plane tilted = Plane::make(Vec3(0.3, -0.2, 1.5), Vec3(0.2, -0.7, 0.4));
+  jobs[0].plane = tilted;
+  jobs[2].plane = Plane::make(Vec3(-1.0, 0.0, 0.25), Vec3(0.0, 1.0, 0.0));
+  jobs[2].closed = false;  // an open wire: no closing edge
+  for (int threads : {1, 2}) {
+    const std::vector<TargetShapeResult> rs = optimize_target_shapes(jobs, threads);
+    for (std::size_t k : {std::size_t{0}, std::size_t{2}}) {
+      INFO("threads " << threads << ", wire " << jobs[k].options.wire_name);
+      const TargetShapeResult& r = rs[k];
+      const TargetShapeResult alone = optimize_target_shape(jobs[k].contour, jobs[k].closed, jobs[k].crossings, jobs[k].options);
+      check_same(r, alone);
+      REQUIRE(r.target.size() == r.points.size());
+      for (std::size_t i = 0; i < r.points.size(); ++i) {
+        const Vec3 expected = jobs[k].plane->to_3d(r.points[i]);
+        CHECK(r.target[i] == expected);
+        // In the plane, at the 2D point's distance from the origin.
+        CHECK(std::abs(jobs[k].plane->signed_distance(r.target[i])) < 1e-12);
+        CHECK(std::abs((r.target[i] - jobs[k].plane->origin).norm() - r.points[i].norm()) < 1e-12);
+      }
+      // The 2D polyline's length: the frame is orthonormal.
+      CHECK(std::abs(r.length - polyline_length(r.points, jobs[k].closed)) < 1e-12);
+      CHECK(r.length > 0.1);
+    }
+    CHECK(rs[1].target.empty());  // no plane: nothing placed
+    CHECK(rs[1].length == 0.0);
+  }
+}

@@ -198,7 +198,12 @@ def solve_all(jobs, native_progress=None, count=None):
 
 
 def _problem(job):
-    return {"points": job["contour"], "closed": job["closed"], "crossings": job["specs"], "options": job["options"]}
+    """The native problem of a job. Its plane makes the native place the result in space and
+    measure it ("target", "length") on the thread that solved it, to_3d and polyline_length's own
+    numbers, while the other thread still solves (a twentieth of the globe's stage after the call)."""
+    origin, u, v = job["frame"]
+    return {"points": job["contour"], "closed": job["closed"], "crossings": job["specs"], "options": job["options"],
+            "plane": {"origin": origin, "u": u, "v": v}}
 
 
 class Memo:
@@ -426,9 +431,13 @@ def run(design, material, settings, native_progress=None, memo=None):
 
     per_wire = []
     for wire, (r, refs, frame), again in zip(design["wires"], solved, reused):
-        target = to_3d(r["points"], *frame)
-        wire["target"] = target.tolist()
-        wire["length"] = polyline_length(target, wire["closed"])
+        if again or "target" not in r:  # placed by the native only for the wire it was solved for
+            target = to_3d(r["points"], *frame)
+            wire["target"] = target.tolist()
+            wire["length"] = polyline_length(target, wire["closed"])
+        else:  # taken out of the result (which the memo keeps) to be the design's own list
+            wire["target"] = r.pop("target")
+            wire["length"] = r["length"]
         wire["target_max_distance"] = r["max_distance"]
         wire["target_rms_distance"] = r["rms_distance"]
         for (c, k), vertex in zip(refs, r["crossing_vertices"]):

@@ -206,6 +206,11 @@ struct TargetShapeResult {
   /// too-close crossings count; contact constraints dropped before solving do not).
   bool feasible = true;
   std::vector<std::string> warnings;  ///< sentences about violated constraints, naming vertices
+  /// For a TargetShapeJob with a `plane` (optimize_target_shapes): `points` in space, metres
+  /// (plane.origin + x u + y v), and their polyline's length (closed: back to the first), summed
+  /// in numpy's order (detail::place_target); else empty and 0.
+  Polyline3 target;
+  double length = 0.0;
 };
 
 /// Optimises one wire.
@@ -226,6 +231,9 @@ struct TargetShapeJob {
   bool closed = false;
   std::vector<TargetCrossing> crossings;
   TargetShapeOptions options;
+  /// The wire's plane (origin, u, v; the normal is not read): its result's `target` and `length`
+  /// are then filled on the thread that solved it.
+  std::optional<Plane> plane;
 };
 
 /// optimize_target_shape of every job, on the calling thread and, with threads = 2, one more
@@ -243,6 +251,11 @@ std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetSh
                                                       const ProgressFn& progress = {});
 
 namespace detail {
+/// Fills r.target (r.points placed in `plane`: origin + x u + y v, in that order) and r.length,
+/// their polyline's length with the edges' norms added as numpy's sum adds them (numpy_sum.hpp):
+/// the same numbers, to the bit, as the target-shape stage's to_3d and polyline_length.
+void place_target(TargetShapeResult& r, const Plane& plane, bool closed);
+
 /// The number of points of the initial resampling that TargetShapeProblem makes of this wire (its
 /// target points, fixed crossing vertices included), without building the problem; -1 where it
 /// cannot count (crossings off the contour, too few points, no length: the problem would say

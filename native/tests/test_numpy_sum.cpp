@@ -1,0 +1,47 @@
+// numpy_sum.hpp: sums whose rounding shows the order of the additions, worked out by hand for
+// numpy's pairwise order, and sums against a long double reference.
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "numpy_sum.hpp"
+
+using wiresculpt::detail::numpy_sum;
+
+TEST_CASE("numpy's sum: fewer than eight values one by one, up to 128 in eight running sums", "[target]") {
+  // Near 1e16 doubles are 2 apart and a tie rounds to the even one: 1e16 + 1 gives 1e16 (even),
+  // 1e16 + 7 gives 1e16 + 8, 1e16 + 15 gives 1e16 + 16. Added one by one, every 1 is lost.
+  std::vector<double> a(7, 1.0);
+  a[0] = 1e16;
+  CHECK(numpy_sum(a.data(), a.size()) == 1e16);
+  // Nine: s0..s7 = the first eight, joined ((s0 + s1) + (s2 + s3)) + ((s4 + s5) + (s6 + s7)) =
+  // ((1e16 + 1) + 2) + 4 = 1e16 + 6, then the ninth: 1e16 + 7, a tie, 1e16 + 8 (np.sum's too).
+  a.assign(9, 1.0);
+  a[0] = 1e16;
+  CHECK(numpy_sum(a.data(), a.size()) == 1e16 + 8);
+  // Seventeen: s0 = 1e16 + 1 = 1e16, s1..s7 = 2; joined 1e16 + 14; the seventeenth after the
+  // join: 1e16 + 15, a tie, 1e16 + 16 (np.sum's too).
+  a.assign(17, 1.0);
+  a[0] = 1e16;
+  CHECK(numpy_sum(a.data(), a.size()) == 1e16 + 16);
+}
+
+TEST_CASE("numpy's sum: longer runs in halves and 8192-value chunks, close to the exact sum", "[target]") {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (std::size_t n : {0u, 1u, 8u, 127u, 128u, 129u, 1000u, 8192u, 8193u, 20000u}) {
+    std::vector<double> a(n);
+    long double exact = 0.0L;
+    for (double& x : a) exact += (x = unit(rng));
+    INFO("n " << n);
+    CHECK(std::abs(numpy_sum(a.data(), n) - static_cast<double>(exact)) <= 1e-12 * (1.0 + static_cast<double>(exact)));
+  }
+  // Two halves at 136 values: the first 64 (a multiple of 8 below 68) and the last 72, each in
+  // running sums. 1e16 first, then 135 ones: the first half's s0 = 1e16 (its seven ones each a
+  // tie, lost), s1..s7 = 8 each, joined 1e16 + 56; the second half is 72 exactly: 1e16 + 128
+  // (np.sum's too; one by one, 1e16).
+  std::vector<double> b(136, 1.0);
+  b[0] = 1e16;
+  CHECK(numpy_sum(b.data(), b.size()) == 1e16 + 128);
+}
