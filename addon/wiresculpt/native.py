@@ -164,6 +164,12 @@ def plane_frame(normal):
     return require().plane_frame(n)
 
 
+def largest_box_side(polylines):
+    """The largest side of the bounding box of all points of `polylines` ((n, 3) arrays, metres):
+    core.design.model_size's number in one native call (0.0 without points)."""
+    return require().largest_box_side(_list(polylines, "polylines"))
+
+
 def slice_mesh(vertices, faces, planes, weld_tolerance=-1.0):
     """Slice a triangle mesh by planes.
 

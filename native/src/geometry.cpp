@@ -1,6 +1,7 @@
 #include "wiresculpt/geometry.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include "wiresculpt/error.hpp"
 
@@ -37,6 +38,18 @@ double length_of(const Points& points, bool closed) {
 
 double polyline_length(const Polyline3& points, bool closed) { return length_of(points, closed); }
 double polyline_length(const Polyline2& points, bool closed) { return length_of(points, closed); }
+
+double largest_box_side(const std::vector<Polyline3>& polylines) {
+  Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity()), high = -low;
+  bool any = false;
+  for (const Polyline3& points : polylines)
+    for (const Vec3& p : points) {
+      if (p.hasNaN()) return std::numeric_limits<double>::quiet_NaN();  // numpy's max and min pass NaN on
+      low = low.cwiseMin(p), high = high.cwiseMax(p);
+      any = true;
+    }
+  return any ? (high - low).maxCoeff() : 0.0;
+}
 
 double signed_area(const Polyline2& points) {
   double twice = 0.0;

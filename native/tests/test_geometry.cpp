@@ -1,5 +1,6 @@
 // Geometry helpers against answers known by hand.
 #include <catch2/catch.hpp>
+#include <cmath>
 
 #include "wiresculpt/geometry.hpp"
 
@@ -15,4 +16,16 @@ TEST_CASE("geometry: polyline_length of a 3 x 4 rectangle, open and closed, in 2
   CHECK(polyline_length(tilted, true) == Approx(14.0));
   CHECK(polyline_length(Polyline2{{1, 2}}, true) == 0.0);
   CHECK(polyline_length(Polyline2{}, true) == 0.0);
+}
+
+TEST_CASE("geometry: largest_box_side over several polylines") {
+  // One polyline spans x in [-1, 2]; the other y in [0.5, 5] and z in [0, 1]: the box is 3 x 4.5 x 1.
+  const Polyline3 a{{-1.0, 1.0, 0.0}, {2.0, 1.0, 0.5}};
+  const Polyline3 b{{0.0, 0.5, 1.0}, {0.5, 5.0, 0.25}, {0.0, 2.0, 0.0}};
+  CHECK(largest_box_side({a, b}) == 4.5);
+  CHECK(largest_box_side({a}) == 3.0);  // x spans 3, y nothing, z 0.5
+  CHECK(largest_box_side({}) == 0.0);
+  CHECK(largest_box_side({Polyline3{}, a}) == 3.0);
+  const Polyline3 bad{{0.0, std::nan(""), 0.0}};
+  CHECK(std::isnan(largest_box_side({a, bad})));
 }

@@ -249,6 +249,7 @@ class Memo:
         # layering, shared by the rounds' copies of the design): each wire's frame and 2D contour,
         # each crossing's bisector and the model's size, checked against the objects they came from.
         self._frames = {}  # wire name -> (contour, origin, normal, (u, v, 2D contour))
+        self._axes = {}  # wire name -> its frame's u and v as tuples of floats (bisector_in_frame's)
         self._bisectors = {}  # (the two wires' plane normals, k, hook) -> h in wire k's frame
         self._size = None  # (the contours, size)
         self.contour_cache = ContourArrays() if contour_cache is None else contour_cache
@@ -261,6 +262,8 @@ class Memo:
                 or entry[2] != list(plane["normal"])):
             entry = (wire["contour"], list(plane["origin"]), list(plane["normal"]), _frame(wire, self.array(wire)))
             self._frames[wire["name"]] = entry
+            u, v = entry[3][0], entry[3][1]
+            self._axes[wire["name"]] = (tuple(u.tolist()), tuple(v.tolist()))
         return entry[3]
 
     def bisector_2d(self, design, crossing, k):
@@ -272,16 +275,21 @@ class Memo:
                crossing["hook"])
         found = self._bisectors.get(key)
         if found is None:
-            u, v, _contour = self.frame(design["wires"][crossing["wires"][k]])
-            found = self._bisectors[key] = bisector_in_frame(design, crossing, k, u, v)
+            wire = design["wires"][crossing["wires"][k]]
+            self.frame(wire)
+            found = self._bisectors[key] = bisector_in_frame(design, crossing, k, *self._axes[wire["name"]])
         return found
 
     def model_size(self, design):
-        """core.design.model_size(design), computed once for the same contours."""
+        """core.design.model_size(design), computed once for the same contours, in one native call
+        (numpy's concatenation and column extremes took about 40 us of the globe's stage, before
+        its first wire could start; the same extremes, so the same number)."""
         contours = [w["contour"] for w in design["wires"]]
         if self._size is None or len(self._size[0]) != len(contours) or any(
                 a is not b for a, b in zip(self._size[0], contours)):
-            self._size = (contours, model_size(design, [self.array(w) for w in design["wires"]]))
+            arrays = [self.array(w) for w in design["wires"]]
+            size = native.largest_box_side(arrays) if arrays else model_size(design, arrays)
+            self._size = (contours, size)
         return self._size[1]
 
     def array(self, wire):
