@@ -206,8 +206,10 @@ def optimize_target_shape(points, closed, crossings, options=None, progress=None
 
 
 def optimize_target_shapes(problems, progress=None, threads=2):
-    """optimize_target_shape of each problem ({"points", "closed", "crossings", "options"}), on up to
-    `threads` (1 or 2) native threads: the results in the problems' order, each as if solved alone.
+    """optimize_target_shape of each problem ({"points", "closed", "crossings", "options", and
+    optionally "plane": {"origin", "u", "v"}}), on up to `threads` (1 or 2) native threads: the
+    results in the problems' order, each as if solved alone (a problem with a plane also gets
+    "target", its points in space as a list of [x, y, z], and "length", metres).
     `problems`: a list, or an iterator read one problem at a time (with 2 threads the other thread
     solves the first while the iterator makes the next: a generator that prepares each wire)."""
     if isinstance(problems, Iterator):

@@ -98,7 +98,7 @@ class BindingInput(unittest.TestCase):
             (lambda: m.optimize_target_shapes([{"points": LINE, "closed": False, "options": {"window": "8"}}]),
              "problems[0]['options']['window']: expected an integer, got str"),
             (lambda: m.optimize_target_shapes([{"points": LINE, "closed": False, "start": []}]),
-             "problems[0]: unknown key 'start' (expected points, closed, crossings, options)"),
+             "problems[0]: unknown key 'start' (expected points, closed, crossings, options, plane)"),
             (lambda: m.optimize_target_shapes([], None, 3), "target shapes: threads must be 1 or 2"),
         ]
         self.check_all(cases)

@@ -119,13 +119,15 @@ class Wrappers(unittest.TestCase):
         def arc(r, n, closed):
             angle = np.linspace(0.0, (2.0 if closed else 1.2) * np.pi, n, endpoint=not closed)
             return np.column_stack([r * np.cos(angle), r * np.sin(angle)])
-        cases = [(0.012, 12, True, [0.0, 0.0, 1.0]), (0.1, 60, False, [0.3, -0.5, 0.8]), (0.45, 400, True, [1.0, 2.0, -0.5])]
+        cases = [(0.012, 12, True, [0.0, 0.0, 1.0]), (0.1, 60, False, [0.3, -0.5, 0.8]),
+                 (0.45, 400, True, [1.0, 2.0, -0.5])]
         problems, frames = [], []
         for k, (r, n, closed, normal) in enumerate(cases):
             _n, u, v = plane_frame(normal)
             origin = [0.1 * k, -0.37, 1.3]
             frames.append((origin, u, v))
-            problems.append({"points": arc(r, n, closed), "closed": closed, "options": {"wire_name": f"P{k}", "min_segment": 0.01},
+            problems.append({"points": arc(r, n, closed), "closed": closed,
+                             "options": {"wire_name": f"P{k}", "min_segment": 0.01},
                              "plane": {"origin": origin, "u": u, "v": v}})
         for threads in (1, 2):
             results = native.optimize_target_shapes(iter(problems), None, threads)
@@ -142,6 +144,9 @@ class Wrappers(unittest.TestCase):
         self.assertNotIn("target", plain)
         with self.assertRaisesRegex(ValueError, r"problems\[0\]\['plane'\]: the key 'v' is missing"):
             native.optimize_target_shapes([dict(problems[0], plane={"origin": [0, 0, 0], "u": [1, 0, 0]})])
+        with self.assertRaisesRegex(ValueError, r"problems\[0\]\['plane'\]\['origin'\]\[2\]: expected a finite number"):
+            native.optimize_target_shapes([dict(problems[0], plane={"origin": [0, 0, float("nan")], "u": [1, 0, 0],
+                                                                    "v": [0, 1, 0]})])
 
     def test_target_shape_results_have_the_documented_keys_and_types(self):
         # The keys as the module's docstring lists them (the Python side reads them by name).

@@ -11,6 +11,8 @@ from unittest import mock
 
 import bench_scenes
 from wiresculpt import native
+from wiresculpt.core.frames import plane_frame, to_3d
+from wiresculpt.core.polylines import polyline_length
 from wiresculpt.stages import layering, target_shape
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -185,6 +187,7 @@ class Threads(unittest.TestCase):
         scene, _V, _F, _planes, cls.design = bench_scenes.load_and_slice(GLOBE)
         layering.run(cls.design, scene.material, scene.settings)
         cls.settings = scene.settings
+        cls.material = scene.material
 
     def jobs(self):
         size = target_shape.model_size(self.design)
@@ -212,6 +215,30 @@ class Threads(unittest.TestCase):
                 self.assertEqual(a["points"].tolist(), d["points"].tolist())
                 self.assertEqual(a["crossings"], d["crossings"])
                 self.assertEqual(a["energy"], d["energy"])
+
+    def test_the_stage_takes_each_solved_wire_placed_by_the_native(self):
+        # run() hands every wire's plane to the native and keeps the placed points and length it
+        # returns (taken out of the result); they are to_3d's and polyline_length's to the bit.
+        design = copy.deepcopy(self.design)
+        sent, returned = [], []
+        solve = target_shape.native.optimize_target_shapes
+
+        def recording(problems, progress=None, threads=2):
+            problems = list(problems)
+            sent.extend(problems)
+            returned.extend(solve(problems, progress, threads))
+            return returned[-len(problems):]
+        with mock.patch.object(target_shape.native, "optimize_target_shapes", recording):
+            target_shape.run(design, self.material, self.settings)
+        self.assertEqual(len(sent), len(design["wires"]))
+        for problem, r, wire in zip(sent, returned, design["wires"]):
+            self.assertEqual(set(problem["plane"]), {"origin", "u", "v"})
+            self.assertNotIn("target", r)  # taken by the design
+            _n, u, v = plane_frame(wire["plane"]["normal"])
+            expected = to_3d(r["points"], wire["plane"]["origin"], u, v)
+            self.assertEqual(wire["target"], expected.tolist())
+            self.assertEqual(wire["length"], polyline_length(expected, wire["closed"]))
+            self.assertEqual(wire["length"], r["length"])
 
     def test_no_native_call_when_every_result_is_kept(self):
         jobs = self.jobs()

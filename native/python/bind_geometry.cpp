@@ -27,7 +27,8 @@ py::tuple plane_frame(const py::object& normal) {
 
 double largest_box_side(const py::object& polylines) {
   std::vector<Polyline3> all;
-  each_item(polylines, "polylines", [&](py::handle item, const std::string& where) { all.push_back(to_points<3>(item, where)); });
+  each_item(polylines, "polylines",
+            [&](py::handle item, const std::string& where) { all.push_back(to_points<3>(item, where)); });
   return wiresculpt::largest_box_side(all);
 }
 

@@ -65,12 +65,12 @@ py::dict to_dict(const TargetShapeResult& r) {
     statuses.append(make_dict("status", s.status, "realised", s.realised, "vertex", s.vertex, "bisector",
                               py::make_tuple(s.bisector.x(), s.bisector.y()), "contact_angle", s.contact_angle,
                               "contact_violation", s.contact_violation, "scale", s.scale, "message", s.message));
-  py::dict d = make_dict("points", to_array(r.points), "crossing_vertices", r.crossing_vertices, "crossings", statuses,
-                   "max_distance", r.max_distance, "rms_distance", r.rms_distance, "min_segment", r.min_segment,
-                   "max_bend", r.max_bend, "max_length_violation", r.max_length_violation, "max_angle_violation",
-                   r.max_angle_violation, "iterations", r.iterations, "sweeps", r.sweeps, "sqp_blocks", r.sqp_blocks,
-                   "sqp_fallbacks", r.sqp_fallbacks, "seconds", r.seconds, "nlopt_result", r.nlopt_result, "energy",
-                   r.energy, "feasible", r.feasible, "warnings", r.warnings);
+  py::dict d = make_dict(
+      "points", to_array(r.points), "crossing_vertices", r.crossing_vertices, "crossings", statuses, "max_distance",
+      r.max_distance, "rms_distance", r.rms_distance, "min_segment", r.min_segment, "max_bend", r.max_bend,
+      "max_length_violation", r.max_length_violation, "max_angle_violation", r.max_angle_violation, "iterations",
+      r.iterations, "sweeps", r.sweeps, "sqp_blocks", r.sqp_blocks, "sqp_fallbacks", r.sqp_fallbacks, "seconds",
+      r.seconds, "nlopt_result", r.nlopt_result, "energy", r.energy, "feasible", r.feasible, "warnings", r.warnings);
   if (!r.target.empty()) {  // a problem with a "plane"
     d["target"] = to_lists(r.target);
     d["length"] = r.length;
@@ -81,13 +81,11 @@ py::dict to_dict(const TargetShapeResult& r) {
 // A problem's "plane": {"origin", "u", "v"}, three 3-vectors (the normal is not needed).
 Plane to_plane(py::handle d, const std::string& path) {
   Plane plane;
-  const auto seen = read_fields(d, path,
-                                {{"origin", [&](py::handle v, const std::string& at) { plane.origin = to_vector<3>(v, at); }},
-                                 {"u", [&](py::handle v, const std::string& at) { plane.u = to_vector<3>(v, at); }},
-                                 {"v", [&](py::handle v, const std::string& at) { plane.v = to_vector<3>(v, at); }}});
-  require_keys(seen, path, {"origin", "u", "v"});
-  if (!plane.origin.allFinite() || !plane.u.allFinite() || !plane.v.allFinite())
-    throw InputError(path + ": origin, u and v must be finite");
+  auto axis = [](Vec3& out) {
+    return [&out](py::handle v, const std::string& at) { out = to_vector<3>(v, at); };
+  };
+  const auto seen = read_fields(d, path, {{"origin", axis(plane.origin)}, {"u", axis(plane.u)}, {"v", axis(plane.v)}});
+  require_keys(seen, path, {"origin", "u", "v"});  // each number finite: to_vector says which is not
   return plane;
 }
 

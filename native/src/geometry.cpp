@@ -48,7 +48,9 @@ double largest_box_side(const std::vector<Polyline3>& polylines) {
       low = low.cwiseMin(p), high = high.cwiseMax(p);
       any = true;
     }
-  return any ? (high - low).maxCoeff() : 0.0;
+  if (!any) return 0.0;
+  const Vec3 sides = high - low;  // NaN where a column is all +inf or all -inf, as numpy's
+  return sides.hasNaN() ? std::numeric_limits<double>::quiet_NaN() : sides.maxCoeff();
 }
 
 double signed_area(const Polyline2& points) {

@@ -315,7 +315,8 @@ struct TargetShapeBatch::State {
       while (!worker_ended.wait_for(lock, std::chrono::milliseconds(20), [&] { return ended.load(); })) {
         if (!ask_progress || stop) continue;
         lock.unlock();
-        asked("target_shape", static_cast<double>(finished.load()) / static_cast<double>(slots.size()));
+        const double jobs_done = static_cast<double>(finished.load());  // of none: all
+        asked("target_shape", slots.empty() ? 1.0 : jobs_done / static_cast<double>(slots.size()));
         lock.lock();
       }
     } catch (...) {

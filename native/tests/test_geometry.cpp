@@ -1,6 +1,7 @@
 // Geometry helpers against answers known by hand.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <limits>
 
 #include "wiresculpt/geometry.hpp"
 
@@ -28,4 +29,10 @@ TEST_CASE("geometry: largest_box_side over several polylines") {
   CHECK(largest_box_side({Polyline3{}, a}) == 3.0);
   const Polyline3 bad{{0.0, std::nan(""), 0.0}};
   CHECK(std::isnan(largest_box_side({a, bad})));
+}
+
+TEST_CASE("geometry: largest_box_side is NaN where a side is inf - inf, as numpy's model size") {
+  const double inf = std::numeric_limits<double>::infinity();
+  CHECK(std::isnan(largest_box_side({Polyline3{{0.0, 0.0, inf}, {1.0, 5.0, inf}}})));
+  CHECK(largest_box_side({Polyline3{{0.0, 0.0, 0.0}, {1.0, 5.0, inf}}}) == inf);
 }

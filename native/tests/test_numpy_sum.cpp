@@ -25,6 +25,20 @@ TEST_CASE("numpy's sum: fewer than eight values one by one, up to 128 in eight r
   a.assign(17, 1.0);
   a[0] = 1e16;
   CHECK(numpy_sum(a.data(), a.size()) == 1e16 + 16);
+  // Eight: one block, nothing left over: ((1e16 + 1) + 2) + 4 = 1e16 + 6.
+  a.assign(8, 1.0);
+  a[0] = 1e16;
+  CHECK(numpy_sum(a.data(), a.size()) == 1e16 + 6);
+  // 128, still one run of blocks: s0 = 1e16 (fifteen ties lost), s1..s7 = 16; 1e16 + 112.
+  a.assign(128, 1.0);
+  a[0] = 1e16;
+  CHECK(numpy_sum(a.data(), a.size()) == 1e16 + 112);
+  // 129: halves of 64 and 65. The first: s0 = 1e16, s1..s7 = 8, 1e16 + 56; the second: eight sums
+  // of 8 and one more, 65; 1e16 + 121 is a tie: 1e16 + 120 (np.sum's too; as one run of blocks
+  // it would be 1e16 + 112).
+  a.assign(129, 1.0);
+  a[0] = 1e16;
+  CHECK(numpy_sum(a.data(), a.size()) == 1e16 + 120);
 }
 
 TEST_CASE("numpy's sum: longer runs in halves and 8192-value chunks, close to the exact sum", "[target]") {
@@ -37,6 +51,11 @@ TEST_CASE("numpy's sum: longer runs in halves and 8192-value chunks, close to th
     INFO("n " << n);
     CHECK(std::abs(numpy_sum(a.data(), n) - static_cast<double>(exact)) <= 1e-12 * (1.0 + static_cast<double>(exact)));
   }
+  // 9,000 values of 0.1: a chunk of 8,192 and one of 808. np.sum (numpy 1.24) gives
+  // 900.0000000000001; the halves without the chunks would give 899.9999999999998, one by one
+  // 900.0000000001361.
+  const std::vector<double> tenths(9000, 0.1);
+  CHECK(numpy_sum(tenths.data(), tenths.size()) == 900.0000000000001);
   // Two halves at 136 values: the first 64 (a multiple of 8 below 68) and the last 72, each in
   // running sums. 1e16 first, then 135 ones: the first half's s0 = 1e16 (its seven ones each a
   // tie, lost), s1..s7 = 8 each, joined 1e16 + 56; the second half is 72 exactly: 1e16 + 128

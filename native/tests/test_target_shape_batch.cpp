@@ -387,7 +387,8 @@ TEST_CASE("target shapes: a job with a plane has its result placed in space and 
     for (std::size_t k : {std::size_t{0}, std::size_t{2}}) {
       INFO("threads " << threads << ", wire " << jobs[k].options.wire_name);
       const TargetShapeResult& r = rs[k];
-      const TargetShapeResult alone = optimize_target_shape(jobs[k].contour, jobs[k].closed, jobs[k].crossings, jobs[k].options);
+      const TargetShapeJob& job = jobs[k];
+      const TargetShapeResult alone = optimize_target_shape(job.contour, job.closed, job.crossings, job.options);
       check_same(r, alone);
       REQUIRE(r.target.size() == r.points.size());
       for (std::size_t i = 0; i < r.points.size(); ++i) {

@@ -35,8 +35,9 @@ double polyline_length(const Polyline3& points, bool closed);
 double polyline_length(const Polyline2& points, bool closed);
 
 /// The largest side of the bounding box of every point of `polylines` (metres; 0 without points,
-/// NaN when a coordinate is NaN): the add-on's model size (core/design.py model_size, the same
-/// extremes and differences, so the same number).
+/// NaN when a coordinate is NaN or a side is inf - inf): the add-on's model size (core/design.py
+/// model_size, the same extremes and differences, so the same number; that one raises without
+/// points).
 double largest_box_side(const std::vector<Polyline3>& polylines);
 
 /// Signed area of a closed 2D polygon (positive when counter-clockwise).

@@ -241,7 +241,8 @@ struct TargetShapeJob {
 /// first), and between two windows of a windowed wire hands it over when a free one has clearly
 /// more left, so that three equal wires share two threads (only who runs which piece, never a
 /// result, depends on it: detail::TargetShapeRun). Every result is the one
-/// optimize_target_shape returns for that job alone, and they come back in the jobs' order.
+/// optimize_target_shape returns for that job alone (with `target` and `length` filled for a job
+/// with a plane), and they come back in the jobs' order.
 /// Only the calling thread calls `progress` (with a job's own fractions, and while it waits for
 /// the other thread's last job); when it asks to stop, both threads stop at their next progress
 /// poll (every 16 evaluations). After both threads stopped, throws the exception `progress` threw
@@ -335,11 +336,12 @@ std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetSh
 }  // namespace detail
 
 /// optimize_target_shapes with the jobs handed over one at a time: with two threads, the other
-/// thread is started at the first add() and solves while the caller prepares the next jobs (the
-/// stage's Python reads each wire's frame and crossings; issue 17, seventeenth round); finish()
-/// then works on the calling thread too until every job is solved, exactly as
-/// optimize_target_shapes does (it is this batch with every job added at once). Every result is
-/// the one optimize_target_shape returns for that job alone, in the order added. Before finish()
+/// thread is woken when the batch is made, starts at the first add() and solves while the caller
+/// prepares the next jobs (the stage's Python reads each wire's frame and crossings; issue 17,
+/// seventeenth and eighteenth rounds); finish() then works on the calling thread too until every
+/// job is solved, exactly as optimize_target_shapes does (it is this batch with every job added at
+/// once). Every result is the one optimize_target_shape returns for that job alone (with its
+/// `target` and `length` for a job with a plane), in the order added. Before finish()
 /// the other thread polls no `progress` and hands no wire over. Call add() and finish() from the
 /// thread that made the batch; destroying a batch that was not finished stops its other thread
 /// at its next poll and joins it.
