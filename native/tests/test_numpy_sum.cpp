@@ -9,36 +9,33 @@
 
 using wiresculpt::detail::numpy_sum;
 
+namespace {
+// numpy_sum of 1e16 followed by n - 1 ones, less 1e16 (exact: the two are close).
+double after_1e16(std::size_t n) {
+  std::vector<double> a(n, 1.0);
+  a[0] = 1e16;
+  return numpy_sum(a.data(), n) - 1e16;
+}
+}  // namespace
+
 TEST_CASE("numpy's sum: fewer than eight values one by one, up to 128 in eight running sums", "[target]") {
   // Near 1e16 doubles are 2 apart and a tie rounds to the even one: 1e16 + 1 gives 1e16 (even),
   // 1e16 + 7 gives 1e16 + 8, 1e16 + 15 gives 1e16 + 16. Added one by one, every 1 is lost.
-  std::vector<double> a(7, 1.0);
-  a[0] = 1e16;
-  CHECK(numpy_sum(a.data(), a.size()) == 1e16);
-  // Nine: s0..s7 = the first eight, joined ((s0 + s1) + (s2 + s3)) + ((s4 + s5) + (s6 + s7)) =
-  // ((1e16 + 1) + 2) + 4 = 1e16 + 6, then the ninth: 1e16 + 7, a tie, 1e16 + 8 (np.sum's too).
-  a.assign(9, 1.0);
-  a[0] = 1e16;
-  CHECK(numpy_sum(a.data(), a.size()) == 1e16 + 8);
+  CHECK(after_1e16(7) == 0.0);
+  // Eight: one block, nothing left over: s0..s7 = the values, joined ((s0 + s1) + (s2 + s3)) +
+  // ((s4 + s5) + (s6 + s7)) = ((1e16 + 1) + 2) + 4 = 1e16 + 6.
+  CHECK(after_1e16(8) == 6.0);
+  // Nine: the same join, then the ninth: 1e16 + 7, a tie, 1e16 + 8 (np.sum's too).
+  CHECK(after_1e16(9) == 8.0);
   // Seventeen: s0 = 1e16 + 1 = 1e16, s1..s7 = 2; joined 1e16 + 14; the seventeenth after the
   // join: 1e16 + 15, a tie, 1e16 + 16 (np.sum's too).
-  a.assign(17, 1.0);
-  a[0] = 1e16;
-  CHECK(numpy_sum(a.data(), a.size()) == 1e16 + 16);
-  // Eight: one block, nothing left over: ((1e16 + 1) + 2) + 4 = 1e16 + 6.
-  a.assign(8, 1.0);
-  a[0] = 1e16;
-  CHECK(numpy_sum(a.data(), a.size()) == 1e16 + 6);
+  CHECK(after_1e16(17) == 16.0);
   // 128, still one run of blocks: s0 = 1e16 (fifteen ties lost), s1..s7 = 16; 1e16 + 112.
-  a.assign(128, 1.0);
-  a[0] = 1e16;
-  CHECK(numpy_sum(a.data(), a.size()) == 1e16 + 112);
+  CHECK(after_1e16(128) == 112.0);
   // 129: halves of 64 and 65. The first: s0 = 1e16, s1..s7 = 8, 1e16 + 56; the second: eight sums
   // of 8 and one more, 65; 1e16 + 121 is a tie: 1e16 + 120 (np.sum's too; as one run of blocks
   // it would be 1e16 + 112).
-  a.assign(129, 1.0);
-  a[0] = 1e16;
-  CHECK(numpy_sum(a.data(), a.size()) == 1e16 + 120);
+  CHECK(after_1e16(129) == 120.0);
 }
 
 TEST_CASE("numpy's sum: longer runs in halves and 8192-value chunks, close to the exact sum", "[target]") {
@@ -60,7 +57,5 @@ TEST_CASE("numpy's sum: longer runs in halves and 8192-value chunks, close to th
   // running sums. 1e16 first, then 135 ones: the first half's s0 = 1e16 (its seven ones each a
   // tie, lost), s1..s7 = 8 each, joined 1e16 + 56; the second half is 72 exactly: 1e16 + 128
   // (np.sum's too; one by one, 1e16).
-  std::vector<double> b(136, 1.0);
-  b[0] = 1e16;
-  CHECK(numpy_sum(b.data(), b.size()) == 1e16 + 128);
+  CHECK(after_1e16(136) == 128.0);
 }
