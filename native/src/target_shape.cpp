@@ -6,6 +6,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <exception>
 #include <limits>
 #include <numbers>
@@ -1179,12 +1180,23 @@ detail::TargetShapeRun detail::run_target_shape(const Polyline2& contour, bool c
       for (int k : b.constraints) viol = std::max(viol, problem.constraint(k, q));
       return std::make_pair(viol, problem.energy_terms(q, b.terms));
     };
-    const auto [viol0, e0] = merit(before);
     data.p = before;
+    bool moved_at_all = false;
     if (finite) {
       Polyline2& after = data.after;
       after = before;
-      for (std::size_t k = 0; k < b.points.size(); ++k) after[b.points[k]] = data.scale_x * Vec2(x[2 * k], x[2 * k + 1]);
+      for (std::size_t k = 0; k < b.points.size(); ++k) {
+        const int q = b.points[k];
+        after[q] = data.scale_x * Vec2(x[2 * k], x[2 * k + 1]);
+        // bit for bit (-0.0 is not 0.0 here): else the test below decides which of the two is kept
+        moved_at_all = moved_at_all || std::memcmp(after[q].data(), before[q].data(), sizeof(Vec2)) != 0;
+      }
+    }
+    // A block that ends where it started, to the bit (about half the windows of a converging
+    // sweep), keeps `before` whichever way the test goes: its two merits would be equal.
+    if (moved_at_all) {
+      const Polyline2& after = data.after;
+      const auto [viol0, e0] = merit(before);
       const auto [viol1, e1] = merit(after);
       const double tol = o.constraint_tol;
       const bool feasible_and_lower = viol1 <= tol && (viol0 > tol || e1 <= e0 + 1e-14 * std::abs(e0));
