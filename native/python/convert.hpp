@@ -281,19 +281,25 @@ py::array_t<double> to_array(const std::vector<Point>& points) {
   return out;
 }
 
-/// A fixed-size vector as a list of floats.
+/// A fixed-size vector as a list of floats (made at its size and each set in its place, without
+/// append's calls and resizing: a solve converts thousands of points).
 template <class Derived>
 py::list to_list(const Eigen::MatrixBase<Derived>& v) {
-  py::list out;
-  for (Eigen::Index k = 0; k < v.size(); ++k) out.append(v[k]);
+  py::list out(static_cast<std::size_t>(v.size()));
+  for (Eigen::Index k = 0; k < v.size(); ++k) {
+    PyObject* x = PyFloat_FromDouble(v[k]);
+    if (!x) throw py::error_already_set();
+    PyList_SET_ITEM(out.ptr(), k, x);
+  }
   return out;
 }
 
 /// Points as a list of lists of floats (the design document's polylines).
 template <class Point>
 py::list to_lists(const std::vector<Point>& points) {
-  py::list out;
-  for (const Point& p : points) out.append(to_list(p));
+  py::list out(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    PyList_SET_ITEM(out.ptr(), static_cast<Py_ssize_t>(i), to_list(points[i]).release().ptr());
   return out;
 }
 
