@@ -52,6 +52,13 @@ constexpr double kHandOverSeconds = 2e-4;
 // the next job (the stage's Python preparing a wire) mostly come within a few hundred µs.
 constexpr std::chrono::microseconds kAwakeWait{1000};
 
+// Waits awake, yielding the core, until done() or kAwakeWait has passed (the caller then sleeps).
+template <class Done>
+void wait_awake(Done done) {
+  using Clock = std::chrono::steady_clock;
+  for (const auto until = Clock::now() + kAwakeWait; !done() && Clock::now() < until;) std::this_thread::yield();
+}
+
 // Guards the jobs' bookkeeping between two pieces (a few comparisons over the jobs): never throws,
 // unlike std::mutex, inside the threads' noexcept loops.
 class SpinLock {
@@ -238,8 +245,7 @@ struct TargetShapeBatch::State {
         slot = mine == none ? nullptr : &slots[mine];
       }
       if (!slot) {  // nothing free yet: wait for the next add (or the close), awake for a while
-        for (const auto until = Clock::now() + kAwakeWait; posted.load() == seen && Clock::now() < until;)
-          std::this_thread::yield();
+        wait_awake([&] { return posted.load() != seen; });
         posted.wait(seen);
         continue;
       }
@@ -309,7 +315,7 @@ struct TargetShapeBatch::State {
       closed = true;
     }
     post();
-    for (const auto until = Clock::now() + kAwakeWait; !ended && Clock::now() < until;) std::this_thread::yield();
+    wait_awake([&] { return ended.load(); });
     try {
       std::unique_lock<std::mutex> lock(mutex);
       while (!worker_ended.wait_for(lock, std::chrono::milliseconds(20), [&] { return ended.load(); })) {

@@ -248,23 +248,28 @@ class Memo:
         # What every round derives again from the same contours and planes (read-only after the
         # layering, shared by the rounds' copies of the design): each wire's frame and 2D contour,
         # each crossing's bisector and the model's size, checked against the objects they came from.
-        self._frames = {}  # wire name -> (contour, origin, normal, (u, v, 2D contour))
-        self._axes = {}  # wire name -> its frame's u and v as tuples of floats (bisector_in_frame's)
+        # wire name -> (contour, origin, normal, (u, v, 2D contour), (u, v) as tuples of floats)
+        self._frames = {}
         self._bisectors = {}  # (the two wires' plane normals, k, hook) -> h in wire k's frame
         self._size = None  # (the contours, size)
         self.contour_cache = ContourArrays() if contour_cache is None else contour_cache
 
     def frame(self, wire):
         """_frame(wire), computed once per contour and plane."""
+        return self._frame_entry(wire)[3]
+
+    def _frame_entry(self, wire):
+        """The wire's entry of _frames, made again when its contour or plane changed; its last item
+        is the frame's axes as floats (bisector_in_frame reads them element by element)."""
         plane = wire["plane"]
         entry = self._frames.get(wire["name"])
         if (entry is None or entry[0] is not wire["contour"] or entry[1] != list(plane["origin"])
                 or entry[2] != list(plane["normal"])):
-            entry = (wire["contour"], list(plane["origin"]), list(plane["normal"]), _frame(wire, self.array(wire)))
+            frame = _frame(wire, self.array(wire))
+            entry = (wire["contour"], list(plane["origin"]), list(plane["normal"]), frame,
+                     (tuple(frame[0].tolist()), tuple(frame[1].tolist())))
             self._frames[wire["name"]] = entry
-            u, v = entry[3][0], entry[3][1]
-            self._axes[wire["name"]] = (tuple(u.tolist()), tuple(v.tolist()))
-        return entry[3]
+        return entry
 
     def bisector_2d(self, design, crossing, k):
         """desired_bisector(design, crossing, k) in the frame (u, v) of wire k's plane (Memo.frame),
@@ -275,9 +280,8 @@ class Memo:
                crossing["hook"])
         found = self._bisectors.get(key)
         if found is None:
-            wire = design["wires"][crossing["wires"][k]]
-            self.frame(wire)
-            found = self._bisectors[key] = bisector_in_frame(design, crossing, k, *self._axes[wire["name"]])
+            u, v = self._frame_entry(design["wires"][crossing["wires"][k]])[4]
+            found = self._bisectors[key] = bisector_in_frame(design, crossing, k, u, v)
         return found
 
     def model_size(self, design):
