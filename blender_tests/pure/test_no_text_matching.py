@@ -16,8 +16,8 @@ Message-like: a name (or attribute) called `reason`, `message`, `msg`, `error`, 
 `verdict` or `what` (or ending in `_reason`, `_message`, ...), a subscript or `.get` of such a key
 (`design["reason"]`, `failure.get("message")`), `str(exc)` or `exc.args` of a name an `except ... as`
 binds, a `.what()` call, a name assigned one of those, and any of those through `.lower()`,
-`.strip()`, `.split()`, a slice or an index, `x or ""` or an f-string. The scanner is tested on snippets whose verdict is
-known by hand.
+`.strip()`, `.split()`, a slice or an index, `x or ""` or an f-string. The scanner is tested on
+snippets whose verdict is known by hand.
 """
 import ast
 import functools

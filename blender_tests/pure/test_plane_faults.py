@@ -120,7 +120,8 @@ class Words(unittest.TestCase):
                             "closed": False},
                            {"name": "X/0", "contour": [[0, 0, 0], [0.5, 0, 0]], "closed": False},
                            {"name": "Y/0", "contour": [[0, 0, 0], [0.5, 0, 0]], "closed": False}],
-                 "crossings": [{"wires": [0, 1], "contour_vertices": [1, 0]}, {"wires": [0, 2], "contour_vertices": [2, 0]},
+                 "crossings": [{"wires": [0, 1], "contour_vertices": [1, 0]},
+                               {"wires": [0, 2], "contour_vertices": [2, 0]},
                                {"wires": [0, 1], "contour_vertices": [3, 1]}]}
         words = "crossings 1 and 2, too close to their neighbours along the wires for a free bending point between them"
         self.assertEqual(plane_faults.verdict_fault(probe, {"reason": "x; y", "reason_causes": [TOO_CLOSE]}),

@@ -157,6 +157,7 @@ def screen_fault(probe, decided=lambda: False):
             return ("dropped", (closest[1],), closest[2])
     return fault or ("mechanism", (), ("the layering's verdict",))
 
+
 def verdict_fault(probe, solved):
     """The fault of a candidate that passed the screen (`probe`: its layered design) after its full
     solve `solved` ended not stable: "close" when its reason names crossings too close along a wire
@@ -178,6 +179,7 @@ def _wires(joined):
 def plane_of(wire_name):
     """The plane a wire's name belongs to ("Z1/0" -> "Z1")."""
     return wire_name.rsplit("/", 1)[0]
+
 
 def _by(other):
     """", where wires A and B cross it" for the two wires whose crossings come close, else ""."""
@@ -229,7 +231,8 @@ def _no_advice(fault, min_segment):
 
 def _advise_hinge(fault, min_segment):
     _kind, wires, other = fault
-    out = [f"add a plane whose wire crosses wire {w} away from its line with {_wires(on)}" for w, on in zip(wires, other)]
+    out = [f"add a plane whose wire crosses wire {w} away from its line with {_wires(on)}"
+           for w, on in zip(wires, other)]
     planes = sorted({plane_of(w) for w in wires})
     if len(planes) >= 2:
         out.append(f"move or tilt planes {' and '.join(planes)} towards each other until their wires cross "
