@@ -9,7 +9,7 @@ import time
 
 from . import native
 from .core import settings as settings_table
-from .core.design import NO_WIRES, ONE_WIRE, new_design
+from .core.design import NO_WIRES, ONE_WIRE, TOO_CLOSE, new_design
 from .core.polylines import ContourArrays
 from .core.sizes import size_warnings
 from .fab import buildability
@@ -201,6 +201,8 @@ def relayer(design, material, settings, say, native_progress, checkpoint, hook_p
                  f"for a free bending point)") if too_close else ""
         shaped["reason"] += (f"; layering again without the {len(forbidden | too_close)} hooks the target shape cannot "
                              f"realise{close} finds no stable assembly (stages.relayering)")
+        if too_close and TOO_CLOSE not in shaped.setdefault("reason_causes", []):
+            shaped["reason_causes"].append(TOO_CLOSE)
         attempt = shaped
     attempt["stages"]["relayering"] = {"rounds": rounds, "forbidden": _pairs(forbidden),
                                        "max_rounds": extra_rounds, "seconds": time.perf_counter() - start}

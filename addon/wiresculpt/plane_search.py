@@ -548,7 +548,7 @@ def nearby(vertices, faces, planes, material, settings, want=1, budget=BUDGET_SE
         solved = s.solve(copy.deepcopy(design))
         if solved is None or not solved["stable"]:
             fault = ((("stopped" if s.timed_out > stopped else "failed"), (), ()) if solved is None
-                     else plane_faults.verdict_fault(probe, solved, min_segment))
+                     else plane_faults.verdict_fault(probe, solved))
             tally.fault(family, fault, changes)
             return
         tally.fault(family, ("stable", (), ()), changes)

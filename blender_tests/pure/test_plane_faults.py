@@ -24,6 +24,7 @@ import numpy as np
 
 from wiresculpt import native, pipeline, plane_search
 from wiresculpt.core import plane_faults
+from wiresculpt.core.design import TOO_CLOSE
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.scene import PlaneSpec
 from wiresculpt.core.settings import defaults
@@ -111,6 +112,43 @@ class Structural(unittest.TestCase):
                       plane_faults.advice([("hinge", ("W/0",), ("X/0",))]))
 
 
+class Words(unittest.TestCase):
+    def test_the_verdict_is_read_from_the_cause_s_code_not_its_words(self):
+        # wires Z, X, Y of Structural.SIX with contours of their own: along Z/0 (the x axis, 0 to 1 m)
+        # X/0 crosses at 0.10 m and Y/0 at 0.11 m, 10 mm apart (the closest), X/0 again at 0.60 m
+        probe = {"wires": [{"name": "Z/0", "contour": [[0, 0, 0], [0.1, 0, 0], [0.11, 0, 0], [0.6, 0, 0], [1, 0, 0]],
+                            "closed": False},
+                           {"name": "X/0", "contour": [[0, 0, 0], [0.5, 0, 0]], "closed": False},
+                           {"name": "Y/0", "contour": [[0, 0, 0], [0.5, 0, 0]], "closed": False}],
+                 "crossings": [{"wires": [0, 1], "contour_vertices": [1, 0]},
+                               {"wires": [0, 2], "contour_vertices": [2, 0]},
+                               {"wires": [0, 1], "contour_vertices": [3, 1]}]}
+        words = "crossings 1 and 2, too close to their neighbours along the wires for a free bending point between them"
+        self.assertEqual(plane_faults.verdict_fault(probe, {"reason": "x; y", "reason_causes": [TOO_CLOSE]}),
+                         ("close", ("Z/0",), ("X/0", "Y/0")))
+        self.assertEqual(plane_faults.verdict_fault(probe, {"reason": words + "; then"}), ("unstable", (), (words,)))
+
+    def test_one_wording_per_kind_in_every_place(self):
+        # the kinds whose sentence and summary phrase had come apart read the same in both
+        for fault, words in ((("unsolved", (), ()), "passed the screen, but the search ended before their full solve"),
+                             (("slow", (), ()), "were stopped in the layering's search (its screening time)")):
+            self.assertEqual(plane_faults.describe(fault), words)
+            self.assertEqual(plane_faults.summary({fault: 3}), f"3 {words}")
+        close = ("close", ("Y/0",), ("XA/0", "XB/0"))
+        self.assertEqual(plane_faults.describe(close, 0.015),
+                         "passed the screen, but have crossings closer than 2 x min_segment (30 mm) along wire Y/0, "
+                         "where wires XA/0 and XB/0 cross it, which the target shape cannot realise")
+        self.assertEqual(plane_faults.summary({close: 2}, 0.015),
+                         "2 passed the screen, but have crossings closer than 2 x min_segment (30 mm) along a wire, "
+                         "which the target shape cannot realise (wire Y/0, where wires XA/0 and XB/0 cross it)")
+        self.assertEqual(plane_faults.KINDS[:3], ("misses", "few", "refused"))
+        self.assertEqual(plane_faults.WIRE_KINDS, ("alone", "apart", "hinge"))
+        self.assertEqual(plane_faults.PASSED_KINDS, ("near", "close", "unstable", "stopped", "failed", "unsolved",
+                                                     "stable"))
+        with self.assertRaises(ValueError):
+            plane_faults.describe(("nonsense", (), ()))
+
+
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)
 class Closest(unittest.TestCase):
     @staticmethod
@@ -133,8 +171,9 @@ class Closest(unittest.TestCase):
         self.assertEqual(sorted(others), ["XA/0", "XB/0"])
         # a full solve that says so is counted as "close" on that wire, and the advice moves XA and XB apart
         solved = {"reason": "the target shape cannot realise crossings 1 and 2, too close to their neighbours along "
-                            f"the wires for a free bending point between them (the closest: wire '{wire}': ...)"}
-        fault = plane_faults.verdict_fault(probe, solved, 0.015)
+                            f"the wires for a free bending point between them (the closest: wire '{wire}': ...)",
+                  "reason_causes": [TOO_CLOSE]}
+        fault = plane_faults.verdict_fault(probe, solved)
         self.assertEqual(fault[:2], ("close", (wire,)))
         advice = plane_faults.advice([fault], 0.015)
         self.assertEqual(len(advice), 1)
@@ -162,6 +201,11 @@ class Closest(unittest.TestCase):
         solved = s.solve(copy.deepcopy(design))
         self.assertFalse(solved["stable"])
         self.assertIn("too close to", solved["reason"])
+        # the cause the reason names travels as a code, which the search counts the candidate by
+        self.assertIn(TOO_CLOSE, solved["reason_causes"])
+        fault = plane_faults.verdict_fault(probe, solved)
+        self.assertEqual(fault[0], "close")
+        self.assertEqual(sorted(fault[2]), ["XA/0", "XB/0"])
         text = plane_faults.describe(s.fault, 0.015)
         self.assertIn("closer than 2 x min_segment (30 mm)", text)
         # two crossings 2 R asin(d / R) apart for d = 12 mm: 24 mm, more than min_segment but less than

@@ -38,7 +38,7 @@ from unittest import mock
 import numpy as np
 
 from wiresculpt import native, pipeline
-from wiresculpt.core.design import new_design, wire_entry
+from wiresculpt.core.design import TOO_CLOSE, new_design, wire_entry
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.settings import defaults
 from wiresculpt.stages import layering, target_shape
@@ -258,6 +258,7 @@ class Relayering(unittest.TestCase):
                                                f"to a neighbour along a wire for a free bending point) finds no "
                                                f"stable assembly (stages.relayering)"),
                         new["reason"])
+        self.assertEqual(new["reason_causes"], [TOO_CLOSE])  # the cause the note names, as its code
 
     def test_the_close_geometry(self):
         # P and Q 3 deg apart along A: 10.5 mm, shorter than min_segment, so neither hook of either

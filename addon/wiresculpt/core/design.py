@@ -36,7 +36,7 @@ KEYS = {
     "top": {
         "format": "design", "version": "design", "units": "design", "material": "design",
         "torque_fraction": "design", "machine": "design", "wires": "design", "stages": "design",
-        "stable": "layering", "reason": "layering",
+        "stable": "layering", "reason": "layering", "reason_causes": "layering",
         "pending_stages": "pipeline", "warnings": "every stage",
         "crossings": "layering", "assembly_order": "layering", "assembly_steps": "layering",
         "two_hand_steps": "layering", "close_crossings": "layering", "required_size": "layering",
@@ -70,7 +70,7 @@ KEYS = {
 # material without density, a user's cut, the batch's exports.
 OPTIONAL = {
     "top": {"close_crossings", "required_size", "load_capacity", "load_factor", "fabrication", "warnings",
-            "buildability", "search_incomplete", "plane_search"},
+            "buildability", "search_incomplete", "plane_search", "reason_causes"},
     "wire": {"cut_override", "cut_point", "out_of_plane_deflection", "out_of_plane_deflection_vertex"},
     "crossing": set(),
     "stages": set(),
@@ -84,6 +84,11 @@ OPTIONAL = {
 NO_WIRES = "no plane cuts the mesh: move the planes through the mesh"
 ONE_WIRE = "a sculpture needs at least two wires: add a plane or pick more contours"
 SETUP_REASONS = (NO_WIRES, ONE_WIRE)
+
+
+# The codes of the causes a `reason` names (`reason_causes`), for the code that acts on a cause;
+# the reason's words are for people.
+TOO_CLOSE = "too_close"  # crossings too close along a wire for a free bending point between them
 
 
 def setup_problem(design):

@@ -1,5 +1,5 @@
 """Why a placement of the slicing planes gives no stable design, read from its layered crossing
-network (issue 15: "every scene ends stable or says why no nearby placement exists"). bpy-free,
+network, so that every nearby search ends stable or says why no nearby placement exists. bpy-free,
 numpy only; plane_search.py counts these faults over the candidates it screens and solves.
 
 A fault is a tuple (kind, wires, other): `kind` one of KINDS, `wires` the names of the wires at
@@ -23,15 +23,15 @@ applies is the candidate's fault):
   configuration for another reason: its own words (`reason`), cut at the first ';'.
 
 Faults of a candidate that passed the screen come from its full solve (see verdict_fault).
+
+Every kind is one entry of FAULTS: its words (one sentence, named by the fault for describe and
+generic for summary's counts), the items summary counts under it, and its advice.
 """
-import re
+from typing import Callable, NamedTuple
 
 import numpy as np
 
-WIRE_KINDS = ("alone", "apart", "hinge")  # faults that name the wires at fault
-PASSED_KINDS = ("near", "close", "unstable", "stopped", "failed", "unsolved", "stable")  # faults after the screen
-KINDS = ("misses", "few", "refused", "slow", "incomplete", "alone", "apart", "hinge", "dropped", "mechanism", "near",
-         "close", "unstable", "stopped", "failed", "unsolved", "stable")
+from .design import TOO_CLOSE
 
 
 def wire_gaps(design):
@@ -158,18 +158,16 @@ def screen_fault(probe, decided=lambda: False):
     return fault or ("mechanism", (), ("the layering's verdict",))
 
 
-def verdict_fault(probe, solved, min_segment):
+def verdict_fault(probe, solved):
     """The fault of a candidate that passed the screen (`probe`: its layered design) after its full
-    solve `solved` ended not stable: "close" when the target shape could not realise crossings too
-    close along a wire (named with the two wires whose crossings come closest on it, from the
-    probe), else "unstable" with the solve's reason cut at the first ';'."""
-    reason = solved.get("reason") or ""
-    if "too close to" in reason and "free bending point" in reason:
+    solve `solved` ended not stable: "close" when its reason names crossings too close along a wire
+    for a free bending point between them (`reason_causes` holds TOO_CLOSE), named by the probe's
+    closest gap (its wire and the two wires crossing it there), else "unstable" with the solve's
+    reason cut at the first ';'."""
+    if TOO_CLOSE in solved.get("reason_causes", ()):
         closest = closest_gap(probe)
-        named = re.search(r"the closest: wire '([^']+)'", reason)
-        if closest is not None and (named is None or named.group(1) == closest[1] or closest[0] < 2.0 * min_segment):
-            return ("close", (closest[1],), closest[2])
-        return ("close", (named.group(1),) if named else (), ())
+        return ("close", (closest[1],), closest[2]) if closest is not None else ("close", (), ())
+    reason = solved.get("reason") or ""
     return ("unstable", (), (reason.split(";", 1)[0][:160],))
 
 
@@ -183,97 +181,143 @@ def plane_of(wire_name):
     return wire_name.rsplit("/", 1)[0]
 
 
-def describe(fault, min_segment=None):
-    """A fault as the words a count goes with ("41 hinge: ...")."""
-    kind, wires, other = fault
-    ws = " and ".join(f"wire {w}" for w in wires)
-    if kind == "misses":
-        return f"put plane {other[0]} off the mesh (it cuts no contour)"
-    if kind == "few":
-        return "leave fewer than two wires"
-    if kind == "refused":
-        return f"are refused by the crossing network ({other[0]})"
-    if kind == "slow":
-        return "stopped in the layering's search after its screening time"
-    if kind == "incomplete":
-        return "were left undecided: the layering's search reached max_nodes"
-    if kind == "alone":
-        return f"leave {ws} crossing no other wire"
-    if kind == "apart":
-        return f"leave {ws} apart from the rest"
-    if kind == "hinge":
-        on = " and ".join(f"wire {w} (on {_wires(o)})" for w, o in zip(wires, other))
-        return f"hinge: {on} {'is' if len(wires) == 1 else 'are'} held only at crossings on one line" + (
-            "" if len(wires) == 1 else " each")
-    if kind == "mechanism":
-        return f"are a mechanism ({other[0]})"
-    if kind == "dropped":
-        limit = f" ({2000 * min_segment:.0f} mm)" if min_segment else ""
-        by = f", where wires {other[0]} and {other[1]} cross it" if len(other) == 2 else ""
-        return (f"are no stable structure without the hooks the target shape cannot realise at crossings closer "
-                f"than 2 x min_segment{limit} along {ws}{by}")
-    if kind == "near":
-        limit = f" ({1000 * min_segment:.0f} mm)" if min_segment else ""
-        by = f", where wires {other[0]} and {other[1]} cross it" if len(other) == 2 else ""
-        return (f"passed the screen, but have crossings closer than min_segment{limit} along {ws}{by} "
-                "(left unsolved: such candidates are solved last, and the search ended first)")
-    if kind == "close":
-        limit = f" ({2000 * min_segment:.0f} mm)" if min_segment else ""
-        by = f", where wires {other[0]} and {other[1]} cross it" if len(other) == 2 else ""
-        return f"passed the screen, but have crossings closer than 2 x min_segment{limit} along {ws}{by}"
-    if kind == "unstable":
-        return f"passed the screen, but their full solve is not stable ({other[0]})"
-    if kind == "stopped":
-        return "passed the screen, but the budget stopped their full solve"
-    if kind == "failed":
-        return "passed the screen, but the solver could not finish them"
-    if kind == "unsolved":
-        return "passed the screen, but the budget ended before their full solve"
-    if kind == "stable":
-        return "are stable"
-    raise ValueError(f"unknown fault kind {kind!r}")
+def _by(other):
+    """", where wires A and B cross it" for the two wires whose crossings come close, else ""."""
+    return f", where wires {other[0]} and {other[1]} cross it" if len(other) == 2 else ""
 
 
-KIND_WORDS = {
-    "misses": "put a plane off the mesh (it cuts no contour)",
-    "few": "leave fewer than two wires",
-    "refused": "are refused by the crossing network",
-    "slow": "were stopped in the layering's search (its screening time)",
-    "incomplete": "were left undecided: the layering's search reached max_nodes",
-    "alone": "leave a wire crossing no other wire",
-    "apart": "leave wires apart from the rest",
-    "hinge": "hinge: a wire held only at crossings on one line turns about it",
-    "dropped": "are no stable structure without the hooks the target shape cannot realise at crossings closer "
-               "than 2 x min_segment{two} along a wire",
-    "mechanism": "are a mechanism of several wires",
-    "near": "passed the screen, but have crossings closer than min_segment{min} along a wire (left unsolved: such "
-            "candidates are solved last, and the search ended first)",
-    "close": "passed the screen, but have crossings closer than 2 x min_segment{two} along a wire, which the target "
-             "shape cannot realise",
-    "unstable": "passed the screen, but their full solve is not stable",
-    "stopped": "passed the screen, but the budget stopped their full solve",
-    "failed": "passed the screen, but the solver could not finish them",
-    "unsolved": "passed the screen, but the search ended before their full solve",
-    "stable": "are stable",
-}
+def _limits(min_segment):
+    """The words' min_segment figures: {min} and {two} (2 x min_segment), "" without one."""
+    return {"min": f" ({1000 * min_segment:.0f} mm)" if min_segment else "",
+            "two": f" ({2000 * min_segment:.0f} mm)" if min_segment else ""}
 
 
-def _items(fault):
-    """What a fault names, one label each: the wires at fault (with the wires they hinge on, or
-    the two wires whose crossings come close on them), the plane off the mesh, the solver's words."""
-    kind, wires, other = fault
-    if kind == "hinge":
-        return [f"wire {w} on {_wires(o)}" for w, o in zip(wires, other)]
-    if kind in ("near", "close", "dropped"):
-        return [f"wire {w}" + (f", where wires {other[0]} and {other[1]} cross it" if len(other) == 2 else "")
-                for w in wires]
-    if kind == "misses":
-        return [f"plane {other[0]}"]
-    if kind in ("alone", "apart"):
-        return [f"wire {w}" for w in wires]
-    if kind in ("mechanism", "unstable", "refused"):
-        return [o for o in other]
+def _named(fault):
+    """The words' fields as one fault names them (describe)."""
+    _kind, wires, other = fault
+    hinged = " and ".join(f"wire {w} (on {_wires(o)})" for w, o in zip(wires, other))
+    return {"wires": " and ".join(f"wire {w}" for w in wires), "by": _by(other),
+            "detail": f" ({other[0]})" if other else "", "plane": f"plane {other[0]}" if other else "a plane",
+            "hinged": hinged + (" is" if len(wires) == 1 else " are"), "tail": "" if len(wires) == 1 else " each"}
+
+
+def _no_items(fault):
     return []
+
+
+def _each_wire(fault):
+    return [f"wire {w}" for w in fault[1]]
+
+
+def _wire_on(fault):
+    return [f"wire {w} on {_wires(o)}" for w, o in zip(fault[1], fault[2])]
+
+
+def _wire_by(fault):
+    return [f"wire {w}" + _by(fault[2]) for w in fault[1]]
+
+
+def _plane(fault):
+    return [f"plane {fault[2][0]}"]
+
+
+def _other(fault):
+    return list(fault[2])
+
+
+def _no_advice(fault, min_segment):
+    return []
+
+
+def _advise_hinge(fault, min_segment):
+    _kind, wires, other = fault
+    out = [f"add a plane whose wire crosses wire {w} away from its line with {_wires(on)}"
+           for w, on in zip(wires, other)]
+    planes = sorted({plane_of(w) for w in wires})
+    if len(planes) >= 2:
+        out.append(f"move or tilt planes {' and '.join(planes)} towards each other until their wires cross "
+                   "each other off those lines")
+    return out
+
+
+def _advise_alone(fault, min_segment):
+    return [f"move plane {plane_of(w)} until wire {w} crosses at least two other wires, or add a plane crossing "
+            f"wire {w}" for w in fault[1]]
+
+
+def _advise_apart(fault, min_segment):
+    return [f"add a plane crossing {' and '.join(f'wire {w}' for w in fault[1])} and the rest"]
+
+
+def _advise_spacing(fault, min_segment):
+    """Crossings too close along a wire: the two planes whose wires cross it there moved apart."""
+    _kind, wires, other = fault
+    if len(other) != 2:
+        return []
+    a, b = plane_of(other[0]), plane_of(other[1])
+    gap = f" at least {2000 * min_segment:.0f} mm" if min_segment else ""
+    if a == b:
+        return [f"move plane {a} so that its two crossings along wire {wires[0]} are{gap} apart, or scale the model up"]
+    return [f"move planes {a} and {b} apart, so that their crossings along wire {wires[0]} are{gap} apart, or "
+            "scale the model up"]
+
+
+class Kind(NamedTuple):
+    """One kind of fault: the words a count of its candidates goes with ("41 hinge: ..."), whose
+    {fields} the fault names (describe, _named) or `generic` fills (summary, counting many faults of
+    the kind), {min} and {two} the min_segment figures; what it names, one label each (`items`,
+    counted by summary); what to change (`advice`)."""
+    words: str
+    generic: dict = {}
+    items: Callable = _no_items
+    advice: Callable = _no_advice
+    names_wires: bool = False  # the fault names the wires at fault
+    passed: bool = False  # a fault of a candidate that passed the screen
+
+
+SOME_WIRE = {"wires": "a wire", "by": ""}
+FAULTS = {
+    "misses": Kind("put {plane} off the mesh (it cuts no contour)", {"plane": "a plane"}, _plane),
+    "few": Kind("leave fewer than two wires"),
+    "refused": Kind("are refused by the crossing network{detail}", {"detail": ""}, _other),
+    "slow": Kind("were stopped in the layering's search (its screening time)"),
+    "incomplete": Kind("were left undecided: the layering's search reached max_nodes"),
+    "alone": Kind("leave {wires} crossing no other wire", {"wires": "a wire"}, _each_wire, _advise_alone,
+                  names_wires=True),
+    "apart": Kind("leave {wires} apart from the rest", {"wires": "wires"}, _each_wire, _advise_apart,
+                  names_wires=True),
+    "hinge": Kind("hinge: {hinged} held only at crossings on one line{tail}",
+                  {"hinged": "a wire", "tail": " turns about it"}, _wire_on, _advise_hinge, names_wires=True),
+    "dropped": Kind("are no stable structure without the hooks the target shape cannot realise at crossings closer "
+                    "than 2 x min_segment{two} along {wires}{by}", SOME_WIRE, _wire_by, _advise_spacing),
+    "mechanism": Kind("are a mechanism{detail}", {"detail": " of several wires"}, _other),
+    "near": Kind("passed the screen, but have crossings closer than min_segment{min} along {wires}{by} (left "
+                 "unsolved: such candidates are solved last, and the search ended first)", SOME_WIRE, _wire_by,
+                 _advise_spacing, passed=True),
+    "close": Kind("passed the screen, but have crossings closer than 2 x min_segment{two} along {wires}{by}, which "
+                  "the target shape cannot realise", SOME_WIRE, _wire_by, _advise_spacing, passed=True),
+    "unstable": Kind("passed the screen, but their full solve is not stable{detail}", {"detail": ""}, _other,
+                     passed=True),
+    "stopped": Kind("passed the screen, but the budget stopped their full solve", passed=True),
+    "failed": Kind("passed the screen, but the solver could not finish them", passed=True),
+    "unsolved": Kind("passed the screen, but the search ended before their full solve", passed=True),
+    "stable": Kind("are stable", passed=True),
+}
+KINDS = tuple(FAULTS)  # their order ranks kinds of equal counts
+WIRE_KINDS = tuple(k for k, v in FAULTS.items() if v.names_wires)  # faults that name the wires at fault
+PASSED_KINDS = tuple(k for k, v in FAULTS.items() if v.passed)  # faults after the screen
+
+
+def _entry(fault):
+    try:
+        return FAULTS[fault[0]]
+    except KeyError:
+        raise ValueError(f"unknown fault kind {fault[0]!r}") from None
+
+
+def describe(fault, min_segment=None):
+    """A fault as the words a count goes with ("41 hinge: ..."), naming what it names."""
+    return _entry(fault).words.format(**_limits(min_segment), **_named(fault))
 
 
 def summary(faults, min_segment=None, shown=4):
@@ -284,18 +328,18 @@ def summary(faults, min_segment=None, shown=4):
     kinds, named = {}, {}
     for fault, n in faults.items():
         kinds[fault[0]] = kinds.get(fault[0], 0) + n
-        for item in _items(fault):
+        for item in _entry(fault).items(fault):
             named.setdefault(fault[0], {})
             named[fault[0]][item] = named[fault[0]].get(item, 0) + n
     ranked = sorted(kinds.items(), key=lambda kv: (-kv[1], KINDS.index(kv[0])))
-    words = {"min": f" ({1000 * min_segment:.0f} mm)" if min_segment else "",
-             "two": f" ({2000 * min_segment:.0f} mm)" if min_segment else ""}
+    limits = _limits(min_segment)
     parts = []
     for kind, n in ranked[:shown]:
         items = sorted(named.get(kind, {}).items(), key=lambda kv: (-kv[1], kv[0]))
         detail = ", ".join(item if len(items) == 1 else f"{item} in {k}" for item, k in items[:3])
         more = f", {len(items) - 3} more" if len(items) > 3 else ""
-        parts.append(f"{n} {KIND_WORDS[kind].format(**words)}" + (f" ({detail}{more})" if detail else ""))
+        words = FAULTS[kind].words.format(**limits, **FAULTS[kind].generic)
+        parts.append(f"{n} {words}" + (f" ({detail}{more})" if detail else ""))
     rest = sum(n for _kind, n in ranked[shown:])
     if rest:
         parts.append(f"{rest} for {len(ranked) - shown} other reason{'s' if len(ranked) - shown > 1 else ''} "
@@ -304,38 +348,15 @@ def summary(faults, min_segment=None, shown=4):
 
 
 def advice(faults, min_segment=None):
-    """What to change, from the faults that stopped the most candidates (a list of sentences):
-    for a hinged wire, a plane crossing it away from its line; for two planes whose wires hinge,
-    moving them together so that their wires cross; for a wire crossing nothing, a plane crossing it;
-    for crossings too close along a wire, the two planes at fault moved apart."""
-    out = []
-    for kind, wires, other in faults:
-        if kind == "hinge":
-            for w, on in zip(wires, other):
-                out.append(f"add a plane whose wire crosses wire {w} away from its line with {_wires(on)}")
-            planes = sorted({plane_of(w) for w in wires})
-            if len(planes) >= 2:
-                out.append(f"move or tilt planes {' and '.join(planes)} towards each other until their wires cross "
-                           "each other off those lines")
-        elif kind == "alone":
-            for w in wires:
-                out.append(f"move plane {plane_of(w)} until wire {w} crosses at least two other wires, or add a "
-                           f"plane crossing wire {w}")
-        elif kind == "apart":
-            out.append(f"add a plane crossing {' and '.join(f'wire {w}' for w in wires)} and the rest")
-        elif kind in ("near", "close", "dropped") and len(other) == 2:
-            a, b = plane_of(other[0]), plane_of(other[1])
-            gap = f" at least {2000 * min_segment:.0f} mm" if min_segment else ""
-            if a == b:
-                out.append(f"move plane {a} so that its two crossings along wire {wires[0]} are{gap} apart, or "
-                           "scale the model up")
-            else:
-                out.append(f"move planes {a} and {b} apart, so that their crossings along wire {wires[0]} are{gap} "
-                           "apart, or scale the model up")
+    """What to change, from the faults that stopped the most candidates (a list of sentences, each
+    once): for a hinged wire, a plane crossing it away from its line; for two planes whose wires
+    hinge, moving them together so that their wires cross; for a wire crossing nothing, a plane
+    crossing it; for crossings too close along a wire, the two planes at fault moved apart."""
     unique = []
-    for s in out:
-        if s not in unique:
-            unique.append(s)
+    for fault in faults:
+        for s in _entry(fault).advice(fault, min_segment):
+            if s not in unique:
+                unique.append(s)
     return unique
 
 

@@ -97,11 +97,12 @@ def recheck(design, material, settings, native_progress=None, contours=None):
                                  settings_for(material, settings), native_progress)
 
 
-def recheck_verdict(design, material, settings, cause, count, native_progress=None, contours=None):
+def recheck_verdict(design, material, settings, cause, count, native_progress=None, contours=None, codes=()):
     """The layering's verdict after a later stage nulled `count` crossings for `cause` (a
     sentence naming them): re-checks the assembly (recheck) and, when it no longer stands, sets
-    `stable` false with a `reason` naming the cause and the step that fails. Returns the number
-    of LPs the re-check solved. `contours` as for recheck."""
+    `stable` false with a `reason` naming the cause and the step that fails, and `reason_causes`
+    to `codes` (those of the causes `cause` names, core/design.py) when there are any. Returns the
+    number of LPs the re-check solved. `contours` as for recheck."""
     verdict = recheck(design, material, settings, native_progress, contours)
     if not verdict["stable"] and design["stable"]:
         step = design["assembly_steps"][verdict["failed_step"]]
@@ -109,4 +110,6 @@ def recheck_verdict(design, material, settings, cause, count, native_progress=No
         design["stable"] = False
         design["reason"] = (f"{cause}; without {'them' if count > 1 else 'it'} the assembly is no longer stable "
                             f"when adding {names}")
+        if codes:
+            design["reason_causes"] = list(codes)
     return verdict["lp_solves"]

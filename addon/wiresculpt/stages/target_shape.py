@@ -16,7 +16,7 @@ import time
 import numpy as np
 
 from .. import native
-from ..core.design import crossing_axis, model_size
+from ..core.design import TOO_CLOSE, crossing_axis, model_size
 from ..core.frames import plane_frame, to_2d, to_3d
 from ..core.polylines import ContourArrays, polyline_length
 from . import layering
@@ -476,7 +476,8 @@ def run(design, material, settings, native_progress=None, memo=None):
     if nulled:  # the verdict is the layering's: it re-checks the assembly without them
         design["stages"]["target_shape"]["recheck_lp_solves"] = layering.recheck_verdict(
             design, material, settings, unrealised_summary(nulled, size), len(nulled), native_progress,
-            [memo.array(w) for w in design["wires"]] if memo is not None else None)
+            [memo.array(w) for w in design["wires"]] if memo is not None else None,
+            [TOO_CLOSE] if any(n["status"] == "too_close" for n in nulled) else [])
     worst = max(w["max_distance"] for w in per_wire)
     return (f"{len(per_wire)} wires, largest distance to the contour {worst * 1000:.2f} mm, "
             f"{len(nulled)} crossings nulled, {iterations} iterations ({seconds:.3f} s)")
