@@ -61,11 +61,11 @@ import time
 
 import numpy as np
 
-from . import native, pipeline
-from .core import plane_faults
-from .core.plane_faults import Tally, close_gaps, crossing_gaps  # noqa: F401 (the search's names for them)
-from .core.scene import PlaneSpec
-from .stages import layering, slicing, target_shape
+from .. import native, pipeline
+from ..core import plane_faults
+from ..core.plane_faults import Tally, close_gaps, crossing_gaps  # noqa: F401 (the search's names for them)
+from ..core.scene import PlaneSpec
+from ..stages import layering, slicing, target_shape
 
 MODES = ("off", "nearby", "auto")
 OFFSETS = (0.02, 0.04, 0.07, 0.10, 0.15, 0.20)  # fractions of the model size S, both ways
