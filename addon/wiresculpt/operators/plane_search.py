@@ -27,6 +27,7 @@ from ..blend.registration import classes_factory
 from ..blend.view import redraw_3d_views
 from ..core.jobs import WorkerJob
 from ..core.scene import PlaneSpec
+from ..core.solve_context import SolveContext
 from ..props import material_of, solver_settings
 from . import optimize
 from .progress import WorkerModal
@@ -114,15 +115,16 @@ class SearchJob(WorkerJob):
         self.messages.append(message)
 
     def work(self):
+        context = SolveContext(self._progress, self.cancel_event.is_set)
         try:
             if self.mode == "nearby":
                 self.found, self.searched, _ = plane_search.nearby(
-                    self.V, self.F, self.planes, self.material, self.settings, MAX_CANDIDATES, UI_BUDGET_SECONDS,
-                    progress=self._progress, cancel=self.cancel_event.is_set)
+                    (self.V, self.F), self.planes, self.material, self.settings, MAX_CANDIDATES, UI_BUDGET_SECONDS,
+                    context=context)
             else:
                 self.found, self.searched, _ = plane_search.auto(
-                    self.V, self.F, self.count, self.material, self.settings, MAX_CANDIDATES, UI_BUDGET_SECONDS,
-                    progress=self._progress, cancel=self.cancel_event.is_set)
+                    (self.V, self.F), self.count, self.material, self.settings, MAX_CANDIDATES, UI_BUDGET_SECONDS,
+                    context=context)
         except pipeline.Cancelled:
             self.cancelled = True
             return
