@@ -42,13 +42,13 @@ from .. import native, pipeline
 from ..blend import cut_handles, mesh
 from ..blend.mesh import triangle_count
 from ..blend import results as scene_results
+from ..blend.machine import chosen_stock
 from ..blend.handles import contour_plane_name, handles, target_name, target_problem, ticked_planes
 from ..blend.registration import classes_factory
 from ..blend.view import redraw_3d_views
 from ..core.jobs import WorkerJob
 from ..core.live_verdict import CANNOT_SOLVE, ERROR, SOLVING, of_design, shortened, verdict
 from ..props import LIVE_HOOKS, material_of, solve_inputs, solver_settings
-from .optimize import chosen_stock
 
 TICK_SECONDS = 0.1  # while nothing changes
 ACTIVE_TICK_SECONDS = 0.02  # while a plane moves or a job runs: the verdict is seen sooner
@@ -167,7 +167,7 @@ class LiveJob(WorkerJob):
 
     def __init__(self, key, vertices, faces, planes, cuts, material, settings, stock=None):
         super().__init__()
-        self.stock = stock  # (m, profile name) the size warnings and limits name (optimize.chosen_stock)
+        self.stock = stock  # (m, profile name) the size warnings and limits name (blend/machine.chosen_stock)
         self.key = key
         self.vertices, self.faces, self.planes, self.cuts = vertices, faces, planes, cuts
         self.material, self.settings = material, settings

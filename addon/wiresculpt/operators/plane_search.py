@@ -29,8 +29,7 @@ from ..core.jobs import WorkerJob
 from ..core.scene import PlaneSpec
 from ..core.solve_context import SolveContext
 from ..props import material_of, solver_settings
-from . import optimize
-from .progress import WorkerModal
+from .progress import JOIN_SECONDS, WorkerModal, busy
 
 MAX_CANDIDATES = 3
 UI_BUDGET_SECONDS = 60.0  # the panel's search may take longer than the batch's: Esc stops it
@@ -132,7 +131,7 @@ class SearchJob(WorkerJob):
         for candidate in self.found:
             candidate["preview"] = candidate_preview(candidate, self.mode, size)
 
-    def stop(self, timeout=optimize.JOIN_SECONDS):
+    def stop(self, timeout=JOIN_SECONDS):
         self.cancel_event.set()
         self.thread.join(timeout)
         return not self.thread.is_alive()
@@ -148,7 +147,7 @@ JOB = None
 
 
 def running():
-    return JOB is not None or optimize.running()
+    return JOB is not None or busy("optimize")
 
 
 def _store(job):
