@@ -1,4 +1,4 @@
-"""The plane assistant (plane_search.py, issue 15) in-process, on a sphere whose plane circles are
+"""The plane assistant (the plane_search package) in-process, on a sphere whose plane circles are
 known by hand: the planes z = c1 and x = c2 (c in units of the radius) cut circles that cross iff
 c1^2 + c2^2 < 1, and a plane at distance c from the centre along (1, 1, 0)/sqrt2 meets y = 0 iff
 c < 1/sqrt2 and z = 0.7 iff c^2 < 0.51. Every stable design found is re-checked by

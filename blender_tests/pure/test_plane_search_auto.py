@@ -1,4 +1,4 @@
-"""What auto's proposals and ranking rest on (plane_search.py, issue 15), on scenes whose answers
+"""What auto's proposals and ranking rest on (the plane_search package), on scenes whose answers
 are known by hand:
 
 - crossing_gaps / close_gaps: the distances along a wire between consecutive crossings, on a
