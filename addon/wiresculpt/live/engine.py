@@ -16,11 +16,11 @@ The verdict's words are core/live_verdict's: "not stable — <reason>" only for 
 not stable, "cannot solve — <what to do>" when the scene as set up cannot be solved (no target, no
 contour ticked, a panel value or plane the solver refuses, fewer than two wires), "error — …" for our
 unexpected error; a long reason is shown to the end of its first clause, the whole one in
-WIRESCULPT_OT_live_reason's tooltip.
+the tooltip of operators/live.py's WIRESCULPT_OT_live_reason.
 
 Nothing is written to the scene or the .blend: the verdict and the wires' preview (STATE.preview,
 line segments in each wire's colour, computed on the worker by blend/results.wire_shapes) live in
-module state, shown by the Wire panel and drawn by ui/overlay.py, so no live update touches the
+live/state.py's STATE, shown by the Wire panel and drawn by ui/overlay.py, so no live update touches the
 undo history. The wire curves themselves are not rewritten (blend/results.write_results would also
 replace the stored design of the last Optimize and its markers and cut handles); Optimize does.
 
