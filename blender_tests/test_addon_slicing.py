@@ -15,7 +15,8 @@ import wiresculpt
 from wiresculpt import native
 from wiresculpt.blend import contours as blend_contours
 from wiresculpt.blend import handles as blend_handles
-from wiresculpt.operators import live, slicing
+from wiresculpt.live import engine as live
+from wiresculpt.operators import slicing
 from wiresculpt.ui import panel
 
 from helpers import BlenderCase, FakeLayout, clear_scene, draw, register_addon, save_and_reload

@@ -99,7 +99,7 @@ class LiveRefused(BlenderCase):
     def test_large_mesh_is_refused(self):
         import bpy
 
-        from wiresculpt.operators import live
+        from wiresculpt.live import engine as live
 
         bpy.ops.mesh.primitive_grid_add(x_subdivisions=320, y_subdivisions=320)  # 320² quads: 204,800 triangles
         target = bpy.context.view_layer.objects.active
@@ -122,7 +122,7 @@ class LiveRefused(BlenderCase):
     def test_modifiers_count(self):
         import bpy
 
-        from wiresculpt.operators import live
+        from wiresculpt.live import engine as live
 
         bpy.ops.mesh.primitive_cube_add()  # 12 triangles of its own
         cube = bpy.context.view_layer.objects.active
@@ -179,32 +179,33 @@ class LiveFollowsTheScene(BlenderCase):
         """Runs the timer's steps until the verdict of the scene as it is now is shown."""
         import time
 
-        from wiresculpt.operators import live
+        from wiresculpt.live import engine as live
 
         began = time.monotonic()
         while True:
             self.assertIsNotNone(live.tick(), "the live timer ended")
-            if live.STATE.job is None and live.STATE.solved == live.snapshot(self.scene()):
-                return live.STATE.verdict
+            now = live.observed()
+            if now.job is None and now.solved == live.snapshot(self.scene()):
+                return live.observed().verdict
             if time.monotonic() - began > timeout:
-                self.fail(f"no verdict within {timeout} s: {live.STATE.verdict!r}")
+                self.fail(f"no verdict within {timeout} s: {live.observed().verdict!r}")
             time.sleep(0.02)
 
     def extent(self):
         """The largest distance of the live preview's points from the target's centre (m)."""
         import numpy as np
 
-        from wiresculpt.operators import live
+        from wiresculpt.live import engine as live
 
         return max(float(np.max(np.linalg.norm(lines - np.asarray(self.target.location), axis=1)))
-                   for _colour, lines in live.STATE.preview)
+                   for _colour, lines in live.observed().preview)
 
     def test_settings_are_part_of_the_verdict(self):
         import math
 
         import bpy
 
-        from wiresculpt.operators import live
+        from wiresculpt.live import engine as live
 
         self.ws.live = True
         self.assertStands(self.settle())
@@ -220,7 +221,7 @@ class LiveFollowsTheScene(BlenderCase):
         verdict = self.settle()
         self.assertEqual(verdict, "cannot solve — the smallest bend must be smaller than the largest bend "
                                   "(Machine settings)")
-        self.assertEqual(live.STATE.preview, [])
+        self.assertEqual(live.observed().preview, [])
         self.assertTrue(bpy.app.timers.is_registered(live.tick))
         self.ws.max_bend_deg, self.ws.min_bend_deg = max_bend, min_bend
         self.assertStands(self.settle())
@@ -229,28 +230,28 @@ class LiveFollowsTheScene(BlenderCase):
         import bpy
         from mathutils import Matrix
 
-        from wiresculpt.operators import live
+        from wiresculpt.live import engine as live
 
         self.ws.live = True
         self.assertStands(self.settle())
-        before, seen = self.extent(), live.STATE.geometry
+        before, seen = self.extent(), live.observed().geometry
         self.assertAlmostEqual(before, 0.125, delta=0.01)  # the wires lie on the globe
         self.target.data.transform(Matrix.Scale(0.6, 4))  # an edit of the mesh, its matrix unchanged
         self.target.data.update()
         bpy.context.view_layer.update()
-        self.assertGreater(live.STATE.geometry, seen)
+        self.assertGreater(live.observed().geometry, seen)
         self.settle()
         self.assertAlmostEqual(self.extent(), 0.6 * 0.125, delta=0.01)
-        seen = live.STATE.geometry
+        seen = live.observed().geometry
         self.target.modifiers.new("Subdivision", 'SUBSURF')
         bpy.context.view_layer.update()
-        self.assertGreater(live.STATE.geometry, seen)
-        seen = live.STATE.geometry
+        self.assertGreater(live.observed().geometry, seen)
+        seen = live.observed().geometry
         self.settle()
-        self.assertEqual(live.STATE.geometry, seen)  # reading the mesh is no edit: no endless re-solving
+        self.assertEqual(live.observed().geometry, seen)  # reading the mesh is no edit: no endless re-solving
 
     def test_a_target_taken_out_of_the_scene(self):
-        from wiresculpt.operators import live
+        from wiresculpt.live import engine as live
 
         self.ws.live = True
         self.assertStands(self.settle())
@@ -258,7 +259,7 @@ class LiveFollowsTheScene(BlenderCase):
             collection.objects.unlink(self.target)
         verdict = self.settle()
         self.assertTrue(verdict.startswith(f"cannot solve — Target '{self.target.name}' is not in scene"), verdict)
-        self.assertEqual(live.STATE.preview, [])
+        self.assertEqual(live.observed().preview, [])
 
     def test_setup_problems_cannot_solve(self):
         """A scene that cannot be solved as set up says so, and never reads as a verdict on the design."""
@@ -267,7 +268,7 @@ class LiveFollowsTheScene(BlenderCase):
         import bpy
 
         from wiresculpt import native
-        from wiresculpt.operators import live
+        from wiresculpt.live import engine as live
         from wiresculpt.ui import panel
 
         self.ws.live = True
@@ -278,7 +279,7 @@ class LiveFollowsTheScene(BlenderCase):
                                         "become wires")
         self.assertEqual(live.line(), "Live: cannot solve — No contour is ticked: Slice, then tick the contours "
                                       "that become wires")
-        self.assertEqual(live.STATE.preview, [])
+        self.assertEqual(live.observed().preview, [])
         self.assertEqual(live.whole_reason(), "")  # shown whole: no button for it
         layout = drawn_live()
         layout.operator.assert_not_called()
@@ -287,8 +288,8 @@ class LiveFollowsTheScene(BlenderCase):
         self.assertEqual(labels[0].kwargs["icon"], 'INFO')
         self.assertEqual(" ".join(c.kwargs["text"] for c in labels), live.line())
         # drawn unlike a verdict: neither the stable tick nor the not-stable warning, not red
-        self.assertEqual(panel.live_look(live.STATE.verdict), ('INFO', False))
-        self.assertNotIn(panel.live_look(live.STATE.verdict)[0],
+        self.assertEqual(panel.live_look(live.observed().verdict), ('INFO', False))
+        self.assertNotIn(panel.live_look(live.observed().verdict)[0],
                          (panel.live_look("stable")[0], panel.live_look("not stable — crossing 3 pulls")[0]))
         for item in self.ws.contours:
             item.use = True
@@ -306,7 +307,7 @@ class LiveFollowsTheScene(BlenderCase):
     def test_one_wire_cannot_solve(self):
         """One contour ticked: the solve ends with the pipeline's "at least two wires", a setup problem
         drawn as the others (info icon, not red), not "not stable"."""
-        from wiresculpt.operators import live
+        from wiresculpt.live import engine as live
         from wiresculpt.ui import panel
 
         self.ws.live = True
@@ -315,7 +316,7 @@ class LiveFollowsTheScene(BlenderCase):
             item.use = False
         self.assertEqual(self.settle(), "cannot solve — a sculpture needs at least two wires: add a plane or pick "
                                         "more contours")
-        self.assertEqual(panel.live_look(live.STATE.verdict), ('INFO', False))
+        self.assertEqual(panel.live_look(live.observed().verdict), ('INFO', False))
         for item in self.ws.contours:
             item.use = True
         self.assertStands(self.settle())
@@ -324,7 +325,7 @@ class LiveFollowsTheScene(BlenderCase):
         """Its ticked contour is gone (the solve's ValueError): what the window test's second step sees."""
         import bpy
 
-        from wiresculpt.operators import live
+        from wiresculpt.live import engine as live
 
         self.ws.live = True
         self.assertStands(self.settle())
@@ -333,7 +334,7 @@ class LiveFollowsTheScene(BlenderCase):
         bpy.context.view_layer.update()
         self.assertEqual(self.settle(), "cannot solve — plane Slice A cuts no contour of the mesh now (contour index 0 "
                                         "does not exist)")
-        self.assertEqual(live.STATE.preview, [])
+        self.assertEqual(live.observed().preview, [])
         plane.location.z = 0.0
         bpy.context.view_layer.update()
         self.assertStands(self.settle())
@@ -344,7 +345,7 @@ class LiveFollowsTheScene(BlenderCase):
 
         import bpy
 
-        from wiresculpt.operators import live
+        from wiresculpt.live import engine as live
         from wiresculpt.ui import panel
 
         self.ws.live = True
@@ -361,7 +362,7 @@ class LiveFollowsTheScene(BlenderCase):
             verdict = self.settle()
         self.assertEqual(verdict, "error — internal error (KeyError: 'hook'); please report it")
         self.assertEqual(panel.live_look(verdict), ('CANCEL', True))
-        self.assertEqual(live.STATE.preview, [])
+        self.assertEqual(live.observed().preview, [])
         self.target.location.x -= 0.002
         bpy.context.view_layer.update()
         self.assertStands(self.settle())
@@ -374,7 +375,8 @@ class LiveFollowsTheScene(BlenderCase):
 
         import bpy
 
-        from wiresculpt.operators import live
+        from wiresculpt.live import engine as live
+        from wiresculpt.operators.live import WIRESCULPT_OT_live_reason
         from wiresculpt.ui import panel
 
         self.ws.live = True
@@ -382,7 +384,7 @@ class LiveFollowsTheScene(BlenderCase):
         self.addCleanup(setattr, self.ws, "max_bend_deg", self.ws.max_bend_deg)  # the scene's settings stay
         self.ws.max_bend_deg = math.radians(30.0)
         verdict = self.settle()
-        reason = live.STATE.reason
+        reason = live.observed().reason
         first = reason[:reason.index(";")]
         # each crossing named once ("crossing 0 on wire Slice A/0: it needs …", not "…: crossing 0 on wire
         # Slice A/0 needs …")
@@ -395,15 +397,15 @@ class LiveFollowsTheScene(BlenderCase):
         self.assertEqual(verdict, "not stable — " + first + "…")
         self.assertEqual(panel.live_look(verdict), ('ERROR', False))
         self.assertEqual(live.whole_reason(), reason)
-        self.assertEqual(live.WIRESCULPT_OT_live_reason.description(bpy.context, None), reason)
+        self.assertEqual(WIRESCULPT_OT_live_reason.description(bpy.context, None), reason)
         self.assertEqual(bpy.ops.wiresculpt.live_reason(), {'FINISHED'})
         layout = drawn_live()
-        layout.operator.assert_called_once_with(live.WIRESCULPT_OT_live_reason.bl_idname, icon='COPYDOWN')
+        layout.operator.assert_called_once_with(WIRESCULPT_OT_live_reason.bl_idname, icon='COPYDOWN')
 
     def test_the_toggle_set_without_its_update(self):
         import bpy
 
-        from wiresculpt.operators import live
+        from wiresculpt.live import engine as live
 
         self.ws["live"] = 1  # as undo or a scene switch sets it: no update called
         self.assertFalse(bpy.app.timers.is_registered(live.tick))
@@ -422,7 +424,7 @@ class LiveFollowsTheScene(BlenderCase):
 
         import bpy
 
-        from wiresculpt.operators import live
+        from wiresculpt.live import engine as live
 
         self.ws.live = True
         failure = RuntimeError("the solver's thread could not start")
@@ -447,7 +449,7 @@ class LiveFollowsTheScene(BlenderCase):
 
         import bpy
 
-        from wiresculpt.operators import live
+        from wiresculpt.live import engine as live
 
         # As with GPU subdivision, the evaluated mesh the refusal counts is the cage (2,208
         # triangles); the triangles read for slicing are the subdivided ones, over 100,000.

@@ -581,7 +581,7 @@ class StaleReport(Case):
         """blend/handles.target_name: the record Optimize keeps, Live's snapshot and the stale check
         read the picked target's name, "" without one, alike."""
         from wiresculpt.blend.handles import target_name
-        from wiresculpt.operators import live
+        from wiresculpt.live import engine as live
 
         self.optimize()
         scene = bpy.context.scene

@@ -13,7 +13,7 @@ import bpy  # noqa: E402
 import wiresculpt  # noqa: E402
 
 wiresculpt.register()
-from wiresculpt.operators import live  # noqa: E402
+from wiresculpt.live import engine as live  # noqa: E402
 from ui_steps import globe_scene as setup, guarded, report, start_watchdog  # noqa: E402
 
 seen = {}

@@ -24,18 +24,21 @@ def guarded(seen, step):
 
 
 class Held:
-    """`module.name` made to wait, polling its `cancel` keyword, up to `seconds` before it runs, so
-    that a test's cancel or next move surely lands while the work is under way however fast the
-    work has become. restore() puts the original back."""
+    """`module.name` made to wait, polling its `cancel` keyword (or its `context` keyword's, a
+    SolveContext), up to `seconds` before it runs, so that a test's cancel or next move surely lands
+    while the work is under way however fast the work has become. restore() puts the original back."""
 
     def __init__(self, module, name, seconds):
         self.module, self.name, self.original = module, name, getattr(module, name)
 
-        def held(*args, cancel=None, **kwargs):
+        def held(*args, **kwargs):
+            cancel = kwargs.get("cancel")
+            if cancel is None and kwargs.get("context") is not None:
+                cancel = kwargs["context"].cancelled
             until = time.monotonic() + seconds
             while cancel is not None and not cancel() and time.monotonic() < until:
                 time.sleep(0.01)
-            return self.original(*args, cancel=cancel, **kwargs)
+            return self.original(*args, **kwargs)
         setattr(module, name, held)
 
     def restore(self):

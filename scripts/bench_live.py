@@ -10,7 +10,7 @@ handles, the contours the scene file picks ticked), Live on, and once the first 
 MOVES moves of the scene's first plane by STEP metres along its normal (back and forth). Each
 move's round trip runs from the moment the plane's location is set to the moment the verdict is
 shown: the overlay's first draw of the new preview when the verdict has wires, else the moment
-the panel's line changed (operators/live.STATE.shown_at; the panel redraw is tagged then).
+the panel's line changed (live/state.observed().shown_at; the panel redraw is tagged then).
 It includes Live's settle time and timer granularity, the re-slicing and the solve with the
 layering's own hooks. Writes OUT.json: {"cases": [{name, round_trips [s], verdicts, ...}]}.
 """
@@ -66,15 +66,15 @@ def load_case(manifest_dir, case):
 
 def measure(manifest_dir, case):
     """A generator the timer steps: yields seconds to wait; fills and returns the case's record."""
-    from wiresculpt.operators import live
+    from wiresculpt.live import engine as live
 
     record = {"name": case["name"], "round_trips": [], "verdicts": []}
     handle, normal, wires = load_case(manifest_dir, case)
     record["wires_ticked"] = wires
 
     def shown():
-        return (live.STATE.job is None and live.STATE.solved is not None
-                and live.STATE.solved == live.snapshot(bpy.context.scene))
+        now = live.observed()
+        return now.job is None and now.solved is not None and now.solved == live.snapshot(bpy.context.scene)
 
     bpy.context.scene.wiresculpt.live = True
     began = time.monotonic()
@@ -87,26 +87,26 @@ def measure(manifest_dir, case):
     for k in range(MOVES):
         handle.location += (STEP if k % 2 == 0 else -STEP) * normal
         moved = time.monotonic()
-        results = len(live.STATE.results)
-        while not (shown() and len(live.STATE.results) > results):
+        results = len(live.observed().results)
+        while not (shown() and len(live.observed().results) > results):
             if time.monotonic() - moved > SETTLE_LIMIT:
                 record["error"] = f"move {k + 1}: no verdict in {SETTLE_LIMIT:.0f} s"
                 return record
             yield POLL
-        done = live.STATE.shown_at
+        done = live.observed().shown_at
         record.setdefault("verdict_set", []).append(done - moved)  # the panel's line changed
-        record.setdefault("job_seconds", []).append(live.STATE.job_seconds)  # slicing + solve on the worker
-        if live.STATE.preview:  # shown = drawn: wait for the overlay's first draw after the verdict
-            while live.STATE.drawn_at is None or live.STATE.drawn_at < done:
+        record.setdefault("job_seconds", []).append(live.observed().job_seconds)  # slicing + solve on the worker
+        if live.observed().preview:  # shown = drawn: wait for the overlay's first draw after the verdict
+            while live.observed().drawn_at is None or live.observed().drawn_at < done:
                 if time.monotonic() - moved > SETTLE_LIMIT:
                     record["error"] = f"move {k + 1}: the preview was not drawn"
                     return record
                 yield POLL
-            done = live.STATE.drawn_at
+            done = live.observed().drawn_at
         record["round_trips"].append(done - moved)
         record["verdicts"].append(live.line())
     bpy.context.scene.wiresculpt.live = False
-    durations = live.STATE.durations
+    durations = live.observed().durations
     record["longest_tick"] = max(durations) if durations else None
     record["median"] = statistics.median(record["round_trips"])
     record["job_median"] = statistics.median(record["job_seconds"])

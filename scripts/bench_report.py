@@ -20,7 +20,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(os.path.dirname(HERE), "addon"))
 from wiresculpt.core.files import write_atomic  # noqa: E402
 
-LIVE_SETTLE_MS = 50  # operators/live.SETTLE_SECONDS, named in the prose
+LIVE_SETTLE_MS = 50  # live/engine.SETTLE_SECONDS, named in the prose
 KNOWN_STAGES = ["layering", "target_shape", "forces", "rest_shape"]
 # The paper's Table 2 columns and the stages of ours they correspond to.
 PAPER_COLUMNS = [("stab_s", "Stab.", ["layering"]), ("shape_s", "S.Opt.", ["target_shape"]),

@@ -10,7 +10,7 @@ import time
 from . import native
 from .core import settings as settings_table
 from .core.design import NO_WIRES, ONE_WIRE, TOO_CLOSE, new_design
-from .core.polylines import ContourArrays
+from .core.solve_context import Cancelled, OutOfTime, SolveContext, quiet  # noqa: F401 (the pipeline's names)
 from .core.sizes import size_warnings
 from .fab import buildability
 from .stages import forces, layering, slicing, target_shape
@@ -29,29 +29,11 @@ HOOK_PATTERNS = 64
 HOOK_SECONDS = 60.0
 
 
-class Cancelled(Exception):
-    """The user cancelled; the caller keeps its previous state."""
-
-
-class OutOfTime(RuntimeError):
-    """The solve ran past settings.max_solve_seconds; the caller keeps its previous state."""
-
-    def __init__(self, budget, stage):
-        super().__init__(f"the solve stopped at its time budget, settings.max_solve_seconds = {budget:g} s, during "
-                         f"the {stage.replace('_', ' ')}: raise the budget, or give fewer planes or a smaller "
-                         f"max_nodes")
-        self.budget, self.stage = budget, stage
-
-
-def _quiet(stage, message):
-    pass
-
-
 def slice_and_pick(vertices, faces, planes, material, settings, progress=None):
     """A new design whose wires are the contours the planes' rules pick. `planes`: objects with
     name, origin, normal, contours (the rule)."""
     design = new_design(material, settings)
-    (progress or _quiet)("slicing", slicing.run(design, vertices, faces, planes, settings))
+    (progress or quiet)("slicing", slicing.run(design, vertices, faces, planes, settings))
     return design
 
 
@@ -65,29 +47,8 @@ def solve(design, material, settings, progress=None, cancel=None, stock=None, ho
     hooks_by_forces (None: HOOK_PATTERNS; 1: the layering's own, as Live does); `hook_seconds`: no
     new pattern after this many seconds (None: HOOK_SECONDS; the plane search's final solve). Past settings.max_solve_seconds (wall
     clock) the solve stops the same way and raises OutOfTime, naming the key and the stage."""
-    cancelled = cancel or (lambda: False)
     budget = float(settings.get("max_solve_seconds") or settings_table.SETTINGS["max_solve_seconds"][0])
-    deadline = time.monotonic() + budget
-    at = {"stage": "layering"}  # the stage under way, for OutOfTime's message
-
-    def say(stage, message):
-        at["stage"] = stage
-        (progress or _quiet)(stage, message)
-
-    def out_of_time():
-        return time.monotonic() > deadline
-
-    def native_progress(stage, _fraction):
-        if isinstance(stage, str) and stage:  # the solver's parts of the layering are the layering
-            at["stage"] = "layering" if stage in ("network", "check_assembly") else stage
-        return not (cancelled() or out_of_time())
-
-    def checkpoint():
-        if cancelled():
-            raise Cancelled()
-        if out_of_time():
-            raise OutOfTime(budget, at["stage"])
-
+    context = SolveContext(progress, cancel, budget)
     design["pending_stages"] = list(ALL_STAGES)
     if len(design["wires"]) < 2:
         design["stable"] = False
@@ -96,13 +57,11 @@ def solve(design, material, settings, progress=None, cancel=None, stock=None, ho
     apply_cuts(design, settings.get("cuts"))
     for warning in size_warnings(design, *(stock or ())):  # before the long work: the figure, at once
         design.setdefault("warnings", []).append(warning)
-        say("size", warning)
+        context.say("size", warning)
     try:
-        return relayer(design, material, settings, say, native_progress, checkpoint, hook_patterns, hook_seconds)
+        return relayer(design, material, settings, context, hook_patterns, hook_seconds)
     except native.Cancelled:
-        if not cancelled() and out_of_time():
-            raise OutOfTime(budget, at["stage"]) from None
-        raise Cancelled() from None
+        raise context.stopped() from None
 
 
 def _copy_sharing_contours(design):
@@ -121,7 +80,7 @@ def _at_crossings(pairs):
     return f"crossing{'s' if len(ids) > 1 else ''} {target_shape.id_list(ids)}"
 
 
-def relayer(design, material, settings, say, native_progress, checkpoint, hook_patterns=None, hook_seconds=None):
+def relayer(design, material, settings, context, hook_patterns=None, hook_seconds=None):
     """Layering, then target shape, forces and rest shape (shape_and_rest); while the result is not
     stable because the target shape could not realise some crossing's hook, forbid those (crossing,
     hook) pairs (target_shape.unrealisable: the failed hook, or both hooks of a crossing too close to
@@ -137,23 +96,22 @@ def relayer(design, material, settings, say, native_progress, checkpoint, hook_p
     why. Records every layering run in stages.relayering. Returns the design of
     the last round, or, when the last layering found no stable assembly under the forbidden hooks,
     of the last round that reached the target shape (its shapes and reason show why), saying so.
-    `hook_patterns`: hooks_by_forces' `patterns` bound (None: HOOK_PATTERNS); `hook_seconds`: its
-    time bound over every round (None: HOOK_SECONDS)."""
+    `context`: the solve's SolveContext (core/solve_context.py: progress, cancel, deadline, and the
+    memos every round shares). `hook_patterns`: hooks_by_forces' `patterns` bound (None:
+    HOOK_PATTERNS); `hook_seconds`: its time bound over every round (None: HOOK_SECONDS)."""
     extra_rounds = int(layering.knob(settings, "relayer_rounds"))
     # Layering replaces (never edits) each wire's contour, so the copies share the contours.
     pristine = _copy_sharing_contours(design) if extra_rounds else None
     up_front = target_shape.REALISED_ANGLE if extra_rounds else None  # None: every hook (the old path)
     forbidden, too_close, rounds, start, shaped = set(), set(), [], time.perf_counter(), None
-    same_solves = {}  # target-shape solves by exact input, for every round (target_shape.Memo `same`)
-    contour_cache = ContourArrays()  # every round's contours as arrays (layering.run, target_shape.Memo)
     hook_deadline = time.monotonic() + (HOOK_SECONDS if hook_seconds is None else hook_seconds)  # one bound for the hook searches of every round
     round_ = 0
     while True:
         began = time.perf_counter()
-        checkpoint()
+        context.checkpoint()
         attempt = design if not rounds else _copy_sharing_contours(pristine)
-        say("layering", layering.run(attempt, material, settings, native_progress, forbidden=forbidden, too_close=up_front,
-                                     contour_cache=contour_cache))
+        context.say("layering", layering.run(attempt, material, settings, context.native_progress, forbidden=forbidden,
+                                             too_close=up_front, contour_cache=context.contour_cache))
         attempt["pending_stages"].remove("layering")
         # The crossings' spacing is the same every round, and a learnt pair is never a too-close
         # one, so the native lists them all each round.
@@ -166,22 +124,21 @@ def relayer(design, material, settings, say, native_progress, checkpoint, hook_p
             # finish either, so the loop stops on its verdict, as in any later round.)
             rounds.append({"forbidden": [], "too_close": _pairs(too_close), "stable": False,
                            "verdict": attempt["reason"], "unrealised": [], "seconds": time.perf_counter() - began})
-            say("relayering", f"the layering finds no stable assembly without the {len(too_close)} hooks at "
-                              f"{_at_crossings(too_close)}, too close to a neighbour along a wire for a free bending "
-                              f"point; layering again with every hook, for the target shape to show what it cannot "
-                              f"realise")
+            context.say("relayering", f"the layering finds no stable assembly without the {len(too_close)} hooks "
+                                      f"at {_at_crossings(too_close)}, too close to a neighbour along a wire for a "
+                                      f"free bending point; layering again with every hook, for the target shape to "
+                                      f"show what it cannot realise")
             up_front, too_close = None, set()
             continue
         excluded = forbidden | too_close
         for message in attempt.get("close_crossings", []):
-            say("layering", message)
+            context.say("layering", message)
         if attempt["stable"]:
             # shape_and_rest on the layering's hooks and on the other stable patterns of equal Eq. 2
             # cost that use no forbidden hook; the best forces win among the stable (buildable) ones,
             # and when none is, the layering's own pattern is kept, so the round learns from it.
-            attempt = hooks_by_forces(attempt, material, settings, say, native_progress, checkpoint,
-                                      patterns=hook_patterns, seconds=hook_seconds, forbidden=excluded, deadline=hook_deadline,
-                                      same_solves=same_solves, contour_cache=contour_cache)
+            attempt = hooks_by_forces(attempt, material, settings, context, patterns=hook_patterns,
+                                      seconds=hook_seconds, forbidden=excluded, deadline=hook_deadline)
             shaped = attempt
         learnt = target_shape.unrealisable(attempt) - excluded
         rounds.append({"forbidden": _pairs(forbidden), "too_close": _pairs(too_close), "stable": attempt["stable"],
@@ -191,10 +148,10 @@ def relayer(design, material, settings, say, native_progress, checkpoint, hook_p
             break
         forbidden |= learnt
         round_ += 1
-        say("relayering", f"round {round_}: the target shape cannot realise "
-                          f"{', '.join(f'hook {h:+d} at crossing {c}' for c, h in sorted(learnt))}; "
-                          f"layering again without {'them' if len(learnt) > 1 else 'it'} "
-                          f"({len(forbidden | too_close)} hooks forbidden)")
+        context.say("relayering", f"round {round_}: the target shape cannot realise "
+                                  f"{', '.join(f'hook {h:+d} at crossing {c}' for c, h in sorted(learnt))}; "
+                                  f"layering again without {'them' if len(learnt) > 1 else 'it'} "
+                                  f"({len(forbidden | too_close)} hooks forbidden)")
     if "target_shape" in attempt["pending_stages"] and shaped is not None and not attempt.get("search_incomplete"):
         # The too-close hooks were forbidden before any target shape failed them: say where they are.
         close = (f" ({len(too_close)} of them at {_at_crossings(too_close)}, too close to a neighbour along a wire "
@@ -288,8 +245,7 @@ def _tighten(design, memo, machine_limit_deg, floor_deg):
     return changed, stuck
 
 
-def shape_and_rest(design, material, settings, say, native_progress, checkpoint, solves=None, same_solves=None,
-                   contour_cache=None):
+def shape_and_rest(design, material, settings, context, solves=None):
     """Target shape, then forces and rest shape, with the coupling of Sec. 4.3: the machine's
     maximum bend limits the rest shape, which is only known after the forces. A rest bend beyond
     it comes from the torque its vertex carries (Eq. 12), so the target shape is solved again with
@@ -300,10 +256,11 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint,
     from what the previous one learnt (target_shape.Memo): its nulled crossings, its vertex limits,
     and the wires whose optimum the new limits leave optimal. Then the buildability verdict
     (fab/buildability.py): a bend still over the limit makes the design not stable, by name.
-    `solves`: a target_shape.Memo's per-wire solves to share with other calls (hooks_by_forces: a
-    wire whose crossings keep their hooks is not solved again; the vertex limits are part of a
-    solve's key); `same_solves` (a dict, see target_shape.Memo) carries the solves of identical
-    problems across re-layering rounds; `contour_cache` (a core.polylines.ContourArrays) the contours' arrays."""
+    `context`: the solve's SolveContext (core/solve_context.py): its say, native_progress and
+    checkpoint, and its memos (`same_solves`, the solves of identical problems across re-layering
+    rounds, target_shape.Memo; `contour_cache`, the contours' arrays). `solves`: a
+    target_shape.Memo's per-wire solves to share with other calls (hooks_by_forces: a wire whose
+    crossings keep their hooks is not solved again; the vertex limits are part of a solve's key)."""
     import copy
 
     def fresh(d):
@@ -315,16 +272,16 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint,
     target_limit = machine_limit
     kink = 180.0 - settings["contact_angle_deg"]  # a hooked crossing bends at least this much
     before = fresh(design)
-    memo = target_shape.Memo(same_solves, contour_cache)
+    memo = target_shape.Memo(context.same_solves, context.contour_cache)
     if solves is not None:
         memo.solves = solves
     totals = dict.fromkeys(("seconds", "iterations", "wire_solves", "reused_wires"), 0)
     for round_ in range(COUPLING_ROUNDS):
         if round_:
             design = fresh(before)
-        checkpoint()
-        say("target_shape", target_shape.run(design, material, {**settings, "max_bend_deg": target_limit},
-                                             native_progress, memo))
+        context.checkpoint()
+        context.say("target_shape", target_shape.run(design, material, {**settings, "max_bend_deg": target_limit},
+                                                     context.native_progress, memo))
         design["pending_stages"].remove("target_shape")
         stage = design["stages"]["target_shape"]
         for key in totals:  # the stage's cost over every coupling round; its shapes are the last round's
@@ -335,7 +292,7 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint,
         stage["coupling_rounds"] = round_ + 1
         if not design["stable"]:  # forces need the hooks of a complete stable assembly
             return design
-        checkpoint()
+        context.checkpoint()
         # The load capacity (twelve LPs, most of the stage's time) is only kept from the last round:
         # a round that may be followed by another skips it when a rest bend is over the limit, the
         # case in which another round follows (computed below if the rounds stop there anyway).
@@ -345,9 +302,10 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint,
         within = math.radians(machine_limit) + ANGLE_SLACK if round_ + 1 < COUPLING_ROUNDS else None
         if "density" in material:  # an earlier solve's must not stand for a skipped one
             design.pop("load_capacity", None)
-        say("forces", forces.run(design, material, settings, native_progress, load_capacity_within=within))
+        context.say("forces", forces.run(design, material, settings, context.native_progress,
+                                         load_capacity_within=within))
         design["pending_stages"].remove("forces")
-        say("rest_shape", forces.rest_summary(design))
+        context.say("rest_shape", forces.rest_summary(design))
         design["pending_stages"].remove("rest_shape")
         excess = _largest_over_bend(design, machine_limit)
         stage["rest_excess_deg"] = max(excess, 0.0)
@@ -358,14 +316,15 @@ def shape_and_rest(design, material, settings, say, native_progress, checkpoint,
             target_limit = max(1.0, kink + 0.01, target_limit - stuck - COUPLING_MARGIN_DEG)
         if not changed and stuck <= 0.0:
             break
-        say("target_shape", f"a rest bend exceeds the machine's {machine_limit:g} deg by {excess:.4f} deg; "
-                            f"solving again with {changed} vertex bend limit{'s' if changed != 1 else ''} lowered so "
-                            f"that the rest bends stay {COUPLING_MARGIN_DEG:g} deg inside, other bends up to "
-                            f"{target_limit:.2f} deg (Sec. 4.3)")
+        context.say("target_shape", f"a rest bend exceeds the machine's {machine_limit:g} deg by {excess:.4f} "
+                                    f"deg; solving again with {changed} vertex bend "
+                                    f"limit{'s' if changed != 1 else ''} lowered so that the rest bends stay "
+                                    f"{COUPLING_MARGIN_DEG:g} deg inside, other bends up to {target_limit:.2f} deg "
+                                    f"(Sec. 4.3)")
     if "density" in material and "load_capacity" not in design:  # the last round skipped it
         del design.get("warnings", [])[warnings_before:]
-        checkpoint()
-        say("forces", forces.run(design, material, settings, native_progress))
+        context.checkpoint()
+        context.say("forces", forces.run(design, material, settings, context.native_progress))
     # "Stable" means buildable: the bend program of every wire, with the machine profile in use.
     buildability.apply(design)
     return design
@@ -446,8 +405,7 @@ def choose(scores):
     return min(near)[1]
 
 
-def hooks_by_forces(design, material, settings, say, native_progress, checkpoint, patterns=None, seconds=None,
-                    forbidden=(), deadline=None, same_solves=None, contour_cache=None):
+def hooks_by_forces(design, material, settings, context, patterns=None, seconds=None, forbidden=(), deadline=None):
     """shape_and_rest on the layering's hooks and on the other hook patterns of the same Eq. 2
     cost (equal_cost_patterns) whose assembly order stays stable (Eq. 1, layering.recheck), and
     keeps the design whose forces are best (force_score, choose): first the weakest-direction load
@@ -459,9 +417,9 @@ def hooks_by_forces(design, material, settings, say, native_progress, checkpoint
     `design` itself (and returned), as the stages do. `patterns` and `seconds`
     default to HOOK_PATTERNS and HOOK_SECONDS (read at the call). `forbidden`: (crossing id, hook)
     pairs no pattern may use (relayer's). `deadline` (time.monotonic()): no new pattern after it,
-    instead of `seconds` from the call (relayer's, shared by its rounds); `same_solves`: relayer's
-    solves of identical target-shape problems and `contour_cache` its contours' arrays (shape_and_rest). When no pattern
-    ends stable, the layering's own pattern
+    instead of `seconds` from the call (relayer's, shared by its rounds). `context`: the solve's
+    SolveContext (its memos go to shape_and_rest; patterns after the first say nothing). When no
+    pattern ends stable, the layering's own pattern
     is the result (relayer learns from its unrealisable hooks)."""
     patterns = HOOK_PATTERNS if patterns is None else patterns
     seconds = HOOK_SECONDS if seconds is None else seconds
@@ -483,15 +441,14 @@ def hooks_by_forces(design, material, settings, say, native_progress, checkpoint
         if index and time.monotonic() > stop_at:
             cut = True
             break
-        checkpoint()
+        context.checkpoint()
         trial = _with_hooks(scored, hooks)
         checked += 1
         try:
-            if index and not layering.recheck(trial, material, settings, native_progress)["stable"]:
+            if index and not layering.recheck(trial, material, settings, context.native_progress)["stable"]:
                 continue
             stable += 1
-            trial = shape_and_rest(trial, material, settings, say if index == 0 else _quiet, native_progress,
-                                   checkpoint, shared, same_solves, contour_cache)
+            trial = shape_and_rest(trial, material, settings, context if index == 0 else context.quiet(), shared)
         except (native.Cancelled, OutOfTime):
             raise
         except (ValueError, RuntimeError):  # another pattern the solver cannot finish: not a better one
@@ -506,9 +463,8 @@ def hooks_by_forces(design, material, settings, say, native_progress, checkpoint
     best_score = None if pick is None else scores[pick]
     if user_cuts:  # the chosen pattern again, with the user's cuts; the layering's when that breaks it
         for index in dict.fromkeys((chosen, 0)):
-            checkpoint()
-            best = shape_and_rest(_with_hooks(base, candidates[index]), material, settings, _quiet, native_progress,
-                                  checkpoint, shared, same_solves, contour_cache)
+            context.checkpoint()
+            best = shape_and_rest(_with_hooks(base, candidates[index]), material, settings, context.quiet(), shared)
             chosen, best_score = index, force_score(best)
             if best_score is not None:
                 break
@@ -526,9 +482,9 @@ def hooks_by_forces(design, material, settings, say, native_progress, checkpoint
             f"{patterns} patterns and {seconds:g} s{' over every re-layering round' if deadline is not None else ''}); "
             "a better one may exist")
     if chosen and best_score is not None:
-        say("forces", f"hooks by forces: pattern {chosen} of {checked} tried (weakest load "
-                      f"{best_score[0]:.2f}x the weight at the plastic limit, out of plane "
-                      f"{100 * best_score[1]:.1f}% of the largest force)")
+        context.say("forces", f"hooks by forces: pattern {chosen} of {checked} tried (weakest load "
+                              f"{best_score[0]:.2f}x the weight at the plastic limit, out of plane "
+                              f"{100 * best_score[1]:.1f}% of the largest force)")
     design.clear()  # callers keep the dict they passed (operators/optimize.py)
     design.update(best)
     return design

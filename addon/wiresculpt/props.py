@@ -126,7 +126,7 @@ SETTING_PROPS = ("min_segment", "max_bend_deg", "min_bend_deg", "contact_angle_d
 ADVANCED_PROPS = ("in_plane_tiebreak", "max_nodes", "relayer_rounds")  # the panel's Advanced box
 
 
-LIVE_HOOKS = []  # operators/live.py's live_changed (props may not import operators)
+LIVE_HOOKS = []  # live/engine.py's live_changed (props may not import live)
 
 
 def _live_changed(settings, context):

@@ -1,8 +1,9 @@
 """The add-on's import rule (DESIGN.md): imports point down only,
 
-    ui -> operators -> props -> blend -> plane_search -> pipeline -> {stages, fab} -> core -> native,
+    ui -> operators -> live -> props -> blend -> plane_search -> pipeline -> {stages, fab} -> core -> native,
 
-a module may import its own folder's modules, and no import circle exists. Every import counts,
+a module may import its own folder's modules (an operator module only operators/progress.py, the
+helpers they share: one operator never asks another), and no import circle exists. Every import counts,
 lazy ones inside functions too, except those inside register()/unregister() (the package's
 __init__ imports its top layers there). Checked by parsing every module's source."""
 import ast
@@ -14,8 +15,10 @@ from helpers import ROOT
 PACKAGE = os.path.join(ROOT, "addon", "wiresculpt")
 # Layer of each top-level part of the package: a module may import parts of a lower number, or of
 # its own part.
-LAYERS = {"ui": 8, "operators": 7, "props": 6, "blend": 5, "plane_search": 4.5, "pipeline": 4, "stages": 3, "fab": 3, "core": 2,
-          "native": 1, "_wiresculpt": 0}
+LAYERS = {"ui": 8, "operators": 7, "live": 6.5, "props": 6, "blend": 5, "plane_search": 4.5, "pipeline": 4, "stages": 3,
+          "fab": 3, "core": 2, "native": 1, "_wiresculpt": 0}
+# The one module of operators/ that the others may import: what their modals share.
+OPERATORS_SHARED = {"operators.progress"}
 
 
 def modules():
@@ -81,6 +84,13 @@ class Layers(unittest.TestCase):
                     wrong.append(f"{self.known[name]}:{line}: {name} imports {target}, a layer above or beside it")
         self.assertEqual(wrong, [])
 
+    def test_operators_do_not_import_each_other(self):
+        wrong = [f"{self.known[name]}:{line}: {name} imports {target}"
+                 for name, found in self.graph.items() if part(name) == "operators" and name != "operators"
+                 for line, target in found
+                 if part(target) == "operators" and target not in OPERATORS_SHARED | {"operators"}]
+        self.assertEqual(wrong, [])
+
     def test_no_import_circle(self):
         edges = {name: {t for _line, t in found if t in self.known} for name, found in self.graph.items()}
         state, circles = {}, []
@@ -112,6 +122,21 @@ class Layers(unittest.TestCase):
             os.remove(f.name)
         self.assertEqual([t for _l, t in found], ["props", "core.files"])
         self.assertGreater(LAYERS[part("props")], LAYERS[part("core.fake")])
+
+    def test_the_checker_sees_an_operator_importing_another(self):
+        """An operator module importing another (not the shared progress helpers) is found, so the
+        rule above can fail."""
+        import tempfile
+
+        with tempfile.NamedTemporaryFile("w", suffix=".py", delete=False) as f:
+            f.write("from .optimize import running\nfrom .progress import JOIN_SECONDS\n")
+        try:
+            found = imports("operators.fake", f.name, self.known)
+        finally:
+            os.remove(f.name)
+        targets = [t for _l, t in found]
+        self.assertEqual(targets, ["operators.optimize", "operators.progress"])
+        self.assertEqual([t for t in targets if t not in OPERATORS_SHARED], ["operators.optimize"])
 
 
 if __name__ == "__main__":

@@ -7,6 +7,7 @@ from unittest import mock
 import numpy as np
 
 from wiresculpt import native, pipeline
+from wiresculpt.core import solve_context
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.scene import PlaneSpec
 from wiresculpt.core.settings import defaults
@@ -140,7 +141,8 @@ class Cancelling(unittest.TestCase):
 
 
 class Clock:
-    """A stand-in for the time module in pipeline: monotonic() advances `step` seconds per call."""
+    """A stand-in for the time module in pipeline and its solve context (core/solve_context.py):
+    monotonic() advances `step` seconds per call."""
 
     def __init__(self, step):
         import time
@@ -162,10 +164,11 @@ class TimeBudget(unittest.TestCase):
         settings = dict(defaults(), max_solve_seconds=budget)
         design = pipeline.slice_and_pick(V, F, PLANES, PRESETS["steel"], settings)
         saved, pipeline.time = pipeline.time, Clock(step)
+        solve_context.time = pipeline.time  # one clock for both, read in the same order
         try:
             return pipeline.solve(design, PRESETS["steel"], settings, cancel=cancel)
         finally:
-            pipeline.time = saved
+            pipeline.time = solve_context.time = saved
 
     def test_the_budget_stops_the_solve_and_names_the_key(self):
         stages = ("layering", "target shape", "forces", "rest shape", "load capacity", "relayering", "size")

@@ -162,7 +162,7 @@ class Closest(unittest.TestCase):
 
     def test_two_planes_close_together_are_named(self):
         # d = 5 mm: 10 mm apart
-        s = plane_search.Searcher(*sphere(R), PRESETS["steel"], settings())
+        s = plane_search.Searcher(sphere(R), PRESETS["steel"], settings())
         d = 0.005
         _ok, _design, probe = s.screen_layered(self.planes(d))
         gap, wire, others = plane_faults.closest_gap(probe)
@@ -187,7 +187,7 @@ class Closest(unittest.TestCase):
         # which cross nothing else, would be held by nothing. With every hook the layering finds
         # them stable; the screen, which forbids the hooks the target shape cannot realise, fails
         # them as "dropped", and the full pipeline agrees: not stable, for crossings too close.
-        s = plane_search.Searcher(*sphere(R), PRESETS["steel"], settings())
+        s = plane_search.Searcher(sphere(R), PRESETS["steel"], settings())
         ok, design, probe = s.screen_layered(self.planes(0.005))
         self.assertFalse(ok)
         self.assertEqual(len(probe["crossings"]), 10)  # Y-Z 2, each X plane 2 on Y and 2 on Z
@@ -228,7 +228,7 @@ class NoNearbyPlacement(unittest.TestCase):
         self.V, self.F = sphere(R)
 
     def test_every_candidate_is_counted_and_the_reason_names_the_hinges(self):
-        found, s, _start = plane_search.nearby(self.V, self.F, PARALLEL, PRESETS["steel"], settings(), budget=600.0)
+        found, s, _start = plane_search.nearby((self.V, self.F), PARALLEL, PRESETS["steel"], settings(), budget=600.0)
         self.assertEqual(found, [])
         self.assertEqual(s.screened, CANDIDATES)
         self.assertEqual(s.full_solves, 0)  # nothing passed the screen
@@ -253,7 +253,7 @@ class NoNearbyPlacement(unittest.TestCase):
         self.assertNotIn("budget", reason)
 
     def test_a_search_cut_short_says_how_much_was_left(self):
-        found, s, _start = plane_search.nearby(self.V, self.F, PARALLEL, PRESETS["steel"], settings(), budget=0.0)
+        found, s, _start = plane_search.nearby((self.V, self.F), PARALLEL, PRESETS["steel"], settings(), budget=0.0)
         self.assertEqual((found, s.screened), ([], 0))
         reason = plane_search.nearby_reason(s)
         self.assertIn(f"The 0 s budget ended the search after 0 of {CANDIDATES} candidates: {CANDIDATES} left "

@@ -1,4 +1,4 @@
-"""The plane assistant (plane_search.py, issue 15) in-process, on a sphere whose plane circles are
+"""The plane assistant (the plane_search package) in-process, on a sphere whose plane circles are
 known by hand: the planes z = c1 and x = c2 (c in units of the radius) cut circles that cross iff
 c1^2 + c2^2 < 1, and a plane at distance c from the centre along (1, 1, 0)/sqrt2 meets y = 0 iff
 c < 1/sqrt2 and z = 0.7 iff c^2 < 0.51. Every stable design found is re-checked by
@@ -156,7 +156,7 @@ class Nearby(unittest.TestCase):
         self.assertLess(distance, 0.9)  # W moved towards the centre (or turned), never away
 
     def test_every_candidate_returned_passes_the_recheck(self):
-        found, searcher, _start = plane_search.nearby(self.V, self.F, HINGE, PRESETS["steel"],
+        found, searcher, _start = plane_search.nearby((self.V, self.F), HINGE, PRESETS["steel"],
                                                       settings(plane_search="nearby"), want=3, budget=60.0)
         self.assertTrue(found)
         costs = [c["cost"] for c in found]
@@ -185,7 +185,7 @@ class Nearby(unittest.TestCase):
                          [(tuple(float(c) for c in p.origin), tuple(float(c) for c in p.normal)) for p in BASE])
 
     def test_a_solve_past_the_budget_is_stopped_and_a_cancel_still_cancels(self):
-        s = plane_search.Searcher(self.V, self.F, PRESETS["steel"], settings())
+        s = plane_search.Searcher((self.V, self.F), PRESETS["steel"], settings())
         placements = [plane_search.Placement(p.name, p.origin, p.normal, p.contours) for p in BASE]
         ok, design, _close = s.screen(placements)
         self.assertTrue(ok)  # the base is stable (test_the_scenes_are_what_the_hand_says)
@@ -274,7 +274,7 @@ class ReusedSlices(unittest.TestCase):
             self.assertAlmostEqual(abs(point[free]), math.sqrt(1 - fixed), delta=0.01)
 
     def test_a_screen_with_shared_slices_equals_one_from_scratch(self):
-        s = plane_search.Searcher(self.V, self.F, PRESETS["steel"], self.settings)
+        s = plane_search.Searcher((self.V, self.F), PRESETS["steel"], self.settings)
         singles, candidates = self.candidates(s)
         s.slice_ahead([p for c, _ in candidates for p in c] + [c for cs in singles.values() for c in cs])
         # the 4 given planes and 25 changes of each, less the 4 changes of the contour rule, which
@@ -291,7 +291,7 @@ class ReusedSlices(unittest.TestCase):
             self.by_hand(probe, z1, x1)
 
     def test_slicing_ahead_leaves_refused_placements_to_their_candidates(self):
-        s = plane_search.Searcher(self.V, self.F, PRESETS["steel"], self.settings)
+        s = plane_search.Searcher((self.V, self.F), PRESETS["steel"], self.settings)
         good = plane_search.Placement("Z1", (0.0, 0.0, 0.7 * R), (0, 0, 1), "largest")
         bad = plane_search.Placement("Bad", (0.0, 0.0, 0.0), (0, 0, 1), "largest")
         bad.origin = (math.nan, 0.0, 0.0)  # a placement the slicer refuses
@@ -304,7 +304,7 @@ class ReusedSlices(unittest.TestCase):
         self.assertEqual(len(s._contours(good)), 1)
         # A look-ahead of the refused placement alone does not raise (it would end the search):
         # the refusal is kept and only reaches the candidates that hold it, when screened.
-        again = plane_search.Searcher(self.V, self.F, PRESETS["steel"], self.settings)
+        again = plane_search.Searcher((self.V, self.F), PRESETS["steel"], self.settings)
         again.slice_ahead([bad])
         self.assertEqual(list(again.cache), [])
         self.assertIn("expected a finite number, got nan", again.refused[repr(bad.key())])

@@ -1,4 +1,4 @@
-"""What auto's proposals and ranking rest on (plane_search.py, issue 15), on scenes whose answers
+"""What auto's proposals and ranking rest on (the plane_search package), on scenes whose answers
 are known by hand:
 
 - crossing_gaps / close_gaps: the distances along a wire between consecutive crossings, on a
@@ -22,6 +22,7 @@ import unittest
 import numpy as np
 
 from wiresculpt import native, plane_search
+from wiresculpt.plane_search import searcher
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.settings import defaults
 
@@ -79,7 +80,7 @@ class Gaps(unittest.TestCase):
 class CloseCrossings(unittest.TestCase):
     def layered(self, d):
         V, F = sphere(R)
-        s = plane_search.Searcher(V, F, PRESETS["steel"], settings())
+        s = plane_search.Searcher((V, F), PRESETS["steel"], settings())
         planes = [plane_search.Placement("Y", (0, 0, 0), (0, 1, 0), "largest"),
                   plane_search.Placement("Z", (0, 0, 0), (0, 0, 1), "largest"),
                   plane_search.Placement("XA", (d, 0, 0), (1, 0, 0), "largest"),
@@ -110,7 +111,7 @@ class CloseCrossings(unittest.TestCase):
 class Connected(unittest.TestCase):
     def setUp(self):
         self.V, self.F = two_spheres()
-        self.s = plane_search.Searcher(self.V, self.F, PRESETS["steel"], settings())
+        self.s = plane_search.Searcher((self.V, self.F), PRESETS["steel"], settings())
 
     def on_a(self, design):
         """{wire name: whether all its points lie on sphere A (|p| = R, within the polygon's sag)}"""
@@ -137,7 +138,7 @@ class Connected(unittest.TestCase):
         # sphere A alone with the base and W at x = 0.8 R, which crosses only Y (test_plane_search's
         # HINGE): W's only contour is dropped, so no connected part reaches every plane
         V, F = sphere(R)
-        s = plane_search.Searcher(V, F, PRESETS["steel"], settings())
+        s = plane_search.Searcher((V, F), PRESETS["steel"], settings())
         self.assertIsNone(s.connected(BASE + [place("W", (0.8, 0, 0), (1, 0, 0))]))
         kept = s.connected(BASE)
         self.assertEqual([p.contours for p in kept], [[0]] * 4)
@@ -149,7 +150,7 @@ class AreaQuantiles(unittest.TestCase):
         # a share (h + R) / (2 R) of its 4 pi R^2, so the plane below which a share q lies is at
         # h = R (2 q - 1), whatever the axis (a fine sphere: ring height pi R / 96)
         V, F = sphere(R, segments=96, rings=96)
-        s = plane_search.Searcher(V, F, PRESETS["steel"], settings())
+        s = plane_search.Searcher((V, F), PRESETS["steel"], settings())
         for axis in (np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])):
             for q in (0.05, 0.25, 0.5, 0.75, 0.9):
                 p = plane_search.area_quantile_plane(s, axis, q, "Q")
@@ -161,7 +162,7 @@ class AreaQuantiles(unittest.TestCase):
 class Grow(unittest.TestCase):
     def test_sets_grown_from_one_plane_fewer(self):
         V, F = sphere(R)
-        s = plane_search.Searcher(V, F, PRESETS["steel"], settings())
+        s = plane_search.Searcher((V, F), PRESETS["steel"], settings())
         grown = plane_search.grow(s, 4, [np.eye(3)], 0.015, time.perf_counter() + 600.0)
         self.assertTrue(grown)
         keys = [g[:2] for g in grown]
@@ -190,7 +191,7 @@ class Finish(unittest.TestCase):
 
     def candidate(self):
         V, F = sphere(R)
-        s = plane_search.Searcher(V, F, PRESETS["steel"], settings())
+        s = plane_search.Searcher((V, F), PRESETS["steel"], settings())
         ok, design, _probe = s.screen_layered(self.GREAT)
         self.assertTrue(ok)
         verified = s.solve(copy.deepcopy(design))
@@ -216,12 +217,12 @@ class Finish(unittest.TestCase):
     def test_a_stopped_comparison_keeps_the_verified_design(self):
         s, c = self.candidate()
         verified = c["design"]
-        saved = plane_search.FINAL_SECONDS
-        plane_search.FINAL_SECONDS = 0.0  # the final solve is stopped at its first check
+        saved = searcher.FINAL_SECONDS
+        searcher.FINAL_SECONDS = 0.0  # the final solve is stopped at its first check
         try:
             s.finish(c)
         finally:
-            plane_search.FINAL_SECONDS = saved
+            searcher.FINAL_SECONDS = saved
         self.assertEqual(s.final["hook_search"], "the layering's hooks")
         self.assertIn("stopped", s.final["why"])
         self.assertIs(c["design"], verified)

@@ -1,4 +1,4 @@
-"""The words of Live's verdict line (operators/live.py; the Wire panel adds "Live: "): its kinds,
+"""The words of Live's verdict line (live/engine.py; the Wire panel adds "Live: "): its kinds,
 each said with one prefix, and the part of a long reason the line shows.
 
 - "stable", "solving…": a word alone;

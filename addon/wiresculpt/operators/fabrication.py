@@ -15,26 +15,12 @@ from .. import native
 from ..blend import calibration as scene_calibration
 from ..blend import preview as scene_preview
 from ..blend import results as scene_results
+from ..blend.machine import chosen_profile
 from ..blend.registration import classes_factory
 from ..fab import export, streaming
 from ..core import calibration as cal
 from ..props import NO_WIRE
 from .progress import WorkerModal
-
-
-def chosen_profile(scene):
-    """The machine profile of the panel's file (None: the default). ValueError naming the file."""
-    path = scene.wiresculpt.machine_profile.strip()
-    if not path:
-        return None
-    full = os.path.normpath(bpy.path.abspath(path))
-    try:
-        return cal.load_profile(full)
-    except FileNotFoundError:
-        raise ValueError(f"machine profile {full} does not exist (Calibration > Save Machine Profile "
-                         "writes one; leave the field empty for the default)") from None
-    except OSError as exc:
-        raise ValueError(f"machine profile {full}: {exc.strerror or exc}") from None
 
 
 def preview_machine(scene, profile):

@@ -21,17 +21,15 @@ from .. import native, pipeline
 from ..blend import cut_handles, mesh, target_watch
 from ..blend import results as scene_results
 from ..blend.handles import plane_ids, target_name, target_problem, ticked_planes
+from ..blend.machine import chosen_stock
 from ..blend.view import redraw_3d_views
 from ..blend.registration import classes_factory
-from ..core import sizes
 from ..core.jobs import WorkerJob
 from ..core.limits import OVER_LIMITS, STOCK_LENGTH, recorded_stock
 from ..core.live_verdict import STABLE, of_design
 from ..props import material_of, solver_settings
-from .fabrication import chosen_profile
-from .progress import TIMER_SECONDS, WorkerModal
+from .progress import JOIN_SECONDS, TIMER_SECONDS, WorkerModal, note_running
 
-JOIN_SECONDS = 0.2  # the longest a cancel waits for the worker in Blender's UI thread
 STAGE_LABELS = {"slicing": "Slicing", "layering": "Layering", "target_shape": "Target shape",
                 "forces": "Forces", "rest_shape": "Rest shape", "writing": "Writing results"}
 
@@ -75,16 +73,6 @@ def solve_record(scene, material, settings):
     return record
 
 
-def chosen_stock(scene):
-    """(m, profile name): the stock of the Fabrication panel's machine profile, which the size
-    warnings and limits name; the default profile's when none is chosen or it cannot be read (the
-    Export then says what is wrong with it)."""
-    try:
-        return sizes.stock(chosen_profile(scene))
-    except ValueError:
-        return sizes.stock(None)
-
-
 def summary(design, stock_length=STOCK_LENGTH):
     """(report type, sentence) for the finished design, in the words of Live's verdict
     (core/live_verdict.of_design): stable, stable over its limits (never a plain "Stable" beside a
@@ -125,7 +113,7 @@ class Job(WorkerJob):
         self.cancel_event = threading.Event()
         self.scene_name = ""  # set by the operator: the scene the results go to
         self.inputs = None  # set by the operator: solve_record of the scene as the solve started
-        self.stock = None  # set by the operator: (m, profile name) the size warnings name (chosen_stock)
+        self.stock = None  # set by the operator: (m, profile name) the size warnings name (blend/machine.chosen_stock)
         self.started = time.perf_counter()
 
     def _progress(self, stage, message):
@@ -167,6 +155,9 @@ JOB = None  # the Job while an Optimize runs in the UI, else None
 
 def running():
     return JOB is not None
+
+
+note_running("optimize", running)
 
 
 def _wait_for_worker(job):

@@ -27,9 +27,9 @@ from ..blend.registration import classes_factory
 from ..blend.view import redraw_3d_views
 from ..core.jobs import WorkerJob
 from ..core.scene import PlaneSpec
+from ..core.solve_context import SolveContext
 from ..props import material_of, solver_settings
-from . import optimize
-from .progress import WorkerModal
+from .progress import JOIN_SECONDS, WorkerModal, busy
 
 MAX_CANDIDATES = 3
 UI_BUDGET_SECONDS = 60.0  # the panel's search may take longer than the batch's: Esc stops it
@@ -114,15 +114,16 @@ class SearchJob(WorkerJob):
         self.messages.append(message)
 
     def work(self):
+        context = SolveContext(self._progress, self.cancel_event.is_set)
         try:
             if self.mode == "nearby":
                 self.found, self.searched, _ = plane_search.nearby(
-                    self.V, self.F, self.planes, self.material, self.settings, MAX_CANDIDATES, UI_BUDGET_SECONDS,
-                    progress=self._progress, cancel=self.cancel_event.is_set)
+                    (self.V, self.F), self.planes, self.material, self.settings, MAX_CANDIDATES, UI_BUDGET_SECONDS,
+                    context=context)
             else:
                 self.found, self.searched, _ = plane_search.auto(
-                    self.V, self.F, self.count, self.material, self.settings, MAX_CANDIDATES, UI_BUDGET_SECONDS,
-                    progress=self._progress, cancel=self.cancel_event.is_set)
+                    (self.V, self.F), self.count, self.material, self.settings, MAX_CANDIDATES, UI_BUDGET_SECONDS,
+                    context=context)
         except pipeline.Cancelled:
             self.cancelled = True
             return
@@ -130,7 +131,7 @@ class SearchJob(WorkerJob):
         for candidate in self.found:
             candidate["preview"] = candidate_preview(candidate, self.mode, size)
 
-    def stop(self, timeout=optimize.JOIN_SECONDS):
+    def stop(self, timeout=JOIN_SECONDS):
         self.cancel_event.set()
         self.thread.join(timeout)
         return not self.thread.is_alive()
@@ -146,7 +147,7 @@ JOB = None
 
 
 def running():
-    return JOB is not None or optimize.running()
+    return JOB is not None or busy("optimize")
 
 
 def _store(job):

@@ -2,6 +2,18 @@
 wakes the modal, Blender's progress indicator, a line in the status bar, and the 3D views (the
 sidebar's panels) redrawn."""
 TIMER_SECONDS = 0.1
+JOIN_SECONDS = 0.2  # the longest a cancel waits for the worker in Blender's UI thread
+_RUNNING = {}  # kind of job ("optimize") -> running(): whether one runs now
+
+
+def note_running(kind, running):
+    """Makes `running()` (whether a job of `kind` runs now) known to the other operators."""
+    _RUNNING[kind] = running
+
+
+def busy(kind):
+    """Whether a job of `kind` runs now (False for a kind no operator noted)."""
+    return kind in _RUNNING and bool(_RUNNING[kind]())
 
 
 class WorkerModal:

@@ -5,9 +5,9 @@ import bpy
 
 from ..blend import guide as assembly_guide
 from ..blend import results as scene_results
+from ..blend.machine import chosen_profile
 from ..blend.registration import classes_factory
 from ..core import calibration as cal
-from .fabrication import chosen_profile
 
 
 class WIRESCULPT_OT_assembly_guide(bpy.types.Operator):

@@ -1,4 +1,4 @@
-"""Viewport overlay: Live's preview wires (operators/live.STATE.preview) while Live is on; the
+"""Viewport overlay: Live's preview wires (live/engine.preview_shown) while Live is on; the
 plane assistant's previewed candidate (operators/plane_search.PREVIEW: its wires, and the outlines
 of the planes it moves or adds); the contact force at every crossing as an arrow (gpu module, no bgl), and
 each wire's predicted out-of-plane deflection as a whisker.
@@ -10,7 +10,6 @@ whisker at the target vertex where it deflects most, along its plane normal, DEF
 the deflection long (so 1 mm shows as 1 cm), red when over the limit (DEFLECTION_LIMIT, the
 solver's default 2 mm), else blue.
 """
-import time
 
 import bpy
 import gpu
@@ -19,7 +18,7 @@ from gpu_extras.batch import batch_for_shader
 
 from ..blend import compat, results
 from ..core.limits import DEFLECTION_LIMIT
-from ..operators import live
+from ..live import engine as live
 from ..operators import plane_search
 
 ARROW_SHARE = 0.2
@@ -92,18 +91,17 @@ def deflection_whiskers(design, shown=None):
 
 
 def draw_live():
-    """The live verdict's wires (operators/live.py) as lines in their colours, over everything: the
+    """The live verdict's wires (live/engine.py) as lines in their colours, over everything: the
     wires lie on the target's surface, where a depth test hid all but their kinks in Solid view."""
     shader = uniform_colour_shader()
     gpu.state.line_width_set(2.0)
     gpu.state.depth_test_set('NONE')
     shader.bind()
-    for colour, lines in live.STATE.preview:
+    for colour, lines in live.preview_shown():
         shader.uniform_float("color", colour)
         batch_for_shader(shader, 'LINES', {"pos": lines}).draw(shader)
     gpu.state.line_width_set(1.0)
-    live.STATE.drawn += 1
-    live.STATE.drawn_at = time.monotonic()
+    live.note_drawn()
 
 
 def draw_candidate(preview):
@@ -122,7 +120,7 @@ def draw_candidate(preview):
 
 
 def draw():
-    if live.STATE.running and live.STATE.preview:
+    if live.preview_shown():
         draw_live()
     preview = plane_search.PREVIEW
     if preview is not None and plane_search.previewed(bpy.context) is not None:

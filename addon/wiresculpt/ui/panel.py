@@ -7,7 +7,8 @@ from .. import native
 from ..blend.handles import contour_plane_name
 from ..blend.registration import classes_factory
 from ..core import live_verdict
-from ..operators import live
+from ..live import engine as live
+from ..operators.live import WIRESCULPT_OT_live_reason
 from ..operators.slicing import WIRESCULPT_OT_add_plane, WIRESCULPT_OT_slice
 from .stale import live_hint
 
@@ -90,7 +91,7 @@ def wrap_labels(layout, context, text, icon='NONE'):
 
 
 def live_look(verdict):
-    """(icon, alert) of the live line showing `verdict` (live.STATE.verdict)."""
+    """(icon, alert) of the live line showing `verdict` (live.verdict_shown())."""
     kind = live_verdict.kind_of(verdict)
     return LIVE_ICONS.get(kind, 'NONE'), kind == live_verdict.ERROR
 
@@ -98,15 +99,15 @@ def live_look(verdict):
 def draw_live(layout, context):
     """The live verdict, wrapped; under it, when the line shows part of the reason, a button whose
     tooltip is the whole reason (a click copies it)."""
-    icon, alert = live_look(live.STATE.verdict)
+    icon, alert = live_look(live.verdict_shown())
     col = layout.column()
     col.alert = alert
     wrap_labels(col, context, live.line(), icon=icon)
-    hint = live_hint(context, live.STATE.verdict)
+    hint = live_hint(context, live.verdict_shown())
     if hint:  # Live keeps the layering's own hooks; a current Optimize that says otherwise wins
         wrap_labels(layout, context, hint, icon='INFO')
     if live.whole_reason():
-        layout.operator(live.WIRESCULPT_OT_live_reason.bl_idname, icon='COPYDOWN')
+        layout.operator(WIRESCULPT_OT_live_reason.bl_idname, icon='COPYDOWN')
 
 
 class VIEW3D_PT_wiresculpt(bpy.types.Panel):

@@ -1,0 +1,60 @@
+"""The headless pipeline with settings.plane_search (the batch script's entry)."""
+from .. import pipeline
+from ..core.solve_context import SolveContext
+from .auto import auto, family_planes
+from .nearby import nearby
+from .placements import Placement
+from .records import _record, _summary, nearby_reason
+
+MODES = ("off", "nearby", "auto")
+
+
+def run(vertices, faces, planes, material, settings, progress=None, cancel=None, stock=None):
+    """The headless pipeline with settings.plane_search: "off" -> pipeline.run; "nearby" -> the
+    given planes first, the nearby search when they give no stable design; "auto" -> planes
+    from the mesh. The design carries `plane_search` whenever a search ran; when none is found the
+    design of the given planes (nearby) or of the first proposal (auto) is returned, not stable,
+    with the reason saying what was tried. `stock`: as pipeline.solve's. Returns (design, planes
+    actually used)."""
+    say = progress or (lambda stage, message: None)
+    context = SolveContext(progress, cancel)  # the search's progress and cancel
+    mode = settings.get("plane_search", "off")
+    if mode == "off":
+        return pipeline.run(vertices, faces, planes, material, settings, progress, cancel, stock), list(planes)
+    if mode == "nearby":
+        if not planes:
+            raise ValueError('settings.plane_search "nearby" needs planes to start from; give "planes" or use "auto"')
+        found, s, start = nearby((vertices, faces), planes, material, settings, 1, context=context, stock=stock)
+        if found:
+            best = found[0]
+            design = best["design"]
+        else:
+            design = pipeline.run(vertices, faces, planes, material, settings, progress, cancel, stock)
+            best = None
+            if not design["stable"]:
+                design["reason"] = (f"{nearby_reason(s)}. The planes as given: {design['reason']}"
+                                    if design["reason"] else nearby_reason(s))
+        design["plane_search"] = _record("nearby", planes, best, s, start)
+        used = [p.spec() for p in best["planes"]] if best else list(planes)
+        say("plane_search", _summary(design["plane_search"]))
+        return design, used
+    if mode == "auto":
+        count = int(settings.get("plane_count", 5))
+        found, s, start = auto((vertices, faces), count, material, settings, context=context, stock=stock)
+        if found:
+            best = found[0]
+            design = best["design"]
+            used = [p.spec() for p in best["planes"]]
+        else:
+            best = None
+            used = [p.spec() for p in family_planes(s, (count - count // 2, count // 2, 0))]
+            design = pipeline.run(vertices, faces, used, material, settings, progress, cancel, stock)
+            if not design["stable"]:
+                design["reason"] += (f"; no proposed set of {count} planes ({s.screened} tried) gives a "
+                                     f"stable design")
+        design["plane_search"] = _record("auto", planes, best or ({"planes": [
+            Placement(p.name, p.origin, p.normal, p.contours) for p in used], "changes": [], "score": None}
+            if design["stable"] else None), s, start)
+        say("plane_search", _summary(design["plane_search"]))
+        return design, used
+    raise ValueError(f'settings.plane_search must be one of {", ".join(MODES)}, got {mode!r}')

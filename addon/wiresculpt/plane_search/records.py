@@ -1,0 +1,34 @@
+"""What a search did, for the design's `plane_search` record, its progress line and the reason
+when it found nothing."""
+import time
+
+from .placements import OFFSETS, TILTS_DEG, Placement
+
+
+def _record(mode, before, candidate, searcher, start):
+    return {"mode": mode,
+            "planes_before": [Placement(p.name, p.origin, p.normal, p.contours).as_dict() for p in before],
+            "planes_after": [p.as_dict() for p in candidate["planes"]] if candidate else [],
+            "changes": candidate["changes"] if candidate else [],
+            "candidates": searcher.screened, "full_solves": searcher.full_solves,
+            "budget_seconds": searcher.budget, "solves_stopped": searcher.timed_out,
+            "solves_failed": searcher.failed, "final_solve": searcher.final,
+            "seconds": time.perf_counter() - start, "score": candidate["score"] if candidate else None,
+            "measure": ("cost = sum of |offset| / model size + tilt in radians + 0.05 per contour-rule change; "
+                        "score = -cost" if mode == "nearby" else
+                        "score = coverage (share of mesh vertices within 0.1 model size of a wire) "
+                        "- 10 * max target deviation / model size")}
+
+
+def nearby_reason(searcher):
+    """Why the nearby search `searcher` ran found no stable placement (plane_faults.Tally.report):
+    what it searched, how far the budget let it, its candidates counted by fault, what to change."""
+    s = searcher
+    return s.tally.report(OFFSETS[-1] * s.size * 1000.0, s.size * 1000.0, TILTS_DEG[-1], s.budget,
+                          float(s.settings.get("min_segment") or 0.0))
+
+
+def _summary(record):
+    what = "; ".join(record["changes"]) or ("the planes as given" if record["planes_after"] else "nothing stable")
+    return (f"{record['mode']}: {what} ({record['candidates']} candidates screened, {record['full_solves']} "
+            f"full solves, {record['seconds']:.2f} s)")
