@@ -45,7 +45,6 @@ PENDING_PYTHON = {
 IDENT = re.compile(r"[A-Za-z_][A-Za-z_0-9]*")
 KEYWORDS_BEFORE_BODY = {"const", "noexcept", "override", "final", "mutable", "constexpr", "consteval",
                         "volatile", "try", "static"}
-NOT_A_CALL = {"if", "for", "while", "switch", "catch", "return", "sizeof", "alignof", "decltype", "noexcept"}
 
 
 def blank(source):
@@ -229,8 +228,6 @@ def in_init_list(head):
     closed = False
     for k, t in enumerate(names):
         if t == "(":
-            if depth == 0 and k > 0 and names[k - 1] in ("operator", "decltype", "alignas", "noexcept"):
-                pass
             depth += 1
         elif t == ")":
             depth -= 1
