@@ -339,291 +339,274 @@ double violation(const ForceProblem& p, const Eigen::VectorXd& a, double force_s
   return v;
 }
 
-}  // namespace
-
-ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, const std::vector<std::vector<int>>& steps,
-                            const std::vector<int>& cuts, const ForceOptions& options, const ProgressFn& progress) {
-  const auto start = std::chrono::steady_clock::now();
-  auto since = [](std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+// Near the LP's optimum: the forces least out of their wires' planes (ForceOptions::least_out_of_plane),
+// from the force LP `lp` (its polytope rows in `added`, its basis in `held`), into a.
+void least_out_of_plane(const ForceProblem& problem, const Network& net, const ForceOptions& options,
+                        const detail::LinearProgram& lp, const detail::TorqueBlocks& blocks,
+                        const std::set<std::pair<int, int>>& added, detail::HeldLp& held, ForceResult& r,
+                        Eigen::VectorXd& a) {
+  const int K = problem.columns();
+  // Near the optimum: minimise Σ s over s_{h,w} >= |f_h · n_w| (2 per hooked crossing h),
+  // keeping G_stb within tie_tolerance of the optimum and every other row.
+  const int H = K / 4;
+  const double best = problem.normal_weights().dot(a);
+  detail::LinearProgram tie = lp;
+  tie.maximise = false;
+  tie.obj.assign(K + 2 * H, 0.0);
+  for (int i = 0; i < 2 * H; ++i) tie.obj[K + i] = 1.0;
+  tie.col_lo.resize(K + 2 * H, 0.0);
+  tie.col_hi.resize(K + 2 * H, kInf);
+  int next = static_cast<int>(tie.row_lo.size());
+  auto entry = [&](int col, double v) {
+    tie.tri_row.push_back(next);
+    tie.tri_col.push_back(col);
+    tie.tri_val.push_back(v);
   };
-  report_progress(progress, "forces", 0.0);
-  const ForceProblem problem(net, hooks, steps, cuts, options);
+  for (int j = 0; j < K; ++j) entry(j, problem.normal_weights()(j));
+  tie.row_lo.push_back((1.0 - options.tie_tolerance) * best);
+  tie.row_hi.push_back(kInf);
+  ++next;
+  for (int h = 0; h < H; ++h)
+    for (int w = 0; w < 2; ++w)
+      for (double sign : {1.0, -1.0}) {
+        const Crossing& x = net.crossings[r.column_crossing[4 * h]];
+        const Vec3& n = net.wires[x.wires[w]].plane.normal;
+        for (int q = 0; q < 4; ++q) entry(4 * h + q, -sign * n.dot(problem.pyramid(r.column_crossing[4 * h])[q]));
+        entry(K + 2 * h + w, 1.0);  // s - sign (f·n) >= 0
+        tie.row_lo.push_back(0.0);
+        tie.row_hi.push_back(kInf);
+        ++next;
+      }
+  detail::TorqueBlocks padded{Eigen::MatrixXd::Zero(blocks.A.rows(), K + 2 * H), blocks.c};
+  padded.A.leftCols(K) = blocks.A;
+  std::set<std::pair<int, int>> tie_added = added;
+  const detail::LpSolution tied =
+      detail::solve_lp_with_torque_rows(tie, padded, problem.polytope(), problem.t_max(), tie_added, &r.lp_rounds,
+                                      options.lp_warm_start, &held);
+  r.lp_iterations += tied.iterations;
+  if (tied.status == detail::LpSolution::optimal)
+    for (int j = 0; j < K; ++j) a(j) = std::max(0.0, tied.x[j]);
+}
+
+// The force LP (Eq. 6-8 with the bound's polytope rows added as they are violated), and the
+// least-out-of-plane LP after it when asked: the coefficients into a, the counts into r.
+void solve_by_lp(const ForceProblem& problem, const Network& net, const ForceOptions& options, bool least,
+                 const ProgressFn& progress, ForceResult& r, Eigen::VectorXd& a) {
   const int K = problem.columns();
   const double F_ref = problem.t_max() / problem.length_scale();
-  ForceResult r;
-  r.cuts = cuts;
-  r.t_max = problem.t_max();
-  r.column_crossing = problem.column_crossing();
-  Eigen::VectorXd a = Eigen::VectorXd::Zero(K);
   const Eigen::MatrixXd& M = problem.equilibrium();
   const Eigen::MatrixXd& T = problem.torque_rows();
   const Eigen::MatrixXd& Nk = problem.normal_rows();
-
-  const bool use_lp = options.algorithm != ForceAlgorithm::slsqp;
-  const bool least = options.least_out_of_plane && options.algorithm != ForceAlgorithm::slsqp;
-  const bool use_nlp = options.algorithm == ForceAlgorithm::slsqp ||
-                       (options.algorithm == ForceAlgorithm::lp_then_slsqp && !least && problem.weight() > 0 &&
-                        problem.assembly_matrix().squaredNorm() > 0);
-  if (K > 0 && use_lp) {
-    const auto t0 = std::chrono::steady_clock::now();
-    detail::LinearProgram lp;
-    lp.maximise = true;
-    lp.obj.assign(problem.normal_weights().data(), problem.normal_weights().data() + K);
-    lp.col_lo.assign(K, 0.0);
-    lp.col_hi.assign(K, kInf);
-    detail::append_rows(lp, M, 0.0, 0.0);
-    detail::append_rows(lp, T, -problem.t_max(), problem.t_max());  // |n·t_v| <= t_max: implied by either bound
-    detail::append_rows(lp, Nk, 0.0, kInf);
-    // The other rows of the bound's polytope join as solutions violate them.
-    const detail::TorqueBlocks blocks{problem.torque_frame_rows(), Eigen::VectorXd::Zero(problem.torque_frame_rows().rows())};
-    std::set<std::pair<int, int>> added;
-    // The problem GLPK holds, passed from loop to loop: the least-out-of-plane LP below starts from
-    // the force LP's optimal basis.
-    detail::HeldLp held;
-    detail::LpSolution sol =
+  const auto t0 = std::chrono::steady_clock::now();
+  detail::LinearProgram lp;
+  lp.maximise = true;
+  lp.obj.assign(problem.normal_weights().data(), problem.normal_weights().data() + K);
+  lp.col_lo.assign(K, 0.0);
+  lp.col_hi.assign(K, kInf);
+  detail::append_rows(lp, M, 0.0, 0.0);
+  detail::append_rows(lp, T, -problem.t_max(), problem.t_max());  // |n·t_v| <= t_max: implied by either bound
+  detail::append_rows(lp, Nk, 0.0, kInf);
+  // The other rows of the bound's polytope join as solutions violate them.
+  const detail::TorqueBlocks blocks{problem.torque_frame_rows(), Eigen::VectorXd::Zero(problem.torque_frame_rows().rows())};
+  std::set<std::pair<int, int>> added;
+  // The problem GLPK holds, passed from loop to loop: the least-out-of-plane LP below starts from
+  // the force LP's optimal basis.
+  detail::HeldLp held;
+  detail::LpSolution sol =
+      detail::solve_lp_with_torque_rows(lp, blocks, problem.polytope(), problem.t_max(), added, &r.lp_rounds,
+                                        options.lp_warm_start, &held);
+  r.lp_iterations = sol.iterations;
+  if (sol.status == detail::LpSolution::unbounded) {
+    // Bound every coefficient: when the optimum then keeps away from the cap, it is the
+    // problem's (rows not yet added had left a force free); otherwise name the crossings
+    // whose force no torque limits.
+    const double cap = 1e6 * F_ref;
+    lp.col_hi.assign(K, cap);
+    report_progress(progress, "forces", 0.25);  // between the two LPs
+    const detail::LpSolution capped =
         detail::solve_lp_with_torque_rows(lp, blocks, problem.polytope(), problem.t_max(), added, &r.lp_rounds,
-                                          options.lp_warm_start, &held);
-    r.lp_iterations = sol.iterations;
-    if (sol.status == detail::LpSolution::unbounded) {
-      // Bound every coefficient: when the optimum then keeps away from the cap, it is the
-      // problem's (rows not yet added had left a force free); otherwise name the crossings
-      // whose force no torque limits.
-      const double cap = 1e6 * F_ref;
-      lp.col_hi.assign(K, cap);
-      report_progress(progress, "forces", 0.25);  // between the two LPs
-      const detail::LpSolution capped =
-          detail::solve_lp_with_torque_rows(lp, blocks, problem.polytope(), problem.t_max(), added, &r.lp_rounds,
-                                          options.lp_warm_start, &held);
-      r.lp_iterations += capped.iterations;
-      std::string names;
-      if (capped.status == detail::LpSolution::optimal)
-        for (int j = 0; j < K; ++j)
-          if (capped.x[j] > 0.5 * cap && names.find(" " + std::to_string(r.column_crossing[j]) + ",") == std::string::npos)
-            names += " " + std::to_string(r.column_crossing[j]) + ",";
-      if (capped.status == detail::LpSolution::optimal && names.empty()) {
-        sol = capped;
-      } else {
-        if (!names.empty()) names.pop_back();
-        throw SolverError("the contact forces are unbounded: no wire's bending torque limits the force at crossing" +
-                          (names.empty() ? std::string("s") : names) +
-                          "; check the cuts and that every wire has more than one crossing");
-      }
-    }
-    if (sol.status != detail::LpSolution::optimal)
-      throw SolverError("the force LP could not be solved (" +
-                        (sol.status == detail::LpSolution::infeasible ? std::string("GLPK found it infeasible")
-                         : sol.reason.empty()                         ? std::string("GLPK failed")
-                                                                      : sol.reason) +
-                        "); check the material's numbers and the model's size, or report this input");
-    for (int j = 0; j < K; ++j) a(j) = std::max(0.0, sol.x[j]);
-    if (least) {
-      // Near the optimum: minimise Σ s over s_{h,w} >= |f_h · n_w| (2 per hooked crossing h),
-      // keeping G_stb within tie_tolerance of the optimum and every other row.
-      const int H = K / 4;
-      const double best = problem.normal_weights().dot(a);
-      detail::LinearProgram tie = lp;
-      tie.maximise = false;
-      tie.obj.assign(K + 2 * H, 0.0);
-      for (int i = 0; i < 2 * H; ++i) tie.obj[K + i] = 1.0;
-      tie.col_lo.resize(K + 2 * H, 0.0);
-      tie.col_hi.resize(K + 2 * H, kInf);
-      int next = static_cast<int>(tie.row_lo.size());
-      auto entry = [&](int col, double v) {
-        tie.tri_row.push_back(next);
-        tie.tri_col.push_back(col);
-        tie.tri_val.push_back(v);
-      };
-      for (int j = 0; j < K; ++j) entry(j, problem.normal_weights()(j));
-      tie.row_lo.push_back((1.0 - options.tie_tolerance) * best);
-      tie.row_hi.push_back(kInf);
-      ++next;
-      for (int h = 0; h < H; ++h)
-        for (int w = 0; w < 2; ++w)
-          for (double sign : {1.0, -1.0}) {
-            const Crossing& x = net.crossings[r.column_crossing[4 * h]];
-            const Vec3& n = net.wires[x.wires[w]].plane.normal;
-            for (int q = 0; q < 4; ++q) entry(4 * h + q, -sign * n.dot(problem.pyramid(r.column_crossing[4 * h])[q]));
-            entry(K + 2 * h + w, 1.0);  // s - sign (f·n) >= 0
-            tie.row_lo.push_back(0.0);
-            tie.row_hi.push_back(kInf);
-            ++next;
-          }
-      detail::TorqueBlocks padded{Eigen::MatrixXd::Zero(blocks.A.rows(), K + 2 * H), blocks.c};
-      padded.A.leftCols(K) = blocks.A;
-      std::set<std::pair<int, int>> tie_added = added;
-      const detail::LpSolution tied =
-          detail::solve_lp_with_torque_rows(tie, padded, problem.polytope(), problem.t_max(), tie_added, &r.lp_rounds,
-                                          options.lp_warm_start, &held);
-      r.lp_iterations += tied.iterations;
-      if (tied.status == detail::LpSolution::optimal)
-        for (int j = 0; j < K; ++j) a(j) = std::max(0.0, tied.x[j]);
-    }
-    r.method = least ? "lp+least_out_of_plane" : "lp";
-    r.lp_seconds = since(t0);
-  }
-  report_progress(progress, "forces", 0.5);
-
-  if (K > 0 && use_nlp) {
-    const auto t0 = std::chrono::steady_clock::now();
-    // Null space of M: a = N z keeps M a = 0 to rounding.
-    Eigen::BDCSVD<Eigen::MatrixXd> svd(M, Eigen::ComputeFullV);
-    const Eigen::VectorXd& sv = svd.singularValues();
-    const double tol = 1e-10 * std::max(1.0, sv.size() ? sv(0) : 1.0);
-    int rank = 0;
-    for (Eigen::Index i = 0; i < sv.size(); ++i)
-      if (sv(i) > tol) ++rank;
-    const Eigen::MatrixXd N = svd.matrixV().rightCols(K - rank);
-    const int k = static_cast<int>(N.cols());
-    if (k > 0) {
-      // Constraint rows in z (c(z) = G z - h <= 0), scaled to O(1): signs and normal forces by
-      // F_ref (always in the set), torque rows e·t_v <= t_max of the bound's polytope by t_max
-      // (a working set of them; c = e·t_v / t_max - 1).
-      Eigen::MatrixXd G_fixed(K + Nk.rows(), k);
-      G_fixed.topRows(K) = -N / F_ref;
-      G_fixed.bottomRows(Nk.rows()) = -Nk * N / F_ref;
-      const TorquePolytope& poly = problem.polytope();
-      const int F = static_cast<int>(poly.rows.size());
-      const Eigen::Index V = T.rows();
-      const Eigen::MatrixXd TF = problem.torque_frame_rows() * N / problem.t_max();  // 3V × k
-      std::vector<double> z(static_cast<std::size_t>(k));
-      Eigen::Map<Eigen::VectorXd>(z.data(), k) = N.transpose() * a;
-      // c of every torque row at z: F × V.
-      auto torque_values = [&]() {
-        const Eigen::VectorXd t = TF * Eigen::Map<const Eigen::VectorXd>(z.data(), k);
-        Eigen::MatrixXd c(F, V);
-        for (Eigen::Index v = 0; v < V; ++v)
-          for (int e = 0; e < F; ++e) c(e, v) = poly.rows[e].dot(t.segment<3>(3 * v)) - 1.0;
-        return c;
-      };
-      // The working set, as (polytope row, vertex) pairs: torque rows within the margin of their
-      // bound at the start (the LP's optimum sits on many of them), at most kTopRows per vertex
-      // (the facets around its torque's direction: a polytope vertex joins 5 or 6), later any
-      // row the solution violates. For in_plane (rows ±n) this is every row within the margin.
-      constexpr int kTopRows = 6;
-      const double kNear =
-          -(problem.torque_bound() == TorqueBound::full_3d ? options.working_set_margin_3d : options.working_set_margin);
-      std::set<std::pair<int, int>> in_set;
-      auto add_near = [&](const Eigen::MatrixXd& c) {
-        std::vector<int> order(static_cast<std::size_t>(F));
-        for (Eigen::Index v = 0; v < V; ++v) {
-          if (c.col(v).maxCoeff() < kNear) continue;
-          for (int e = 0; e < F; ++e) order[e] = e;
-          const int top = std::min(F, kTopRows);
-          std::partial_sort(order.begin(), order.begin() + top, order.end(),
-                            [&](int x, int y) { return c(x, v) > c(y, v); });
-          for (int i = 0; i < top && c(order[i], v) >= kNear; ++i) in_set.insert({order[i], static_cast<int>(v)});
-        }
-      };
-      // The rows through ±n t_max at every vertex: they bound every torque component (for
-      // in_plane they are every row).
-      auto add_apex = [&]() {
-        for (Eigen::Index v = 0; v < V; ++v)
-          for (int e : poly.apex) in_set.insert({e, static_cast<int>(v)});
-      };
-      bool partial = options.working_set && use_lp;  // from zero nothing is near a bound yet
-      if (!options.working_set) {
-        for (int e = 0; e < F; ++e)
-          for (Eigen::Index v = 0; v < V; ++v) in_set.insert({e, static_cast<int>(v)});
-      } else if (partial) {
-        add_near(torque_values());
-      } else {
-        add_apex();
-      }
-      SlsqpData data{&problem, &N, {}, {}, &progress};
-      const Eigen::VectorXd a_start = a;
-      const double g_start = problem.objective(a_start);
-      double g = 0.0;
-      nlopt::result res = nlopt::FAILURE;
-      for (int round = 0;; ++round) {
-        const Eigen::Index rows = K + static_cast<Eigen::Index>(in_set.size()) + Nk.rows();
-        data.G.resize(rows, k);
-        data.h = Eigen::VectorXd::Zero(rows);
-        data.G.topRows(K) = G_fixed.topRows(K);
-        Eigen::Index i = K;
-        for (const auto& [e, v] : in_set) {
-          data.G.row(i) = poly.rows[e].transpose() * TF.middleRows(3 * v, 3);
-          data.h(i++) = 1.0;
-        }
-        data.G.bottomRows(Nk.rows()) = G_fixed.bottomRows(Nk.rows());
-        nlopt::opt opt(nlopt::LD_SLSQP, static_cast<unsigned>(k));
-        opt.set_max_objective(slsqp_objective, &data);
-        opt.add_inequality_mconstraint(slsqp_constraints, &data,
-                                       std::vector<double>(static_cast<std::size_t>(rows), options.constraint_tol));
-        opt.set_ftol_rel(options.ftol_rel);
-        opt.set_xtol_rel(options.xtol_rel);
-        opt.set_maxeval(std::max(1, options.max_iterations - data.evaluations));
-        try {
-          res = opt.optimize(z, g);
-          r.nlopt_result = detail::nlopt_result_text(res);
-        } catch (const nlopt::forced_stop&) {
-          if (data.cancelled) throw Cancelled();
-          r.nlopt_result = "NLOPT_FORCED_STOP";
-          break;
-        } catch (const std::exception& e) {
-          if (data.cancelled) throw Cancelled();
-          r.nlopt_result = std::string("NLOPT_FAILURE (") + e.what() + ")";
-          if (!partial) break;
-          // A partial set may leave the relaxed problem unbounded: start again with the rows
-          // that bound every torque (for in_plane: every row).
-          partial = false;
-          add_apex();
-          Eigen::Map<Eigen::VectorXd>(z.data(), k) = N.transpose() * a_start;
-          continue;
-        }
-        r.working_set_rounds = round + 1;
-        r.working_set_rows = static_cast<int>(rows);
-        // Rows outside the set that the solution violates join it, with their near neighbours
-        // in value; none violated: the relaxed optimum is feasible, hence the full optimum.
-        const Eigen::MatrixXd c = torque_values();
-        std::vector<std::pair<int, int>> violated;
-        for (Eigen::Index v = 0; v < V; ++v)
-          for (int e = 0; e < F; ++e)
-            if (c(e, v) > options.constraint_tol && !in_set.count({e, static_cast<int>(v)}))
-              violated.push_back({e, static_cast<int>(v)});
-        if (violated.empty() || data.evaluations >= options.max_iterations) break;
-        in_set.insert(violated.begin(), violated.end());
-        add_near(c);
-      }
-      if (data.cancelled) throw Cancelled();
-      r.iterations = data.evaluations;
-      Eigen::VectorXd a_nlp = N * Eigen::Map<const Eigen::VectorXd>(z.data(), k);
-      // Rounding-level negatives (SLSQP's constraint tolerance) are set to zero.
+                                        options.lp_warm_start, &held);
+    r.lp_iterations += capped.iterations;
+    std::string names;
+    if (capped.status == detail::LpSolution::optimal)
       for (int j = 0; j < K; ++j)
-        if (a_nlp(j) < 0 && a_nlp(j) > -1e-7 * F_ref) a_nlp(j) = 0.0;
-      const double v = violation(problem, a_nlp, F_ref);
-      const double g_nlp = problem.objective(a_nlp);
-      const bool from_lp = use_lp;
-      if (v <= 1e-7 && (!from_lp || g_nlp >= g_start - 1e-9 * std::max(1.0, std::abs(g_start)))) {
-        a = a_nlp;
-        r.method = from_lp ? "lp+slsqp" : "slsqp";
-      } else if (from_lp) {
-        r.warnings.push_back("the assembly term could not be improved by SLSQP (" + r.nlopt_result +
-                             "); the forces maximise the normal-force sum alone");
-      } else {
-        throw SolverError("SLSQP found no feasible contact forces (" + r.nlopt_result +
-                          "); use the default algorithm");
-      }
-    } else if (!use_lp) {
-      r.method = "slsqp";
+        if (capped.x[j] > 0.5 * cap && names.find(" " + std::to_string(r.column_crossing[j]) + ",") == std::string::npos)
+          names += " " + std::to_string(r.column_crossing[j]) + ",";
+    if (capped.status == detail::LpSolution::optimal && names.empty()) {
+      sol = capped;
+    } else {
+      if (!names.empty()) names.pop_back();
+      throw SolverError("the contact forces are unbounded: no wire's bending torque limits the force at crossing" +
+                        (names.empty() ? std::string("s") : names) +
+                        "; check the cuts and that every wire has more than one crossing");
     }
-    r.nlp_seconds = since(t0);
   }
-  if (r.method.empty()) r.method = use_lp ? "lp" : "slsqp";
-  report_progress(progress, "forces", 0.9);
+  if (sol.status != detail::LpSolution::optimal)
+    throw SolverError("the force LP could not be solved (" +
+                      (sol.status == detail::LpSolution::infeasible ? std::string("GLPK found it infeasible")
+                       : sol.reason.empty()                         ? std::string("GLPK failed")
+                                                                    : sol.reason) +
+                      "); check the material's numbers and the model's size, or report this input");
+  for (int j = 0; j < K; ++j) a(j) = std::max(0.0, sol.x[j]);
+  if (least) least_out_of_plane(problem, net, options, lp, blocks, added, held, r, a);
+  r.method = least ? "lp+least_out_of_plane" : "lp";
+  r.lp_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
 
-  // Every constraint but the torque rows is homogeneous in a (M a = 0, a >= 0, N_k >= 0): forces
-  // that a solver's tolerance left outside the 3D bound's polytope (SLSQP's result is accepted
-  // up to 1e-7 relative) are scaled into it, so that |t_v| <= t_max holds to rounding.
-  Eigen::VectorXd gauges = problem.torque_gauges(a);
-  if (options.torque_bound == TorqueBound::full_3d && gauges.size() > 0 && gauges.maxCoeff() > 1.0) {
-    a /= gauges.maxCoeff();
-    gauges = problem.torque_gauges(a);
+// SLSQP's answer a_nlp taken when it is feasible and, from the LP's optimum, no worse than
+// where it started (g_start); otherwise a warning (from the LP) or an error (SLSQP alone).
+void accept_slsqp(const ForceProblem& problem, bool use_lp, Eigen::VectorXd a_nlp, double g_start, ForceResult& r,
+                  Eigen::VectorXd& a) {
+  const int K = problem.columns();
+  const double F_ref = problem.t_max() / problem.length_scale();
+  // Rounding-level negatives (SLSQP's constraint tolerance) are set to zero.
+  for (int j = 0; j < K; ++j)
+    if (a_nlp(j) < 0 && a_nlp(j) > -1e-7 * F_ref) a_nlp(j) = 0.0;
+  const double v = violation(problem, a_nlp, F_ref);
+  const double g_nlp = problem.objective(a_nlp);
+  const bool from_lp = use_lp;
+  if (v <= 1e-7 && (!from_lp || g_nlp >= g_start - 1e-9 * std::max(1.0, std::abs(g_start)))) {
+    a = a_nlp;
+    r.method = from_lp ? "lp+slsqp" : "slsqp";
+  } else if (from_lp) {
+    r.warnings.push_back("the assembly term could not be improved by SLSQP (" + r.nlopt_result +
+                         "); the forces maximise the normal-force sum alone");
+  } else {
+    throw SolverError("SLSQP found no feasible contact forces (" + r.nlopt_result +
+                      "); use the default algorithm");
   }
-  r.torque_bound = options.torque_bound;
-  r.torque_active = gauges.size() > 0 && gauges.maxCoeff() >= 1.0 - 1e-6;
+}
 
-  // Results.
+// SLSQP over z, a = N z (N the null space of M), from a, with a working set of the bound's
+// torque rows (ForceOptions::working_set): the coefficients into a, the counts into r.
+void slsqp_in_null_space(const ForceProblem& problem, const ForceOptions& options, bool use_lp,
+                         const Eigen::MatrixXd& N, const ProgressFn& progress, ForceResult& r, Eigen::VectorXd& a) {
+  const int K = problem.columns();
+  const int k = static_cast<int>(N.cols());
+  const double F_ref = problem.t_max() / problem.length_scale();
+  const Eigen::MatrixXd& T = problem.torque_rows();
+  const Eigen::MatrixXd& Nk = problem.normal_rows();
+  // Constraint rows in z (c(z) = G z - h <= 0), scaled to O(1): signs and normal forces by
+  // F_ref (always in the set), torque rows e·t_v <= t_max of the bound's polytope by t_max
+  // (a working set of them; c = e·t_v / t_max - 1).
+  Eigen::MatrixXd G_fixed(K + Nk.rows(), k);
+  G_fixed.topRows(K) = -N / F_ref;
+  G_fixed.bottomRows(Nk.rows()) = -Nk * N / F_ref;
+  const TorquePolytope& poly = problem.polytope();
+  const int F = static_cast<int>(poly.rows.size());
+  const Eigen::Index V = T.rows();
+  const Eigen::MatrixXd TF = problem.torque_frame_rows() * N / problem.t_max();  // 3V × k
+  std::vector<double> z(static_cast<std::size_t>(k));
+  Eigen::Map<Eigen::VectorXd>(z.data(), k) = N.transpose() * a;
+  // c of every torque row at z: F × V.
+  auto torque_values = [&]() {
+    const Eigen::VectorXd t = TF * Eigen::Map<const Eigen::VectorXd>(z.data(), k);
+    Eigen::MatrixXd c(F, V);
+    for (Eigen::Index v = 0; v < V; ++v)
+      for (int e = 0; e < F; ++e) c(e, v) = poly.rows[e].dot(t.segment<3>(3 * v)) - 1.0;
+    return c;
+  };
+  // The working set, as (polytope row, vertex) pairs: torque rows within the margin of their
+  // bound at the start (the LP's optimum sits on many of them), at most kTopRows per vertex
+  // (the facets around its torque's direction: a polytope vertex joins 5 or 6), later any
+  // row the solution violates. For in_plane (rows ±n) this is every row within the margin.
+  constexpr int kTopRows = 6;
+  const double kNear =
+      -(problem.torque_bound() == TorqueBound::full_3d ? options.working_set_margin_3d : options.working_set_margin);
+  std::set<std::pair<int, int>> in_set;
+  auto add_near = [&](const Eigen::MatrixXd& c) {
+    std::vector<int> order(static_cast<std::size_t>(F));
+    for (Eigen::Index v = 0; v < V; ++v) {
+      if (c.col(v).maxCoeff() < kNear) continue;
+      for (int e = 0; e < F; ++e) order[e] = e;
+      const int top = std::min(F, kTopRows);
+      std::partial_sort(order.begin(), order.begin() + top, order.end(),
+                        [&](int x, int y) { return c(x, v) > c(y, v); });
+      for (int i = 0; i < top && c(order[i], v) >= kNear; ++i) in_set.insert({order[i], static_cast<int>(v)});
+    }
+  };
+  // The rows through ±n t_max at every vertex: they bound every torque component (for
+  // in_plane they are every row).
+  auto add_apex = [&]() {
+    for (Eigen::Index v = 0; v < V; ++v)
+      for (int e : poly.apex) in_set.insert({e, static_cast<int>(v)});
+  };
+  bool partial = options.working_set && use_lp;  // from zero nothing is near a bound yet
+  if (!options.working_set) {
+    for (int e = 0; e < F; ++e)
+      for (Eigen::Index v = 0; v < V; ++v) in_set.insert({e, static_cast<int>(v)});
+  } else if (partial) {
+    add_near(torque_values());
+  } else {
+    add_apex();
+  }
+  SlsqpData data{&problem, &N, {}, {}, &progress};
+  const Eigen::VectorXd a_start = a;
+  const double g_start = problem.objective(a_start);
+  double g = 0.0;
+  nlopt::result res = nlopt::FAILURE;
+  for (int round = 0;; ++round) {
+    const Eigen::Index rows = K + static_cast<Eigen::Index>(in_set.size()) + Nk.rows();
+    data.G.resize(rows, k);
+    data.h = Eigen::VectorXd::Zero(rows);
+    data.G.topRows(K) = G_fixed.topRows(K);
+    Eigen::Index i = K;
+    for (const auto& [e, v] : in_set) {
+      data.G.row(i) = poly.rows[e].transpose() * TF.middleRows(3 * v, 3);
+      data.h(i++) = 1.0;
+    }
+    data.G.bottomRows(Nk.rows()) = G_fixed.bottomRows(Nk.rows());
+    nlopt::opt opt(nlopt::LD_SLSQP, static_cast<unsigned>(k));
+    opt.set_max_objective(slsqp_objective, &data);
+    opt.add_inequality_mconstraint(slsqp_constraints, &data,
+                                   std::vector<double>(static_cast<std::size_t>(rows), options.constraint_tol));
+    opt.set_ftol_rel(options.ftol_rel);
+    opt.set_xtol_rel(options.xtol_rel);
+    opt.set_maxeval(std::max(1, options.max_iterations - data.evaluations));
+    try {
+      res = opt.optimize(z, g);
+      r.nlopt_result = detail::nlopt_result_text(res);
+    } catch (const nlopt::forced_stop&) {
+      if (data.cancelled) throw Cancelled();
+      r.nlopt_result = "NLOPT_FORCED_STOP";
+      break;
+    } catch (const std::exception& e) {
+      if (data.cancelled) throw Cancelled();
+      r.nlopt_result = std::string("NLOPT_FAILURE (") + e.what() + ")";
+      if (!partial) break;
+      // A partial set may leave the relaxed problem unbounded: start again with the rows
+      // that bound every torque (for in_plane: every row).
+      partial = false;
+      add_apex();
+      Eigen::Map<Eigen::VectorXd>(z.data(), k) = N.transpose() * a_start;
+      continue;
+    }
+    r.working_set_rounds = round + 1;
+    r.working_set_rows = static_cast<int>(rows);
+    // Rows outside the set that the solution violates join it, with their near neighbours
+    // in value; none violated: the relaxed optimum is feasible, hence the full optimum.
+    const Eigen::MatrixXd c = torque_values();
+    std::vector<std::pair<int, int>> violated;
+    for (Eigen::Index v = 0; v < V; ++v)
+      for (int e = 0; e < F; ++e)
+        if (c(e, v) > options.constraint_tol && !in_set.count({e, static_cast<int>(v)}))
+          violated.push_back({e, static_cast<int>(v)});
+    if (violated.empty() || data.evaluations >= options.max_iterations) break;
+    in_set.insert(violated.begin(), violated.end());
+    add_near(c);
+  }
+  if (data.cancelled) throw Cancelled();
+  r.iterations = data.evaluations;
+  accept_slsqp(problem, use_lp, N * Eigen::Map<const Eigen::VectorXd>(z.data(), k), g_start, r, a);
+}
+
+// The result's figures from the coefficients a: forces, normal forces, out-of-plane shares,
+// objective terms, residual, and each wire's torques.
+void fill_results(const ForceProblem& problem, const Network& net, const std::vector<int>& hooks,
+                  const std::vector<int>& cuts, const Eigen::VectorXd& a, const ProgressFn& progress,
+                  ForceResult& r) {
+  const int K = problem.columns();
+  const Eigen::MatrixXd& M = problem.equilibrium();
   r.coefficients = a;
   r.forces = problem.forces(a);
   const int C = static_cast<int>(net.crossings.size());
@@ -661,6 +644,67 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
                            std::to_string(r.wires[w].max_torque_3d) + " N m, above t_max = " + std::to_string(r.t_max) +
                            " N m (torque_bound in_plane bounds in-plane bending only; see docs/method-forces.md, §3)");
   }
+}
+
+}  // namespace
+
+ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, const std::vector<std::vector<int>>& steps,
+                            const std::vector<int>& cuts, const ForceOptions& options, const ProgressFn& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  auto since = [](std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+  report_progress(progress, "forces", 0.0);
+  const ForceProblem problem(net, hooks, steps, cuts, options);
+  const int K = problem.columns();
+  ForceResult r;
+  r.cuts = cuts;
+  r.t_max = problem.t_max();
+  r.column_crossing = problem.column_crossing();
+  Eigen::VectorXd a = Eigen::VectorXd::Zero(K);
+  const Eigen::MatrixXd& M = problem.equilibrium();
+
+  const bool use_lp = options.algorithm != ForceAlgorithm::slsqp;
+  const bool least = options.least_out_of_plane && options.algorithm != ForceAlgorithm::slsqp;
+  const bool use_nlp = options.algorithm == ForceAlgorithm::slsqp ||
+                       (options.algorithm == ForceAlgorithm::lp_then_slsqp && !least && problem.weight() > 0 &&
+                        problem.assembly_matrix().squaredNorm() > 0);
+  if (K > 0 && use_lp) solve_by_lp(problem, net, options, least, progress, r, a);
+  report_progress(progress, "forces", 0.5);
+
+  if (K > 0 && use_nlp) {
+    const auto t0 = std::chrono::steady_clock::now();
+    // Null space of M: a = N z keeps M a = 0 to rounding.
+    Eigen::BDCSVD<Eigen::MatrixXd> svd(M, Eigen::ComputeFullV);
+    const Eigen::VectorXd& sv = svd.singularValues();
+    const double tol = 1e-10 * std::max(1.0, sv.size() ? sv(0) : 1.0);
+    int rank = 0;
+    for (Eigen::Index i = 0; i < sv.size(); ++i)
+      if (sv(i) > tol) ++rank;
+    const Eigen::MatrixXd N = svd.matrixV().rightCols(K - rank);
+    const int k = static_cast<int>(N.cols());
+    if (k > 0) {
+      slsqp_in_null_space(problem, options, use_lp, N, progress, r, a);
+    } else if (!use_lp) {
+      r.method = "slsqp";
+    }
+    r.nlp_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  if (r.method.empty()) r.method = use_lp ? "lp" : "slsqp";
+  report_progress(progress, "forces", 0.9);
+
+  // Every constraint but the torque rows is homogeneous in a (M a = 0, a >= 0, N_k >= 0): forces
+  // that a solver's tolerance left outside the 3D bound's polytope (SLSQP's result is accepted
+  // up to 1e-7 relative) are scaled into it, so that |t_v| <= t_max holds to rounding.
+  Eigen::VectorXd gauges = problem.torque_gauges(a);
+  if (options.torque_bound == TorqueBound::full_3d && gauges.size() > 0 && gauges.maxCoeff() > 1.0) {
+    a /= gauges.maxCoeff();
+    gauges = problem.torque_gauges(a);
+  }
+  r.torque_bound = options.torque_bound;
+  r.torque_active = gauges.size() > 0 && gauges.maxCoeff() >= 1.0 - 1e-6;
+
+  fill_results(problem, net, hooks, cuts, a, progress, r);
   r.seconds = since(start);
   report_progress(progress, "forces", 1.0);
   return r;

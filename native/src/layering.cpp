@@ -520,9 +520,9 @@ std::vector<std::array<bool, 2>> too_close_hooks(const Network& net, double cont
   return ok;
 }
 
-LayeringResult layering(const Network& net, const LayeringOptions& options, const ProgressFn& progress) {
-  const auto t0 = std::chrono::steady_clock::now();
-  validate(options.contact);
+namespace {
+
+void check_input(const Network& net, const LayeringOptions& options) {
   const int P = static_cast<int>(net.wires.size());
   const int C = static_cast<int>(net.crossings.size());
   if (P == 0) throw InputError("layering needs at least one wire");
@@ -537,26 +537,153 @@ LayeringResult layering(const Network& net, const LayeringOptions& options, cons
   for (const auto& x : net.crossings)
     if (x.wires[0] < 0 || x.wires[0] >= P || x.wires[1] < 0 || x.wires[1] >= P || x.wires[0] == x.wires[1])
       throw InputError("the network has a crossing with invalid wire ids; build it with build_network");
+}
 
-  if (options.forbid_too_close) {
-    if (!std::isfinite(options.too_close_angle_tolerance) || options.too_close_angle_tolerance < 0.0)
-      throw InputError("too_close_angle_tolerance must be a finite angle >= 0 (radians), got " +
-                       std::to_string(options.too_close_angle_tolerance));
-    LayeringOptions limited = options;
-    limited.forbid_too_close = false;
-    const auto realisable = too_close_hooks(net, options.contact.contact_angle, options.too_close_angle_tolerance);
-    if (limited.allowed_hooks.empty()) limited.allowed_hooks.assign(C, {true, true});
-    std::vector<std::array<int, 2>> forbidden;
-    for (int c = 0; c < C; ++c)
+// The layering with the hooks the target shape cannot realise (too_close_hooks) forbidden, and
+// the hooks so forbidden named in the result.
+LayeringResult with_too_close_forbidden(const Network& net, const LayeringOptions& options,
+                                        const ProgressFn& progress) {
+  const int C = static_cast<int>(net.crossings.size());
+  if (!std::isfinite(options.too_close_angle_tolerance) || options.too_close_angle_tolerance < 0.0)
+    throw InputError("too_close_angle_tolerance must be a finite angle >= 0 (radians), got " +
+                     std::to_string(options.too_close_angle_tolerance));
+  LayeringOptions limited = options;
+  limited.forbid_too_close = false;
+  const auto realisable = too_close_hooks(net, options.contact.contact_angle, options.too_close_angle_tolerance);
+  if (limited.allowed_hooks.empty()) limited.allowed_hooks.assign(C, {true, true});
+  std::vector<std::array<int, 2>> forbidden;
+  for (int c = 0; c < C; ++c)
+    for (int k = 0; k < 2; ++k)
+      if (limited.allowed_hooks[c][k] && !realisable[c][k]) {
+        limited.allowed_hooks[c][k] = false;
+        forbidden.push_back({c, k == 1 ? 1 : -1});
+      }
+  LayeringResult r = layering(net, limited, progress);
+  r.too_close_forbidden = forbidden;
+  return r;
+}
+
+// Why the wires do not hang together through their crossings, or "" when they do.
+std::string disconnected(const Network& net) {
+  const int P = static_cast<int>(net.wires.size());
+  std::vector<int> comp(P, -1);
+  std::vector<int> stack{0};
+  comp[0] = 0;
+  while (!stack.empty()) {
+    const int w = stack.back();
+    stack.pop_back();
+    for (const auto& x : net.crossings)
       for (int k = 0; k < 2; ++k)
-        if (limited.allowed_hooks[c][k] && !realisable[c][k]) {
-          limited.allowed_hooks[c][k] = false;
-          forbidden.push_back({c, k == 1 ? 1 : -1});
+        if (x.wires[k] == w && comp[x.wires[1 - k]] < 0) {
+          comp[x.wires[1 - k]] = 0;
+          stack.push_back(x.wires[1 - k]);
         }
-    LayeringResult r = layering(net, limited, progress);
-    r.too_close_forbidden = forbidden;
-    return r;
   }
+  for (int w = 0; w < P; ++w) {
+    if (comp[w] >= 0) continue;
+    bool any = false;
+    for (const auto& x : net.crossings) any = any || x.wires[0] == w || x.wires[1] == w;
+    return any ? "wire " + quoted(net, w) + " and the wires it crosses are not connected to wire " +
+                     quoted(net, 0) + " through any crossing; a sculpture must hang together"
+               : "wire " + quoted(net, w) + " crosses no other wire, so nothing can hold it";
+  }
+  return "";
+}
+
+// Why no hook configuration can make the finished sculpture stable, `relaxed` being the check
+// with both hooks' pyramids at every crossing.
+std::string never_stable(const Network& net, const StabilityResult& relaxed) {
+  const int P = static_cast<int>(net.wires.size());
+  const int C = static_cast<int>(net.crossings.size());
+  std::string reason;
+  // Name what moves, from the null space of the crossings as ball joints (mechanism.hpp),
+  // rather than the LP's failing load, whose wire need not be the one that moves.
+  const Mechanism mechanism = find_mechanism(net);
+  reason = "no hook configuration can make the finished sculpture stable: even with both hook directions "
+           "allowed at every crossing, ";
+  if (!mechanism.moving.empty()) {
+    reason += mechanism_message(net, mechanism);
+  } else {  // rigid as ball joints, yet the allowed pyramids do not span (forbidden hooks, degenerate contact angle)
+    int w = relaxed.failed_wire;
+    if (w < 0) {  // the combined load failed: name the wire with the fewest crossings
+      std::vector<int> count(P, 0);
+      for (const auto& x : net.crossings) ++count[x.wires[0]], ++count[x.wires[1]];
+      w = static_cast<int>(std::min_element(count.begin(), count.end()) - count.begin());
+    }
+    std::vector<int> cs;
+    for (int c = 0; c < C; ++c)
+      if (net.crossings[c].wires[0] == w || net.crossings[c].wires[1] == w) cs.push_back(c);
+    static const char* what[6] = {"a force along x", "a force along y", "a force along z",
+                                  "a torque about x", "a torque about y", "a torque about z"};
+    reason += "the wires cannot balance " +
+              (relaxed.failed_component >= 0 ? std::string(what[relaxed.failed_component])
+                                             : std::string("every load")) +
+              " on wire " + quoted(net, w) + " (its crossing" + (cs.size() == 1 ? " " : "s ") +
+              crossing_list(cs) + "): the wires are held at too few crossings";
+  }
+  return reason;
+}
+
+// The best structure the search found, into r.
+void take_found(LayeringResult& r, const Network& net, const Search& s) {
+  const int P = static_cast<int>(net.wires.size());
+  const int C = static_cast<int>(net.crossings.size());
+  r.stable = true;
+  r.hooks = s.best_hooks_;
+  r.assembly_order = s.best_order_;
+  r.steps = s.best_steps_;
+  r.max_metric = s.best_.max;
+  r.null_crossings = s.best_.nulls;
+  r.sum_metric = s.best_.sum;
+  r.unbalanced_in_plane = unbalanced_in_plane(net, r.hooks);
+  for (int c = 0; c < C; ++c) r.metric[c] = r.hooks[c] == 0 ? 0.0 : s.cost_[c][r.hooks[c] > 0 ? 1 : 0];
+  for (int k = 0; k < static_cast<int>(r.steps.size()); ++k)
+    if (r.steps[k].size() > (k == 0 ? 2u : 1u)) r.two_hand_steps.push_back(k);
+  if (!r.two_hand_steps.empty()) {
+    std::vector<std::string> which;
+    for (int k : r.two_hand_steps) which.push_back(wire_list(net, r.steps[k]));
+    r.warnings.push_back("no order adding one wire at a time is stable; these steps add two wires at once and "
+                         "need two hands: " + join(which));
+  }
+  if (P == 2)
+    r.warnings.push_back("a two-wire sculpture can turn about the line where the planes meet; it is judged "
+                         "under forces only, like the first pair of any assembly (Sec. 4.2)");
+}
+
+// No stable structure: the deepest the search reached and why, into r.
+void take_unstable(LayeringResult& r, const Network& net, const Search& s, const LayeringOptions& options,
+                   bool tried_pairs) {
+  const int C = static_cast<int>(net.crossings.size());
+  r.stable = false;
+  if (!s.deep_order_.empty()) {
+    r.hooks = s.deep_hooks_;
+    r.assembly_order = s.deep_order_;
+    r.steps = s.deep_steps_;
+    for (int c = 0; c < C; ++c) {
+      r.metric[c] = r.hooks[c] == 0 ? 0.0 : s.cost_[c][r.hooks[c] > 0 ? 1 : 0];
+      r.max_metric = std::max(r.max_metric, r.metric[c]);
+      r.sum_metric += r.metric[c];
+    }
+  }
+  // A stopped search proves nothing: it says so, never that no stable assembly exists.
+  r.reason = s.stopped() ? "search incomplete: the layering stopped after " + std::to_string(s.nodes_) +
+                               " nodes (max_nodes = " + std::to_string(options.max_nodes) +
+                               ") before finding a stable assembly; a stable one may exist: raise max_nodes (0: no "
+                               "limit) to search further"
+                         : explain(net, s, tried_pairs);
+  r.reason += forbidden_note(options);
+}
+
+}  // namespace
+
+LayeringResult layering(const Network& net, const LayeringOptions& options, const ProgressFn& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  validate(options.contact);
+  const int P = static_cast<int>(net.wires.size());
+  const int C = static_cast<int>(net.crossings.size());
+  check_input(net, options);
+
+  if (options.forbid_too_close) return with_too_close_forbidden(net, options, progress);
 
   LayeringResult r;
   r.hooks.assign(C, 0);
@@ -574,30 +701,8 @@ LayeringResult layering(const Network& net, const LayeringOptions& options, cons
     return finish();
   }
   // A wire sculpture must be connected through crossings.
-  {
-    std::vector<int> comp(P, -1);
-    std::vector<int> stack{0};
-    comp[0] = 0;
-    while (!stack.empty()) {
-      const int w = stack.back();
-      stack.pop_back();
-      for (const auto& x : net.crossings)
-        for (int k = 0; k < 2; ++k)
-          if (x.wires[k] == w && comp[x.wires[1 - k]] < 0) {
-            comp[x.wires[1 - k]] = 0;
-            stack.push_back(x.wires[1 - k]);
-          }
-    }
-    for (int w = 0; w < P; ++w) {
-      if (comp[w] >= 0) continue;
-      bool any = false;
-      for (const auto& x : net.crossings) any = any || x.wires[0] == w || x.wires[1] == w;
-      r.reason = any ? "wire " + quoted(net, w) + " and the wires it crosses are not connected to wire " +
-                           quoted(net, 0) + " through any crossing; a sculpture must hang together"
-                     : "wire " + quoted(net, w) + " crosses no other wire, so nothing can hold it";
-      return finish();
-    }
-  }
+  r.reason = disconnected(net);
+  if (!r.reason.empty()) return finish();
 
   Search s(net, options, progress);
   // Necessary for any answer: the finished sculpture with both hooks' pyramids at every crossing
@@ -607,31 +712,7 @@ LayeringResult layering(const Network& net, const LayeringOptions& options, cons
     for (int w = 0; w < P; ++w) all[w] = w;
     const StabilityResult relaxed = s.checker_.check(all, s.relaxed_, P == 2);
     if (!relaxed.stable) {
-      // Name what moves, from the null space of the crossings as ball joints (mechanism.hpp),
-      // rather than the LP's failing load, whose wire need not be the one that moves.
-      const Mechanism mechanism = find_mechanism(net);
-      r.reason = "no hook configuration can make the finished sculpture stable: even with both hook directions "
-                 "allowed at every crossing, ";
-      if (!mechanism.moving.empty()) {
-        r.reason += mechanism_message(net, mechanism);
-      } else {  // rigid as ball joints, yet the allowed pyramids do not span (forbidden hooks, degenerate contact angle)
-        int w = relaxed.failed_wire;
-        if (w < 0) {  // the combined load failed: name the wire with the fewest crossings
-          std::vector<int> count(P, 0);
-          for (const auto& x : net.crossings) ++count[x.wires[0]], ++count[x.wires[1]];
-          w = static_cast<int>(std::min_element(count.begin(), count.end()) - count.begin());
-        }
-        std::vector<int> cs;
-        for (int c = 0; c < C; ++c)
-          if (net.crossings[c].wires[0] == w || net.crossings[c].wires[1] == w) cs.push_back(c);
-        static const char* what[6] = {"a force along x", "a force along y", "a force along z",
-                                      "a torque about x", "a torque about y", "a torque about z"};
-        r.reason += "the wires cannot balance " +
-                    (relaxed.failed_component >= 0 ? std::string(what[relaxed.failed_component])
-                                                   : std::string("every load")) +
-                    " on wire " + quoted(net, w) + " (its crossing" + (cs.size() == 1 ? " " : "s ") +
-                    crossing_list(cs) + "): the wires are held at too few crossings";
-      }
+      r.reason = never_stable(net, relaxed);
       r.reason += forbidden_note(options);
       r.stats.lp_solves = s.checker_.lp_solves();
       return finish();
@@ -671,47 +752,10 @@ LayeringResult layering(const Network& net, const LayeringOptions& options, cons
   if (stopped)
     r.warnings.push_back("the layering search stopped after " + std::to_string(s.nodes_) +
                          " nodes (max_nodes); the result may not be optimal");
-  if (s.found()) {
-    r.stable = true;
-    r.hooks = s.best_hooks_;
-    r.assembly_order = s.best_order_;
-    r.steps = s.best_steps_;
-    r.max_metric = s.best_.max;
-    r.null_crossings = s.best_.nulls;
-    r.sum_metric = s.best_.sum;
-    r.unbalanced_in_plane = unbalanced_in_plane(net, r.hooks);
-    for (int c = 0; c < C; ++c) r.metric[c] = r.hooks[c] == 0 ? 0.0 : s.cost_[c][r.hooks[c] > 0 ? 1 : 0];
-    for (int k = 0; k < static_cast<int>(r.steps.size()); ++k)
-      if (r.steps[k].size() > (k == 0 ? 2u : 1u)) r.two_hand_steps.push_back(k);
-    if (!r.two_hand_steps.empty()) {
-      std::vector<std::string> which;
-      for (int k : r.two_hand_steps) which.push_back(wire_list(net, r.steps[k]));
-      r.warnings.push_back("no order adding one wire at a time is stable; these steps add two wires at once and "
-                           "need two hands: " + join(which));
-    }
-    if (P == 2)
-      r.warnings.push_back("a two-wire sculpture can turn about the line where the planes meet; it is judged "
-                           "under forces only, like the first pair of any assembly (Sec. 4.2)");
-  } else {
-    r.stable = false;
-    if (!s.deep_order_.empty()) {
-      r.hooks = s.deep_hooks_;
-      r.assembly_order = s.deep_order_;
-      r.steps = s.deep_steps_;
-      for (int c = 0; c < C; ++c) {
-        r.metric[c] = r.hooks[c] == 0 ? 0.0 : s.cost_[c][r.hooks[c] > 0 ? 1 : 0];
-        r.max_metric = std::max(r.max_metric, r.metric[c]);
-        r.sum_metric += r.metric[c];
-      }
-    }
-    // A stopped search proves nothing: it says so, never that no stable assembly exists.
-    r.reason = s.stopped() ? "search incomplete: the layering stopped after " + std::to_string(s.nodes_) +
-                                 " nodes (max_nodes = " + std::to_string(options.max_nodes) +
-                                 ") before finding a stable assembly; a stable one may exist: raise max_nodes (0: no "
-                                 "limit) to search further"
-                           : explain(net, s, tried_pairs);
-    r.reason += forbidden_note(options);
-  }
+  if (s.found())
+    take_found(r, net, s);
+  else
+    take_unstable(r, net, s, options, tried_pairs);
   report_progress(progress, "layering", 1.0);
   return finish();
 }

@@ -229,6 +229,162 @@ struct RawCrossing {
   Vec3 point;
 };
 
+// The crossings of wires i and j (RawCrossing, into raw), matched one to one along the line
+// their planes share; where the two only touch, a warning in net.
+void meet(Network& net, int i, int j, double tol, std::vector<RawCrossing>& raw) {
+  const WireSpec& wi = net.wires[i];
+  const WireSpec& wj = net.wires[j];
+  const Vec3 cr = wi.plane.normal.cross(wj.plane.normal);
+  if (cr.norm() < 1e-9) {
+    if (std::abs(wi.plane.signed_distance(wj.plane.origin)) <= tol) check_same_plane(wi, wj, tol);
+    return;  // parallel planes: no crossings
+  }
+  const Vec3 d = cr.normalized();
+  Eigen::Matrix3d A;
+  A.row(0) = wi.plane.normal.transpose();
+  A.row(1) = wj.plane.normal.transpose();
+  A.row(2) = d.transpose();
+  const Vec3 rhs(wi.plane.normal.dot(wi.plane.origin), wj.plane.normal.dot(wj.plane.origin), 0.0);
+  const Vec3 p0 = A.fullPivLu().solve(rhs);
+  const auto ei = plane_events(wi, wj.plane, p0, d, tol, wj.name);
+  const auto ej = plane_events(wj, wi.plane, p0, d, tol, wi.name);
+  // Greedy one-to-one matching of events closest along the line.
+  std::vector<std::tuple<double, int, int>> cand;
+  for (int a = 0; a < static_cast<int>(ei.size()); ++a)
+    for (int b = 0; b < static_cast<int>(ej.size()); ++b) {
+      const double gap = std::abs(ei[a].t - ej[b].t);
+      if (gap <= tol) cand.emplace_back(gap, a, b);
+    }
+  std::sort(cand.begin(), cand.end());
+  std::vector<char> used_a(ei.size(), 0), used_b(ej.size(), 0);
+  for (const auto& [gap, a, b] : cand) {
+    if (used_a[a] || used_b[b]) continue;
+    used_a[a] = used_b[b] = 1;
+    const Event& x = ei[a];
+    const Event& y = ej[b];
+    if (x.kind == 0 && y.kind == 0) {
+      RawCrossing rc;
+      rc.wires = {i, j};
+      rc.at = {x, y};
+      rc.t = 0.5 * (x.t + y.t);
+      rc.point = p0 + rc.t * d;
+      raw.push_back(rc);
+    } else {
+      auto how = [](const Event& e) {
+        return e.kind == 1 ? std::string("touches") : (e.kind == 2 ? std::string("ends on") : std::string("crosses"));
+      };
+      net.warnings.push_back("wires " + quoted(wi.name) + " and " + quoted(wj.name) + " meet at " +
+                             fmt_point(x.p) + " without crossing (" + quoted(wi.name) + " " + how(x) +
+                             " the plane of " + quoted(wj.name) + ", " + quoted(wj.name) + " " + how(y) +
+                             " the plane of " + quoted(wi.name) + "); no crossing is made there");
+    }
+  }
+}
+
+// Three wires through one point: refused, naming them.
+void refuse_three_at_a_point(const Network& net, const std::vector<RawCrossing>& raw, double tol) {
+  for (std::size_t a = 0; a < raw.size(); ++a)
+    for (std::size_t b = a + 1; b < raw.size(); ++b) {
+      // Within two tolerances: both could sit on one wire vertex.
+      if ((raw[a].point - raw[b].point).norm() > 2 * tol) continue;
+      std::set<int> ws{raw[a].wires[0], raw[a].wires[1], raw[b].wires[0], raw[b].wires[1]};
+      std::vector<std::string> names;
+      for (int w : ws) names.push_back(quoted(net.wires[w].name));
+      std::string list;
+      for (std::size_t k = 0; k < names.size(); ++k)
+        list += (k == 0 ? "" : (k + 1 == names.size() ? " and " : ", ")) + names[k];
+      throw InputError("wires " + list + " all pass through one point " + fmt_point(raw[a].point) +
+                       "; at most two wires may meet at a point: move one of the planes slightly");
+    }
+}
+
+// The crossings of wire w (net.crossings, in the order of raw) as vertices of its polyline, and
+// each crossing's vertex on it.
+void insert_crossings(Network& net, int w, const std::vector<RawCrossing>& raw, double tol) {
+  const int C = static_cast<int>(raw.size());
+  WireSpec& wire = net.wires[w];
+  const int n = static_cast<int>(wire.points.size());
+  std::map<int, int> at_vertex;                              // old vertex -> crossing
+  std::map<int, std::vector<std::pair<double, int>>> on_edge;  // edge -> (frac, crossing)
+  std::vector<std::pair<int, Event>> here;
+  for (int c = 0; c < C; ++c)
+    for (int k = 0; k < 2; ++k)
+      if (raw[c].wires[k] == w) here.push_back({c, raw[c].at[k]});
+  for (const auto& [c, e] : here)
+    if (e.vertex >= 0) at_vertex[e.vertex] = c;
+  for (const auto& [c, e] : here) {
+    if (e.vertex >= 0) continue;
+    const int a = e.edge, b = (e.edge + 1) % n;
+    const double len = (wire.points[b] - wire.points[a]).norm();
+    const Vec3& p = net.crossings[c].point;
+    auto interior = [&](int v) { return wire.closed || (v != 0 && v != n - 1); };
+    if ((p - wire.points[a]).norm() <= tol && interior(a) && !at_vertex.count(a)) {
+      at_vertex[a] = c;
+    } else if ((p - wire.points[b]).norm() <= tol && interior(b) && !at_vertex.count(b)) {
+      at_vertex[b] = c;
+    } else {
+      on_edge[a].push_back({e.frac * len, c});
+    }
+  }
+  Polyline3 rebuilt;
+  for (int k = 0; k < n; ++k) {
+    auto it = at_vertex.find(k);
+    if (it != at_vertex.end()) {
+      const int c = it->second;
+      const int side = net.crossings[c].wires[0] == w ? 0 : 1;
+      net.crossings[c].vertices[side] = static_cast<int>(rebuilt.size());
+      rebuilt.push_back(net.crossings[c].point);
+    } else {
+      rebuilt.push_back(wire.points[k]);
+    }
+    auto eit = on_edge.find(k);
+    if (eit == on_edge.end()) continue;
+    auto list = eit->second;
+    std::sort(list.begin(), list.end());
+    for (const auto& [s, c] : list) {
+      const int side = net.crossings[c].wires[0] == w ? 0 : 1;
+      net.crossings[c].vertices[side] = static_cast<int>(rebuilt.size());
+      rebuilt.push_back(net.crossings[c].point);
+    }
+  }
+  wire.points = std::move(rebuilt);
+}
+
+// Size of the model and crossings too close along a wire.
+void size_and_close_crossings(Network& net, const NetworkOptions& options) {
+  const int P = static_cast<int>(net.wires.size());
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  for (const auto& w : net.wires)
+    for (const auto& p : w.points) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+  net.size = P > 0 ? (hi - lo).maxCoeff() : 0.0;
+  net.min_segment = options.min_segment;
+  for (int w = 0; w < P; ++w) {
+    const WireSpec& wire = net.wires[w];
+    for (const Network::Gap& gap : net.gaps_of(w)) {
+      const int ca = gap.a, cb = gap.b;
+      const double dist = gap.arc;
+      if (dist >= options.min_segment) continue;
+      CrossingGap g;
+      g.wire = w;
+      g.crossings = {ca, cb};
+      g.distance = dist;
+      g.scale = dist > 0 ? options.min_segment / dist : 1e300;
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%.2f", g.scale);
+      const auto [apart, least] = detail::versus(dist, options.min_segment, 4, 'g');
+      g.message = "wire " + quoted(wire.name) + ": crossings " + std::to_string(ca) + " and " + std::to_string(cb) +
+                  " are " + apart + " m apart along the wire, less than the machine's minimum segment " + least +
+                  " m; scale the model up at least " + buf + " times (largest side " +
+                  fmt_len(net.size) + " -> " + fmt_len(net.size * g.scale) + ")";
+      net.min_scale = std::max(net.min_scale, g.scale);
+      net.close_crossings.push_back(g);
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<Network::Gap> Network::gaps_of(int w) const {
@@ -282,69 +438,10 @@ Network build_network(const std::vector<WireSpec>& input, const NetworkOptions& 
   for (int i = 0; i < P; ++i)
     for (int j = i + 1; j < P; ++j) {
       step();
-      const WireSpec& wi = net.wires[i];
-      const WireSpec& wj = net.wires[j];
-      const Vec3 cr = wi.plane.normal.cross(wj.plane.normal);
-      if (cr.norm() < 1e-9) {
-        if (std::abs(wi.plane.signed_distance(wj.plane.origin)) <= tol) check_same_plane(wi, wj, tol);
-        continue;  // parallel planes: no crossings
-      }
-      const Vec3 d = cr.normalized();
-      Eigen::Matrix3d A;
-      A.row(0) = wi.plane.normal.transpose();
-      A.row(1) = wj.plane.normal.transpose();
-      A.row(2) = d.transpose();
-      const Vec3 rhs(wi.plane.normal.dot(wi.plane.origin), wj.plane.normal.dot(wj.plane.origin), 0.0);
-      const Vec3 p0 = A.fullPivLu().solve(rhs);
-      const auto ei = plane_events(wi, wj.plane, p0, d, tol, wj.name);
-      const auto ej = plane_events(wj, wi.plane, p0, d, tol, wi.name);
-      // Greedy one-to-one matching of events closest along the line.
-      std::vector<std::tuple<double, int, int>> cand;
-      for (int a = 0; a < static_cast<int>(ei.size()); ++a)
-        for (int b = 0; b < static_cast<int>(ej.size()); ++b) {
-          const double gap = std::abs(ei[a].t - ej[b].t);
-          if (gap <= tol) cand.emplace_back(gap, a, b);
-        }
-      std::sort(cand.begin(), cand.end());
-      std::vector<char> used_a(ei.size(), 0), used_b(ej.size(), 0);
-      for (const auto& [gap, a, b] : cand) {
-        if (used_a[a] || used_b[b]) continue;
-        used_a[a] = used_b[b] = 1;
-        const Event& x = ei[a];
-        const Event& y = ej[b];
-        if (x.kind == 0 && y.kind == 0) {
-          RawCrossing rc;
-          rc.wires = {i, j};
-          rc.at = {x, y};
-          rc.t = 0.5 * (x.t + y.t);
-          rc.point = p0 + rc.t * d;
-          raw.push_back(rc);
-        } else {
-          auto how = [](const Event& e) {
-            return e.kind == 1 ? std::string("touches") : (e.kind == 2 ? std::string("ends on") : std::string("crosses"));
-          };
-          net.warnings.push_back("wires " + quoted(wi.name) + " and " + quoted(wj.name) + " meet at " +
-                                 fmt_point(x.p) + " without crossing (" + quoted(wi.name) + " " + how(x) +
-                                 " the plane of " + quoted(wj.name) + ", " + quoted(wj.name) + " " + how(y) +
-                                 " the plane of " + quoted(wi.name) + "); no crossing is made there");
-        }
-      }
+      meet(net, i, j, tol, raw);
     }
 
-  // Three wires through one point.
-  for (std::size_t a = 0; a < raw.size(); ++a)
-    for (std::size_t b = a + 1; b < raw.size(); ++b) {
-      // Within two tolerances: both could sit on one wire vertex.
-      if ((raw[a].point - raw[b].point).norm() > 2 * tol) continue;
-      std::set<int> ws{raw[a].wires[0], raw[a].wires[1], raw[b].wires[0], raw[b].wires[1]};
-      std::vector<std::string> names;
-      for (int w : ws) names.push_back(quoted(net.wires[w].name));
-      std::string list;
-      for (std::size_t k = 0; k < names.size(); ++k)
-        list += (k == 0 ? "" : (k + 1 == names.size() ? " and " : ", ")) + names[k];
-      throw InputError("wires " + list + " all pass through one point " + fmt_point(raw[a].point) +
-                       "; at most two wires may meet at a point: move one of the planes slightly");
-    }
+  refuse_three_at_a_point(net, raw, tol);
 
   // Crossing order: by wire pair, then along the planes' common line.
   std::sort(raw.begin(), raw.end(), [](const RawCrossing& x, const RawCrossing& y) {
@@ -361,85 +458,10 @@ Network build_network(const std::vector<WireSpec>& input, const NetworkOptions& 
   // Insert the crossings as vertices of both wires.
   for (int w = 0; w < P; ++w) {
     step();
-    WireSpec& wire = net.wires[w];
-    const int n = static_cast<int>(wire.points.size());
-    std::map<int, int> at_vertex;                              // old vertex -> crossing
-    std::map<int, std::vector<std::pair<double, int>>> on_edge;  // edge -> (frac, crossing)
-    std::vector<std::pair<int, Event>> here;
-    for (int c = 0; c < C; ++c)
-      for (int k = 0; k < 2; ++k)
-        if (raw[c].wires[k] == w) here.push_back({c, raw[c].at[k]});
-    for (const auto& [c, e] : here)
-      if (e.vertex >= 0) at_vertex[e.vertex] = c;
-    for (const auto& [c, e] : here) {
-      if (e.vertex >= 0) continue;
-      const int a = e.edge, b = (e.edge + 1) % n;
-      const double len = (wire.points[b] - wire.points[a]).norm();
-      const Vec3& p = net.crossings[c].point;
-      auto interior = [&](int v) { return wire.closed || (v != 0 && v != n - 1); };
-      if ((p - wire.points[a]).norm() <= tol && interior(a) && !at_vertex.count(a)) {
-        at_vertex[a] = c;
-      } else if ((p - wire.points[b]).norm() <= tol && interior(b) && !at_vertex.count(b)) {
-        at_vertex[b] = c;
-      } else {
-        on_edge[a].push_back({e.frac * len, c});
-      }
-    }
-    Polyline3 rebuilt;
-    for (int k = 0; k < n; ++k) {
-      auto it = at_vertex.find(k);
-      if (it != at_vertex.end()) {
-        const int c = it->second;
-        const int side = net.crossings[c].wires[0] == w ? 0 : 1;
-        net.crossings[c].vertices[side] = static_cast<int>(rebuilt.size());
-        rebuilt.push_back(net.crossings[c].point);
-      } else {
-        rebuilt.push_back(wire.points[k]);
-      }
-      auto eit = on_edge.find(k);
-      if (eit == on_edge.end()) continue;
-      auto list = eit->second;
-      std::sort(list.begin(), list.end());
-      for (const auto& [s, c] : list) {
-        const int side = net.crossings[c].wires[0] == w ? 0 : 1;
-        net.crossings[c].vertices[side] = static_cast<int>(rebuilt.size());
-        rebuilt.push_back(net.crossings[c].point);
-      }
-    }
-    wire.points = std::move(rebuilt);
+    insert_crossings(net, w, raw, tol);
   }
 
-  // Size of the model and crossings too close along a wire.
-  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-  for (const auto& w : net.wires)
-    for (const auto& p : w.points) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-  net.size = P > 0 ? (hi - lo).maxCoeff() : 0.0;
-  net.min_segment = options.min_segment;
-  for (int w = 0; w < P; ++w) {
-    const WireSpec& wire = net.wires[w];
-    for (const Network::Gap& gap : net.gaps_of(w)) {
-      const int ca = gap.a, cb = gap.b;
-      const double dist = gap.arc;
-      if (dist >= options.min_segment) continue;
-      CrossingGap g;
-      g.wire = w;
-      g.crossings = {ca, cb};
-      g.distance = dist;
-      g.scale = dist > 0 ? options.min_segment / dist : 1e300;
-      char buf[64];
-      std::snprintf(buf, sizeof buf, "%.2f", g.scale);
-      const auto [apart, least] = detail::versus(dist, options.min_segment, 4, 'g');
-      g.message = "wire " + quoted(wire.name) + ": crossings " + std::to_string(ca) + " and " + std::to_string(cb) +
-                  " are " + apart + " m apart along the wire, less than the machine's minimum segment " + least +
-                  " m; scale the model up at least " + buf + " times (largest side " +
-                  fmt_len(net.size) + " -> " + fmt_len(net.size * g.scale) + ")";
-      net.min_scale = std::max(net.min_scale, g.scale);
-      net.close_crossings.push_back(g);
-    }
-  }
+  size_and_close_crossings(net, options);
   net.required_size = net.size * net.min_scale;
   report_progress(progress, "network", 1.0);
   return net;

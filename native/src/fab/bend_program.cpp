@@ -63,6 +63,56 @@ namespace {
 
 std::string from_cut(double metres) { return fmt(to_mm(metres), 1) + " mm from the cut"; }
 
+// Feeds: every one must reach l_min. Step k feeds the wire before bend k (the G-code's and the
+// bend table's numbering), so a feed is named by the bends around it. s_at: arc length from the
+// cut at each input point; feed_start: the input point where each step's feed starts.
+void check_feeds(const BendProgram& prog, const MachineProfile& profile, const std::vector<double>& s_at,
+                 const std::vector<std::size_t>& feed_start, std::vector<BendProblem>& problems) {
+  const std::size_t n = s_at.size();
+  const int bends = static_cast<int>(prog.steps.size()) - 1;
+  for (std::size_t k = 0; k < prog.steps.size(); ++k) {
+    const BendStep& s = prog.steps[k];
+    if (s.feed + kFeedSlack < profile.min_feed) {
+      const int step = static_cast<int>(k) + 1;
+      const std::size_t to = s.vertex >= 0 ? static_cast<std::size_t>(s.vertex) : n - 1;
+      const std::string where = step == 1 ? (bends > 0 ? "from the cut to bend 1" : "the whole wire")
+                                : s.vertex < 0 ? "after bend " + std::to_string(bends) + ", to the end"
+                                               : "between bends " + std::to_string(step - 1) + " and " +
+                                                     std::to_string(step);
+      const auto [fed, least] = detail::versus(to_mm(s.feed), to_mm(profile.min_feed), 3);
+      problems.push_back({BendProblem::Kind::short_feed, step, static_cast<int>(feed_start[k]), static_cast<int>(to),
+                          s_at[feed_start[k]], s.feed, profile.min_feed,
+                          "step " + std::to_string(step) + " feeds " + fed + " mm (" + where + ", " +
+                              from_cut(s_at[feed_start[k]]) +
+                              "), shorter than the machine's minimum feed between bends of " + least + " mm"});
+    }
+  }
+}
+
+// The commanded angles (spring-back compensation) and the machine time of every step.
+void compensate_and_time(BendProgram& prog, const MachineProfile& profile, const std::vector<double>& s_at,
+                         std::vector<BendProblem>& problems) {
+  for (std::size_t k = 0; k < prog.steps.size(); ++k) {
+    BendStep& s = prog.steps[k];
+    prog.wire_length += s.feed;
+    if (s.vertex < 0) {
+      prog.machine_seconds += s.feed / profile.feed_speed;
+      continue;
+    }
+    if (std::abs(s.bend) > profile.max_bend + kAngleSlack) continue;  // already a problem: over the limit
+    try {
+      s.commanded = compensate(s.bend, profile, static_cast<int>(k + 1));
+    } catch (const InputError& e) {
+      problems.push_back({BendProblem::Kind::command, static_cast<int>(k) + 1, s.vertex, s.vertex,
+                          s_at[static_cast<std::size_t>(s.vertex)], std::abs(s.bend), profile.max_commanded,
+                          e.what()});
+      continue;
+    }
+    prog.machine_seconds += std::max(profile.seconds_per_bend,
+                                     s.feed / profile.feed_speed + 2.0 * std::abs(s.commanded) / profile.bend_speed);
+  }
+}
+
 // The program and everything that keeps it from being made (bend_program.hpp); input errors throw.
 BendProgram build(const Polyline2& points, const MachineProfile& profile, std::vector<BendProblem>& problems) {
   validate(profile);
@@ -146,47 +196,8 @@ BendProgram build(const Polyline2& points, const MachineProfile& profile, std::v
   prog.dropped_turn = carry;
   prog.bend_count = static_cast<int>(prog.steps.size()) - 1;
 
-  // Feeds: every one must reach l_min. Step k feeds the wire before bend k (the G-code's and the
-  // bend table's numbering), so a feed is named by the bends around it.
-  const int bends = static_cast<int>(prog.steps.size()) - 1;
-  for (std::size_t k = 0; k < prog.steps.size(); ++k) {
-    const BendStep& s = prog.steps[k];
-    if (s.feed + kFeedSlack < profile.min_feed) {
-      const int step = static_cast<int>(k) + 1;
-      const std::size_t to = s.vertex >= 0 ? static_cast<std::size_t>(s.vertex) : n - 1;
-      const std::string where = step == 1 ? (bends > 0 ? "from the cut to bend 1" : "the whole wire")
-                                : s.vertex < 0 ? "after bend " + std::to_string(bends) + ", to the end"
-                                               : "between bends " + std::to_string(step - 1) + " and " +
-                                                     std::to_string(step);
-      const auto [fed, least] = detail::versus(to_mm(s.feed), to_mm(profile.min_feed), 3);
-      problems.push_back({BendProblem::Kind::short_feed, step, static_cast<int>(feed_start[k]), static_cast<int>(to),
-                          s_at[feed_start[k]], s.feed, profile.min_feed,
-                          "step " + std::to_string(step) + " feeds " + fed + " mm (" + where + ", " +
-                              from_cut(s_at[feed_start[k]]) +
-                              "), shorter than the machine's minimum feed between bends of " + least + " mm"});
-    }
-  }
-
-  // Compensation and time.
-  for (std::size_t k = 0; k < prog.steps.size(); ++k) {
-    BendStep& s = prog.steps[k];
-    prog.wire_length += s.feed;
-    if (s.vertex < 0) {
-      prog.machine_seconds += s.feed / profile.feed_speed;
-      continue;
-    }
-    if (std::abs(s.bend) > profile.max_bend + kAngleSlack) continue;  // already a problem: over the limit
-    try {
-      s.commanded = compensate(s.bend, profile, static_cast<int>(k + 1));
-    } catch (const InputError& e) {
-      problems.push_back({BendProblem::Kind::command, static_cast<int>(k) + 1, s.vertex, s.vertex,
-                          s_at[static_cast<std::size_t>(s.vertex)], std::abs(s.bend), profile.max_commanded,
-                          e.what()});
-      continue;
-    }
-    prog.machine_seconds += std::max(profile.seconds_per_bend,
-                                     s.feed / profile.feed_speed + 2.0 * std::abs(s.commanded) / profile.bend_speed);
-  }
+  check_feeds(prog, profile, s_at, feed_start, problems);
+  compensate_and_time(prog, profile, s_at, problems);
 
   prog.shape_error = arclength_distance(points, rebuild_polyline(prog));
   return prog;

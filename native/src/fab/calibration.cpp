@@ -295,9 +295,9 @@ Polyline2 simulate_cantilever(double kb, double length, double tip_force, double
   return x;
 }
 
-CantileverFit fit_cantilever(const std::vector<CantileverRecord>& records, const CantileverOptions& o) {
-  const double L = o.overhang;
-  if (!(L > 0) || !std::isfinite(L)) throw InputError("cantilever: the overhang must be a length > 0 m");
+namespace {
+
+void check_options(const CantileverOptions& o) {
   if (!(o.linear_density >= 0) || !std::isfinite(o.linear_density))
     throw InputError("cantilever: the linear density must be >= 0 kg/m");
   if (!(o.gravity > 0) || !std::isfinite(o.gravity)) throw InputError("cantilever: gravity must be > 0");
@@ -307,9 +307,12 @@ CantileverFit fit_cantilever(const std::vector<CantileverRecord>& records, const
     throw InputError("cantilever: smoothing_degree >= 2, nodes >= 3 and simulation_segments >= 2 are needed");
   if (o.smoothing_degree > 50 || o.nodes > 1000 || o.simulation_segments > 100000)
     throw InputError("cantilever: smoothing_degree <= 50, nodes <= 1000 and simulation_segments <= 100000 are the limits");
-  if (records.empty()) throw InputError("cantilever: the capture has no rows");
+}
 
-  // Group rows into frames (load, loaded), loads ascending, loaded before unloaded.
+// The capture's rows grouped into frames (load, loaded), loads ascending, loaded before
+// unloaded, each frame's marks in order along the wire.
+std::vector<CantileverFrame> frames_of(const std::vector<CantileverRecord>& records, double L) {
+  std::vector<CantileverFrame> frames;
   std::map<std::pair<double, int>, CantileverFrame> groups;
   for (const CantileverRecord& r : records) {
     if (!std::isfinite(r.load) || r.load < 0)
@@ -327,7 +330,6 @@ CantileverFit fit_cantilever(const std::vector<CantileverRecord>& records, const
     f.s.push_back(r.s);
     f.deflection.push_back(r.deflection);
   }
-  CantileverFit fit;
   for (auto& entry : groups) {
     CantileverFrame& f = entry.second;  // not a structured binding: lambdas capture it (clang 14)
     std::vector<int> order(f.s.size());
@@ -347,10 +349,16 @@ CantileverFit fit_cantilever(const std::vector<CantileverRecord>& records, const
       throw InputError(at_line(f.line) + "the " + grams(f.load) + (f.loaded ? " loaded" : " unloaded") +
                        " frame has " + std::to_string(f.s.size()) +
                        (f.s.size() == 1 ? " mark" : " marks") + "; at least 3 along the wire are needed");
-    fit.frames.push_back(f);
+    frames.push_back(f);
   }
+  return frames;
+}
 
-  // Plastic limit: the largest load up to which every unloaded shape returns to the 0 g shape.
+// Plastic limit: the largest load up to which every unloaded shape returns to the 0 g shape
+// (the largest loaded frame's load when no frame is unloaded). Sets the fit's plastic_* fields
+// and every unloaded frame's return_error.
+double plastic_limit(CantileverFit& fit, const CantileverOptions& o) {
+  const double L = o.overhang;
   const CantileverFrame* initial = nullptr;
   bool any_unloaded = false;
   for (const CantileverFrame& f : fit.frames) {
@@ -372,7 +380,7 @@ CantileverFit fit_cantilever(const std::vector<CantileverRecord>& records, const
     // more than kNoiseReach standard deviations of the difference that the marks' noise makes
     // (from the polynomials' covariances and the pooled scatter of the two frames). Reading
     // noise of half a millimetre on both frames would otherwise push the largest mark difference
-    // past 1 mm on a wire that returned (issue 21 item 9). Noise-free marks: the plain rule.
+    // past 1 mm on a wire that returned. Noise-free marks: the plain rule.
     constexpr double kNoiseReach = 2.0;
     const Smoothed initial_shape = smooth(*initial, L, o.smoothing_degree);
     const auto powers = [&](const Smoothed& sm, double s) {
@@ -425,6 +433,49 @@ CantileverFit fit_cantilever(const std::vector<CantileverRecord>& records, const
     }
     fit.plastic_load = limit_load;
   }
+  return limit_load;
+}
+
+// Check: simulate every used frame with the fitted k_b, compare at the marks.
+void compare_with_simulation(CantileverFit& fit, const CantileverOptions& o, double weight) {
+  const double L = o.overhang;
+  double sum_d2 = 0.0;
+  int marks = 0;
+  for (std::size_t fi = 0; fi < fit.frames.size(); ++fi) {
+    CantileverFrame& f = fit.frames[fi];
+    if (!f.used) continue;
+    const int m = o.simulation_segments;
+    const Polyline2 sim = simulate_cantilever(fit.bending_stiffness, L, f.load * o.gravity, weight, m);
+    const double hs = L / m;
+    double frame_d2 = 0.0;
+    for (std::size_t i = 0; i < f.s.size(); ++i) {
+      const int k = std::clamp(static_cast<int>(std::floor(f.s[i] / hs)), 0, m - 1);
+      const double t = (f.s[i] - k * hs) / hs;
+      const Vec2 p = (1.0 - t) * sim[k] + t * sim[k + 1];
+      f.simulated.push_back(-p.y());
+      const double d2 = (p - Vec2(f.x[i], -f.deflection[i])).squaredNorm();
+      frame_d2 += d2;
+      fit.position_max = std::max(fit.position_max, std::sqrt(d2));
+    }
+    f.position_rms = std::sqrt(frame_d2 / static_cast<double>(f.s.size()));
+    sum_d2 += frame_d2;
+    marks += static_cast<int>(f.s.size());
+  }
+  fit.position_rms = std::sqrt(sum_d2 / marks);
+}
+
+}  // namespace
+
+CantileverFit fit_cantilever(const std::vector<CantileverRecord>& records, const CantileverOptions& o) {
+  const double L = o.overhang;
+  if (!(L > 0) || !std::isfinite(L)) throw InputError("cantilever: the overhang must be a length > 0 m");
+  check_options(o);
+  if (records.empty()) throw InputError("cantilever: the capture has no rows");
+
+  CantileverFit fit;
+  fit.frames = frames_of(records, L);
+
+  const double limit_load = plastic_limit(fit, o);
 
   // Eq. 13: k_b = Σ g t / Σ g² over the evaluation nodes of the used frames.
   const int nodes = o.nodes;
@@ -483,30 +534,7 @@ CantileverFit fit_cantilever(const std::vector<CantileverRecord>& records, const
     }
   }
 
-  // Check: simulate every used frame with the fitted k_b, compare at the marks.
-  double sum_d2 = 0.0;
-  int marks = 0;
-  for (std::size_t fi = 0; fi < fit.frames.size(); ++fi) {
-    CantileverFrame& f = fit.frames[fi];
-    if (!f.used) continue;
-    const int m = o.simulation_segments;
-    const Polyline2 sim = simulate_cantilever(fit.bending_stiffness, L, f.load * o.gravity, weight, m);
-    const double hs = L / m;
-    double frame_d2 = 0.0;
-    for (std::size_t i = 0; i < f.s.size(); ++i) {
-      const int k = std::clamp(static_cast<int>(std::floor(f.s[i] / hs)), 0, m - 1);
-      const double t = (f.s[i] - k * hs) / hs;
-      const Vec2 p = (1.0 - t) * sim[k] + t * sim[k + 1];
-      f.simulated.push_back(-p.y());
-      const double d2 = (p - Vec2(f.x[i], -f.deflection[i])).squaredNorm();
-      frame_d2 += d2;
-      fit.position_max = std::max(fit.position_max, std::sqrt(d2));
-    }
-    f.position_rms = std::sqrt(frame_d2 / static_cast<double>(f.s.size()));
-    sum_d2 += frame_d2;
-    marks += static_cast<int>(f.s.size());
-  }
-  fit.position_rms = std::sqrt(sum_d2 / marks);
+  compare_with_simulation(fit, o, weight);
   return fit;
 }
 

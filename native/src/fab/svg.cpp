@@ -64,6 +64,77 @@ double wire_length_mm(const TemplateWire& w) {
   return to_mm(s);
 }
 
+// The closing overlap of a loop: the last `overlap` of the path q (page coordinates, mm), a wide band.
+std::string overlap_band(const TemplateWire& w, const std::vector<Vec2>& q, const SvgOptions& o) {
+  double left = to_mm(w.overlap);
+  std::vector<Vec2> band{q.back()};
+  for (std::size_t i = q.size() - 1; i > 0 && left > 0.0; --i) {
+    const double len = (q[i] - q[i - 1]).norm();
+    if (len >= left) {
+      band.push_back(q[i] + (left / len) * (q[i - 1] - q[i]));
+      left = 0.0;
+    } else {
+      band.push_back(q[i - 1]);
+      left -= len;
+    }
+  }
+  std::string s = "    <g class=\"overlap\" data-mm=\"" + num(to_mm(w.overlap)) +
+                  "\"><polyline fill=\"none\" stroke=\"#00a070\" "
+                  "stroke-opacity=\"0.45\" stroke-width=\"" + num(4 * o.stroke_mm) + "\" stroke-linecap=\"butt\" points=\"";
+  for (std::size_t i = 0; i < band.size(); ++i) {
+    if (i) s += ' ';
+    s += num(band[i].x());
+    s += ',';
+    s += num(band[i].y());
+  }
+  char words[96];
+  std::snprintf(words, sizeof words, "overlap %.1f mm past the loop's cut", to_mm(w.overlap));
+  const Vec2 at = band.back();
+  s += "\"/><text x=\"" + num(at.x() + o.tick_mm) + "\" y=\"" + num(at.y() + o.tick_mm + 0.6 * o.label_mm) +
+       "\" font-family=\"sans-serif\" font-size=\"" + num(0.6 * o.label_mm) + "\" fill=\"#00a070\">" + words +
+       "</text></g>\n";
+  return s;
+}
+
+// Where the bender starts (a dot on the first point), which way the wire comes out of it (an
+// arrow beside the first segment, pointing along it) and where it is cut (a bar across the
+// last point). All in green, away from the black centreline, ticks and rings.
+std::string start_and_cut(const std::vector<Vec2>& q, const SvgOptions& o) {
+  const std::string mark = "#008060";
+  const double sw = o.stroke_mm * 0.6;
+  std::string s = "    <circle class=\"start\" cx=\"" + num(q.front().x()) + "\" cy=\"" + num(q.front().y()) +
+                  "\" r=\"" + num(1.5 * o.stroke_mm + 0.5) + "\" fill=\"" + mark + "\"/>\n";
+  if (q.size() >= 2) {
+    std::size_t j = 1;  // the first point apart from the start: the feed direction
+    while (j + 1 < q.size() && (q[j] - q[0]).norm() < 1e-9) ++j;
+    Vec2 d = q[j] - q[0];
+    const double seg = d.norm();
+    d = seg > 1e-12 ? Vec2(d / seg) : Vec2(1, 0);
+    const Vec2 n(-d.y(), d.x());
+    const double along = std::min(10.0, std::max(seg, 4.0));  // arrow length, mm
+    const Vec2 a = q[0] + o.tick_mm * n, tip = a + along * d;
+    const Vec2 h1 = tip - 1.5 * d + 0.8 * n, h2 = tip - 1.5 * d - 0.8 * n;
+    s += "    <g class=\"feed\" data-dx=\"" + num(d.x()) + "\" data-dy=\"" + num(d.y()) + "\">";
+    s += "<line x1=\"" + num(a.x()) + "\" y1=\"" + num(a.y()) + "\" x2=\"" + num(tip.x()) + "\" y2=\"" + num(tip.y()) +
+         "\" stroke=\"" + mark + "\" stroke-width=\"" + num(sw) + "\"/>";
+    s += "<polygon points=\"" + num(tip.x()) + "," + num(tip.y()) + " " + num(h1.x()) + "," + num(h1.y()) + " " +
+         num(h2.x()) + "," + num(h2.y()) + "\" fill=\"" + mark + "\"/></g>\n";
+    // the cut: a bar across the wire at its last point
+    std::size_t k = q.size() - 2;
+    while (k > 0 && (q.back() - q[k]).norm() < 1e-9) --k;
+    Vec2 e = q.back() - q[k];
+    e = e.norm() > 1e-12 ? Vec2(e.normalized()) : Vec2(1, 0);
+    const Vec2 en(-e.y(), e.x());
+    const Vec2 c1 = q.back() + o.tick_mm * en, c2 = q.back() - o.tick_mm * en;
+    s += "    <line class=\"cut\" x1=\"" + num(c1.x()) + "\" y1=\"" + num(c1.y()) + "\" x2=\"" + num(c2.x()) +
+         "\" y2=\"" + num(c2.y()) + "\" stroke=\"" + mark + "\" stroke-width=\"" + num(2 * sw) + "\"/>\n";
+    const Vec2 t = q.back() + (o.tick_mm + 1.0) * en;
+    s += "    <text class=\"cut-label\" x=\"" + num(t.x()) + "\" y=\"" + num(t.y()) +
+         "\" font-family=\"sans-serif\" font-size=\"" + num(0.6 * o.label_mm) + "\" fill=\"" + mark + "\">cut</text>\n";
+  }
+  return s;
+}
+
 // The wire's elements with its cell's top-left corner at (ox, oy) on the page.
 std::string wire_group(const TemplateWire& w, std::size_t index, double ox, double oy, const SvgOptions& o) {
   const Box b = bbox_mm(w);
@@ -83,34 +154,7 @@ std::string wire_group(const TemplateWire& w, std::size_t index, double ox, doub
     s += num(q[i].y());
   }
   s += "\"/>\n";
-  if (w.overlap > 0.0 && q.size() >= 2) {  // the closing overlap: the last `overlap` of the path, a wide band
-    double left = to_mm(w.overlap);
-    std::vector<Vec2> band{q.back()};
-    for (std::size_t i = q.size() - 1; i > 0 && left > 0.0; --i) {
-      const double len = (q[i] - q[i - 1]).norm();
-      if (len >= left) {
-        band.push_back(q[i] + (left / len) * (q[i - 1] - q[i]));
-        left = 0.0;
-      } else {
-        band.push_back(q[i - 1]);
-        left -= len;
-      }
-    }
-    s += "    <g class=\"overlap\" data-mm=\"" + num(to_mm(w.overlap)) + "\"><polyline fill=\"none\" stroke=\"#00a070\" "
-         "stroke-opacity=\"0.45\" stroke-width=\"" + num(4 * o.stroke_mm) + "\" stroke-linecap=\"butt\" points=\"";
-    for (std::size_t i = 0; i < band.size(); ++i) {
-      if (i) s += ' ';
-      s += num(band[i].x());
-      s += ',';
-      s += num(band[i].y());
-    }
-    char words[96];
-    std::snprintf(words, sizeof words, "overlap %.1f mm past the loop's cut", to_mm(w.overlap));
-    const Vec2 at = band.back();
-    s += "\"/><text x=\"" + num(at.x() + o.tick_mm) + "\" y=\"" + num(at.y() + o.tick_mm + 0.6 * o.label_mm) +
-         "\" font-family=\"sans-serif\" font-size=\"" + num(0.6 * o.label_mm) + "\" fill=\"#00a070\">" + words +
-         "</text></g>\n";
-  }
+  if (w.overlap > 0.0 && q.size() >= 2) s += overlap_band(w, q, o);
   const std::string preview_colour = "#8000c0";
   if (w.preview.size() >= 2) {  // the predicted wire: dashed, thinner, violet (named in the legend)
     s += "    <polyline class=\"preview\" fill=\"none\" stroke=\"" + preview_colour + "\" stroke-width=\"" +
@@ -173,41 +217,7 @@ std::string wire_group(const TemplateWire& w, std::size_t index, double ox, doub
     s += "<text x=\"" + num(lx + 10.0) + "\" y=\"" + num(ly) + "\" font-family=\"sans-serif\" font-size=\"" +
          num(0.6 * o.label_mm) + "\" fill=\"" + preview_colour + "\">" + words + "</text></g>\n";
   }
-  // Where the bender starts (a dot on the first point), which way the wire comes out of it (an
-  // arrow beside the first segment, pointing along it) and where it is cut (a bar across the
-  // last point). All in green, away from the black centreline, ticks and rings.
-  const std::string mark = "#008060";
-  const double sw = o.stroke_mm * 0.6;
-  s += "    <circle class=\"start\" cx=\"" + num(q.front().x()) + "\" cy=\"" + num(q.front().y()) + "\" r=\"" +
-       num(1.5 * o.stroke_mm + 0.5) + "\" fill=\"" + mark + "\"/>\n";
-  if (q.size() >= 2) {
-    std::size_t j = 1;  // the first point apart from the start: the feed direction
-    while (j + 1 < q.size() && (q[j] - q[0]).norm() < 1e-9) ++j;
-    Vec2 d = q[j] - q[0];
-    const double seg = d.norm();
-    d = seg > 1e-12 ? Vec2(d / seg) : Vec2(1, 0);
-    const Vec2 n(-d.y(), d.x());
-    const double along = std::min(10.0, std::max(seg, 4.0));  // arrow length, mm
-    const Vec2 a = q[0] + o.tick_mm * n, tip = a + along * d;
-    const Vec2 h1 = tip - 1.5 * d + 0.8 * n, h2 = tip - 1.5 * d - 0.8 * n;
-    s += "    <g class=\"feed\" data-dx=\"" + num(d.x()) + "\" data-dy=\"" + num(d.y()) + "\">";
-    s += "<line x1=\"" + num(a.x()) + "\" y1=\"" + num(a.y()) + "\" x2=\"" + num(tip.x()) + "\" y2=\"" + num(tip.y()) +
-         "\" stroke=\"" + mark + "\" stroke-width=\"" + num(sw) + "\"/>";
-    s += "<polygon points=\"" + num(tip.x()) + "," + num(tip.y()) + " " + num(h1.x()) + "," + num(h1.y()) + " " +
-         num(h2.x()) + "," + num(h2.y()) + "\" fill=\"" + mark + "\"/></g>\n";
-    // the cut: a bar across the wire at its last point
-    std::size_t k = q.size() - 2;
-    while (k > 0 && (q.back() - q[k]).norm() < 1e-9) --k;
-    Vec2 e = q.back() - q[k];
-    e = e.norm() > 1e-12 ? Vec2(e.normalized()) : Vec2(1, 0);
-    const Vec2 en(-e.y(), e.x());
-    const Vec2 c1 = q.back() + o.tick_mm * en, c2 = q.back() - o.tick_mm * en;
-    s += "    <line class=\"cut\" x1=\"" + num(c1.x()) + "\" y1=\"" + num(c1.y()) + "\" x2=\"" + num(c2.x()) +
-         "\" y2=\"" + num(c2.y()) + "\" stroke=\"" + mark + "\" stroke-width=\"" + num(2 * sw) + "\"/>\n";
-    const Vec2 t = q.back() + (o.tick_mm + 1.0) * en;
-    s += "    <text class=\"cut-label\" x=\"" + num(t.x()) + "\" y=\"" + num(t.y()) +
-         "\" font-family=\"sans-serif\" font-size=\"" + num(0.6 * o.label_mm) + "\" fill=\"" + mark + "\">cut</text>\n";
-  }
+  s += start_and_cut(q, o);
   s += "  </g>\n";
   return s;
 }
