@@ -1,13 +1,11 @@
 """The code's shape limits: no function body in native/src over 120 lines, no lambda there over
-40, no Python function in the add-on with more than 8 parameters.
+40 (the add-on's parameter limit is test_parameters.py's).
 
 A body's length is counted in physical lines, from the line of its opening brace to the line of
 its closing brace, both included; a function's lines include those of the lambdas inside it,
 and each lambda is also measured alone. The C++ is read by a brace-matching scan over the
 source with its comments, string and character literals and preprocessor lines blanked (line
-breaks kept), so it needs no compiler. Python parameters are counted from the syntax tree:
-self and cls (as the first parameter) are not counted, *args and **kwargs count one each."""
-import ast
+breaks kept), so it needs no compiler."""
 import os
 import re
 import unittest
@@ -16,30 +14,13 @@ from helpers import ROOT
 
 MAX_FUNCTION_LINES = 120
 MAX_LAMBDA_LINES = 40
-MAX_PARAMETERS = 8
 
-# Functions allowed more than MAX_PARAMETERS parameters, "module.path:qualified.name" -> reason.
-# At most three.
-PARAMETER_EXCEPTIONS = {
-    "ui.panel:WIRESCULPT_UL_contours.draw_item": "Blender calls UIList.draw_item with these eight "
-                                                  "arguments after self; the signature is Blender's",
-}
-
-# Offenders that branches in work now remove (the target-shape stage's split, one context object
-# for a solve); emptied once those are merged. Native entries are path prefixes below the root.
+# Offenders that a branch in work now removes (the target-shape stage's split); emptied once it is
+# merged. Entries are path prefixes below the root.
 PENDING_NATIVE = {
     "native/src/target_shape",
     "native/src/numpy_sum.hpp",
     "native/src/small_triangular.hpp",
-}
-PENDING_PYTHON = {
-    "native:stream_program",
-    "pipeline:shape_and_rest",
-    "pipeline:hooks_by_forces",
-    "plane_search:nearby",
-    "plane_search:auto",
-    "fab.streaming:StreamJob.__init__",
-    "core.stale:changes",
 }
 
 IDENT = re.compile(r"[A-Za-z_][A-Za-z_0-9]*")
@@ -303,51 +284,6 @@ def native_offenders():
     return out
 
 
-def parameter_count(node):
-    a = node.args
-    positional = a.posonlyargs + a.args
-    count = len(positional) + len(a.kwonlyargs) + (a.vararg is not None) + (a.kwarg is not None)
-    if positional and positional[0].arg in ("self", "cls"):
-        count -= 1
-    return count
-
-
-def python_functions(source):
-    """[(qualified name, line, parameters)] of every def in a module."""
-    out = []
-
-    def walk(node, prefix):
-        for child in ast.iter_child_nodes(node):
-            if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef)):
-                name = prefix + child.name
-                out.append((name, child.lineno, parameter_count(child)))
-                walk(child, name + ".")
-            elif isinstance(child, ast.ClassDef):
-                walk(child, prefix + child.name + ".")
-            else:
-                walk(child, prefix)
-
-    walk(ast.parse(source), "")
-    return out
-
-
-def python_offenders(allowed):
-    """["module:name (line N): P parameters"] of the add-on, names in `allowed` left out."""
-    out = []
-    package = os.path.join(ROOT, "addon", "wiresculpt")
-    for folder, _dirs, files in os.walk(package):
-        for name in sorted(files):
-            if not name.endswith(".py"):
-                continue
-            path = os.path.join(folder, name)
-            module = os.path.relpath(path, package)[:-3].replace(os.sep, ".")
-            for qualified, line, count in python_functions(open(path, encoding="utf-8").read()):
-                key = f"{module}:{qualified}"
-                if count > MAX_PARAMETERS and key not in allowed:
-                    out.append(f"{key} (line {line}): {count} parameters (at most {MAX_PARAMETERS})")
-    return out
-
-
 def numbered(body_lines, head="void f() {", tail="}"):
     """A function whose body spans `body_lines` lines, braces' lines included."""
     inner = [f"  x += {k};" for k in range(body_lines - 2)]
@@ -426,22 +362,11 @@ class Scanner(unittest.TestCase):
         self.assertEqual(measure(src), [("function", 9, 5), ("function", 14, 1), ("function", 20, 3),
                                         ("function", 25, 3)])
 
-    def test_python_parameters_leave_out_self_and_count_star_arguments_once(self):
-        src = ("def f(a, b, /, c, *args, d, **kw):\n    pass\n"
-               "class C:\n    def m(self, a):\n        def inner(x, y): pass\n"
-               "    @classmethod\n    def k(cls): pass\n")
-        self.assertEqual(python_functions(src), [("f", 1, 6), ("C.m", 4, 1), ("C.m.inner", 5, 2), ("C.k", 7, 0)])
-
 
 class Limits(unittest.TestCase):
     def test_native_functions_and_lambdas_are_short(self):
         offenders = native_offenders()
         self.assertEqual(offenders, [], "split these by role:\n" + "\n".join(offenders))
-
-    def test_python_functions_take_few_parameters(self):
-        self.assertLessEqual(len(PARAMETER_EXCEPTIONS), 3, "at most three documented exceptions")
-        offenders = python_offenders(set(PARAMETER_EXCEPTIONS) | PENDING_PYTHON)
-        self.assertEqual(offenders, [], "pass a context or an options object instead:\n" + "\n".join(offenders))
 
 
 if __name__ == "__main__":
