@@ -249,6 +249,25 @@ TEST_CASE("structure3d: two rods tied at a point: equal and opposite tie forces,
   CHECK(r.wires[0].max_distance > 1e-4);  // A's tip sags
 }
 
+TEST_CASE("structure3d: a tie with an offset holds its offset and still balances", "[structure3d]") {
+  // tied_pair with the tie's nodes to be 3 mm apart along z (A's above B's, as two wires' axes at
+  // a crossing), from a start where they coincide: the start is made to hold the tie, the result
+  // holds it to rounding, and each wire's forces balance with ±T.
+  Structure3dInput in = tied_pair();
+  in.ties[0].offset = Vec3(0.0, 0.0, 0.003);
+  const Structure3dOptions o;
+  const Structure3dResult r = solve_structure3d(in, o);
+  INFO(describe(r.cause, r.cause_figure));
+  REQUIRE(r.converged);
+  CHECK((r.wires[0].points[4] - r.wires[1].points[4] - in.ties[0].offset).norm() < 1e-12);
+  const std::vector<std::vector<Vec3>> weight = lumped_weight(in, o);
+  Vec3 on_a = r.clamps[0].force + in.loads[0].force + r.tie_forces[0];
+  Vec3 on_b = r.pins[0].force + r.pins[1].force + in.loads[1].force - r.tie_forces[0];
+  for (int v = 0; v < 9; ++v) on_a += weight[0][v], on_b += weight[1][v];
+  CHECK(on_a.norm() < 1e-7 * r.load_scale);
+  CHECK(on_b.norm() < 1e-7 * r.load_scale);
+}
+
 TEST_CASE("structure3d: a wire held at one point does not stand", "[structure3d]") {
   // A and B as tied_pair, but B straight along y (plane x = 0.1) and held by its one tie alone.
   Polyline3 a;
