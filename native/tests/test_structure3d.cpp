@@ -438,6 +438,29 @@ TEST_CASE("structure3d: bad input gives one InputError naming it", "[structure3d
   fails(good, "shear_modulus", o);
 }
 
+TEST_CASE("structure3d: moving too far and running out of iterations are told apart", "[structure3d]") {
+  // The elastica of P L²/EI = 2 (tip down 0.49 L = 15 cm): with max_motion 1 cm it has moved away;
+  // with one Newton iteration it has not converged. The sentence names the motion in mm.
+  Structure3dInput in;
+  in.wires.push_back(wire("cantilever", cantilever_points(0.3, 10), Vec3::UnitY()));
+  in.clamps.push_back({0, 0});
+  in.loads.push_back({{0, 10}, Vec3(0, 0, -2.0 * 0.73 / 0.09)});
+  Structure3dOptions o = weightless();
+  o.max_motion = 0.01;
+  const Structure3dResult far = solve_structure3d(in, o);
+  CHECK_FALSE(far.converged);
+  CHECK(far.cause == Structure3dCause::moved_away);
+  CHECK(far.cause_figure > 0.01);
+  CHECK(describe(far.cause, far.cause_figure).find(" mm ") != std::string::npos);
+  o = weightless();
+  o.max_iterations = 1;
+  const Structure3dResult capped = solve_structure3d(in, o);
+  CHECK_FALSE(capped.converged);
+  CHECK(capped.cause == Structure3dCause::iteration_cap);
+  CHECK(capped.iterations == 1);
+  CHECK(capped.residual > o.tolerance);
+}
+
 TEST_CASE("structure3d: progress is reported and cancellation honoured", "[structure3d]") {
   Structure3dInput in;
   in.wires.push_back(wire("cantilever", cantilever_points(0.3, 10), Vec3::UnitY()));

@@ -44,7 +44,8 @@
 // larger (coordinates carry ε × size; 2e-8 N for 3 mm steel, 1 cm edges, a 0.2 m structure).
 //
 // Not standing. (1) At the start, the unbalanced forces g drive a motion nothing resists when the
-// linear response (H + 1e-14 × its largest diagonal)⁻¹ g, table contacts closed, moves a node over
+// linear response (H + 1e-14 × its largest diagonal)⁻¹ g, table contacts closed (every table node
+// at most `smoothing` above the table given the table's stiffness), moves a node over
 // 100 × size (a resisted response is a few sizes at most): mechanism. (2) At convergence the
 // unregularised reduced Hessian must be positive definite, every LDLᵀ pivot above 1e-12 of the
 // largest: otherwise mechanism. A wire whose spin about itself (all its angles turned alike, no
