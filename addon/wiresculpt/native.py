@@ -226,6 +226,29 @@ def forces_and_rest(wires, crossings, steps, material, settings=None, progress=N
                                      progress)
 
 
+# The causes of structure3d's result (native/include/wiresculpt/structure3d.hpp, Structure3dCause).
+STRUCTURE3D_CAUSES = ("none", "mechanism", "no_equilibrium", "moved_away", "iteration_cap")
+
+
+def structure3d(wires, ties=None, loads=None, clamps=None, pins=None, table=None, options=None, progress=None):
+    """The 3D equilibrium of the assembled structure (discrete elastic rods tied at their crossings).
+    wires: [{"name", "rest" (n, 3) m, "start" (n, 3) m, "normal" (3)}]; nodes are [wire, vertex];
+    ties: [{"a", "b", "offset"}]; loads: [{"node", "force" N}]; clamps, pins: [node];
+    table: {"z0", "nodes", "stiffness", "smoothing", "hold_horizontal"} or None.
+    Returns {"converged", "cause" (STRUCTURE3D_CAUSES), "message", "residual", "iterations",
+    "wires": [{"points" (n, 3), "angles", "max_distance", "max_distance_vertex"}],
+    "tie_forces" (force on node a, N), "clamps", "pins", "table": [{"node", "force", "moment"}]}."""
+    items = [_point_item(_point_item(item, i, "wires", "rest", 3), i, "wires", "start", 3)
+             for i, item in enumerate(_list(wires, "wires"))]
+    return require().structure3d(items, ties, loads, clamps, pins, table, options, progress)
+
+
+def pyramid_fit(force, pyramid):
+    """Whether `force` (3) lies in the cone of the four rows of `pyramid` (4, 3), e.g. a crossing's
+    contact pyramid: {"coefficients", "distance" N, "inside"}."""
+    return require().pyramid_fit(force, as_points(pyramid, "pyramid"))
+
+
 # --- fabrication -----------------------------------------------------------------------------------
 
 def default_machine_profile():

@@ -11,5 +11,6 @@ void bind_layering(pybind11::module_& m);
 void bind_target_shape(pybind11::module_& m);
 void bind_forces(pybind11::module_& m);
 void bind_calibration(pybind11::module_& m);
+void bind_structure3d(pybind11::module_& m);
 
 }  // namespace wiresculpt::python

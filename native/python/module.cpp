@@ -39,4 +39,5 @@ PYBIND11_MODULE(_wiresculpt, m) {
   wiresculpt::python::bind_target_shape(m);
   wiresculpt::python::bind_forces(m);
   wiresculpt::python::bind_calibration(m);
+  wiresculpt::python::bind_structure3d(m);
 }
