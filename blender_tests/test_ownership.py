@@ -168,3 +168,24 @@ class NothingLeaks(Case):
         self.assertEqual(streaming.PENDING, {})
         self.assertEqual(streaming.LAST, {})
         self.assertGreater(session.generation(), generation)
+
+    def test_a_stream_that_ends_after_a_load_records_nothing(self):
+        import numpy as np
+
+        square = np.array([[0, 0], [0.05, 0], [0.05, 0.05], [0, 0.05]], dtype=float)
+        lines = native.stream_lines(native.write_gcode(None, square, {}, "Slice A/0", "steel"))
+        profile = native.validate_machine_profile({})
+
+        def dry_run():
+            return streaming.StreamJob("Slice A/0", "/dev/null-port", lines, profile, {}, dry_run=True)
+
+        job = dry_run()
+        job.run()
+        streaming.finish(job)  # in the file it started from: its last run is shown
+        self.assertIn("Slice A/0", streaming.LAST)
+        job = dry_run()
+        bpy.ops.wm.read_homefile(use_empty=True)  # the file closes while the stream runs
+        job.run()
+        self.assertEqual(streaming.finish(job)[0], {'INFO'})
+        self.assertEqual(streaming.LAST, {})
+        self.assertEqual(streaming.PENDING, {})
