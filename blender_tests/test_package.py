@@ -120,6 +120,25 @@ OPTIMIZE = textwrap.dedent("""
     print("WIRES", len(wires))
 """)
 
+# The extension zip put through the legacy Add-ons > Install (Blender 3.4): which add-ons Blender
+# lists as new, what they say, and what enabling them does.
+WRONG_ZIP = textwrap.dedent("""
+    import json, sys, addon_utils, bpy
+    zip_path, user = sys.argv[sys.argv.index("--") + 1:]
+    before = {m.__name__ for m in addon_utils.modules()}
+    result = bpy.ops.preferences.addon_install(filepath=zip_path)
+    new = sorted({m.__name__ for m in addon_utils.modules(refresh=False)} - before)
+    infos = {m.__name__: addon_utils.module_bl_info(m) for m in addon_utils.modules(refresh=False) if m.__name__ in new}
+    errors = []
+    for name in new:
+        addon_utils.enable(name, default_set=True, handle_error=lambda ex: errors.append(str(ex)))
+    enabled = sorted(a.module for a in bpy.context.preferences.addons if a.module in new)
+    print("WRONG-ZIP", json.dumps({"install": sorted(result), "new": new, "enabled": enabled, "errors": errors,
+                                   "infos": {k: {f: v.get(f, "") for f in ("name", "description", "warning")}
+                                             for k, v in infos.items()},
+                                   "panel": hasattr(bpy.types, "VIEW3D_PT_wiresculpt")}))
+""")
+
 GLIBC = {"ld-linux-x86-64.so.2", "libc.so.6", "libm.so.6", "libpthread.so.0", "libdl.so.2", "librt.so.1"}
 
 
@@ -150,7 +169,8 @@ class PackageTest(unittest.TestCase):
     def test_zip_installs_and_loads(self):
         with tempfile.TemporaryDirectory() as tmp:
             zip_path, _extension = package(tmp)
-            self.assertRegex(os.path.basename(zip_path), r"^wiresculpt-\d+\.\d+\.\d+-linux-x86_64\.zip$")
+            self.assertRegex(os.path.basename(zip_path), r"^wiresculpt-addon-\d+\.\d+\.\d+-linux-x86_64\.zip$")
+            self.assertRegex(os.path.basename(_extension), r"^wiresculpt-extension-\d+\.\d+\.\d+-linux-x64\.zip$")
             user = os.path.join(tmp, "user")
             script = os.path.join(tmp, "check.py")
             with open(script, "w") as f:
@@ -209,6 +229,40 @@ class PackageTest(unittest.TestCase):
                     self.assertTrue(p.startswith(user), f"{name} came from {p}, not from the installed add-on")
             wires = int(next(line for line in r.stdout.splitlines() if line.startswith("WIRES")).split()[1])
             self.assertGreaterEqual(wires, 3)
+
+    def test_the_extension_zip_explains_itself_to_a_legacy_install(self):
+        """Blender 3.4's Add-ons > Install with the extension zip (issue 48): Blender lists exactly
+        one new add-on, whose name, description and warning say which zip to use; enabling it
+        fails with the sentence naming the add-on zip, registers nothing of wiresculpt, and the
+        add-on zip's name differs from the extension's by more than a platform spelling."""
+        with tempfile.TemporaryDirectory() as tmp:
+            addon_zip, extension_zip = package(tmp)
+            addon_name = os.path.basename(addon_zip)
+            self.assertIn("-addon-", addon_name)
+            self.assertIn("-extension-", os.path.basename(extension_zip))
+            user = os.path.join(tmp, "user")
+            script = os.path.join(tmp, "wrong_zip.py")
+            with open(script, "w") as f:
+                f.write(WRONG_ZIP)
+            r = run_blender(script, extension_zip, user, env={"BLENDER_USER_SCRIPTS": user})
+            self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+            seen = json.loads(next(line for line in r.stdout.splitlines()
+                                   if line.startswith("WRONG-ZIP")).split(" ", 1)[1])
+            self.assertEqual(seen["install"], ["FINISHED"])
+            self.assertEqual(seen["new"], ["wiresculpt_extension_zip"], r.stdout)
+            info = seen["infos"]["wiresculpt_extension_zip"]
+            self.assertIn("wrong zip", info["name"])
+            for field in ("description", "warning"):
+                self.assertIn(addon_name, info[field])
+            self.assertEqual(seen["enabled"], [])
+            self.assertEqual(len(seen["errors"]), 1, seen["errors"])
+            self.assertIn(addon_name, seen["errors"][0])
+            self.assertIn("Blender 4.2", seen["errors"][0])
+            self.assertFalse(seen["panel"])
+            # what the zip put at the top of the add-ons folder is named for deleting
+            for name in ("__init__.py", "core/", "libs/", "wiresculpt_extension_zip.py"):
+                self.assertIn(name, seen["errors"][0])
+                self.assertTrue(os.path.exists(os.path.join(user, "addons", name.rstrip("/"))), name)
 
     def test_extension_zip_carries_its_solver(self):
         """The extension zip, whose files sit at its top level, carries the same libraries in libs/

@@ -190,7 +190,15 @@ class FindStablePlanes(Case):
         self.assertIsNone(ops.RESULT)
 
     def test_apply_without_a_search_is_refused(self):
-        self.assertFalse(ops.WIRESCULPT_OT_apply_planes.poll(bpy.context))
+        """The button stays pressable (poll) and says why it does nothing (issue 48)."""
+        before = placements()
+        with self.assertRaises(ops.Refused) as ctx:
+            ops.apply_candidate(bpy.context, 0)
+        self.assertEqual(ctx.exception.code, ops.NO_RESULT)
+        with self.assertRaises(RuntimeError) as op:  # an ERROR report, which bpy.ops raises
+            bpy.ops.wiresculpt.apply_planes(index=0)
+        self.assertIn("Cannot apply: " + ops.refusal(ops.NO_RESULT), str(op.exception))
+        self.assertEqual(placements(), before)
 
 
 class NoNearbyPlacement(Case):

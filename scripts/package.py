@@ -1,10 +1,17 @@
 """Builds two zips in dist/, each with the compiled module inside:
 
-- wiresculpt-<version>-linux-x86_64.zip: the add-on folder, for Preferences > Add-ons > Install
-  (Blender 3.4 to 4.1, and 4.2+ as a legacy add-on);
-- wiresculpt-<version>-linux_x64.zip: the extension (Blender 4.2+, Install from Disk or
+- wiresculpt-addon-<version>-linux-x86_64.zip: the add-on folder, for Preferences > Add-ons >
+  Install (Blender 3.4 to 4.1, and 4.2+ as a legacy add-on);
+- wiresculpt-extension-<version>-linux-x64.zip: the extension (Blender 4.2+, Install from Disk or
   `blender --command extension install-file`): blender_manifest.toml and the package's files at
   the top of the zip, as Blender's own `extension build` lays them out.
+
+The wrong zip explains itself (issue 48): Blender's legacy Add-ons > Install extracts a zip into
+scripts/addons/ as it is and lists as new add-ons the top-level .py files and folders whose code
+has a `bl_info` (never a top-level __init__.py). The extension zip's files are at its top, so only
+WRONG_ZIP_MODULE, a top-level module the extension itself never imports, is listed: its bl_info
+says in the add-on list which zip to use, and enabling it fails with that sentence, naming what the
+zip put into the add-ons folder, and does nothing else.
 
 Both zips carry the module for every Python the machine has (package_pythons.py: each CPython 3.x
 from 3.10 with its development headers; the default build's module, scripts/build with
@@ -55,6 +62,53 @@ def versions():
 GLIBC = {"linux-vdso.so.1", "ld-linux-x86-64.so.2", "libc.so.6", "libm.so.6", "libpthread.so.0",
          "libdl.so.2", "librt.so.1", "libutil.so.1", "libresolv.so.2", "libmvec.so.1"}
 LIBS = "libs"  # the folder inside the add-on holding the bundled libraries
+WRONG_ZIP_MODULE = "wiresculpt_extension_zip.py"  # the extension zip's explanation to a legacy install
+
+
+def zip_names(version):
+    """(add-on zip name, extension zip name): the kind in the name, and each platform as its
+    installer spells it (the extension's as blender_manifest.toml's platforms, linux-x64)."""
+    return f"wiresculpt-addon-{version}-linux-x86_64.zip", f"wiresculpt-extension-{version}-linux-x64.zip"
+
+
+def wrong_zip_module(version, sprayed):
+    """The source of WRONG_ZIP_MODULE for this version; `sprayed`: the zip's other top-level names
+    (what a legacy install puts into scripts/addons/)."""
+    addon_zip, _extension_zip = zip_names(version)
+    message = (f"This is the wiresculpt extension zip, for Blender 4.2 and later (Preferences > Get Extensions > "
+               f"Install from Disk). On Blender 3.4 to 4.1 install {addon_zip} through Preferences > Add-ons > "
+               f"Install instead. Installing this zip as a legacy add-on put these into the add-ons folder, "
+               f"which can be deleted: {', '.join(sprayed)}, {WRONG_ZIP_MODULE}")
+    major, minor, patch = (int(x) for x in version.split("."))
+    return f'''# SPDX-License-Identifier: GPL-3.0-or-later
+"""Written by scripts/package.py into the wiresculpt extension zip only: the extension never
+imports it. Installed as a legacy add-on (Blender 3.4 to 4.1, or 4.2+'s Install legacy Add-on),
+the zip's files land in scripts/addons/ and this is the one add-on Blender lists: it says which zip
+to use, and enabling it does nothing but fail with that sentence."""
+
+MESSAGE = {message!r}
+
+bl_info = {{
+    "name": "wiresculpt: wrong zip (the Blender 4.2+ extension)",
+    "author": "wiresculpt developers",
+    "version": ({major}, {minor}, {patch}),
+    "blender": (2, 80, 0),
+    "location": "Preferences > Add-ons > Install: use {addon_zip}",
+    "description": "This is the Blender 4.2+ extension zip; on Blender 3.4 to 4.1 install {addon_zip}",
+    "warning": "Wrong zip for a legacy install: use {addon_zip}",
+    "doc_url": "",
+    "category": "Object",
+}}
+
+
+def register():
+    print("wiresculpt:", MESSAGE)
+    raise RuntimeError(MESSAGE)
+
+
+def unregister():
+    pass
+'''
 
 
 def needed(path):
@@ -161,12 +215,15 @@ def package(out_dir):
         raise SystemExit("wiresculpt: versions disagree: " + ", ".join(f"{k} {v}" for k, v in found.items()))
     version = found["CMakeLists.txt"]
     os.makedirs(out_dir, exist_ok=True)
-    addon_zip = os.path.join(out_dir, f"wiresculpt-{version}-linux-x86_64.zip")
-    extension_zip = os.path.join(out_dir, f"wiresculpt-{version}-linux_x64.zip")
+    addon_zip, extension_zip = (os.path.join(out_dir, name) for name in zip_names(version))
     with tempfile.TemporaryDirectory() as stage:
         files = addon_files(modules(), stage)
         write_zip(addon_zip, "wiresculpt", files)
-        write_zip(extension_zip, "", files)
+        sprayed = sorted({rel.split(os.sep)[0] + ("/" if os.sep in rel else "") for _full, rel in files})
+        explainer = os.path.join(stage, WRONG_ZIP_MODULE)
+        with open(explainer, "w", encoding="utf-8") as f:
+            f.write(wrong_zip_module(version, sprayed))
+        write_zip(extension_zip, "", files + [(explainer, WRONG_ZIP_MODULE)])
     return [addon_zip, extension_zip]
 
 

@@ -194,15 +194,17 @@ class FabFiles(unittest.TestCase):
                 side = s_
             self.assertGreaterEqual(changes, 2, wire["name"])
             lines = self.w.stream_lines(self.w.write_gcode(None, pts, {}, wire["name"], "steel"))
-            self.assertEqual(lines.count("G0 Z-5.0000"), changes)
-            self.assertEqual(lines.count("G0 Z5.0000"), changes)
-            for i, line in enumerate(lines):  # each duck is followed by the bend to the new side
+            back = side != 1  # a program ending on the negative side ducks back before M2
+            self.assertEqual(lines.count("G0 Z-5.0000"), changes + back)
+            self.assertEqual(lines.count("G0 Z5.0000"), changes + back)
+            for i, line in enumerate(lines):  # each duck swings the head across, then the bend or M2
                 if line == "G0 Z-5.0000":
-                    self.assertEqual(lines[i + 1], "G0 Z5.0000")
-                    self.assertTrue(lines[i + 2].startswith("G1 Y"), lines[i + 2])
+                    self.assertIn(lines[i + 1], ("G0 Y20.0000", "G0 Y-20.0000"))  # the default 20 deg swing
+                    self.assertEqual(lines[i + 2], "G0 Z5.0000")
+                    self.assertTrue(lines[i + 3].startswith("G1 Y") or lines[i + 3] == "M2", lines[i + 3])
             pinless = self.w.stream_lines(self.w.write_gcode(None, pts, {"pin_axis": ""}, wire["name"], "steel"))
             self.assertFalse([l for l in pinless if "Z" in l])
-            self.assertEqual(pinless, [l for l in lines if not l.startswith("G0 Z")])
+            self.assertEqual(pinless, [l for l in lines if not l.startswith("G0 ")])
             tested += 1
         self.assertGreaterEqual(tested, 1)
 

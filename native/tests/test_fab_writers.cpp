@@ -365,8 +365,14 @@ TEST_CASE("gcode: the default profile ducks its pin at every change of bend side
   const MachineProfile m;
   CHECK(m.axes.pin_axis == 'Z');
   const auto lines = stream_lines(gcode_program(make_bend_program(zigzag, m), m, GcodeInfo{"Z", "", true}));
-  CHECK(std::count(lines.begin(), lines.end(), "G0 Z-5.0000") == changes);
-  CHECK(std::count(lines.begin(), lines.end(), "G0 Z5.0000") == changes);
+  const int back = side != 1;  // a program ending on the negative side ducks back before M2
+  CHECK(std::count(lines.begin(), lines.end(), "G0 Z-5.0000") == changes + back);
+  CHECK(std::count(lines.begin(), lines.end(), "G0 Z5.0000") == changes + back);
+  for (std::size_t i = 0; i + 2 < lines.size(); ++i)  // between pin down and pin up the head swings across
+    if (lines[i] == "G0 Z-5.0000") {
+      CHECK((lines[i + 1] == "G0 Y20.0000" || lines[i + 1] == "G0 Y-20.0000"));
+      CHECK(lines[i + 2] == "G0 Z5.0000");
+    }
 }
 
 TEST_CASE("gcode: header, axis mapping, units and the bend table", "[fab][gcode]") {
@@ -387,12 +393,15 @@ TEST_CASE("gcode: header, axis mapping, units and the bend table", "[fab][gcode]
   std::snprintf(minus, sizeof minus, "G1 Y-%.4f F5400.0", c);
   const std::vector<std::string> expected{"G21", "G91", "G94",
                                           "G1 X50.0000 F1200.0", plus, minus, "G4 P0",
-                                          "G1 X50.0000 F1200.0", "G0 Z-5.0000", "G0 Z5.0000", minus, plus,
-                                          "G4 P0", "G1 X50.0000 F1200.0", "G4 P0", "M2"};
-  CHECK(lines == expected);  // the default profile moves its pin (Z) before the bend to the other side
+                                          "G1 X50.0000 F1200.0", "G0 Z-5.0000", "G0 Y20.0000", "G0 Z5.0000", minus,
+                                          plus, "G4 P0", "G1 X50.0000 F1200.0", "G4 P0",
+                                          "G0 Z-5.0000", "G0 Y-20.0000", "G0 Z5.0000", "M2"};
+  // the default profile ducks its pin (Z) under the wire, swings the head across (Y, 20 deg) and
+  // raises the pin before the bend to the other side, and ducks back to the positive side at the end
+  CHECK(lines == expected);
 
   // A profile without a pin axis (a head that bends both ways) writes what every profile wrote
-  // before the pin became the default: the same program without the two pin moves.
+  // before the pin became the default: the same program without the ducks.
   MachineProfile no_pin = m;
   no_pin.axes.pin_axis = '\0';
   const std::vector<std::string> expected_no_pin{"G21", "G91", "G94",
@@ -414,8 +423,9 @@ TEST_CASE("gcode: header, axis mapping, units and the bend table", "[fab][gcode]
   CHECK(l2[3] == "G1 A25.0000 F600.0");
   std::snprintf(minus, sizeof minus, "G1 B-%.4f F10800.0", 2 * c);  // left bend, left = negative
   CHECK(l2[4] == "G0 Z-5.0000");  // the pin starts on the positive side: change sides first
-  CHECK(l2[5] == "G0 Z5.0000");
-  CHECK(l2[6] == minus);
+  CHECK(l2[5] == "G0 B40.0000");   // the swing, 20 deg at 2 units/deg, the positive way
+  CHECK(l2[6] == "G0 Z5.0000");
+  CHECK(l2[7] == minus);
   CHECK(std::count_if(l2.begin(), l2.end(), [](const std::string& s) { return s.rfind("G0 Z", 0) == 0; }) == 4);
   CHECK_THROWS_WITH(validate_program({"G1 X5"}, m), Contains("line 1") && Contains("'X'"));
   CHECK_THROWS_WITH(validate_program({"G1 A5", "G1 A5 ; note"}, m), Contains("line 2") && Contains("comment"));

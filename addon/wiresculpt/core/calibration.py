@@ -333,7 +333,7 @@ PROFILE_FORMAT = "wiresculpt-machine-profile"
 PROFILE_KEYS = ("name", "min_segment", "max_bend_deg", "min_bend_deg", "max_commanded_deg",
                 "left_is_positive", "springback_a", "springback_b_deg", "feed_speed_mm_s",
                 "bend_speed_deg_s", "seconds_per_bend", "feed_axis", "bend_axis", "pin_axis",
-                "feed_units_per_mm", "bend_units_per_deg", "pin_travel", "baud", "data_bits",
+                "feed_units_per_mm", "bend_units_per_deg", "pin_travel", "pin_swing_deg", "baud", "data_bits",
                 "stop_bits", "parity", "flow_control")
 
 

@@ -12,12 +12,22 @@ Free of bpy: the add-on's operators, and the tests, call it.
 import numpy as np
 
 from .. import native
+from ..core import session
 from ..core.jobs import WorkerJob
 from . import export
 
 PENDING = {}  # wire name -> Stopped: the program a Resume continues
 JOB = None  # the StreamJob while a wire is being sent, else None
 LAST = {}  # wire name -> (report type, sentence) of its last run, for the panel
+# PENDING and LAST are the open file's (issue 48): another file's wires may have the same names.
+# forget() empties them when a file is loaded (blend/ownership's load handlers), and a stream that
+# ends after a load records nothing (its generation is the closed file's).
+
+
+def forget():
+    """No stop to resume and no last run (a file is being loaded); a running stream goes on."""
+    PENDING.clear()
+    LAST.clear()
 
 
 def rest_wires(design):
@@ -77,6 +87,7 @@ class StreamJob(WorkerJob):
         self.fraction = self.first / len(lines) if lines else 1.0
         self.control = native.stream_control()  # abort is one-shot: a fresh one per run
         self.result = None
+        self.generation = session.generation()  # the file the stream was started from
 
     def _progress(self, _stage, fraction):
         self.fraction = fraction
@@ -124,8 +135,12 @@ def prepare(design, wire, port, profile=None, resume=False, dry_run=False, settl
 
 def finish(job):
     """(report type, one sentence) for a finished job; keeps or drops its wire's stop in PENDING."""
-    LAST[job.wire] = _outcome(job)
-    return LAST[job.wire]
+    outcome = _outcome(job)
+    if job.generation != session.generation():  # started from a file closed since: not this file's
+        PENDING.pop(job.wire, None)
+        return outcome
+    LAST[job.wire] = outcome
+    return outcome
 
 
 def _outcome(job):

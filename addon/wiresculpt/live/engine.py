@@ -412,6 +412,7 @@ def _watch_scene_switch():
 @bpy.app.handlers.persistent
 def _load_pre(*_args):
     stop()
+    STATE.message = STATE.message_target = ""  # a refusal speaks of the closed file's target
 
 
 @bpy.app.handlers.persistent

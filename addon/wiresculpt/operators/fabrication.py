@@ -14,6 +14,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, StringProperty
 from .. import native
 from ..blend import calibration as scene_calibration
 from ..blend import preview as scene_preview
+from ..blend import ownership
 from ..blend import results as scene_results
 from ..blend.machine import chosen_profile
 from ..blend.registration import classes_factory
@@ -239,6 +240,11 @@ class WIRESCULPT_OT_send_cancel(bpy.types.Operator):
         return {'FINISHED'}
 
 
-register, unregister = classes_factory(
+_register, unregister = classes_factory(
     (WIRESCULPT_OT_export_fabrication, WIRESCULPT_OT_pick_port, WIRESCULPT_OT_send_to_machine,
      WIRESCULPT_OT_send_cancel))
+
+
+def register():
+    _register()
+    ownership.on_load(streaming.forget)  # a stream's stop is its file's (blend/ownership registers the handlers)

@@ -9,6 +9,12 @@ viewport overlay (ui/overlay.py draws PREVIEW), like Live's: module state only, 
 no undo step. It lasts until Apply, a click on the same Preview (or another candidate's), Clear,
 a new search or loading a file. The segments are made on the worker with the candidates
 (candidate["preview"]), so a click only points at them.
+
+Whose: a result belongs to the file and scene it was made for (blend/ownership.py: a token written
+into the scene with the result, the scene's name and the file's generation), checked before the
+panel lists it, the overlay draws its preview or Apply writes it; loading a file (File > New, Open,
+Revert) forgets both. The search is an undo step of its own (it writes the token and nothing else),
+so undoing later steps keeps its candidates, and undoing the search hides them.
 """
 import copy
 import threading
@@ -19,12 +25,13 @@ import numpy as np
 from mathutils import Matrix, Vector
 
 from .. import native, pipeline, plane_search
-from ..blend import mesh
+from ..blend import mesh, ownership
 from ..blend import results as scene_results
 from ..blend.handles import (PLANE_MARGIN, add_handle, contour_plane, contour_plane_name, handle_plane, handles,
                              target_problem)
 from ..blend.registration import classes_factory
 from ..blend.view import redraw_3d_views
+from ..core import session
 from ..core.jobs import WorkerJob
 from ..core.scene import PlaneSpec
 from ..core.solve_context import SolveContext
@@ -34,7 +41,13 @@ from .progress import JOIN_SECONDS, WorkerModal, busy
 MAX_CANDIDATES = 3
 UI_BUDGET_SECONDS = 60.0  # the panel's search may take longer than the batch's: Esc stops it
 PLANE_COLOUR = (1.0, 0.85, 0.2, 1.0)  # the outline of a plane the previewed candidate moves or adds
-# What the panel shows: {"scene", "mode", "candidates": [...], "message"} of the last search, or None.
+OWNER_KIND = "plane_search"  # blend/ownership's kind of the assistant's result
+# Refusals of Apply and Preview (causes as codes; the sentence is made in refusal())
+NO_RESULT = "no_result"  # no search in this file yet
+NOT_THIS_SCENE = "not_this_scene"  # the last search was another scene's
+NO_CANDIDATE = "no_candidate"  # the index is not one of the candidates
+# What the panel shows: {"owner", "scene", "mode", "candidates": [...], "message"} of the last
+# search, or None; shown and applied only in the scene its owner names (current()).
 RESULT = None
 # The previewed candidate: {"scene", "index", "wires": [(RGBA, (2k, 3) float32)], "planes": [...]}, or None.
 PREVIEW = None
@@ -108,6 +121,7 @@ class SearchJob(WorkerJob):
         self.cancelled = False
         self.messages = []
         self.scene_name = ""
+        self.generation = session.generation()  # the file the search started in
         self.started = time.perf_counter()
 
     def _progress(self, stage, message):
@@ -150,10 +164,55 @@ def running():
     return JOB is not None or busy("optimize")
 
 
+class Refused(ValueError):
+    """Apply or Preview has nothing to act on: `code` is NO_RESULT, NOT_THIS_SCENE or NO_CANDIDATE."""
+
+    def __init__(self, code):
+        super().__init__(refusal(code))
+        self.code = code
+
+
+def refusal(code):
+    """The sentence of a refusal code."""
+    return {NO_RESULT: "no candidates: run Find Stable Planes or Suggest Planes first",
+            NOT_THIS_SCENE: ("the plane assistant's candidates belong to another scene or file: run Find Stable "
+                             "Planes or Suggest Planes in this scene"),
+            NO_CANDIDATE: "no such candidate: run Find Stable Planes or Suggest Planes again"}[code]
+
+
+def current(context):
+    """The last search's result when it was made for this scene of this file, else None."""
+    if RESULT is None or context.scene is None or not ownership.owns(RESULT["owner"], context.scene):
+        return None
+    return RESULT
+
+
+def _candidate(context, index):
+    """(result, candidate `index`) of this scene's result; Refused otherwise."""
+    result = current(context)
+    if result is None:
+        raise Refused(NO_RESULT if RESULT is None else NOT_THIS_SCENE)
+    if not 0 <= index < len(result["candidates"]):
+        raise Refused(NO_CANDIDATE)
+    return result, result["candidates"][index]
+
+
+def forget():
+    """No result and no preview any more (a file is being loaded)."""
+    global RESULT
+    RESULT = None
+    clear_preview()
+
+
 def _store(job):
+    """The finished search as RESULT, stamped for its scene; None when its file or scene is gone."""
     global RESULT
     clear_preview()
-    RESULT = {"scene": job.scene_name, "mode": job.mode, "candidates": job.found,
+    scene = bpy.data.scenes.get(job.scene_name)
+    owner = None if scene is None else ownership.stamp(scene, OWNER_KIND, job.generation)
+    if owner is None:
+        return None
+    RESULT = {"owner": owner, "scene": job.scene_name, "mode": job.mode, "candidates": job.found,
               "message": (f"{len(job.found)} stable candidate{'s' if len(job.found) != 1 else ''} "
                           f"({job.searched.screened} screened, {job.searched.full_solves} solved, "
                           f"{time.perf_counter() - job.started:.1f} s)" if job.found else
@@ -183,6 +242,9 @@ class _SearchOperator(WorkerModal):
             self.report({'ERROR'}, f"{self.verb}: {job.error}")
             return {'CANCELLED'}
         result = _store(job)
+        if result is None:
+            self.report({'WARNING'}, f"{self.verb}: the file or scene searched was closed meanwhile; nothing to show")
+            return {'CANCELLED'}
         self.report({'INFO'} if job.found else {'WARNING'}, f"{self.verb}: {result['message']}")
         return {'FINISHED'}
 
@@ -248,7 +310,7 @@ class WIRESCULPT_OT_find_planes(_SearchOperator, bpy.types.Operator):
     Apply a candidate (Esc cancels)"""
     bl_idname = "wiresculpt.find_planes"
     bl_label = "Find Stable Planes"
-    bl_options = {'REGISTER'}
+    bl_options = {'REGISTER', 'UNDO'}  # the result's token in the scene: undoing the search hides it
     mode = "nearby"
     verb = "Find Stable Planes"
 
@@ -258,7 +320,7 @@ class WIRESCULPT_OT_suggest_planes(_SearchOperator, bpy.types.Operator):
     coverage and fidelity; Apply adds them as ordinary slicing planes (Esc cancels)"""
     bl_idname = "wiresculpt.suggest_planes"
     bl_label = "Suggest Planes"
-    bl_options = {'REGISTER'}
+    bl_options = {'REGISTER', 'UNDO'}
     mode = "auto"
     verb = "Suggest Planes"
 
@@ -280,13 +342,11 @@ def _place(obj, origin, normal):
 def apply_candidate(context, index):
     """The candidate's planes into the scene (moved handles, or new ones for Suggest), sliced, the
     design's contours ticked, and its design as the result. ValueError when there is no such
-    candidate or a plane it moves is gone."""
-    if RESULT is None or RESULT["scene"] != context.scene.name or not 0 <= index < len(RESULT["candidates"]):
-        raise ValueError("no such candidate: run Find Stable Planes or Suggest Planes first")
-    candidate = RESULT["candidates"][index]
+    candidate in this scene (Refused: its code says why) or a plane it moves is gone."""
+    result, candidate = _candidate(context, index)
     scene = context.scene
     design = candidate["design"]
-    if RESULT["mode"] == "nearby":
+    if result["mode"] == "nearby":
         by_name = {h.name: h for h in handles(scene)}
         missing = [p.name for p in candidate["planes"] if p.name not in by_name]
         if missing:
@@ -329,14 +389,14 @@ def clear_preview():
 
 def preview_candidate(context, index):
     """Previews candidate `index` of the last search (or stops previewing it when it is the one
-    shown); True when a candidate is previewed after. ValueError when there is no such candidate."""
+    shown); True when a candidate is previewed after. Refused when there is no such candidate in this
+    scene."""
     global PREVIEW
-    if RESULT is None or RESULT["scene"] != context.scene.name or not 0 <= index < len(RESULT["candidates"]):
-        raise ValueError("no such candidate: run Find Stable Planes or Suggest Planes first")
+    _result, candidate = _candidate(context, index)
     if previewed(context) == index:
         clear_preview()
         return False
-    shown = RESULT["candidates"][index]["preview"]
+    shown = candidate["preview"]
     PREVIEW = {"scene": context.scene.name, "index": index, "wires": shown["wires"], "planes": shown["planes"]}
     redraw_3d_views()
     return True
@@ -344,7 +404,7 @@ def preview_candidate(context, index):
 
 def previewed(context):
     """The index of the candidate previewed in this scene, or None."""
-    if PREVIEW is None or context.scene is None or PREVIEW["scene"] != context.scene.name:
+    if PREVIEW is None or current(context) is None or PREVIEW["scene"] != context.scene.name:
         return None
     return PREVIEW["index"]
 
@@ -360,7 +420,7 @@ class WIRESCULPT_OT_apply_planes(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return not running() and RESULT is not None and bool(RESULT["candidates"])
+        return not running()  # without candidates in this scene, execute refuses and says why
 
     def execute(self, context):
         try:
@@ -383,7 +443,8 @@ class WIRESCULPT_OT_preview_planes(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return RESULT is not None and bool(RESULT["candidates"])
+        result = current(context)
+        return result is not None and bool(result["candidates"])
 
     def execute(self, context):
         try:
@@ -427,18 +488,13 @@ _register, _unregister = classes_factory((WIRESCULPT_OT_find_planes, WIRESCULPT_
                                           WIRESCULPT_OT_preview_planes_clear, WIRESCULPT_OT_find_planes_cancel))
 
 
-@bpy.app.handlers.persistent
-def _load_pre(*_args):
-    clear_preview()
-
-
 def register():
     _register()
-    bpy.app.handlers.load_pre.append(_load_pre)
+    ownership.register()
+    ownership.on_load(forget)
 
 
 def unregister():
-    if _load_pre in bpy.app.handlers.load_pre:
-        bpy.app.handlers.load_pre.remove(_load_pre)
-    clear_preview()
+    ownership.unregister()
+    forget()
     _unregister()

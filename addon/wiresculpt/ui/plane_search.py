@@ -36,8 +36,8 @@ class VIEW3D_PT_wiresculpt_planes(bpy.types.Panel):
                 wrap_labels(box, context, line)
             box.operator(ops.WIRESCULPT_OT_find_planes_cancel.bl_idname, icon='CANCEL')
             return
-        result = ops.RESULT
-        if result is None or result["scene"] != context.scene.name:
+        result = ops.current(context)  # another file's or scene's result is not shown
+        if result is None:
             return
         wrap_labels(layout, context, result["message"], icon='INFO')
         shown = ops.previewed(context)

@@ -59,7 +59,21 @@ std::string gcode_program(const BendProgram& program, const MachineProfile& prof
   s += "; spring-back fit: measured = " + num(profile.springback_a) + " * commanded + " +
        num(to_deg(profile.springback_b), 3) + " deg\n";
   s += "G21\nG91\nG94\n";
-  int pin_side = 1;  // the pin starts on the side of a positive head move
+  // The pin's side of the wire: +1 where a positive head move bends (where every program starts
+  // and ends), -1 where a negative one does. The head rests at 0 on the +1 side and at +pin_swing
+  // on the -1 side; all moves are relative (G91).
+  int pin_side = 1;
+  const std::string pin(1, ax.pin_axis ? ax.pin_axis : ' ');
+  const double swing = to_deg(ax.pin_swing) * ax.bend_units_per_deg;
+  // The duck to the other side: pin down (under the wire), the head swings across it, pin up.
+  // From +1 to -1 the head turns the positive way (past the wire, as a positive bend would), back
+  // the negative way.
+  auto duck = [&](int to_side) {
+    s += "G0 " + pin + num(-ax.pin_travel) + "\n";
+    s += "G0 " + bend_axis + num(to_side < 0 ? swing : -swing) + "\n";
+    s += "G0 " + pin + num(ax.pin_travel) + "\n";
+    pin_side = to_side;
+  };
   for (std::size_t k = 0; k < program.steps.size(); ++k) {
     const BendStep& st = program.steps[k];
     const bool bends = st.vertex >= 0;
@@ -71,16 +85,15 @@ std::string gcode_program(const BendProgram& program, const MachineProfile& prof
     if (bends) {
       const double move = side * to_deg(st.commanded) * ax.bend_units_per_deg;
       const int wanted = move >= 0 ? 1 : -1;
-      if (ax.pin_axis != '\0' && wanted != pin_side) {
-        const std::string pin(1, ax.pin_axis);
-        s += "G0 " + pin + num(-ax.pin_travel) + "\n";
-        s += "G0 " + pin + num(ax.pin_travel) + "\n";
-        pin_side = wanted;
-      }
+      if (ax.pin_axis != '\0' && wanted != pin_side) duck(wanted);
       s += "G1 " + bend_axis + num(move) + " F" + num(bend_f, 1) + "\n";
       s += "G1 " + bend_axis + num(-move) + " F" + num(bend_f, 1) + "\n";
     }
     if (info.sync_each_step) s += "G4 P0\n";
+  }
+  if (pin_side != 1) {  // the next program starts with the pin on the positive side
+    s += "; pin back to the positive side\n";
+    duck(1);
   }
   s += "M2\n";
   return s;

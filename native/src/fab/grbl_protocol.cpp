@@ -179,18 +179,23 @@ bool is_dwell(const std::string& line) {
 bool is_motionless(const std::string& line) { return (!line.empty() && line[0] == '$') || is_modal_setup(line); }
 
 // What lines a..b (0-based, inclusive) move: "feed 40.000 mm, bend 90.000 deg" (the bend as
-// commanded, the first bend-axis move; the head's return is not repeated).
+// commanded, the first bend-axis G1 move; the head's return is not repeated, and the head's G0
+// swing across the wire in a duck is the pin's move, not a bend).
 std::string moves_of(const std::vector<std::string>& lines, const MachineProfile& profile, std::size_t a,
                      std::size_t b) {
   const AxisMapping& ax = profile.axes;
   const auto up = [](char c) { return static_cast<char>(std::toupper(static_cast<unsigned char>(c))); };
   double feed = 0.0, bend = 0.0;
   bool fed = false, bent = false, pin = false;
-  for (std::size_t j = a; j <= b && j < lines.size(); ++j)
-    for (const Word& w : words_of(lines[j])) {
+  for (std::size_t j = a; j <= b && j < lines.size(); ++j) {
+    const std::vector<Word> words = words_of(lines[j]);
+    const bool rapid = !words.empty() && words[0].letter == 'G' && words[0].value == 0.0;  // a duck's swing
+    for (const Word& w : words) {
       if (w.letter == up(ax.feed_axis)) {
         feed += w.value;
         fed = true;
+      } else if (w.letter == up(ax.bend_axis) && rapid) {
+        pin = true;
       } else if (w.letter == up(ax.bend_axis) && !bent && w.value != 0.0) {
         bend = w.value;
         bent = true;
@@ -198,6 +203,7 @@ std::string moves_of(const std::vector<std::string>& lines, const MachineProfile
         pin = true;
       }
     }
+  }
   std::string out;
   auto add = [&](const std::string& part) { out += (out.empty() ? "" : ", ") + part; };
   if (fed) add("feed " + mm3(feed / ax.feed_units_per_mm) + " mm");

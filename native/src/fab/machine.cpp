@@ -51,6 +51,8 @@ void validate(const MachineProfile& p) {
     require(axis_letter(a.pin_axis), std::string("pin axis '") + a.pin_axis + "' is not a G-code axis letter");
     require(a.pin_axis != a.feed_axis && a.pin_axis != a.bend_axis, "the pin axis must differ from the feed and bend axes");
     require(finite_positive(a.pin_travel) && a.pin_travel <= 1e6, "pin_travel must be positive and at most 1e6 units");
+    require(finite_positive(a.pin_swing) && a.pin_swing <= from_deg(180.0),
+            "pin_swing (key pin_swing_deg) must be positive and at most 180 deg");
   }
   require(finite_positive(a.feed_units_per_mm) && a.feed_units_per_mm <= 1e6,
           "feed_units_per_mm must be positive and at most 1e6");

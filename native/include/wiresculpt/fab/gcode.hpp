@@ -8,8 +8,11 @@
 //   bend   <bend_axis><+-commanded_deg * bend_units_per_deg>, then the opposite move returning the
 //          head to neutral; + for a left (counter-clockwise) bend when left_is_positive
 //          F = bend_speed in deg/min * bend_units_per_deg
-//   pin    (only when pin_axis is set) before a bend on the other side from the previous one:
-//          <pin_axis>-pin_travel (retract) and <pin_axis>+pin_travel (extend), rapid G0.
+//   pin    (only when pin_axis is set) before a bend on the other side from the previous one,
+//          the duck: <pin_axis>-pin_travel (the pin under the wire), <bend_axis>+-pin_swing (the
+//          head swings across the wire: + from the positive-bend side to the negative, - back),
+//          <pin_axis>+pin_travel (the pin up on the other side), each a rapid G0. The pin starts on
+//          the positive-bend side, and a program that ends on the other side ducks back before M2.
 // Each step ends with "G4 P0" when sync_each_step, so GRBL's "ok" for that line means the step
 // has been executed, not just queued (see docs/machine-protocol.md, resume).
 //

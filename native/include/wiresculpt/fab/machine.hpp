@@ -41,6 +41,8 @@ struct AxisMapping {
   double feed_units_per_mm = 1.0;  ///< feed-axis units per millimetre of wire; default 1 (GRBL $100 in steps/mm)
   double bend_units_per_deg = 1.0; ///< bend-axis units per degree of head rotation; default 1
   double pin_travel = 5.0;     ///< pin-axis units to retract (and then re-extend) the pin; default 5
+  double pin_swing = from_deg(20.0);  ///< rad of head rotation, pin retracted, from the rest on one side of
+                               ///< the wire to the rest on the other (profile key pin_swing_deg); default 20°
 };
 
 /// A 2D wire bender: limits, calibration, speeds and how to talk to it.
