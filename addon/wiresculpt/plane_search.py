@@ -65,6 +65,7 @@ from . import native, pipeline
 from .core import plane_faults
 from .core.plane_faults import Tally, close_gaps, crossing_gaps  # noqa: F401 (the search's names for them)
 from .core.scene import PlaneSpec
+from .core.sizes import mesh_size
 from .stages import layering, slicing, target_shape
 
 MODES = ("off", "nearby", "auto")
@@ -138,8 +139,7 @@ def mesh_frame(vertices, faces):
             axes[k] = -axes[k]
     if np.ptp(values) < 1e-2 * max(values.max(), 1e-30):  # a sphere-like spread: the world axes
         axes = np.eye(3)
-    size = float(np.max(V.max(axis=0) - V.min(axis=0)))
-    return centre, axes, size
+    return centre, axes, mesh_size(V)
 
 
 def _perpendiculars(n):

@@ -27,6 +27,7 @@ from ..blend.registration import classes_factory
 from ..blend.view import redraw_3d_views
 from ..core.jobs import WorkerJob
 from ..core.scene import PlaneSpec
+from ..core.sizes import mesh_size
 from ..props import material_of, solver_settings
 from . import optimize
 from .progress import WorkerModal
@@ -126,7 +127,7 @@ class SearchJob(WorkerJob):
         except pipeline.Cancelled:
             self.cancelled = True
             return
-        size = float(np.max(np.ptp(np.asarray(self.V, dtype=float), axis=0)))
+        size = mesh_size(self.V)
         for candidate in self.found:
             candidate["preview"] = candidate_preview(candidate, self.mode, size)
 
