@@ -8,6 +8,7 @@ import math
 import time
 
 from . import native
+from .core import mesh_faults
 from .core import settings as settings_table
 from .core.design import NO_WIRES, ONE_WIRE, TOO_CLOSE, new_design
 from .core.polylines import ContourArrays
@@ -52,6 +53,7 @@ def slice_and_pick(vertices, faces, planes, material, settings, progress=None):
     name, origin, normal, contours (the rule)."""
     design = new_design(material, settings)
     design["model_size"] = mesh_size(vertices)  # the model's size, one figure for every message (core/sizes)
+    design["mesh_faults"] = mesh_faults.check(vertices, faces)  # said in the verdict when it fails (explain)
     (progress or _quiet)("slicing", slicing.run(design, vertices, faces, planes, settings))
     return design
 
@@ -101,6 +103,7 @@ def solve(design, material, settings, progress=None, cancel=None, stock=None, ho
         solved = relayer(design, material, settings, say, native_progress, checkpoint, hook_patterns, hook_seconds)
         # the warnings the design keeps: the solved wires' lengths, the figures its files give
         solved.setdefault("warnings", []).extend(size_warnings(solved, *(stock or ())))
+        mesh_faults.explain(solved)  # a mesh of several parts or with holes: its faults lead the reason
         return solved
     except native.Cancelled:
         if not cancelled() and out_of_time():

@@ -27,6 +27,7 @@ from ..blend.registration import classes_factory
 from ..blend.view import redraw_3d_views
 from ..core.jobs import WorkerJob
 from ..core.scene import PlaneSpec
+from ..core import mesh_faults
 from ..core.sizes import mesh_size
 from ..props import material_of, solver_settings
 from . import optimize
@@ -105,6 +106,7 @@ class SearchJob(WorkerJob):
         self.mode, self.V, self.F, self.planes = mode, V, F, planes
         self.material, self.settings, self.count = material, settings, count
         self.found, self.searched = [], None
+        self.mesh_faults = []  # core/mesh_faults.check of the mesh when nothing was found
         self.cancel_event = threading.Event()
         self.cancelled = False
         self.messages = []
@@ -127,6 +129,8 @@ class SearchJob(WorkerJob):
         except pipeline.Cancelled:
             self.cancelled = True
             return
+        if not self.found:  # what is wrong with the mesh, said before what the search tried
+            self.mesh_faults = mesh_faults.check(self.V, self.F)
         size = mesh_size(self.V)
         for candidate in self.found:
             candidate["preview"] = candidate_preview(candidate, self.mode, size)
@@ -157,6 +161,9 @@ def _store(job):
               "message": (f"{len(job.found)} stable candidate{'s' if len(job.found) != 1 else ''} "
                           f"({job.searched.screened} screened, {job.searched.full_solves} solved, "
                           f"{time.perf_counter() - job.started:.1f} s)" if job.found else
+                          f"No stable placement found: {mesh_faults.words(job.mesh_faults)} "
+                          f"({job.searched.screened} screened, {job.searched.full_solves} solved)"
+                          if job.mesh_faults else
                           f"No stable placement found: {plane_search.nearby_reason(job.searched)}"
                           if job.mode == "nearby" else
                           f"No stable placement found ({job.searched.screened} screened, "
@@ -188,7 +195,9 @@ class _SearchOperator(WorkerModal):
 
     def _job(self, context):
         V, F, planes, material, settings = gather(context, self.mode == "nearby")
-        job = SearchJob(self.mode, V, F, planes, material, settings, self._count(context))
+        count = self._count(context)
+        settings["plane_count"] = count  # the search's own key (core/settings.py), as the batch gives it
+        job = SearchJob(self.mode, V, F, planes, material, settings, count)
         job.scene_name = context.scene.name
         return job
 
@@ -262,10 +271,12 @@ class WIRESCULPT_OT_suggest_planes(_SearchOperator, bpy.types.Operator):
     mode = "auto"
     verb = "Suggest Planes"
 
-    count: bpy.props.IntProperty(name="Planes", description="How many planes to propose", default=5, min=2, max=12)
+    count: bpy.props.IntProperty(name="Planes", description="How many planes to propose (unset: the panel's "
+                                 "Planes)", default=5, min=2, max=12)
 
     def _count(self, context):
-        return self.count
+        """The operator's count when given, else the panel's (scene setting plane_count)."""
+        return self.count if self.properties.is_property_set("count") else context.scene.wiresculpt.plane_count
 
 
 def _place(obj, origin, normal):
