@@ -18,6 +18,7 @@ import numpy as np
 from gpu_extras.batch import batch_for_shader
 
 from ..blend import compat, results
+from ..core import assembly_view
 from ..core.limits import DEFLECTION_LIMIT
 from ..operators import live
 from ..operators import plane_search
@@ -91,6 +92,13 @@ def deflection_whiskers(design, shown=None):
     return {k: np.asarray(v, dtype=np.float32) for k, v in out.items() if v}
 
 
+def live_lines(scene):
+    """Live's preview entries (colour, lines) that the overlay draws in `scene`: the wires added up
+    to the assembly slider's step of the live verdict's own order (every wire at step 0)."""
+    step = scene.wiresculpt.assembly_step if scene is not None else 0
+    return assembly_view.shown_lines(live.STATE.preview, live.STATE.preview_ids, live.STATE.preview_steps, step)
+
+
 def draw_live():
     """The live verdict's wires (operators/live.py) as lines in their colours, over everything: the
     wires lie on the target's surface, where a depth test hid all but their kinks in Solid view."""
@@ -98,7 +106,7 @@ def draw_live():
     gpu.state.line_width_set(2.0)
     gpu.state.depth_test_set('NONE')
     shader.bind()
-    for colour, lines in live.STATE.preview:
+    for colour, lines in live_lines(bpy.context.scene):
         shader.uniform_float("color", colour)
         batch_for_shader(shader, 'LINES', {"pos": lines}).draw(shader)
     gpu.state.line_width_set(1.0)
