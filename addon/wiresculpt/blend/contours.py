@@ -66,11 +66,18 @@ def release_deleted(scenes):
     return cleared
 
 
-def apply_slice(scene, settings, planes, per_plane):
+def contour_counts(settings):
+    """(contours listed, contours ticked: those that become wires): the one count every message
+    gives."""
+    return len(settings.contours), sum(bool(item.use) for item in settings.contours)
+
+
+def apply_slice(scene, settings, planes, per_plane, picked=None):
     """Make the scene's curves and the settings' list match the contours `per_plane` cut by the
     handle objects `planes`, keeping the user's ticks: a tick stays with its plane object (renamed
     or not) and its index; the ticks of a plane that is gone are dropped, even when a new plane
     has taken its name. A copy of a listed plane loses the id it copied (handles.drop_copied_ids).
+    `picked`: the contours to tick ("plane/index" names) instead of the kept ticks.
     Returns (contour count, ticked count, removed curve count)."""
     ticks = {}  # (handle object, index) -> tick
     for item in settings.contours:
@@ -93,9 +100,10 @@ def apply_slice(scene, settings, planes, per_plane):
             item.plane, item.index, item.curve = plane, index, obj
             item.plane_object, item.has_plane_object = handle, True
             item.length, item.closed = contour["length"], contour["closed"]
-            item.use = ticks.get((handle, index), index in longest)
+            item.use = (f"{plane}/{index}" in picked if picked is not None
+                        else ticks.get((handle, index), index in longest))
     for obj in existing.values():  # contours that disappeared
         remove_object(obj)
-    count = len(settings.contours)
+    count, ticked = contour_counts(settings)
     settings.active_contour = min(settings.active_contour, max(count - 1, 0))
-    return count, sum(item.use for item in settings.contours), len(existing)
+    return count, ticked, len(existing)

@@ -21,7 +21,7 @@ from mathutils import Matrix, Vector
 from .. import native, pipeline, plane_search
 from ..blend import mesh
 from ..blend import results as scene_results
-from ..blend.handles import (PLANE_MARGIN, add_handle, contour_plane, contour_plane_name, handle_plane, handles,
+from ..blend.handles import (PLANE_MARGIN, add_handle, contour_plane, handle_plane, handles,
                              target_problem)
 from ..blend.registration import classes_factory
 from ..blend.view import redraw_3d_views
@@ -30,7 +30,7 @@ from ..core.scene import PlaneSpec
 from ..core import mesh_faults
 from ..core.sizes import mesh_size
 from ..props import material_of, solver_settings
-from . import optimize
+from . import optimize, slicing
 from .progress import WorkerModal
 
 MAX_CANDIDATES = 3
@@ -290,8 +290,9 @@ def _place(obj, origin, normal):
 
 def apply_candidate(context, index):
     """The candidate's planes into the scene (moved handles, or new ones for Suggest), sliced, the
-    design's contours ticked, and its design as the result. ValueError when there is no such
-    candidate or a plane it moves is gone."""
+    design's contours ticked, and its design as the result. Returns (the candidate, Slice's
+    sentence: the contours and how many are wires). ValueError when there is no such candidate or
+    a plane it moves is gone."""
     if RESULT is None or RESULT["scene"] != context.scene.name or not 0 <= index < len(RESULT["candidates"]):
         raise ValueError("no such candidate: run Find Stable Planes or Suggest Planes first")
     candidate = RESULT["candidates"][index]
@@ -318,13 +319,12 @@ def apply_candidate(context, index):
             plane, index = w["name"].split("/")
             w["name"] = f"{renamed[plane]}/{index}"
     context.view_layer.update()
-    bpy.ops.wiresculpt.slice()
-    picked = {w["name"] for w in design["wires"]}
-    for item in scene.wiresculpt.contours:
-        item.use = f"{contour_plane_name(item)}/{item.index}" in picked
+    level, sliced = slicing.slice_scene(context, {w["name"] for w in design["wires"]})  # ticked as the design's wires
+    if 'ERROR' in level:
+        raise ValueError(sliced)
     scene_results.write_results(scene, design)
     clear_preview()  # the candidate is now the scene's own
-    return candidate
+    return candidate, sliced
 
 
 def clear_preview():
@@ -375,11 +375,12 @@ class WIRESCULPT_OT_apply_planes(bpy.types.Operator):
 
     def execute(self, context):
         try:
-            candidate = apply_candidate(context, self.index)
+            candidate, sliced = apply_candidate(context, self.index)
         except ValueError as exc:
             self.report({'ERROR'}, f"Cannot apply: {exc}")
             return {'CANCELLED'}
-        self.report({'INFO'}, "Applied: " + ("; ".join(candidate["changes"]) or "the planes as they were"))
+        self.report({'INFO'}, "Applied: " + ("; ".join(candidate["changes"]) or "the planes as they were")
+                    + f". {sliced}")
         return {'FINISHED'}
 
 
