@@ -6,7 +6,7 @@ import unittest
 
 import numpy as np
 
-from wiresculpt import native, pipeline
+from wiresculpt import native, pipeline, plane_search
 from wiresculpt.core import mesh_faults, sizes
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.scene import PlaneSpec
@@ -51,6 +51,8 @@ class MeshVerdictTest(unittest.TestCase):
         design = pipeline.slice_and_pick(V, F, PLANES, PRESETS["steel"], defaults())
         self.assertEqual(design["mesh_faults"], [])
         self.assertAlmostEqual(sizes.model_size(design), 2 * RADIUS, places=9)
+        # the nearby search's "the model's N mm" is the same figure (its frame's size S)
+        self.assertEqual(plane_search.mesh_frame(V, F)[2], design["model_size"])
 
 
 if __name__ == "__main__":
