@@ -73,6 +73,20 @@ class SizeTest(unittest.TestCase):
         self.assertEqual(sizes.size_facts(big, 3.0)[0], {"cause": sizes.TOO_LARGE, "size": 2.0,
                                                           "limit": sizes.LARGEST_MODEL})
 
+    def test_the_limits_and_the_warnings_give_the_same_figures(self):
+        from wiresculpt.core.limits import broken_limits
+
+        d = design(0.2)
+        for k, w in enumerate(d["wires"]):  # solved: each wire its own length, 1.1 m and more
+            w["target"], w["length"] = w["contour"], 1.1 + 0.05 * k
+        d["model_size"] = 1.6  # the mesh's, recorded: the wires' own box is 0.4 m
+        warned = sizes.size_warnings(d)
+        limits = broken_limits(d)
+        self.assertIn("the model is 1.60 m across", warned[0])
+        self.assertIn("1.60 m across, over 1.50 m", limits)
+        self.assertIn("wire C/0 is 1200 mm long", warned[3])
+        self.assertIn("3 wires are longer than the 1000 mm stock, C/0 1200 mm", limits)
+
 
 if __name__ == "__main__":
     unittest.main()
