@@ -191,7 +191,6 @@ def write_fabrication(design, out, say, profile=None, machine=None):
 
 def run(argv):
     import bpy
-    import numpy as np
 
     from wiresculpt import native, plane_search
     from wiresculpt.core.calibration import closed_overlap
@@ -215,7 +214,7 @@ def run(argv):
     check_vertices(V, scene.mesh, scene.size)  # NaN/inf, magnitudes, millimetres, before scaling
     factor = 1.0
     if scene.size is not None:
-        extent = float(np.max(V.max(axis=0) - V.min(axis=0)))
+        extent = sizes.mesh_size(V)
         if extent <= 0:
             raise ValueError(f"mesh file {scene.mesh} has no extent to scale to size {scene.size} m")
         factor = scene.size / extent

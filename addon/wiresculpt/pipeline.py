@@ -8,10 +8,11 @@ import math
 import time
 
 from . import native
+from .core import mesh_faults
 from .core import settings as settings_table
 from .core.design import NO_WIRES, ONE_WIRE, TOO_CLOSE, new_design
+from .core.sizes import mesh_size, size_warnings
 from .core.solve_context import Cancelled, OutOfTime, SolveContext, quiet  # noqa: F401 (the pipeline's names)
-from .core.sizes import size_warnings
 from .fab import buildability
 from .stages import forces, layering, slicing, target_shape
 
@@ -33,6 +34,8 @@ def slice_and_pick(vertices, faces, planes, material, settings, progress=None):
     """A new design whose wires are the contours the planes' rules pick. `planes`: objects with
     name, origin, normal, contours (the rule)."""
     design = new_design(material, settings)
+    design["model_size"] = mesh_size(vertices)  # the model's size, one figure for every message (core/sizes)
+    design["mesh_faults"] = mesh_faults.check(vertices, faces)  # said in the verdict when it fails (explain)
     (progress or quiet)("slicing", slicing.run(design, vertices, faces, planes, settings))
     return design
 
@@ -55,11 +58,14 @@ def solve(design, material, settings, progress=None, cancel=None, stock=None, ho
         design["reason"] = NO_WIRES if not design["wires"] else ONE_WIRE  # setup problems (core/design.py)
         return design
     apply_cuts(design, settings.get("cuts"))
-    for warning in size_warnings(design, *(stock or ())):  # before the long work: the figure, at once
-        design.setdefault("warnings", []).append(warning)
+    for warning in size_warnings(design, *(stock or ())):  # before the long work: the contour's figure, at once
         context.say("size", warning)
     try:
-        return relayer(design, material, settings, context, hook_patterns, hook_seconds)
+        solved = relayer(design, material, settings, context, hook_patterns, hook_seconds)
+        # the warnings the design keeps: the solved wires' lengths, the figures its files give
+        solved.setdefault("warnings", []).extend(size_warnings(solved, *(stock or ())))
+        mesh_faults.explain(solved)  # a mesh of several parts or with holes: its faults lead the reason
+        return solved
     except native.Cancelled:
         raise context.stopped() from None
 

@@ -235,6 +235,8 @@ class WiresculptSettings(bpy.types.PropertyGroup):
     in_plane_tiebreak: _setting("in_plane_tiebreak", "In-Plane Tie-Break")
     max_nodes: _setting("max_nodes", "Max Search Nodes")
     relayer_rounds: _setting("relayer_rounds", "Re-Layering Rounds")
+    # Suggest Planes' count (the search's plane_count); not a solver setting: a solve never reads it
+    plane_count: _setting("plane_count", "Planes")
     show_advanced: BoolProperty(
         name="Advanced", default=False,
         description="Show the layering's search settings (tie-break, node budget, re-layering rounds)")

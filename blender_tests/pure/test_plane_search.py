@@ -13,6 +13,7 @@ import numpy as np
 from wiresculpt import native, pipeline, plane_search
 from wiresculpt.core import contours as contour_rules
 from wiresculpt.core import design as vocabulary
+from wiresculpt.core import sizes
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.scene import PlaneSpec, parse_scene
 from wiresculpt.core.settings import defaults
@@ -223,6 +224,7 @@ class ReusedSlices(unittest.TestCase):
 
     def from_scratch(self, placements):
         design = vocabulary.new_design(PRESETS["steel"], self.settings)
+        design["model_size"] = sizes.mesh_size(self.V)  # as pipeline.slice_and_pick records it
         contours = 0
         for p in placements:
             found, info = slicing.slice_planes(self.V, self.F, [p.spec()], self.settings.get("weld_tolerance"))

@@ -3,8 +3,10 @@ index, and the settings' contour list that the user ticks."""
 import bpy
 from mathutils import Matrix
 
+from .. import native
 from ..core.contours import pick
-from .handles import contour_plane, drop_copied_ids
+from . import mesh
+from .handles import contour_plane, drop_copied_ids, handle_plane, handles, target_problem
 from .objects import remove_object, scene_collection, tagged, write_polyline
 
 CONTOUR_KEY = "wiresculpt_contour"  # custom property {"plane": name, "index": k} on curve objects
@@ -66,11 +68,18 @@ def release_deleted(scenes):
     return cleared
 
 
-def apply_slice(scene, settings, planes, per_plane):
+def contour_counts(settings):
+    """(contours listed, contours ticked: those that become wires): the one count every message
+    gives."""
+    return len(settings.contours), sum(bool(item.use) for item in settings.contours)
+
+
+def apply_slice(scene, settings, planes, per_plane, picked=None):
     """Make the scene's curves and the settings' list match the contours `per_plane` cut by the
     handle objects `planes`, keeping the user's ticks: a tick stays with its plane object (renamed
     or not) and its index; the ticks of a plane that is gone are dropped, even when a new plane
     has taken its name. A copy of a listed plane loses the id it copied (handles.drop_copied_ids).
+    `picked`: the contours to tick ("plane/index" names) instead of the kept ticks.
     Returns (contour count, ticked count, removed curve count)."""
     ticks = {}  # (handle object, index) -> tick
     for item in settings.contours:
@@ -93,9 +102,45 @@ def apply_slice(scene, settings, planes, per_plane):
             item.plane, item.index, item.curve = plane, index, obj
             item.plane_object, item.has_plane_object = handle, True
             item.length, item.closed = contour["length"], contour["closed"]
-            item.use = ticks.get((handle, index), index in longest)
+            item.use = (f"{plane}/{index}" in picked if picked is not None
+                        else ticks.get((handle, index), index in longest))
     for obj in existing.values():  # contours that disappeared
         remove_object(obj)
-    count = len(settings.contours)
+    count, ticked = contour_counts(settings)
     settings.active_contour = min(settings.active_contour, max(count - 1, 0))
-    return count, sum(item.use for item in settings.contours), len(existing)
+    return count, ticked, len(existing)
+
+
+def slice_scene(context, picked=None):
+    """Cuts the target with every slicing plane into the contour list and curves. `picked`: the
+    contours ("plane/index") to tick, instead of keeping the user's ticks (Apply of a plane
+    candidate). Returns (report type, sentence): the counts said are the list's own (contour_counts)."""
+    scene = context.scene
+    settings = scene.wiresculpt
+    target = settings.target
+    problem = target_problem(scene, target)
+    if problem is None and not native.available():
+        problem = native.LOAD_ERROR
+    planes = handles(scene)
+    if problem is None and not planes:
+        problem = "No slicing planes: add one with Add Slicing Plane"
+    if problem:
+        return {'ERROR'}, problem
+    depsgraph = context.evaluated_depsgraph_get()
+    try:
+        specs = [handle_plane(h, depsgraph) for h in planes]
+        V, F = mesh.object_triangles(target, depsgraph)
+        result = native.slice_mesh(V, F, specs)
+    except (ValueError, RuntimeError) as exc:
+        return {'ERROR'}, f"Cannot slice {target.name}: {exc}"
+    names = [name for name, _o, _n in specs]
+    _count, _ticked, removed = apply_slice(scene, settings, planes, result["contours"], picked)
+    count, ticked = contour_counts(settings)
+    missed = [name for name, contours in zip(names, result["contours"]) if not contours]
+    message = (f"Sliced {target.name} with {len(names)} plane{'s' * (len(names) != 1)}: "
+               f"{count} contour{'s' * (count != 1)}, {ticked} used as wires")
+    if removed:
+        message += f", {removed} old curve{'s' * (removed != 1)} removed"
+    if missed:
+        return {'WARNING'}, message + f"; {', '.join(missed)} cut nothing"
+    return {'INFO'}, message

@@ -10,7 +10,7 @@ import bmesh
 import bpy
 import numpy as np
 
-from ..core import stale
+from ..core import assembly_view, stale
 from ..core.design import crossing_direction, dumps
 from . import cut_handles, preview
 from .handles import contour_plane_name, contour_planes, handle_id, handle_plane, is_handle
@@ -300,10 +300,7 @@ def write_results(scene, design, inputs=None):
 
 def visible_wires(design, step):
     """Ids of the wires present after assembly step `step` (1-based; 0 or no order: all)."""
-    steps = design.get("assembly_steps") or []
-    if step <= 0 or not steps:
-        return {w["id"] for w in design["wires"]}
-    return {w for s in steps[:step] for w in s}
+    return assembly_view.visible([w["id"] for w in design["wires"]], design.get("assembly_steps") or [], step)
 
 
 def apply_assembly_step(scene):
@@ -323,6 +320,8 @@ def apply_assembly_step(scene):
         obj.hide_viewport = not (settings.show_markers and all(w in shown for w in wires))
     ids = {w["name"]: w["id"] for w in design["wires"]}
     for name, obj in tagged(scene, cut_handles.CUT_KEY).items():
+        obj.hide_viewport = ids.get(name) not in shown
+    for name, obj in tagged(scene, preview.PREVIEW_KEY).items():  # the machine preview's ghosts
         obj.hide_viewport = ids.get(name) not in shown
 
 

@@ -43,6 +43,7 @@ KEYS = {
         "search_incomplete": "layering",
         "out_of_plane": "forces", "load_capacity": "forces", "load_factor": "forces", "buildability": "pipeline",
         "fabrication": "fabrication", "plane_search": "plane_search",
+        "model_size": "pipeline", "mesh_faults": "pipeline",
     },
     "wire": {
         "id": "slicing", "name": "slicing", "plane": "slicing", "closed": "slicing", "contour": "slicing",
@@ -70,7 +71,7 @@ KEYS = {
 # material without density, a user's cut, the batch's exports.
 OPTIONAL = {
     "top": {"close_crossings", "required_size", "load_capacity", "load_factor", "fabrication", "warnings",
-            "buildability", "search_incomplete", "plane_search", "reason_causes"},
+            "buildability", "search_incomplete", "plane_search", "reason_causes", "model_size", "mesh_faults"},
     "wire": {"cut_override", "cut_point", "out_of_plane_deflection", "out_of_plane_deflection_vertex"},
     "crossing": set(),
     "stages": set(),

@@ -6,9 +6,11 @@ to be of a size such wires make. A design that breaks one of these is never show
 these phrases. Computed from the design's own figures, the same ones its warnings give in full.
 bpy-free.
 """
+import math
+
 from .figures import versus
 # STOCK_LENGTH: the default stock, which callers take from here too
-from .sizes import LARGEST_MODEL, STOCK_LENGTH, model_size, wire_length
+from .sizes import LARGEST_MODEL, MEASURED_WIRE, OVER_STOCK, STOCK_LENGTH, TOO_LARGE, size_facts
 
 # m: the forces stage's deflection_limit (native forces_and_rest; the add-on never sets another):
 # a wire predicted to bend further out of its plane under its contact forces is warned about.
@@ -54,17 +56,20 @@ def broken_limits(design, stock_length=STOCK_LENGTH):
         shown, limit = versus(worst * 1000, DEFLECTION_LIMIT * 1000, 1)
         said.append(f"wire {name} bends {shown} mm out of its plane (limit {limit} mm)" if len(bent) == 1 else
                     f"{len(bent)} wires bend out of their planes, {name} by {shown} mm (limit {limit} mm)")
-    long = [(wire_length(w), w.get("name", "?")) for w in wires if w.get("length") is not None]
-    long = [(length, name) for length, name in long if _over(length, stock_length)]
+    # the figures of the size warnings (core/sizes.size_facts): the solved wires' lengths, the model's size
+    ok = isinstance(stock_length, (int, float)) and math.isfinite(stock_length) and stock_length > 0
+    stock_length = stock_length if ok else STOCK_LENGTH  # as recorded_stock: the default profile's
+    facts = size_facts({"wires": wires, "model_size": design.get("model_size")}, stock_length) if wires else []
+    long = [(f["length"], f["wire"]) for f in facts if f["cause"] == OVER_STOCK and f["measured"] == MEASURED_WIRE
+            and _over(f["length"], stock_length)]
     if long:
         worst, name = max(long)
         shown, limit = versus(worst * 1000, stock_length * 1000, 0)
         said.append(f"wire {name} is {shown} mm long, over the {limit} mm stock" if len(long) == 1 else
                     f"{len(long)} wires are longer than the {limit} mm stock, {name} {shown} mm")
-    if wires:
-        size = model_size({"wires": wires})
-        if _over(size, LARGEST_MODEL):
-            shown, limit = versus(size, LARGEST_MODEL, 2)
+    for f in facts:
+        if f["cause"] == TOO_LARGE and _over(f["size"], LARGEST_MODEL):
+            shown, limit = versus(f["size"], LARGEST_MODEL, 2)
             said.append(f"{shown} m across, over {limit} m")
     return said
 

@@ -9,6 +9,7 @@ import os
 import numpy as np
 
 from .figures import versus
+from .sizes import mesh_size
 
 MAX_MESH_COORDINATE = 1e9  # any unit: beyond it the numbers are garbage, not a model
 MAX_UNSCALED_EXTENT = 10.0  # metres: a larger model without "size" is almost surely in millimetres
@@ -133,7 +134,7 @@ def check_vertices(V, path, size):
             at, most = versus(float(np.abs(V[i]).max()), MAX_MESH_COORDINATE, 6, "g")
             raise ValueError(f"mesh vertex {i} is at {at} from the origin, beyond {most}: mesh file {path} does "
                              f"not hold a model's coordinates")
-        extent = float(np.max(V.max(axis=0) - V.min(axis=0)))
+        extent = mesh_size(V)
         if size is None and extent > MAX_UNSCALED_EXTENT:
             across, most = versus(extent, MAX_UNSCALED_EXTENT, 6, "g")
             raise ValueError(f"your mesh looks like millimetres: mesh file {path} is {across} units across, "

@@ -3,6 +3,8 @@ of this kind, is a warning with the figure, said before the long optimization st
 import math
 from operator import itemgetter
 
+import numpy as np
+
 from .figures import versus
 
 STOCK_LENGTH = 1.0   # m: the default machine profile's straight wire stock (profile key stock_length)
@@ -17,9 +19,17 @@ def stock(profile):
     return float(profile.get("stock_length", STOCK_LENGTH)), profile.get("name") or "the machine profile"
 
 
+# Causes of the size warnings (codes; size_sentence makes their words)
+OVER_STOCK = "over_stock"        # a wire longer than the machine's stock: wire, length, stock, profile, measured
+TOO_LARGE = "model_too_large"    # a model over LARGEST_MODEL: size, limit
+# What a length was measured on: the solved wire (its `length` or target), or only its sliced contour
+# (before the target shape), whose length the solve changes.
+MEASURED_WIRE, MEASURED_CONTOUR = "wire", "contour"
+
+
 def wire_length(wire):
     """m: the wire's own `length`, else the length of its target (or contour) polyline, closed
-    when the wire is closed."""
+    when the wire is closed. Every message, warning and file that gives a wire's length asks here."""
     if wire.get("length") is not None:
         return float(wire["length"])
     points = wire.get("target") or wire.get("contour") or []
@@ -27,29 +37,70 @@ def wire_length(wire):
     return sum(math.dist(a, b) for a, b in zip(path, path[1:]))
 
 
+def measured_on(wire):
+    """MEASURED_WIRE when wire_length(wire) is the solved wire's, MEASURED_CONTOUR when only its
+    sliced contour is known."""
+    return MEASURED_WIRE if wire.get("length") is not None or wire.get("target") else MEASURED_CONTOUR
+
+
+def mesh_size(vertices):
+    """m: the largest side of the bounding box of a mesh's vertices ((n, 3)); 0.0 without any. The
+    model's size: what a scene's "size" sets, what the design records as `model_size`."""
+    V = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
+    return float(np.max(V.max(axis=0) - V.min(axis=0))) if len(V) else 0.0
+
+
 def model_size(design):
-    """m: the largest side of the bounding box of every wire's contour (or target) points."""
+    """m: the model's size, one figure for every message: the design's `model_size` (the mesh's
+    largest side, recorded when it was sliced, mesh_size), else the largest side of the bounding box
+    of every wire's contour (or target) points."""
+    recorded = design.get("model_size")
+    if isinstance(recorded, (int, float)) and math.isfinite(recorded) and recorded > 0:
+        return float(recorded)
     points = [p for w in design["wires"] for p in (w.get("contour") or w.get("target") or [])]
     if not points:
         return 0.0
     return max(max(map(itemgetter(k), points)) - min(map(itemgetter(k), points)) for k in range(3))
 
 
-def size_warnings(design, stock_length=STOCK_LENGTH, profile_name="the default machine profile"):
-    """One sentence per wire longer than `stock_length` (m) and one when the model is over
-    LARGEST_MODEL, each with its figure in millimetres or metres."""
+def scale_advice(design, factor):
+    """The words of "scale the model up by `factor`", with the model's size (model_size) before and
+    after: every scale advice the add-on makes says its figures this way."""
+    size = model_size(design)
+    return (f"scale the model up at least {factor:.2f} times (largest side {size:.4g} m -> "
+            f"{size * factor:.4g} m)")
+
+
+def size_facts(design, stock_length=STOCK_LENGTH, profile_name="the default machine profile"):
+    """The size problems of `design` as causes with their figures: one TOO_LARGE when the model is
+    over LARGEST_MODEL, one OVER_STOCK per wire longer than `stock_length` (m)."""
     if not (isinstance(stock_length, (int, float)) and math.isfinite(stock_length) and stock_length > 0):
         raise ValueError(f"machine profile key stock_length must be a positive number of metres, got {stock_length!r}")
     out = []
     size = model_size(design)
     if size > LARGEST_MODEL:
-        shown, largest = versus(size, LARGEST_MODEL, 2)
-        out.append(f"the model is {shown} m across, over {largest} m: check the mesh's units or "
-                   f"the scene's size (a wire sculpture this large sags and needs very long wires)")
+        out.append({"cause": TOO_LARGE, "size": size, "limit": LARGEST_MODEL})
     for w in design["wires"]:
         length = wire_length(w)
         if length > stock_length:
-            shown, stock_mm = versus(length * 1000, stock_length * 1000, 0)
-            out.append(f"wire {w['name']} is {shown} mm long, longer than the {stock_mm} mm "
-                       f"stock of {profile_name}: it needs a longer stock or a joint")
+            out.append({"cause": OVER_STOCK, "wire": w["name"], "length": length, "stock": float(stock_length),
+                        "profile": profile_name, "measured": measured_on(w)})
     return out
+
+
+def size_sentence(fact):
+    """The words of one size_facts cause, with its figures."""
+    if fact["cause"] == TOO_LARGE:
+        shown, largest = versus(fact["size"], fact["limit"], 2)
+        return (f"the model is {shown} m across, over {largest} m: check the mesh's units or "
+                f"the scene's size (a wire sculpture this large sags and needs very long wires)")
+    shown, stock_mm = versus(fact["length"] * 1000, fact["stock"] * 1000, 0)
+    measured = " (its sliced contour; the solve sets the wire's length)" if fact["measured"] == MEASURED_CONTOUR else ""
+    return (f"wire {fact['wire']} is {shown} mm long{measured}, longer than the {stock_mm} mm "
+            f"stock of {fact['profile']}: it needs a longer stock or a joint")
+
+
+def size_warnings(design, stock_length=STOCK_LENGTH, profile_name="the default machine profile"):
+    """One sentence per wire longer than `stock_length` (m) and one when the model is over
+    LARGEST_MODEL, each with its figure in millimetres or metres (size_facts, size_sentence)."""
+    return [size_sentence(f) for f in size_facts(design, stock_length, profile_name)]

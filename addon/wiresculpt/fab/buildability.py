@@ -15,7 +15,7 @@ the G-code and row k of the bend table), and a place is also given in mm from th
 import numpy as np
 
 from .. import native
-from ..core.design import model_size
+from ..core.sizes import scale_advice
 from ..core.polylines import self_crossings
 from .export import machine_profile
 
@@ -48,10 +48,7 @@ def between_bends(bend_points, edge):
 
 def _scale_advice(design, feed, limit, ends):
     """How to lengthen a short feed: scale the model (every length grows with it)."""
-    size = model_size(design)
-    factor = limit / feed
-    scale = (f"scale the model up at least {factor:.2f} times (largest side {size:.4g} m -> "
-             f"{size * factor:.4g} m)")
+    scale = scale_advice(design, limit / feed)
     if len(ends) == 2:
         return (f"its ends are crossings {ends[0]} and {ends[1]}, fixed points of the wire: {scale} or move the "
                 "planes so that they lie farther apart")

@@ -117,15 +117,18 @@ def whole_reason():
     return STATE.reason if STATE.running and shortened(STATE.reason) else ""
 
 
-def preview_segments(design):
+def preview_segments(design, ids=None):
     """[(RGBA, (2k, 3) float32 segment end points)] of each wire's shape (interlock offsets
-    applied), in the wire's colour: what the overlay draws."""
+    applied), in the wire's colour: what the overlay draws. `ids`: a list that gets each entry's
+    wire id."""
     out = []
     for wire_id, points in scene_results.wire_shapes(design).items():
         if len(points) < 2:
             continue
         wire = next(w for w in design["wires"] if w["id"] == wire_id)
         out.append((scene_results.wire_colour(wire_id), scene_results.polyline_segments(points, wire["closed"])))
+        if ids is not None:
+            ids.append(wire_id)
     return out
 
 
@@ -143,7 +146,7 @@ class LiveJob(WorkerJob):
         self.cancel_event = threading.Event()
         self.cancelled = False
         self.design = None
-        self.preview = []
+        self.preview, self.preview_ids, self.preview_steps = [], [], []
         self.seconds = None  # the work's wall time (slicing, solve, preview), when it ended
 
     def work(self):
@@ -153,7 +156,8 @@ class LiveJob(WorkerJob):
             cut_handles.set_cut_points(design, self.cuts)  # the user's moved cut handles, as build_design gives them
             self.design = pipeline.solve(design, self.material, self.settings, cancel=self.cancel_event.is_set,
                                          stock=self.stock, hook_patterns=LIVE_HOOK_PATTERNS)
-            self.preview = preview_segments(self.design)
+            self.preview = preview_segments(self.design, self.preview_ids)
+            self.preview_steps = self.design.get("assembly_steps") or []
         except pipeline.Cancelled:
             self.cancelled = True
         finally:
@@ -214,6 +218,7 @@ def _step():
             _show(*job.verdict())
             STATE.solved = job.key
             STATE.preview = job.preview if job.error is None else []
+            STATE.preview_ids, STATE.preview_steps = job.preview_ids, job.preview_steps
             STATE.record.results.append(STATE.verdict)
             STATE.record.shown_at, STATE.record.job_seconds = time.monotonic(), job.seconds
         job = None
@@ -323,6 +328,12 @@ def running():
 def preview_shown():
     """The preview segments the overlay draws while Live runs (preview_segments), else []."""
     return STATE.preview if STATE.running else []
+
+
+def preview_order():
+    """The wire id of each preview_shown entry and the shown verdict's assembly_steps (the
+    assembly slider's filter, core/assembly_view.shown_lines), else ([], [])."""
+    return (STATE.preview_ids, STATE.preview_steps) if STATE.running else ([], [])
 
 
 def note_drawn():

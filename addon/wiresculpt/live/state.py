@@ -22,6 +22,9 @@ class LiveState:
         self.verdict = ""
         self.reason = ""  # the whole text behind `verdict` (its reason, problem or error), "" for a word alone
         self.preview = []  # [(RGBA, (2k, 3) float32 segment end points)], one per wire of the shown verdict
+        # the wire id of each preview entry and the verdict's assembly_steps: the slider's filter
+        # (core/assembly_view.shown_lines, ui/overlay)
+        self.preview_ids, self.preview_steps = [], []
         self.mesh_key = None  # the target's name, matrix and geometry count the cached triangles belong to
         self.geometry = 0  # changes of the target's geometry seen by the depsgraph handler (edits, modifiers)
         self.failed = ""  # the last unexpected error's text, printed once
@@ -47,12 +50,12 @@ class LiveRecord:
 STATE = LiveState()
 
 # what observed() shows of the run state, besides the whole record
-_SHOWN = ("running", "verdict", "reason", "preview", "job", "solved", "geometry")
+_SHOWN = ("running", "verdict", "reason", "preview", "preview_steps", "job", "solved", "geometry")
 
 
 def observed(state=STATE):
     """A read-only view of Live now, for the tests and the bench: the run state's running, verdict,
-    reason, preview, job, solved and geometry, and the record's durations, results, shown_at,
+    reason, preview, preview_steps, job, solved and geometry, and the record's durations, results, shown_at,
     drawn_at, job_seconds and drawn (a copy: writing to it changes nothing)."""
     record = state.record
     return types.SimpleNamespace(

@@ -83,6 +83,7 @@ class WIRESCULPT_OT_export_fabrication(bpy.types.Operator):
             self.report({'ERROR'}, f"Cannot export: {exc}")
             return {'CANCELLED'}
         scene_preview.write_ghosts(context.scene, design, result)
+        scene_results.apply_assembly_step(context.scene)  # ghosts of wires not yet added stay hidden
         level, text = export.summary(result, folder)
         self.report({level}, text)
         return {'CANCELLED'} if level == "ERROR" else {'FINISHED'}

@@ -27,13 +27,16 @@ from mathutils import Matrix, Vector
 from .. import native, pipeline, plane_search
 from ..blend import mesh, ownership
 from ..blend import results as scene_results
-from ..blend.handles import (PLANE_MARGIN, add_handle, contour_plane, contour_plane_name, handle_plane, handles,
+from ..blend.handles import (PLANE_MARGIN, add_handle, contour_plane, handle_plane, handles,
                              target_problem)
+from ..blend.contours import slice_scene
 from ..blend.registration import classes_factory
 from ..blend.view import redraw_3d_views
 from ..core import session
 from ..core.jobs import WorkerJob
 from ..core.scene import PlaneSpec
+from ..core import mesh_faults
+from ..core.sizes import mesh_size
 from ..core.solve_context import SolveContext
 from ..props import material_of, solver_settings
 from .progress import JOIN_SECONDS, WorkerModal, busy
@@ -117,6 +120,7 @@ class SearchJob(WorkerJob):
         self.mode, self.V, self.F, self.planes = mode, V, F, planes
         self.material, self.settings, self.count = material, settings, count
         self.found, self.searched = [], None
+        self.mesh_faults = []  # core/mesh_faults.check of the mesh when nothing was found
         self.cancel_event = threading.Event()
         self.cancelled = False
         self.messages = []
@@ -141,7 +145,9 @@ class SearchJob(WorkerJob):
         except pipeline.Cancelled:
             self.cancelled = True
             return
-        size = float(np.max(np.ptp(np.asarray(self.V, dtype=float), axis=0)))
+        if not self.found:  # what is wrong with the mesh, said before what the search tried
+            self.mesh_faults = mesh_faults.check(self.V, self.F)
+        size = mesh_size(self.V)
         for candidate in self.found:
             candidate["preview"] = candidate_preview(candidate, self.mode, size)
 
@@ -216,6 +222,9 @@ def _store(job):
               "message": (f"{len(job.found)} stable candidate{'s' if len(job.found) != 1 else ''} "
                           f"({job.searched.screened} screened, {job.searched.full_solves} solved, "
                           f"{time.perf_counter() - job.started:.1f} s)" if job.found else
+                          f"No stable placement found: {mesh_faults.words(job.mesh_faults)} "
+                          f"({job.searched.screened} screened, {job.searched.full_solves} solved)"
+                          if job.mesh_faults else
                           f"No stable placement found: {plane_search.nearby_reason(job.searched)}"
                           if job.mode == "nearby" else
                           f"No stable placement found ({job.searched.screened} screened, "
@@ -250,7 +259,9 @@ class _SearchOperator(WorkerModal):
 
     def _job(self, context):
         V, F, planes, material, settings = gather(context, self.mode == "nearby")
-        job = SearchJob(self.mode, V, F, planes, material, settings, self._count(context))
+        count = self._count(context)
+        settings["plane_count"] = count  # the search's own key (core/settings.py), as the batch gives it
+        job = SearchJob(self.mode, V, F, planes, material, settings, count)
         job.scene_name = context.scene.name
         return job
 
@@ -324,10 +335,12 @@ class WIRESCULPT_OT_suggest_planes(_SearchOperator, bpy.types.Operator):
     mode = "auto"
     verb = "Suggest Planes"
 
-    count: bpy.props.IntProperty(name="Planes", description="How many planes to propose", default=5, min=2, max=12)
+    count: bpy.props.IntProperty(name="Planes", description="How many planes to propose (unset: the panel's "
+                                 "Planes)", default=5, min=2, max=12)
 
     def _count(self, context):
-        return self.count
+        """The operator's count when given, else the panel's (scene setting plane_count)."""
+        return self.count if self.properties.is_property_set("count") else context.scene.wiresculpt.plane_count
 
 
 def _place(obj, origin, normal):
@@ -341,8 +354,9 @@ def _place(obj, origin, normal):
 
 def apply_candidate(context, index):
     """The candidate's planes into the scene (moved handles, or new ones for Suggest), sliced, the
-    design's contours ticked, and its design as the result. ValueError when there is no such
-    candidate in this scene (Refused: its code says why) or a plane it moves is gone."""
+    design's contours ticked, and its design as the result. Returns (the candidate, Slice's
+    sentence: the contours and how many are wires). ValueError when there is no such candidate in
+    this scene (Refused: its code says why) or a plane it moves is gone."""
     result, candidate = _candidate(context, index)
     scene = context.scene
     design = candidate["design"]
@@ -367,13 +381,12 @@ def apply_candidate(context, index):
             plane, index = w["name"].split("/")
             w["name"] = f"{renamed[plane]}/{index}"
     context.view_layer.update()
-    bpy.ops.wiresculpt.slice()
-    picked = {w["name"] for w in design["wires"]}
-    for item in scene.wiresculpt.contours:
-        item.use = f"{contour_plane_name(item)}/{item.index}" in picked
+    level, sliced = slice_scene(context, {w["name"] for w in design["wires"]})  # ticked as the design's wires
+    if 'ERROR' in level:
+        raise ValueError(sliced)
     scene_results.write_results(scene, design)
     clear_preview()  # the candidate is now the scene's own
-    return candidate
+    return candidate, sliced
 
 
 def clear_preview():
@@ -424,11 +437,12 @@ class WIRESCULPT_OT_apply_planes(bpy.types.Operator):
 
     def execute(self, context):
         try:
-            candidate = apply_candidate(context, self.index)
+            candidate, sliced = apply_candidate(context, self.index)
         except ValueError as exc:
             self.report({'ERROR'}, f"Cannot apply: {exc}")
             return {'CANCELLED'}
-        self.report({'INFO'}, "Applied: " + ("; ".join(candidate["changes"]) or "the planes as they were"))
+        self.report({'INFO'}, "Applied: " + ("; ".join(candidate["changes"]) or "the planes as they were")
+                    + f". {sliced}")
         return {'FINISHED'}
 
 

@@ -1,10 +1,9 @@
 """Slicing: drop plane handles through the target, cut it, show the contours as curves."""
 import bpy
 
-from .. import native
 from ..blend import mesh
-from ..blend.contours import apply_slice, release_deleted
-from ..blend.handles import add_handle, handle_plane, handles, target_problem
+from ..blend.contours import release_deleted, slice_scene
+from ..blend.handles import add_handle, target_problem
 from ..blend.registration import classes_factory
 
 
@@ -43,38 +42,9 @@ class WIRESCULPT_OT_slice(bpy.types.Operator):
     bl_options = {'REGISTER', 'UNDO'}
 
     def execute(self, context):
-        scene = context.scene
-        settings = scene.wiresculpt
-        target = settings.target
-        problem = target_problem(scene, target)
-        if problem is None and not native.available():
-            problem = native.LOAD_ERROR
-        planes = handles(scene)
-        if problem is None and not planes:
-            problem = "No slicing planes: add one with Add Slicing Plane"
-        if problem:
-            self.report({'ERROR'}, problem)
-            return {'CANCELLED'}
-        depsgraph = context.evaluated_depsgraph_get()
-        try:
-            specs = [handle_plane(h, depsgraph) for h in planes]
-            V, F = mesh.object_triangles(target, depsgraph)
-            result = native.slice_mesh(V, F, specs)
-        except (ValueError, RuntimeError) as exc:
-            self.report({'ERROR'}, f"Cannot slice {target.name}: {exc}")
-            return {'CANCELLED'}
-        names = [name for name, _o, _n in specs]
-        count, ticked, removed = apply_slice(scene, settings, planes, result["contours"])
-        missed = [name for name, contours in zip(names, result["contours"]) if not contours]
-        message = (f"Sliced {target.name} with {len(names)} plane{'s' * (len(names) != 1)}: "
-                   f"{count} contour{'s' * (count != 1)}, {ticked} used as wires")
-        if removed:
-            message += f", {removed} old curve{'s' * (removed != 1)} removed"
-        if missed:
-            self.report({'WARNING'}, message + f"; {', '.join(missed)} cut nothing")
-        else:
-            self.report({'INFO'}, message)
-        return {'FINISHED'}
+        level, message = slice_scene(context)
+        self.report(level, message)
+        return {'CANCELLED'} if 'ERROR' in level else {'FINISHED'}
 
 
 _register, _unregister = classes_factory((WIRESCULPT_OT_add_plane, WIRESCULPT_OT_slice))

@@ -6,6 +6,7 @@ import math
 import numpy as np
 
 from ..core.scene import PlaneSpec
+from ..core.sizes import mesh_size
 
 OFFSETS = (0.02, 0.04, 0.07, 0.10, 0.15, 0.20)  # fractions of the model size S, both ways
 TILTS_DEG = (5.0, 10.0, 15.0)
@@ -61,8 +62,7 @@ def mesh_frame(vertices, faces):
             axes[k] = -axes[k]
     if np.ptp(values) < 1e-2 * max(values.max(), 1e-30):  # a sphere-like spread: the world axes
         axes = np.eye(3)
-    size = float(np.max(V.max(axis=0) - V.min(axis=0)))
-    return centre, axes, size
+    return centre, axes, mesh_size(V)
 
 
 def _perpendiculars(n):

@@ -123,6 +123,7 @@ class Searcher:
 
         began = time.perf_counter()
         design = new_design(self.material, self.settings)
+        design["model_size"] = self.size  # the mesh's, as pipeline.slice_and_pick records it (core/sizes)
         arrays = []
         contours = 0
         self.slice_ahead(placements)

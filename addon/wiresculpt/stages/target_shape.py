@@ -403,7 +403,8 @@ def run(design, material, settings, native_progress=None, memo=None):
     `memo` (a Memo) carries the nulled crossings and the solves of an earlier coupling round with a
     higher bend limit into this one, and is updated with this round's."""
     start = time.perf_counter()
-    size = memo.model_size(design) if memo is not None else model_size(design)
+    # the model's size the scale advice names: the recorded mesh's (core/sizes.model_size), else the contours'
+    size = design.get("model_size") or (memo.model_size(design) if memo is not None else model_size(design))
     nulled, iterations, wire_solves = [], 0, 0
     if memo is not None:
         for failure in memo.nulled:

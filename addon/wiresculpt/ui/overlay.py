@@ -17,6 +17,7 @@ import numpy as np
 from gpu_extras.batch import batch_for_shader
 
 from ..blend import compat, results
+from ..core import assembly_view
 from ..core.limits import DEFLECTION_LIMIT
 from ..live import engine as live
 from ..operators import plane_search
@@ -90,6 +91,13 @@ def deflection_whiskers(design, shown=None):
     return {k: np.asarray(v, dtype=np.float32) for k, v in out.items() if v}
 
 
+def live_lines(scene):
+    """Live's preview entries (colour, lines) that the overlay draws in `scene`: the wires added up
+    to the assembly slider's step of the live verdict's own order (every wire at step 0)."""
+    step = scene.wiresculpt.assembly_step if scene is not None else 0
+    return assembly_view.shown_lines(live.preview_shown(), *live.preview_order(), step)
+
+
 def draw_live():
     """The live verdict's wires (live/engine.py) as lines in their colours, over everything: the
     wires lie on the target's surface, where a depth test hid all but their kinks in Solid view."""
@@ -97,7 +105,7 @@ def draw_live():
     gpu.state.line_width_set(2.0)
     gpu.state.depth_test_set('NONE')
     shader.bind()
-    for colour, lines in live.preview_shown():
+    for colour, lines in live_lines(bpy.context.scene):
         shader.uniform_float("color", colour)
         batch_for_shader(shader, 'LINES', {"pos": lines}).draw(shader)
     gpu.state.line_width_set(1.0)

@@ -27,7 +27,9 @@ class VIEW3D_PT_wiresculpt_planes(bpy.types.Panel):
         col = layout.column(align=True)
         col.enabled = native.available() and not ops.running()
         col.operator(ops.WIRESCULPT_OT_find_planes.bl_idname, icon='VIEWZOOM')
-        col.operator(ops.WIRESCULPT_OT_suggest_planes.bl_idname, icon='LIGHTPROBE_PLANAR')
+        row = col.row(align=True)
+        row.operator(ops.WIRESCULPT_OT_suggest_planes.bl_idname, icon='LIGHTPROBE_PLANAR')
+        row.prop(context.scene.wiresculpt, "plane_count")  # how many planes Suggest Planes proposes
         job = ops.JOB
         if job is not None:
             box = layout.box()
