@@ -11,12 +11,11 @@
 #include <limits>
 #include <numbers>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <vector>
 
-#include "figures.hpp"
 #include "nlopt_text.hpp"
+#include "target_shape_messages.hpp"
 #include "target_shape_sqp.hpp"
 #include "wiresculpt/error.hpp"
 
@@ -28,14 +27,9 @@ constexpr double pi = std::numbers::pi;
 // densely sampled target has Φ ≈ 1.63 (h = 2 × spacing); Φ = 0.5 is reached about 0.45 h off it.
 constexpr double kernel_mass_full = 0.5;
 
-std::string fmt(double v, int precision = 3) {
-  std::ostringstream s;
-  s.precision(precision);
-  s << v;
-  return s.str();
-}
-std::string mm(double metres) { return fmt(metres * 1000.0, 3) + " mm"; }
-std::string deg(double radians) { return fmt(radians * 180.0 / pi, 3) + "°"; }
+using detail::deg;
+using detail::fmt;
+using detail::mm;
 
 double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
 
@@ -337,14 +331,10 @@ TargetShapeProblem::TargetShapeProblem(const Polyline2& contour, bool closed,
   // Per-crossing feasibility before solving.
   const double friction_angle = std::atan(o.friction);
   beta_.assign(crossings_.size(), 0.0);
-  auto crossing_name = [&](int c) { return "crossing " + std::to_string(c) + " on wire " + w; };
-  auto mark = [&](int c, const std::string& status, const std::string& message, double scale = 1.0) {
+  auto mark = [&](int c, CrossingCause cause, const CrossingFigures& figures) {
     TargetCrossingStatus& s = statuses_[c];
     if (!s.realised) return;  // keep the first reason
-    s.status = status;
-    s.realised = false;
-    s.message = message;
-    s.scale = scale;
+    detail::set_cause(s, c, w, cause, figures);
   };
   for (std::size_t c = 0; c < crossings_.size(); ++c) {
     const TargetCrossing& x = crossings_[c];
@@ -357,43 +347,32 @@ TargetShapeProblem::TargetShapeProblem(const Polyline2& contour, bool closed,
     beta_[c] = x.contact_angle / 2.0 - friction_angle;
     const int v = s.vertex;
     const int ci = static_cast<int>(c);
-    if (!closed && (v == 0 || v == m - 1))
-      mark(ci, "open_end", crossing_name(ci) + " is at an end of the open wire, where the wire has no kink to open");
-    else if (beta_[c] <= 0.0)
-      mark(ci, "infeasible",
-           crossing_name(ci) + " asks for contact angle " + deg(x.contact_angle) +
-               ", which is not wider than twice the friction angle atan(μ) = " + deg(friction_angle));
-    else if (pi - 2.0 * beta_[c] > o.max_bend + 1e-12)
-    {
-      // the bend is 180° less the contact angle, plus twice the friction angle; a contact angle
-      // of at least 180° - max_bend + 2 atan(μ) fits the machine (rounded up where it is shown,
-      // so the figure given does fit; none from 180° on: then only a larger bend helps)
-      const double fits = (pi - o.max_bend + 2.0 * friction_angle) * 180.0 / pi;
-      const double step = fits >= 100.0 ? 1.0 : fits >= 10.0 ? 0.1 : 0.01;  // deg()'s 3 digits
-      const std::string advice = fits < 180.0 ? ": a contact angle of at least " +
-                                                    fmt(std::ceil(fits / step - 1e-9) * step, 3) + "° fits"
-                                              : std::string();
-      mark(ci, "infeasible",
-           crossing_name(ci) + " needs a bend of at least " + deg(pi - 2.0 * beta_[c]) + " (180° less the contact angle " +
-               deg(x.contact_angle) +
-               (friction_angle > 0.0 ? ", plus twice the friction angle " + deg(friction_angle) : std::string()) +
-               ") but the machine bends at most " + deg(o.max_bend) + advice);
+    CrossingFigures f;
+    f.contact_angle = x.contact_angle;
+    f.friction_angle = friction_angle;
+    if (!closed && (v == 0 || v == m - 1)) {
+      mark(ci, CrossingCause::open_end, {});
+    } else if (beta_[c] <= 0.0) {
+      mark(ci, CrossingCause::contact_vs_friction, f);
+    } else if (pi - 2.0 * beta_[c] > o.max_bend + 1e-12) {
+      // the bend is 180° less the contact angle, plus twice the friction angle
+      f.bend = pi - 2.0 * beta_[c];
+      f.limit = o.max_bend;
+      mark(ci, CrossingCause::min_bend, f);
     }
   }
-  auto scale_message = [&](const Gap& g) {
-    const double scale = 2.0 * lmin / std::max(g.arc, 1e-300);
-    std::string msg = "crossings " + std::to_string(g.a) + " and " + std::to_string(g.b) + " on wire " + w + " are " +
-                      mm(g.arc) + " apart along the wire; a free bending point between them needs " + mm(2.0 * lmin) +
-                      ": scale the model up by " + fmt(scale) + "x";
-    if (o.model_size > 0.0) msg += ", to at least " + fmt(o.model_size * scale) + " m";
-    return std::make_pair(scale, msg);
-  };
   for (const Gap& g : gaps) {
-    const auto [scale, msg] = scale_message(g);
+    CrossingFigures f;
+    f.first = g.a;
+    f.second = g.b;
+    f.length = g.arc;
+    f.limit = lmin;
+    f.scale = 2.0 * lmin / std::max(g.arc, 1e-300);
+    f.model_size = o.model_size;
     if (g.chord < lmin) {
       // The direct segment is too short to bend: a fabrication problem whatever the hooks.
-      mark(g.a, "too_close", msg + " (the straight piece is shorter than the minimum segment)", scale);
-      mark(g.b, "too_close", msg + " (the straight piece is shorter than the minimum segment)", scale);
+      mark(g.a, CrossingCause::short_piece, f);
+      mark(g.b, CrossingCause::short_piece, f);
       continue;
     }
     // A fixed edge: its contact constraint is a constant that either holds or cannot be met.
@@ -402,7 +381,7 @@ TargetShapeProblem::TargetShapeProblem(const Polyline2& contour, bool closed,
       const int v = crossing_vertices_[c];
       const int other = crossing_vertices_[c == g.a ? g.b : g.a];
       const double a = angle_between(initial_[other] - initial_[v], crossings_[c].bisector);
-      if (a > beta_[c] + o.angle_tolerance) mark(c, "too_close", msg, scale);
+      if (a > beta_[c] + o.angle_tolerance) mark(c, CrossingCause::fixed_edge, f);
     }
   }
 
@@ -1342,11 +1321,9 @@ detail::TargetShapeRun detail::run_target_shape(const Polyline2& contour, bool c
     result.max_angle_violation = std::max(result.max_angle_violation, s.contact_violation);
     if (s.contact_violation > o.angle_tolerance) {
       result.feasible = false;
-      s.status = "infeasible";
-      s.realised = false;
-      s.message = "crossing " + std::to_string(c) + " on wire " + w +
-                  ": the kink could not be opened towards the desired bisector within the fabrication limits (an edge is " +
-                  deg(s.contact_violation) + " outside the contact cone)";
+      CrossingFigures f;
+      f.violation = s.contact_violation;
+      detail::set_cause(s, static_cast<int>(c), w, CrossingCause::cone_missed, f);
     }
   }
   // A kink whose neighbours break a machine limit is not made either: the solver met the contact
@@ -1373,15 +1350,17 @@ detail::TargetShapeRun detail::run_target_shape(const Polyline2& contour, bool c
       const double len = (p[k] - p[v]).norm();
       if (bend <= 0.0 && o.min_segment - len <= o.length_tolerance) continue;
       result.feasible = false;
-      s.status = "infeasible";
-      s.realised = false;
-      // the figure and the limit it breaks with the same decimals, enough to tell them apart
-      const auto [shown, limit] = bend > 0.0 ? detail::versus(bend * 180.0 / pi, bend_limit(o, k) * 180.0 / pi, 1)
-                                             : detail::versus(len * 1000.0, o.min_segment * 1000.0, 2);
-      s.message = "crossing " + std::to_string(c) + " on wire " + w +
-                  ": its kink cannot be made within the machine's limits: next to it, at point " + std::to_string(k) +
-                  ", the wire " + (bend > 0.0 ? "bends " + shown + "°, more than " + limit + "°"
-                                                : "has a segment of " + shown + " mm, less than " + limit + " mm");
+      CrossingFigures f;
+      f.point = k;
+      if (bend > 0.0) {
+        f.bend = bend;
+        f.limit = bend_limit(o, k);
+      } else {
+        f.length = len;
+        f.limit = o.min_segment;
+      }
+      detail::set_cause(s, static_cast<int>(c), w,
+                        bend > 0.0 ? CrossingCause::neighbour_bend : CrossingCause::neighbour_segment, f);
       break;
     }
   }

@@ -153,6 +153,42 @@ struct TargetShapeOptions {
   std::string wire_name = "wire";
 };
 
+/// Why a crossing is not realised (TargetCrossingStatus::cause), with the status each gives.
+enum class CrossingCause {
+  none,                 ///< realised, or inactive ("ok", "inactive")
+  open_end,             ///< "open_end": an active crossing at an end of an open wire, with no kink
+  contact_vs_friction,  ///< "infeasible": the contact angle is not wider than twice atan(μ)
+  min_bend,             ///< "infeasible": the least bend the kink needs is over max_bend
+  short_piece,          ///< "too_close": the straight piece to the next crossing is under min_segment
+  fixed_edge,           ///< "too_close": the fixed piece to the next crossing lies outside the cone
+  cone_missed,          ///< "infeasible": after the solve, an edge of the kink outside the cone
+  neighbour_bend,       ///< "infeasible": after the solve, the free point next to it bends too much
+  neighbour_segment,    ///< "infeasible": after the solve, the segment next to it is too short
+};
+
+/// The snake_case name of a cause, as the binding hands it over: "short_piece".
+const char* cause_name(CrossingCause cause);
+
+/// The figures a cause's sentence gives (each 0 / -1 where the cause has none).
+struct CrossingFigures {
+  double contact_angle = 0.0;   ///< radians: α* asked (contact_vs_friction, min_bend)
+  double friction_angle = 0.0;  ///< radians: atan μ (contact_vs_friction, min_bend)
+  /// Radians: min_bend: the least bend the kink needs, π - α* + 2 atan μ; neighbour_bend: the
+  /// bend found at `point`.
+  double bend = 0.0;
+  /// The limit broken: min_bend: max_bend, neighbour_bend: the bend limit at `point` (radians);
+  /// neighbour_segment, short_piece, fixed_edge: min_segment (metres).
+  double limit = 0.0;
+  /// Metres: neighbour_segment: the segment found; short_piece, fixed_edge: the arc between the
+  /// two crossings.
+  double length = 0.0;
+  double violation = 0.0;   ///< radians: cone_missed: how far the worse edge is outside the cone
+  double scale = 1.0;       ///< too_close: as TargetCrossingStatus::scale
+  double model_size = 0.0;  ///< too_close: the model's size (metres; 0: not known)
+  int first = -1, second = -1;  ///< too_close: the two crossings, in the wire's order
+  int point = -1;               ///< neighbour_bend, neighbour_segment: the point next to the kink
+};
+
 /// What happened to one input crossing.
 struct TargetCrossingStatus {
   /// "ok" (realised), "inactive" (null hook, point kept), "too_close" (no free point towards a
@@ -176,6 +212,12 @@ struct TargetCrossingStatus {
   /// 1 otherwise.
   double scale = 1.0;
   std::string message;  ///< a sentence naming the wire and crossing; empty when "ok"/"inactive"
+  CrossingCause cause = CrossingCause::none;  ///< why it is not realised (none when it is)
+  CrossingFigures figures;                    ///< the figures `message` gives
+  /// What follows the crossing's name in "crossing N on wire W: " for a caller that names it its
+  /// own way ("it needs a bend of at least …"); `message` itself when that does not start with
+  /// the crossing's name (too_close, about two crossings); empty when "ok"/"inactive".
+  std::string words;
 };
 
 struct TargetShapeResult {
