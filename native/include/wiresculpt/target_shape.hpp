@@ -429,6 +429,12 @@ class TargetShapeProblem {
   /// Constraints that depend on at least one free point (the solver's constraints).
   const std::vector<Constraint>& constraints() const { return constraints_; }
   const std::vector<TargetCrossingStatus>& statuses() const { return statuses_; }
+  /// The options as solved: spacing 0 replaced by its default.
+  const TargetShapeOptions& options() const { return options_; }
+  /// The crossings as solved: an active crossing's bisector normalised.
+  const std::vector<TargetCrossing>& crossings() const { return crossings_; }
+  /// Radians: crossing c's contact cone half-angle α*/2 - atan μ (0 for an inactive crossing).
+  double beta(std::size_t c) const { return beta_[c]; }
   double kernel_support() const { return h_; }  ///< metres, h of Eq. 4
 
   /// E_d of Eq. 4 (m³); adds dE_d/dp to `grad` when non-null (resized to #points).
@@ -457,8 +463,18 @@ class TargetShapeProblem {
   double imls(const Vec2& q, Vec2* grad = nullptr) const;
 
  private:
-  friend detail::TargetShapeRun detail::run_target_shape(const Polyline2&, bool, const std::vector<TargetCrossing>&,
-                                                         const TargetShapeOptions&, ProgressFn);
+  struct Gap {  // consecutive crossings without a free point between them
+    int a, b;   // crossings
+    double arc, chord;
+  };
+  // The set-up, in this order: the contour's cumulative arc lengths (InputError for no length or
+  // too many target points), the target and its grids, the resampling, the crossings' causes that
+  // no solve changes, the solver's constraints.
+  std::vector<double> arc_lengths(const Polyline2& contour) const;
+  void build_target(const Polyline2& contour);
+  std::vector<Gap> resample(const Polyline2& contour, const std::vector<double>& cum);
+  void check_crossings(const std::vector<Gap>& gaps);
+  void collect_constraints();
   double nearest_squared(const Vec2& q, Vec2* grad) const;
   // Term i of E_d (w_i D(p_i)) and of w_r E_r (weight |Δu_i|²); gradients added to grad. With grad,
   // `sample` (when non-null) gets D(p_i) and its gradient.
