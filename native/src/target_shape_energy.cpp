@@ -31,9 +31,9 @@ double TargetShapeProblem::nearest_squared(const Vec2& q, Vec2* grad) const {
   int best_edge = -1;
   // Equally near edges (two edges meeting at the nearest vertex: one ends there at a + 1·(b - a),
   // the other starts there, points that can differ in the last bit) are decided as the search by
-  // target points did before (issue 17): the edge it tested first, in its order of rings, rows,
+  // target points would decide them: the edge it would test first, in its order of rings, rows,
   // cells, points and, per point k, edge k before edge k - 1; or the lower index when q was
-  // outside the points' grid. So the gradient, hence every solve, is the same as before.
+  // outside the points' grid. So the gradient, hence every solve, keeps that search's answers.
   using Rank = std::array<long long, 5>;
   auto rank = [&](int k) {
     const double fx = (q.x() - grid_origin_.x()) / cell_, fy = (q.y() - grid_origin_.y()) / cell_;

@@ -252,7 +252,7 @@ void TargetShapeProblem::build_target(const Polyline2& contour) {
   // The edges, by the cells of their bounding boxes (ecell_of is monotone, so the cell holding
   // any point of an edge lies in that range), on a grid of its own.
   // Cells of 2h: on the Airplane's recorded solves 1, 2 and 4 h took the same time within the
-  // noise (docs/method-target-shape.md, issue 17, fourth round).
+  // noise (docs/method-target-shape.md).
   edge_cell_ = 2.0 * cell_;
   edge_nx_ = static_cast<int>((hi.x() - lo.x()) / edge_cell_) + 1;
   edge_ny_ = static_cast<int>((hi.y() - lo.y()) / edge_cell_) + 1;

@@ -57,7 +57,7 @@ struct TargetCrossing {
 enum class TargetShapeAlgorithm {
   slsqp,         ///< NLopt LD_SLSQP (default: see docs/method-target-shape.md)
   /// Newton SQP per block (target_shape_sqp.hpp), led by SLSQP's first evaluations where the
-  /// basin is chosen and replaced by SLSQP where it fails; the pipeline's choice (issue 17, see
+  /// basin is chosen and replaced by SLSQP where it fails; the pipeline's choice (see
   /// docs/method-target-shape.md)
   sqp,
   auglag_lbfgs,  ///< NLopt AUGLAG with LD_LBFGS as the local solver
@@ -295,7 +295,7 @@ std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetSh
 
 namespace detail {
 /// Fills r.target (r.points placed in `plane`: origin + x u + y v, in that order) and r.length,
-/// their polyline's length with the edges' norms added as numpy's sum adds them (numpy_sum.hpp):
+/// their polyline's length with the edges' norms added as numpy's sum adds them (exact/numpy_sum.hpp):
 /// the same numbers, to the bit, as the target-shape stage's to_3d and polyline_length.
 void place_target(TargetShapeResult& r, const Plane& plane, bool closed);
 
@@ -379,8 +379,7 @@ std::vector<TargetShapeResult> optimize_target_shapes(const std::vector<TargetSh
 
 /// optimize_target_shapes with the jobs handed over one at a time: with two threads, the other
 /// thread is woken when the batch is made, starts at the first add() and solves while the caller
-/// prepares the next jobs (the stage's Python reads each wire's frame and crossings; issue 17,
-/// seventeenth and eighteenth rounds); finish() then works on the calling thread too until every
+/// prepares the next jobs (the stage's Python reads each wire's frame and crossings); finish() then works on the calling thread too until every
 /// job is solved, exactly as optimize_target_shapes does (it is this batch with every job added at
 /// once). Every result is the one optimize_target_shape returns for that job alone (with its
 /// `target` and `length` for a job with a plane), in the order added. Before finish()
