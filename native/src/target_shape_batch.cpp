@@ -17,7 +17,7 @@
 #include <unistd.h>
 
 #include "wiresculpt/error.hpp"
-#include "wiresculpt/target_shape.hpp"
+#include "wiresculpt/target_shape_batch.hpp"
 
 namespace wiresculpt {
 namespace {
