@@ -357,22 +357,22 @@ class Unrealisable(unittest.TestCase):
            "them needs 30.0 mm: scale the model up by 1.2x")
 
     def forbidden(self, *failures):
-        nulled = [{"crossing": c, "hook": h, "status": status, "message": message,
-                   "whatever_the_hook": target_shape.whatever_the_hook(status, message)}
-                  for c, h, status, message in failures]
+        nulled = [{"crossing": c, "hook": h, "status": status, "message": message, "cause": cause,
+                   "whatever_the_hook": target_shape.whatever_the_hook(cause)}
+                  for c, h, status, cause, message in failures]
         return target_shape.unrealisable({"stages": {"target_shape": {"nulled_crossings": nulled}}})
 
     def test_the_failed_hook_or_both(self):
-        self.assertEqual(self.forbidden((0, 1, "too_close", self.GAP)), {(0, 1)})
+        self.assertEqual(self.forbidden((0, 1, "too_close", "fixed_edge", self.GAP)), {(0, 1)})
         short = self.GAP + " (the straight piece is shorter than the minimum segment)"
-        self.assertEqual(self.forbidden((0, 1, "too_close", short)), {(0, 1), (0, -1)})
-        self.assertEqual(self.forbidden((3, -1, "open_end", "crossing 3 is at an end of the open wire")),
+        self.assertEqual(self.forbidden((0, 1, "too_close", "short_piece", short)), {(0, 1), (0, -1)})
+        self.assertEqual(self.forbidden((3, -1, "open_end", "open_end", "crossing 3 is at an end of the open wire")),
                          {(3, 1), (3, -1)})
         cone = "crossing 2 on wire B/0 misses its contact cone by 3.1 deg"
-        self.assertEqual(self.forbidden((2, -1, "infeasible", cone)), {(2, -1)})
+        self.assertEqual(self.forbidden((2, -1, "infeasible", "cone_missed", cone)), {(2, -1)})
         rule = ("crossing 2 needs a bend of at least 130 deg (contact angle 60 deg minus twice the friction angle) "
                 "but the machine bends at most 120 deg")
-        self.assertEqual(self.forbidden((2, -1, "infeasible", rule)), {(2, 1), (2, -1)})
+        self.assertEqual(self.forbidden((2, -1, "infeasible", "min_bend", rule)), {(2, 1), (2, -1)})
         self.assertEqual(target_shape.unrealisable({"stages": {}}), set())
 
 

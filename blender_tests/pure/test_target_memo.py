@@ -111,7 +111,8 @@ class AgainstColdSolves(unittest.TestCase):
         self.assertEqual(first["stages"]["target_shape"]["reused_wires"], 0)
         bends = [math.degrees(w["max_bend"]) for _k, (_l, w) in memo.solves.items()]
         # Pretend the first round could not realise crossing 0: the next round starts without it.
-        memo.nulled = [{"crossing": 0, "wire": "A/0", "status": "infeasible", "scale": 1.0, "message": "by hand"}]
+        memo.nulled = [{"crossing": 0, "wire": "A/0", "status": "infeasible", "scale": 1.0, "message": "by hand",
+                        "cause": "cone_missed", "words": "by hand"}]
         second = copy.deepcopy(self.design)
         self.assertNotEqual(second["crossings"][0]["hook"], 0)
         target_shape.run(second, self.material, {**self.settings, "max_bend_deg": (max(bends) + machine) / 2},

@@ -64,7 +64,8 @@ py::dict to_dict(const TargetShapeResult& r) {
   for (const TargetCrossingStatus& s : r.crossings)
     statuses.append(make_dict("status", s.status, "realised", s.realised, "vertex", s.vertex, "bisector",
                               py::make_tuple(s.bisector.x(), s.bisector.y()), "contact_angle", s.contact_angle,
-                              "contact_violation", s.contact_violation, "scale", s.scale, "message", s.message));
+                              "contact_violation", s.contact_violation, "scale", s.scale, "message", s.message, "cause",
+                              cause_name(s.cause), "words", s.words));
   py::dict d = make_dict(
       "points", to_array(r.points), "crossing_vertices", r.crossing_vertices, "crossings", statuses, "max_distance",
       r.max_distance, "rms_distance", r.rms_distance, "min_segment", r.min_segment, "max_bend", r.max_bend,
@@ -153,7 +154,8 @@ xtol_rel, constraint_tol, max_iterations (1..1e7), window (0 or 4..10000), sweep
 angle_tolerance, length_tolerance, wire_name); progress: optional callable(stage, fraction) ->
 bool, False cancels (raises Cancelled).
 Returns {"points": (m, 2), "crossing_vertices": [int], "crossings": [{"status", "realised",
-"vertex", "bisector", "contact_angle", "contact_violation", "scale", "message"}], "max_distance",
+"vertex", "bisector", "contact_angle", "contact_violation", "scale", "message", "cause", "words"}],
+"max_distance",
 "rms_distance", "min_segment", "max_bend", "max_length_violation", "max_angle_violation",
 "iterations", "sweeps", "sqp_blocks", "sqp_fallbacks", "seconds", "nlopt_result", "energy", "feasible",
 "warnings"}.

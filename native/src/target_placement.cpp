@@ -3,7 +3,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "numpy_sum.hpp"
+#include "exact/numpy_sum.hpp"
 #include "wiresculpt/target_shape.hpp"
 
 namespace wiresculpt::detail {

@@ -17,7 +17,7 @@
 #include <unistd.h>
 
 #include "wiresculpt/error.hpp"
-#include "wiresculpt/target_shape.hpp"
+#include "wiresculpt/target_shape_batch.hpp"
 
 namespace wiresculpt {
 namespace {
@@ -27,9 +27,8 @@ namespace {
 // round's 42 ms of solving, and came last). With n the target's points (as the solver places them:
 // detail::initial_point_count), a wire solved as one block costs about n² (a dense subproblem per
 // iteration; about 4 µs·n² on the stand-ins), one solved in windows about 12·n of the same units
-// (about 50 µs a point). (The guess was the contour's length / spacing + the crossings, which
-// counted the crossings twice: the Chair's backrest and the Car's 24-point wires looked windowed,
-// hence cheap, and came last; issue 17, fourteenth round.)
+// (about 50 µs a point). The points are counted as the problem resamples them, crossings once:
+// counted twice, short wires with many crossings look windowed, hence cheap, and come last.
 double expected_cost(const TargetShapeJob& job) {
   const TargetShapeOptions& o = job.options;
   const double n = detail::initial_point_count(job.contour, job.closed, job.crossings, o);
@@ -74,7 +73,7 @@ class SpinLock {
 
 // The other thread, made once and kept for the process: a thread started for every call cost
 // about 14 % more CPU than the same solves on one thread (its start and end in the kernel, a fresh
-// stack, malloc arena and caches; issue 17, seventeenth round). It serves one batch at a time;
+// stack, malloc arena and caches). It serves one batch at a time;
 // a batch that finds it busy (another solve on another thread) runs on its own thread alone. It is
 // never destroyed: parked at exit, it is the operating system's to end (joining it from a static
 // destructor could wait on a batch whose caller the interpreter froze).

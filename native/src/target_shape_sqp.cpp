@@ -1,6 +1,6 @@
 #include "target_shape_sqp.hpp"
 
-#include "small_triangular.hpp"
+#include "exact/small_triangular.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
@@ -38,7 +38,7 @@ bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::Vector
   Nt.resize(n, m);
   std::vector<char>& whitened = buffers.whitened;
   whitened.assign(static_cast<std::size_t>(m), 0);
-  d = -g;  // -W⁻¹ g, as llt.solveInPlace(d) gives it (small_triangular.hpp)
+  d = -g;  // -W⁻¹ g, as llt.solveInPlace(d) gives it (exact/small_triangular.hpp)
   lower_solve_in_place(L, n, n, d.data());
   lower_transpose_solve_in_place(L, n, n, d.data());
   lambda = Eigen::VectorXd::Zero(m);
@@ -91,8 +91,8 @@ bool solve_convex_qp(const Eigen::LLT<Eigen::MatrixXd>& llt, const Eigen::Vector
         if (r[j] > 0.0 && u[static_cast<std::size_t>(j)] / r[j] < t1) t1 = u[static_cast<std::size_t>(j)] / r[j], drop = j;
       // Primal step length: to make constraint p hold. The scan found p violated by worst < 0; the
       // dot product is the value every earlier result was computed with (taking `worst` instead
-      // moved a recorded Chair call by 9 mm and changed 85 of 106 scenes, 2 beyond issue 17's
-      // 0.1 mm), and where rounding made it disagree in sign with the scan the step would go
+      // moves a recorded Chair call by 9 mm and changes 85 of 106 scenes, 2 beyond the 0.1 mm
+      // tolerance), and where rounding made it disagree in sign with the scan the step would go
       // backwards: then the scan's.
       double sp = -(At.col(p).dot(d) + c[p]);
       if (first && !(sp < 0.0)) sp = worst;
@@ -329,6 +329,87 @@ class BlockModel {
 double violation(const Eigen::VectorXd& c) { return c.size() ? std::max(0.0, c.maxCoeff()) : 0.0; }
 double infeasibility(const Eigen::VectorXd& c) { return c.cwiseMax(0.0).sum(); }
 
+// The line search of one sqp_block iteration from x along the QP's step d, on the merit
+// f + nu Σ max(0, c_k) (phi0 at x, `slope` its directional derivative), with a second-order
+// correction after a rejected full step. True when a point was accepted: then ws.xt, ws.trial,
+// `ft`, ws.gt, ws.ct and ws.At are that point's, `alpha` its step length, and ws.mu the
+// correction's multipliers where the correction was taken.
+template <class Counted>
+bool sqp_line_search(BlockModel& model, SqpWorkspace& ws, const Eigen::LLT<Eigen::MatrixXd>& factor,
+                     const Eigen::MatrixXd& A, int mc, double nu, double phi0, double slope, Counted&& counted,
+                     double& alpha, double& ft) {
+  const Eigen::VectorXd &x = ws.x, &g = ws.g, &d = ws.d;
+  Eigen::VectorXd &xt = ws.xt, &gt = ws.gt, &ct = ws.ct, &dc = ws.dc, &mc2 = ws.mc2, &csoc = ws.csoc;
+  auto merit = [&](double fv, const Eigen::VectorXd& cv) { return fv + nu * infeasibility(cv); };
+  for (int ls = 0; ls < 40; ++ls) {
+    xt = x + alpha * d;
+    model.to_points(xt, ws.trial);
+    ft = model.evaluate(ws.trial, &gt, ct, &ws.At);
+    counted();
+    if (std::isfinite(ft) && merit(ft, ct) <= phi0 + 1e-4 * alpha * slope) return true;
+    if (ls == 0 && mc > 0) {
+      // Second-order correction (the full step raised the violation of curved active
+      // constraints, the Maratos effect): the same QP with the constraints' values at the trial
+      // point, linearised about x.
+      csoc = ct - A * d;
+      if (solve_convex_qp(factor, g, A, csoc, dc, mc2, ws.qp)) {
+        xt = x + dc;
+        model.to_points(xt, ws.trial);
+        ft = model.evaluate(ws.trial, &gt, ct, &ws.At);
+        counted();
+        if (std::isfinite(ft) && merit(ft, ct) <= phi0 + 1e-4 * slope) {
+          ws.mu = mc2;
+          return true;
+        }
+      }
+    }
+    alpha *= 0.5;
+  }
+  return false;
+}
+
+// NLopt 2.7.1's tests (src/util/stop.c): relative change of f, and of x in the 1-norm.
+bool relstop(double old_value, double value, double reltol) {
+  const double d = std::abs(value - old_value);
+  return d < reltol * (std::abs(value) + std::abs(old_value)) * 0.5 || (reltol > 0.0 && value == old_value);
+}
+bool xstop(const Eigen::VectorXd& xv, const Eigen::VectorXd& old, double reltol) {
+  return (xv - old).lpNorm<1>() < reltol * xv.lpNorm<1>();
+}
+
+// Where Kraft's relaxed test fails after the fifth restart (its tolerance is 0 here), NLopt's
+// code: the roundoff limit, or at a feasible point its ftol or xtol test ×10 against the start of
+// this step (where x and f still are).
+int relaxed_stop(bool feasible, double f0, double f, const Eigen::VectorXd& x, const Eigen::VectorXd& x0, double ftol_rel,
+                 double xtol_rel) {
+  if (!feasible) return NLOPT_ROUNDOFF_LIMITED;
+  if (relstop(f0, f, 10.0 * ftol_rel)) return NLOPT_FTOL_REACHED;
+  if (xstop(x, x0, 10.0 * xtol_rel)) return NLOPT_XTOL_REACHED;
+  return NLOPT_ROUNDOFF_LIMITED;
+}
+
+// Kraft's sums, term by term onto `start`: the test function t = f + Σ μ_j max(c_j, 0).
+double kraft_penalty(const Eigen::VectorXd& mu, const Eigen::VectorXd& cv, double start) {
+  double h = start;
+  for (Eigen::Index j = 0; j < mu.size(); ++j) h += mu[j] * std::max(cv[j], 0.0);
+  return h;
+}
+
+// Powell's damped BFGS update of B with the step s and y = ∇L(x) - ∇L(x0) (y and Bs are buffers).
+void powell_update(Eigen::MatrixXd& B, const Eigen::VectorXd& s, Eigen::VectorXd& y, Eigen::VectorXd& Bs) {
+  Bs.noalias() = B * s;
+  double sy = s.dot(y);
+  const double sBs = s.dot(Bs);
+  const double damped = sBs * 0.2;
+  if (sy < damped) {
+    const double theta = (sBs - damped) / (sBs - sy);
+    y = theta * y + (1.0 - theta) * Bs;
+    sy = damped;
+  }
+  B.noalias() += (y * y.transpose()) / sy;
+  B.noalias() -= (Bs * Bs.transpose()) / sBs;
+}
+
 }  // namespace
 
 Eigen::MatrixXd sqp_lagrangian_hessian(const TargetShapeProblem& problem, const SqpBlock& block,
@@ -477,7 +558,7 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
   QpBuffers& qp = ws.qp;
   ShiftBuffers& shifts = ws.shifts;
   // The line search's buffers (each use sets their contents and sizes).
-  Eigen::VectorXd &xt = ws.xt, &gt = ws.gt, &dc = ws.dc, &mc2 = ws.mc2, &csoc = ws.csoc;
+  Eigen::VectorXd &xt = ws.xt, &gt = ws.gt;
   Eigen::MatrixXd& At = ws.At;
   std::array<int, 2> own_guess{0, 0};
   std::array<int, 2>& shift = settings.shift_guess ? *settings.shift_guess : own_guess;
@@ -503,8 +584,7 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
       break;
     }
     nu = std::max(nu, 1.5 * (mu.size() ? mu.maxCoeff() : 0.0) + 1e-12);
-    auto merit = [&](double fv, const Eigen::VectorXd& cv) { return fv + nu * infeasibility(cv); };
-    const double phi0 = merit(f, c);
+    const double phi0 = f + nu * infeasibility(c);
     const double slope = g.dot(d) - nu * infeasibility(c);
     // Feasible, and the QP predicts a decrease of at most ftol_rel of f (SLSQP's own test on the
     // energy): nothing is left to gain, and a line search could not tell such a step from
@@ -515,40 +595,11 @@ SqpOutcome sqp_block(const TargetShapeProblem& problem, const SqpBlock& block, P
     }
     if (!(slope < 0.0)) return out;
     double alpha = 1.0;
-    bool accepted = false;
     double ft = 0.0;
     // Trial points are evaluated with their gradients: the accepted one (nearly always the first)
     // is the next iterate, whose values the next iteration needs (the same numbers as evaluating it
     // again, one evaluation fewer).
-    for (int ls = 0; ls < 40; ++ls) {
-      xt = x + alpha * d;
-      model.to_points(xt, trial);
-      ft = model.evaluate(trial, &gt, ct, &At);
-      counted();
-      if (std::isfinite(ft) && merit(ft, ct) <= phi0 + 1e-4 * alpha * slope) {
-        accepted = true;
-        break;
-      }
-      if (ls == 0 && mc > 0) {
-        // Second-order correction (the full step raised the violation of curved active
-        // constraints, the Maratos effect): the same QP with the constraints' values at the trial
-        // point, linearised about x.
-        csoc = ct - A * d;
-        if (solve_convex_qp(factor, g, A, csoc, dc, mc2, qp)) {
-          xt = x + dc;
-          model.to_points(xt, trial);
-          ft = model.evaluate(trial, &gt, ct, &At);
-          counted();
-          if (std::isfinite(ft) && merit(ft, ct) <= phi0 + 1e-4 * slope) {
-            accepted = true;
-            mu = mc2;
-            break;
-          }
-        }
-      }
-      alpha *= 0.5;
-    }
-    if (!accepted) return out;
+    if (!sqp_line_search(model, ws, factor, A, mc, nu, phi0, slope, counted, alpha, ft)) return out;
     const double step = (xt - x).lpNorm<Eigen::Infinity>();
     x = xt;
     p.swap(trial);
@@ -629,20 +680,6 @@ SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& bloc
     if (out_of_time && out_of_time()) return static_cast<int>(NLOPT_MAXTIME_REACHED);
     return 0;
   };
-  // Kraft's sums, term by term onto `start`: the test function t = f + Σ μ_j max(c_j, 0).
-  auto penalty = [&](const Eigen::VectorXd& cv, double start) {
-    double h = start;
-    for (int j = 0; j < mc; ++j) h += mu[j] * std::max(cv[j], 0.0);
-    return h;
-  };
-  // NLopt 2.7.1's tests (src/util/stop.c): relative change of f, and of x in the 1-norm.
-  auto relstop = [](double old_value, double value, double reltol) {
-    const double d = std::abs(value - old_value);
-    return d < reltol * (std::abs(value) + std::abs(old_value)) * 0.5 || (reltol > 0.0 && value == old_value);
-  };
-  auto xstop = [](const Eigen::VectorXd& xv, const Eigen::VectorXd& old, double reltol) {
-    return (xv - old).lpNorm<1>() < reltol * xv.lpNorm<1>();
-  };
   double f = evaluate(true);
   if (!finite) return out;
   if (const int stop = budget()) return finish(stop);
@@ -670,19 +707,11 @@ SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& bloc
     x0 = x;
     const double gs = g.dot(s);
     for (int j = 0; j < mc; ++j) mu[j] = std::max(r[j], 0.5 * (mu[j] + r[j]));
-    const double h1 = penalty(c, 0.0);
+    const double h1 = kraft_penalty(mu, c, 0.0);
     const double t0 = f + h1;
     double h3 = gs - h1;
     if (h3 >= 0.0) {  // no descent for the test function: restart from the identity
-      if (++resets > 5) {
-        // Kraft's relaxed test fails (its tolerance is 0 here); NLopt then reports the roundoff
-        // limit, or at a feasible point its ftol or xtol test ×10 against the start of this step
-        // (where x and f still are).
-        if (!feasible) return finish(NLOPT_ROUNDOFF_LIMITED);
-        if (relstop(f0, f, 10.0 * settings.ftol_rel)) return finish(NLOPT_FTOL_REACHED);
-        if (xstop(x, x0, 10.0 * xtol_rel)) return finish(NLOPT_XTOL_REACHED);
-        return finish(NLOPT_ROUNDOFF_LIMITED);
-      }
+      if (++resets > 5) return finish(relaxed_stop(feasible, f0, f, x, x0, settings.ftol_rel, xtol_rel));
       B.setIdentity();
       continue;
     }
@@ -696,7 +725,7 @@ SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& bloc
       f = evaluate(line == 1);
       if (!finite) return out;
       if (const int stop = budget()) return finish(stop);
-      const double dt = penalty(c, f) - t0;
+      const double dt = kraft_penalty(mu, c, f) - t0;
       if (dt <= h3 / 10.0 || line > 10) break;
       alpha = std::max(h3 / (2.0 * (h3 - dt)), 0.1);
     }
@@ -714,17 +743,7 @@ SlsqpOutcome slsqp_block(const TargetShapeProblem& problem, const SqpBlock& bloc
     x_prev = x;
     // Powell's damped BFGS update with y = ∇L(x) - ∇L(x0), both with the step's multipliers.
     y.noalias() = g + A.transpose() * r - v;
-    Bs.noalias() = B * s;
-    double sy = s.dot(y);
-    const double sBs = s.dot(Bs);
-    const double damped = sBs * 0.2;
-    if (sy < damped) {
-      const double theta = (sBs - damped) / (sBs - sy);
-      y = theta * y + (1.0 - theta) * Bs;
-      sy = damped;
-    }
-    B.noalias() += (y * y.transpose()) / sy;
-    B.noalias() -= (Bs * Bs.transpose()) / sBs;
+    powell_update(B, s, y, Bs);
   }
 }
 

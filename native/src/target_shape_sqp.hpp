@@ -129,7 +129,7 @@ struct SqpSettings {
   /// still (about the square of this one, which converges quadratically), so the point stops
   /// within about this of where that QP would have ended it (1e-4: 1.5 µm at the default 15 mm
   /// minimum segment; mostly the confirming QP would not have moved it at all), for a seventh
-  /// fewer SQP iterations (docs/method-target-shape.md, issue 17 eighth round). 0: every step is
+  /// fewer SQP iterations (docs/method-target-shape.md). 0: every step is
   /// confirmed by one more QP (step_tol, ftol_rel).
   double settle_step = 1e-4;
   double ftol_rel = 1e-12;       ///< or when f changed by at most this fraction of it and feasible

@@ -1,11 +1,11 @@
-// numpy_sum.hpp: sums whose rounding shows the order of the additions, worked out by hand for
+// exact/numpy_sum.hpp: sums whose rounding shows the order of the additions, worked out by hand for
 // numpy's pairwise order, and sums against a long double reference.
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <random>
 #include <vector>
 
-#include "numpy_sum.hpp"
+#include "exact/numpy_sum.hpp"
 
 using wiresculpt::detail::numpy_sum;
 

@@ -1,4 +1,4 @@
-// The QP's written-out triangular solves (small_triangular.hpp) against Eigen's own
+// The QP's written-out triangular solves (exact/small_triangular.hpp) against Eigen's own
 // triangularView solves, bit for bit, and against the solution itself (L x = b to rounding).
 #include <catch2/catch.hpp>
 #include <Eigen/Cholesky>
@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <random>
 
-#include "small_triangular.hpp"
+#include "exact/small_triangular.hpp"
 
 using wiresculpt::detail::lower_solve_in_place;
 using wiresculpt::detail::lower_transpose_solve_in_place;

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "wiresculpt/error.hpp"
-#include "wiresculpt/target_shape.hpp"
+#include "wiresculpt/target_shape_batch.hpp"
 
 using namespace wiresculpt;
 using Catch::Matchers::Contains;

@@ -10,7 +10,6 @@ realised kink is then at least as sharp as the one the layering judged stable.
 """
 import math
 import os
-import re
 import time
 
 import numpy as np
@@ -22,17 +21,17 @@ from ..core.polylines import ContourArrays, polyline_length
 from . import layering
 
 FAILED = ("too_close", "infeasible", "open_end")
-# The solver's words (native/src/target_shape.cpp) for failures that no hook can cure: a straight
-# piece between two crossings shorter than min_segment, and a kink the contact angle, friction or
-# machine rule out at every crossing. An "open_end" status is one too.
-SHORT_PIECE = "(the straight piece is shorter than the minimum segment)"
-EVERY_HOOK = (" asks for contact angle ", " needs a bend of at least ")
+# The solver's causes (TargetCrossingStatus::cause) that no hook cures: the straight piece to a
+# neighbouring crossing shorter than min_segment, an open end, a contact angle that friction or the
+# machine's bend limit rules out whichever way the kink opens.
+EVERY_HOOK = frozenset({"short_piece", "open_end", "contact_vs_friction", "min_bend"})
 
 
-def whatever_the_hook(status, message):
-    """A failed crossing status (its `status` and `message`) that the other hook cannot cure."""
-    return (status == "open_end" or (status == "too_close" and message.endswith(SHORT_PIECE))
-            or (status == "infeasible" and any(words in message for words in EVERY_HOOK)))
+def whatever_the_hook(cause):
+    """Whether a failed crossing's `cause` (the native status's code) is one the other hook cannot cure."""
+    return cause in EVERY_HOOK
+
+
 # After the solve, a crossing counts as realised when its kink is inside the contact cone and its
 # segments and bends within the machine's limits to within what a bender can make at all (its
 # reliable minimum bend is 1 deg): SLSQP ends within about 0.02 deg, far below this, while the
@@ -371,14 +370,10 @@ def id_list(numbers):
 
 def crossing_words(failure):
     """The solver's words for one failed crossing (`failure`: a nulled entry), naming it by the
-    design's id, which users see: the solver numbers crossings along the wire and starts its
-    message with "crossing k on wire W" followed by ": " or by its predicate ("needs a bend of at
-    least …"): that opening is replaced by the design's ("…: it needs a bend …"), not repeated."""
-    message, head = failure["message"], f"crossing {failure['crossing']} on wire {failure['wire']}: "
-    opening = re.match(rf"crossing \d+ on wire {re.escape(failure['wire'])}(: | )", message)
-    if opening is None:
-        return head + message
-    return head + ("" if opening.group(1) == ": " else "it ") + message[opening.end():]
+    design's id, which users see, instead of the solver's number along the wire: the design's
+    "crossing N on wire W: " and then the solver's `words`, what follows its own name ("it needs a
+    bend …")."""
+    return f"crossing {failure['crossing']} on wire {failure['wire']}: " + failure["words"]
 
 
 def unrealised_summary(nulled, size):
@@ -429,9 +424,10 @@ def run(design, material, settings, native_progress=None, memo=None):
                 if c["hook"] != 0 and status["status"] in FAILED:
                     entry = failing.setdefault(c["id"], {"crossing": c["id"], "hook": c["hook"], "wire": wire["name"],
                                                          "status": status["status"], "scale": status["scale"],
-                                                         "message": status["message"], "whatever_the_hook": False})
+                                                         "message": status["message"], "cause": status["cause"],
+                                                         "words": status["words"], "whatever_the_hook": False})
                     # on either of its wires (the first one's words are kept)
-                    entry["whatever_the_hook"] |= whatever_the_hook(status["status"], status["message"])
+                    entry["whatever_the_hook"] |= whatever_the_hook(status["cause"])
         if not failing:
             break
         for cid, failure in failing.items():

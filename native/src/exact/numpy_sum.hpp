@@ -1,7 +1,6 @@
 #pragma once
 // The sum of an array of doubles added in numpy's order, so that a length the native code computes
-// is to the bit the one the add-on's Python computed with numpy before (issue 17: the stage's
-// lengths moved into the solve's threads, design.json unchanged).
+// is to the bit the one the add-on's Python computes with numpy (README.md).
 //
 // numpy's add.reduce of a contiguous float64 array (pairwise_sum in its loops, unchanged since
 // numpy 1.9): the array in chunks of its 8192-element buffer added to 0.0 one after the other;

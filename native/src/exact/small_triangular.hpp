@@ -5,7 +5,7 @@
 // with SSE2's two-double packets (panels of EIGEN_TUNE_TRIANGULAR_PANEL_WIDTH rows, the panels'
 // matrix-vector products and the in-panel dot products summed as Eigen sums them), without its
 // dispatch, alignment and blocking logic, which at these sizes cost more than the arithmetic
-// (docs/method-target-shape.md, issue 17, seventeenth round). So every result is Eigen's to the
+// (docs/method-target-shape.md). So every result is Eigen's to the
 // bit. Where Eigen's packets are not SSE2's (a build for AVX or FMA, another processor), or its panel
 // width or version differ, these call Eigen itself. native/tests/test_small_triangular.cpp compares the two.
 
