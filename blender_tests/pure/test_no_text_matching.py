@@ -33,12 +33,6 @@ PATTERN_METHODS = ("search", "match", "fullmatch", "findall", "finditer", "sub",
 SAME_TEXT = ("lower", "upper", "casefold", "strip", "lstrip", "rstrip", "split", "rsplit", "splitlines")
 SCANNED = ("addon/wiresculpt", "scripts")
 
-# Offenders another branch of this round removes (stages/target_shape.py decides re-layering by
-# the native's words until the failed crossings carry a `cause` code); emptied once it is merged.
-PENDING = {
-    ("addon/wiresculpt/stages/target_shape.py", "whatever_the_hook"),
-    ("addon/wiresculpt/stages/target_shape.py", "crossing_words"),
-}
 # Offenders that wait for codes nothing gives yet: the layering's verdict as a code (the corpus
 # report's kinds of reason), the nearby search's figures in plane_search (the corpus table's
 # cell), a code for the pipeline's setup reasons that designs stored before it would lack, the
@@ -220,12 +214,12 @@ class TheScanner(unittest.TestCase):
 class TheTree(unittest.TestCase):
     def test_no_code_tests_a_message_s_text(self):
         found = tree_offences()
-        unexpected = {k: v for k, v in found.items() if k not in PENDING | WAITING}
+        unexpected = {k: v for k, v in found.items() if k not in WAITING}
         self.assertEqual(unexpected, {}, "tests of a message's text; give the cause a code instead")
 
     def test_the_lists_name_only_offenders_that_remain(self):
         found = tree_offences()
-        self.assertEqual({k for k in PENDING | WAITING if k not in found}, set(),
+        self.assertEqual({k for k in WAITING if k not in found}, set(),
                          "listed but no longer offending: take them out of the list")
 
 
