@@ -6,6 +6,7 @@ Every problem is one ValueError whose sentence names the key (as a path such as
 import json
 import math
 import os
+import unicodedata
 from dataclasses import dataclass, field
 
 from . import materials, settings as settings_table
@@ -16,6 +17,12 @@ PLANE_KEYS = {"name", "origin", "normal", "contours"}
 MAX_COORDINATE = 1e6  # metres (or mesh units): beyond this a number is a typo, not a sculpture
 MAX_SIZE = 100.0  # metres
 MAX_PLANES = 64  # a sculpture of more wires than this is beyond the layering's search (docs/robustness.md)
+# A plane's name becomes a Blender object's name in sculpture.blend (Blender keeps 63 bytes of
+# UTF-8 and truncates the rest) and, with its wires' numbers, file names in svg/, dxf/, ...
+MAX_NAME_BYTES = 63
+# A normal component below this fraction of the largest is zero in all but representation: it is
+# set to 0 as the scene is read, so [1e-300, 1, 0] is the plane [0, 1, 0] (docs/robustness.md).
+NORMAL_ZERO = 1e-12
 
 
 @dataclass
@@ -58,11 +65,49 @@ def _vector(value, key):
     return tuple(_number(x, f"{key}[{i}]", -MAX_COORDINATE, MAX_COORDINATE) for i, x in enumerate(value))
 
 
+def clean_normal(normal):
+    """The normal with every component below NORMAL_ZERO of the largest |component| set to 0."""
+    largest = max(abs(c) for c in normal)
+    return tuple(0.0 if abs(c) < NORMAL_ZERO * largest else c for c in normal)
+
+
+def _shown(text, limit=40):
+    """`text` for a message: control and invisible characters escaped (\\n, \\x00, \\u200b), cut to
+    `limit` characters with the length said."""
+    escaped = "".join(json.dumps(ch)[1:-1] if _hidden(ch) or ch in '"\\' else ch for ch in text[:limit])
+    return f'"{escaped}"' + (f" ... ({len(text)} characters)" if len(text) > limit else "")
+
+
+def _hidden(ch):
+    return unicodedata.category(ch) in ("Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp")
+
+
+def _name(name, key):
+    """A plane's name, checked: a non-empty string of at most MAX_NAME_BYTES bytes of UTF-8, with no
+    control or invisible character and no path separator (/ separates the plane from the contour
+    in wire names such as "A/0")."""
+    if not isinstance(name, str) or not name.strip():
+        raise ValueError(f'scene key "{key}" must be a non-empty string')
+    size = len(name.encode("utf-8", "surrogatepass"))
+    if size > MAX_NAME_BYTES:
+        raise ValueError(f'scene key "{key}" is {size} bytes long ({_shown(name)}); a plane name may have at most '
+                         f'{MAX_NAME_BYTES} bytes of UTF-8 (Blender\'s limit for object names)')
+    bad = next((ch for ch in name if _hidden(ch)), None)
+    if bad is not None:
+        raise ValueError(f'scene key "{key}" ({_shown(name)}) holds the control character {_shown(bad)[1:-1]} '
+                         f'(U+{ord(bad):04X}); use printable characters')
+    for sep in ("/", "\\"):
+        if sep in name:
+            raise ValueError(f'scene key "{key}" ({_shown(name)}) holds "{_shown(sep)[1:-1]}"; a plane name may not '
+                             'hold / or \\ (/ separates the plane from the contour in wire names such as "A/0")')
+    return name
+
+
 def _unknown(keys, allowed, where):
     extra = sorted(set(keys) - allowed)
     if extra:
         place = f" in {where}" if where else ""
-        raise ValueError(f'unknown scene key "{extra[0]}"{place}; expected one of: {", ".join(sorted(allowed))}')
+        raise ValueError(f'unknown scene key {_shown(extra[0])}{place}; expected one of: {", ".join(sorted(allowed))}')
 
 
 def _material(value):
@@ -94,8 +139,7 @@ def _plane(value, index, names):
         if required not in value:
             raise ValueError(f'scene key "{key}.{required}" is missing')
     name = value.get("name", chr(ord("A") + index) if index < 26 else f"P{index}")
-    if not isinstance(name, str) or not name.strip():
-        raise ValueError(f'scene key "{key}.name" must be a non-empty string')
+    _name(name, f"{key}.name")
     if name in names:
         raise ValueError(f'scene key "{key}.name": the name "{name}" is used by two planes')
     names.add(name)
@@ -103,6 +147,7 @@ def _plane(value, index, names):
     normal = _vector(value["normal"], f"{key}.normal")
     if math.sqrt(sum(c * c for c in normal)) < 1e-12:
         raise ValueError(f'scene key "{key}.normal" (plane {name}) is zero; give a direction such as [0, 0, 1]')
+    normal = clean_normal(normal)
     contours = value.get("contours", "largest")
     if isinstance(contours, list):
         for i, k in enumerate(contours):
@@ -118,6 +163,10 @@ def _cuts(value):
     if not isinstance(value, dict):
         raise ValueError('scene key "settings.cuts" must be an object such as {"A/0": 12}')
     for name, index in value.items():
+        if len(name.encode("utf-8", "surrogatepass")) > MAX_NAME_BYTES + 8 or any(_hidden(ch) for ch in name):
+            raise ValueError(f'scene key "settings.cuts" names the wire {_shown(name)}, which no plane can have '
+                             f'(a wire name is a plane name of at most {MAX_NAME_BYTES} bytes, "/" and the contour\'s '
+                             'number, with no control character)')
         if isinstance(index, bool) or not isinstance(index, int) or index < 0:
             raise ValueError(f'scene key "settings.cuts.{name}" must be a vertex index (0, 1, ...), got {json.dumps(index)}')
     return dict(value)
