@@ -46,8 +46,12 @@ class Scene:
 
 def _number(value, key, low=None, high=None, low_open=False):
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ValueError(f'scene key "{key}" must be a number, got {json.dumps(value)}')
-    value = float(value)
+        raise ValueError(f'scene key "{key}" must be a number, got {_json_shown(value)}')
+    try:
+        value = float(value)
+    except OverflowError:  # an integer beyond any float (JSON allows 10^400)
+        raise ValueError(f'scene key "{key}" must be a finite number, got an integer of about '
+                         f'{int(value.bit_length() * 0.30103) + 1} digits') from None
     if not math.isfinite(value):
         raise ValueError(f'scene key "{key}" must be a finite number, got {value}')
     if low is not None and (value <= low if low_open else value < low):
@@ -61,7 +65,7 @@ def _number(value, key, low=None, high=None, low_open=False):
 
 def _vector(value, key):
     if not isinstance(value, list) or len(value) != 3:
-        raise ValueError(f'scene key "{key}" must be a list of three numbers, got {json.dumps(value)}')
+        raise ValueError(f'scene key "{key}" must be a list of three numbers, got {_json_shown(value)}')
     return tuple(_number(x, f"{key}[{i}]", -MAX_COORDINATE, MAX_COORDINATE) for i, x in enumerate(value))
 
 
@@ -76,6 +80,17 @@ def _shown(text, limit=40):
     `limit` characters with the length said."""
     escaped = "".join(json.dumps(ch)[1:-1] if _hidden(ch) or ch in '"\\' else ch for ch in text[:limit])
     return f'"{escaped}"' + (f" ... ({len(text)} characters)" if len(text) > limit else "")
+
+
+def _json_shown(value, limit=80):
+    """A JSON value for a message, on one line, cut to `limit` characters."""
+    text = json.dumps(value)
+    return text if len(text) <= limit else text[:limit] + f"... ({len(text)} characters)"
+
+
+def _path_shown(path):
+    """A path for a message: as it is, or escaped when it holds a control character."""
+    return path if not any(_hidden(ch) for ch in path) else _shown(path, 200)
 
 
 def _hidden(ch):
@@ -152,9 +167,9 @@ def _plane(value, index, names):
     if isinstance(contours, list):
         for i, k in enumerate(contours):
             if isinstance(k, bool) or not isinstance(k, int) or k < 0:
-                raise ValueError(f'scene key "{key}.contours[{i}]" must be a contour index (0, 1, ...), got {json.dumps(k)}')
+                raise ValueError(f'scene key "{key}.contours[{i}]" must be a contour index (0, 1, ...), got {_json_shown(k)}')
     elif contours not in ("largest", "all"):
-        raise ValueError(f'scene key "{key}.contours" must be "largest", "all" or a list of indices, got {json.dumps(contours)}')
+        raise ValueError(f'scene key "{key}.contours" must be "largest", "all" or a list of indices, got {_json_shown(contours)}')
     return PlaneSpec(name, origin, normal, contours)
 
 
@@ -168,7 +183,7 @@ def _cuts(value):
                              f'(a wire name is a plane name of at most {MAX_NAME_BYTES} bytes, "/" and the contour\'s '
                              'number, with no control character)')
         if isinstance(index, bool) or not isinstance(index, int) or index < 0:
-            raise ValueError(f'scene key "settings.cuts.{name}" must be a vertex index (0, 1, ...), got {json.dumps(index)}')
+            raise ValueError(f'scene key "settings.cuts.{name}" must be a vertex index (0, 1, ...), got {_json_shown(index)}')
     return dict(value)
 
 
@@ -188,15 +203,15 @@ def _settings(value):
         if unit == "choice":
             if raw not in settings_table.CHOICES[key]:
                 raise ValueError(f'scene key "settings.{key}" must be one of '
-                                 f'{", ".join(json.dumps(c) for c in settings_table.CHOICES[key])}, got {json.dumps(raw)}')
+                                 f'{", ".join(json.dumps(c) for c in settings_table.CHOICES[key])}, got {_json_shown(raw)}')
             out[key] = raw
         elif unit == "bool":
             if not isinstance(raw, bool):
-                raise ValueError(f'scene key "settings.{key}" must be true or false, got {json.dumps(raw)}')
+                raise ValueError(f'scene key "settings.{key}" must be true or false, got {_json_shown(raw)}')
             out[key] = raw
         elif unit == "int":
             if isinstance(raw, bool) or not isinstance(raw, int):
-                raise ValueError(f'scene key "settings.{key}" must be a whole number, got {json.dumps(raw)}')
+                raise ValueError(f'scene key "settings.{key}" must be a whole number, got {_json_shown(raw)}')
             out[key] = int(_number(raw, f"settings.{key}", low, high))
         else:
             out[key] = None if raw is None and _default is None else _number(raw, f"settings.{key}", low, high)
@@ -216,7 +231,7 @@ def parse_scene(data, path="scene.json"):
         raise ValueError('scene key "mesh" must be a file path')
     mesh = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(path)), data["mesh"]))
     if not os.path.isfile(mesh):
-        raise ValueError(f'scene key "mesh": file not found: {mesh}')
+        raise ValueError(f'scene key "mesh": file not found: {_path_shown(mesh)}')
     size = data.get("size")
     if size is not None:
         size = _number(size, "size", 0.0, MAX_SIZE, low_open=True)
@@ -237,7 +252,7 @@ def parse_scene(data, path="scene.json"):
             raise ValueError('scene key "machine_profile" must be the path of a machine profile JSON file')
         profile = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(path)), profile))
         if not os.path.isfile(profile):
-            raise ValueError(f'scene key "machine_profile": file not found: {profile}')
+            raise ValueError(f'scene key "machine_profile": file not found: {_path_shown(profile)}')
     return Scene(os.path.abspath(path), mesh, size, _material(data.get("material")), parsed,
                  settings, profile)
 
@@ -256,4 +271,8 @@ def load_scene(path):
         data = json.loads(text)
     except json.JSONDecodeError as exc:
         raise ValueError(f"{path} line {exc.lineno}: not valid JSON ({exc.msg})") from None
+    except RecursionError:  # thousands of nested [ or {: no scene is that deep
+        raise ValueError(f"{path}: not a scene, its JSON is nested too deeply") from None
+    except ValueError as exc:  # an integer of over 4300 digits (Python's limit for reading one)
+        raise ValueError(f"{path}: not valid JSON ({str(exc).split(':')[0]})") from None
     return parse_scene(data, path)
