@@ -67,6 +67,18 @@ class Names(unittest.TestCase):
         self.assertEqual(scene._settings({"cuts": {"A/0": 3}})["cuts"], {"A/0": 3})
 
 
+class SceneSize(unittest.TestCase):
+    def test_a_scene_file_over_16_mb_is_refused_unread(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "scene.json")
+            with open(path, "w") as f:
+                f.write('{"mesh": "m.obj", "planes": [{"name": "' + "n" * (17 * 1024 ** 2) + '"}]}')
+            with self.assertRaises(ValueError) as ctx:
+                scene.load_scene(path)
+            self.assertEqual(str(ctx.exception), f"scene file {path} is 17 MB; a scene file is at most 16 MB (its "
+                                                 "planes, settings and cuts take a few kB)")
+
+
 class OutFolder(unittest.TestCase):
     def refused(self, out):
         with self.assertRaises(ValueError) as ctx:

@@ -23,6 +23,7 @@ MAX_NAME_BYTES = 63
 # A normal component below this fraction of the largest is zero in all but representation: it is
 # set to 0 as the scene is read, so [1e-300, 1, 0] is the plane [0, 1, 0] (docs/robustness.md).
 NORMAL_ZERO = 1e-12
+MAX_SCENE_BYTES = 16 * 1024 ** 2  # a scene of 64 planes and their cuts is a few kB; 100 MB names were solved
 
 
 @dataclass
@@ -261,6 +262,10 @@ def load_scene(path):
     """Reads and validates the scene file at `path`."""
     try:
         with open(path, encoding="utf-8") as f:
+            size = os.fstat(f.fileno()).st_size
+            if size > MAX_SCENE_BYTES:
+                raise ValueError(f"scene file {path} is {size / 1024 ** 2:.0f} MB; a scene file is at most "
+                                 f"{MAX_SCENE_BYTES // 1024 ** 2} MB (its planes, settings and cuts take a few kB)")
             text = f.read()
     except OSError as exc:
         raise ValueError(f"cannot read scene file {path}: {exc.strerror}") from None
