@@ -2,10 +2,12 @@
 message it must produce; no case may crash, hang or leave a partial file behind."""
 import json
 import os
+import subprocess
 import tempfile
+import time
 import unittest
 
-from helpers import BATCH, ROOT, run_blender, wiresculpt_lines
+from helpers import BATCH, BLENDER, ROOT, run_blender, wiresculpt_lines
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 GLOBE = os.path.join(ROOT, "scripts", "examples", "globe", "globe.obj")
@@ -75,6 +77,7 @@ class BadInput(unittest.TestCase):
                 out = os.path.join(tmp, "out")
                 r = run_blender(BATCH, scene, "--out", out, timeout=120)
                 self.assertEqual(r.returncode, case["exit"], r.stdout + r.stderr)
+                self.assertNotIn("RuntimeWarning", r.stderr)  # numpy's warnings are not messages
                 messages = wiresculpt_lines(r.stderr)
                 if "stderr" in case:
                     self.assertEqual(messages, [case["stderr"].replace("{dir}", tmp)])
@@ -115,6 +118,94 @@ class CommandLine(unittest.TestCase):
             self.assertEqual(wiresculpt_lines(r.stderr),
                              [f"wiresculpt: error: --out {tmp}/out\\xff: the folder name is not UTF-8; choose a name in UTF-8"])
             self.assertEqual(os.listdir(tmp), [])
+
+    def refused(self, out, message, cwd=None):
+        """The globe with --out `out`: exit 1, the one line `message`, before any solve."""
+        r = run_blender(BATCH, self.SCENE, "--out", out, timeout=120)
+        self.assertEqual(r.returncode, 1, r.stdout + r.stderr)
+        self.assertEqual(wiresculpt_lines(r.stderr), [message])
+        self.assertNotIn("wiresculpt: mesh:", r.stdout)  # nothing was solved
+
+    def test_out_folders_no_run_can_write_are_refused_before_the_solve(self):
+        self.refused("", "wiresculpt: error: --out is empty; give the folder the outputs go to (e.g. --out out/globe)")
+        self.refused("/proc/wiresculpt-out", "wiresculpt: error: --out /proc/wiresculpt-out: /proc is on the kernel's "
+                     "proc file system, not a place for files; choose a folder on a disk")
+        self.refused("/sys/kernel/wiresculpt-out", "wiresculpt: error: --out /sys/kernel/wiresculpt-out: /sys/kernel is on "
+                     "the kernel's sysfs file system, not a place for files; choose a folder on a disk")
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.path.join(tmp, "a" * 300, "out")
+            self.refused(out, f"wiresculpt: error: --out {out[:60]}...: the folder name {'a' * 20}... is 300 bytes "
+                              "long; a name in a path may have at most 255 bytes")
+            self.assertEqual(os.listdir(tmp), [])
+
+    def test_a_folder_where_design_json_belongs_is_refused_not_deleted(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.path.join(tmp, "out")
+            os.makedirs(os.path.join(out, "design.json"))
+            with open(os.path.join(out, "design.json", "mine.txt"), "w") as f:
+                f.write("the user's")
+            self.refused(out, f"wiresculpt: error: --out {out}: {out}/design.json is a folder, where the run writes "
+                              "the file design.json; move it away or choose another --out")
+            self.assertEqual(sorted(os.listdir(out)), ["design.json"])
+            self.assertEqual(os.listdir(os.path.join(out, "design.json")), ["mine.txt"])
+
+    def test_a_second_run_on_the_same_folder_is_refused_while_the_first_writes(self):
+        """Two real batch processes on one --out: the second is refused at once, naming the folder
+        and the first's process; the first ends with its whole set, no staging folder is lost."""
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.path.join(tmp, "out")
+            cmd = [BLENDER, "--background", "--factory-startup", "--python-exit-code", "1", "--python", BATCH,
+                   "--", self.SCENE, "--out", out]
+            first = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                     env=dict(os.environ, WIRESCULPT_STAGING_FAULT="slow:0.2"))
+            try:
+                lock = os.path.join(out, ".wiresculpt-lock")
+                deadline = time.monotonic() + 60
+                while not (os.path.exists(lock) and open(lock).read().strip()) and time.monotonic() < deadline:
+                    time.sleep(0.05)
+                self.assertIsNone(first.poll(), "the first run ended before it took the folder")
+                second = run_blender(BATCH, self.SCENE, "--out", out, timeout=120)
+                self.assertEqual(second.returncode, 1, second.stdout + second.stderr)
+                self.assertEqual(wiresculpt_lines(second.stderr), [
+                    f"wiresculpt: error: --out {out}: another wiresculpt run (process {first.pid}) is writing to this "
+                    "folder; wait for it to end or choose another --out"])
+                stdout, stderr = first.communicate(timeout=300)
+            finally:
+                if first.poll() is None:
+                    first.kill()
+                    first.wait()
+            self.assertEqual(first.returncode, 0, stdout + stderr)
+            self.assertEqual(sorted(e for e in os.listdir(out) if e.startswith(".")), [])
+            with open(os.path.join(out, "design.json")) as f:
+                self.assertTrue(json.load(f)["stable"])
+            # and the folder is free again: a third run writes
+            third = run_blender(BATCH, self.SCENE, "--out", out, timeout=300)
+            self.assertEqual(third.returncode, 0, third.stdout + third.stderr)
+
+    def test_normal_components_zero_but_for_representation_solve_as_zeros(self):
+        """[1e-300, 1, 0] stopped GLPK, [1e-99, 1, 0] was refused by the force LP: both are the
+        plane [0, 1, 0], and the design is the same as its."""
+        with open(self.SCENE) as f:
+            scene = json.load(f)
+        scene["mesh"] = os.path.join(os.path.dirname(self.SCENE), scene["mesh"])
+        designs = {}
+        with tempfile.TemporaryDirectory() as tmp:
+            for tiny in (0.0, 1e-300, 1e-99):
+                scene["planes"][2]["normal"] = [tiny, 1.0, 0.0]
+                path = os.path.join(tmp, f"scene-{tiny}.json")
+                with open(path, "w") as f:
+                    json.dump(scene, f)
+                out = os.path.join(tmp, f"out-{tiny}")
+                r = run_blender(BATCH, path, "--out", out, timeout=300)
+                self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+                with open(os.path.join(out, "design.json")) as f:
+                    design = json.load(f)
+                for timed in ("stages", "fabrication"):
+                    design.pop(timed, None)
+                designs[tiny] = design
+        self.assertEqual(designs[0.0]["wires"][2]["plane"]["normal"], [0.0, 1.0, 0.0])
+        self.assertEqual(designs[1e-300], designs[0.0])
+        self.assertEqual(designs[1e-99], designs[0.0])
 
     def test_a_disk_that_fills_during_the_blend_save_keeps_the_earlier_set(self):
         with tempfile.TemporaryDirectory() as tmp:

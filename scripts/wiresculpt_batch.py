@@ -26,8 +26,9 @@ if os.path.isdir(os.path.join(ADDON, "wiresculpt")) and ADDON not in sys.path:
 
 EXIT_STABLE, EXIT_FAILURE, EXIT_UNSTABLE = 0, 1, 2
 # What a run writes into DIR, replaced as one set (files, or folders that belong to the run).
-OUTPUTS = ("design.json", "sculpture.blend", "sculpture.blend1", "render.png", "assembly", "svg", "dxf", "templates",
-           "gcode", "bends", "bendlist")
+OUTPUT_FILES = ("design.json", "sculpture.blend", "sculpture.blend1", "render.png")
+OUTPUT_FOLDERS = ("assembly", "svg", "dxf", "templates", "gcode", "bends", "bendlist")
+OUTPUTS = OUTPUT_FILES + OUTPUT_FOLDERS
 
 
 class _Parser(argparse.ArgumentParser):
@@ -190,22 +191,33 @@ def write_fabrication(design, out, say, profile=None, machine=None):
 
 
 def run(argv):
-    import bpy
-
-    from wiresculpt import native, plane_search
-    from wiresculpt.core.calibration import closed_overlap
-    from wiresculpt.core.design import write_design
-    from wiresculpt.core.meshcheck import check_output_folder, check_vertices
-    from wiresculpt.core.staging import staged
-    from wiresculpt.core.scene import load_scene
-    from wiresculpt.core import sizes
-    from wiresculpt.blend.mesh import import_mesh
+    from wiresculpt.core import staging
+    from wiresculpt.core.meshcheck import check_output_folder
 
     def say(stage, message):
         print(f"wiresculpt: {stage}: {message}", flush=True)
 
     args = parse_args(argv)
     check_output_folder(args.out)  # before any work: a full solve must not end in "cannot write"
+    # One writer per folder, from before the solve to the end (a second run is refused at once);
+    # a folder made for a run that is refused is removed again.
+    with staging.claim(args.out):
+        staging.check_kinds(args.out, OUTPUT_FILES, OUTPUT_FOLDERS)
+        return _run(args, say)
+
+
+def _run(args, say):
+    import bpy
+
+    from wiresculpt import native, plane_search
+    from wiresculpt.core.calibration import closed_overlap
+    from wiresculpt.core.design import write_design
+    from wiresculpt.core.meshcheck import check_vertices
+    from wiresculpt.core.staging import staged
+    from wiresculpt.core.scene import load_scene
+    from wiresculpt.core import sizes
+    from wiresculpt.blend.mesh import import_mesh
+
     scene = load_scene(args.scene)
     native.require()
     bpy.ops.wm.read_factory_settings(use_empty=True)

@@ -28,9 +28,27 @@ namespace wiresculpt::python {
 namespace {
 
 using namespace wiresculpt::fab;
+// `s` quoted for a message on one line: bytes outside printable ASCII as \n, \t, \r or \xNN,
+// quote and backslash escaped, at most 40 bytes shown.
+std::string quoted(const std::string& s) {
+  static const char* hex = "0123456789abcdef";
+  std::string out = "'";
+  for (std::size_t i = 0; i < s.size() && i < 40; ++i) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    if (c == '\n') out += "\\n";
+    else if (c == '\t') out += "\\t";
+    else if (c == '\r') out += "\\r";
+    else if (c == '\'' || c == '\\') out += std::string("\\") + static_cast<char>(c);
+    else if (c < 0x20 || c >= 0x7f) out += std::string("\\x") + hex[c >> 4] + hex[c & 15];
+    else out += static_cast<char>(c);
+  }
+  return out + (s.size() > 40 ? "'... (" + std::to_string(s.size()) + " bytes)" : "'");
+}
+
 char axis_letter(py::handle v, const std::string& at) {
   const std::string s = to_text(v, at);
-  if (s.size() > 1) wrong(at, "one letter", "'" + s + "'");
+  if (s.size() > 1 || (s.size() == 1 && !std::isalpha(static_cast<unsigned char>(s[0]))))
+    wrong(at, "one letter", quoted(s));
   return s.empty() ? '\0' : static_cast<char>(std::toupper(static_cast<unsigned char>(s[0])));
 }
 
@@ -50,7 +68,7 @@ MachineProfile to_profile(py::handle d) {
                {"feed_speed_mm_s", [&](py::handle v, const std::string& at) { p.feed_speed = from_mm(to_number(v, at)); }},
                {"bend_speed_deg_s", degrees(p.bend_speed)}, field::number("seconds_per_bend", p.seconds_per_bend),
                {"feed_axis", axis(p.axes.feed_axis)}, {"bend_axis", axis(p.axes.bend_axis)},
-               {"pin_axis", [&](py::handle v, const std::string& at) { p.axes.pin_axis = v.is_none() ? '\0' : axis_letter(v, at); }},
+               {"pin_axis", axis(p.axes.pin_axis)},  // "" for none; null is refused as every null is
                field::number("feed_units_per_mm", p.axes.feed_units_per_mm),
                field::number("bend_units_per_deg", p.axes.bend_units_per_deg),
                field::number("pin_travel", p.axes.pin_travel), {"pin_swing_deg", degrees(p.axes.pin_swing)},

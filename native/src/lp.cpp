@@ -31,10 +31,18 @@ int bound_type(double lo, double hi) {
 
 double finite_or_zero(double v) { return std::isfinite(v) ? v : 0.0; }
 
-// The first number GLPK cannot take among the triplets from `first_tri`, the objective and column
-// bounds (when `columns`) and the row bounds from `first_row`, as a sentence; empty when all are
-// fine. solve_lp checks the whole problem; the cutting-plane rounds only the rows they add.
-std::string out_of_range(const LinearProgram& in, std::size_t first_tri, std::size_t first_row, bool columns) {
+// A matrix entry that is rounding noise of its column (|a| <= kNoise × the column's largest
+// |a|, `col_max`), zero in all but representation: GLPK never sees it (glpk_rows drops it), so
+// it is not refused for being below kSmallest either (a plane normal [1e-99, 1, 0] makes entries
+// of 9e-101 beside ones of 0.5; they must solve as the zeros of [0, 1, 0] do). Never a number
+// that is not finite.
+bool is_noise(double v, double col_max) { return std::isfinite(v) && !(std::abs(v) > kNoise * col_max); }
+
+// The first number GLPK cannot take among the triplets from `first_tri` (rounding noise aside,
+// is_noise against `col_max`), the objective and column bounds (when `columns`) and the row bounds
+// from `first_row`, as a sentence; empty when all are fine. solve_lp checks the whole problem; the cutting-plane rounds only the rows they add.
+std::string out_of_range(const LinearProgram& in, std::size_t first_tri, std::size_t first_row, bool columns,
+                         const std::vector<double>& col_max) {
   auto bad = [](double v, bool nonzero_entry) {
     if (!std::isfinite(v)) return true;
     const double a = std::abs(v);
@@ -46,7 +54,7 @@ std::string out_of_range(const LinearProgram& in, std::size_t first_tri, std::si
     return s.str();
   };
   for (std::size_t t = first_tri; t < in.tri_val.size(); ++t)
-    if (in.tri_val[t] != 0.0 && bad(in.tri_val[t], true))
+    if (in.tri_val[t] != 0.0 && !is_noise(in.tri_val[t], col_max[in.tri_col[t]]) && bad(in.tri_val[t], true))
       return say("a coefficient (row " + std::to_string(in.tri_row[t]) + ", column " + std::to_string(in.tri_col[t]) + ")",
                  in.tri_val[t]);
   if (columns)
@@ -303,14 +311,14 @@ LpSolution HeldLp::build(const LinearProgram& in) {
                    std::to_string(in.tri_col[t]) + ", outside the LP";
       return out;
     }
-  out.reason = out_of_range(in, 0, 0, true);
-  if (!out.reason.empty()) return out;
   // Entries below 1e-13 of their column's largest are rounding noise of cross products (a
   // structural zero computed as 1e-19 would otherwise pin a variable); rows left empty become
   // free when their bounds admit 0 up to rounding, else the LP is infeasible.
   std::vector<double> col_max(K, 0.0), col_min_kept(K, std::numeric_limits<double>::infinity());
   for (std::size_t t = 0; t < in.tri_val.size(); ++t)
     col_max[in.tri_col[t]] = std::max(col_max[in.tri_col[t]], std::abs(in.tri_val[t]));
+  out.reason = out_of_range(in, 0, 0, true, col_max);
+  if (!out.reason.empty()) return out;
   const GlpkRows g = glpk_rows(in, 0, 0, col_max, &col_min_kept);
   if (g.infeasible) {
     out.status = LpSolution::infeasible;
@@ -353,15 +361,15 @@ LpSolution HeldLp::extend(const LinearProgram& in) {
     if (in.tri_row[t] < static_cast<int>(s.rows) || in.tri_row[t] >= static_cast<int>(R) || in.tri_col[t] < 0 ||
         in.tri_col[t] >= static_cast<int>(K) || (t > s.tris && in.tri_row[t] < in.tri_row[t - 1]))
       return out;
-  std::string bad = out_of_range(in, s.tris, s.rows, true);
-  if (!bad.empty()) {
-    out.reason = std::move(bad);
-    return out;
-  }
   std::vector<double> col_max = s.col_max;
   col_max.resize(K, 0.0);
   for (std::size_t t = s.tris; t < T; ++t)
     col_max[in.tri_col[t]] = std::max(col_max[in.tri_col[t]], std::abs(in.tri_val[t]));
+  std::string bad = out_of_range(in, s.tris, s.rows, true, col_max);
+  if (!bad.empty()) {
+    out.reason = std::move(bad);
+    return out;
+  }
   for (std::size_t j = 0; j < K0; ++j)
     if (!(s.col_min_kept[j] > kNoise * col_max[j])) return out;  // an entry held would be noise now
   std::vector<double> col_min_kept = s.col_min_kept;
@@ -484,6 +492,19 @@ LpSolution solve_lp_with_torque_rows(LinearProgram& lp, const TorqueBlocks& bloc
 }
 
 
+namespace {
+
+// The largest |entry| of each of `cols` columns (an index outside them counts for none).
+std::vector<double> column_largest(int cols, const std::vector<int>& tri_col, const std::vector<double>& tri_val) {
+  std::vector<double> out(static_cast<std::size_t>(cols), 0.0);
+  for (std::size_t t = 0; t < tri_val.size(); ++t)
+    if (tri_col[t] >= 0 && tri_col[t] < cols && std::isfinite(tri_val[t]))
+      out[static_cast<std::size_t>(tri_col[t])] = std::max(out[static_cast<std::size_t>(tri_col[t])], std::abs(tri_val[t]));
+  return out;
+}
+
+}  // namespace
+
 struct EqualityLp::State {
   glp_prob* p = nullptr;
   unsigned generation = 0;  // GLPK's environment when `p` was made (glpk_guard.hpp)
@@ -564,10 +585,14 @@ EqualityLp::EqualityLp(int rows, int cols, const std::vector<int>& tri_row, cons
   std::vector<double> ar{0.0};
   bool valid = rows >= 0 && cols >= 0 && cost.size() == static_cast<std::size_t>(cols) &&
                tri_row.size() == tri_val.size() && tri_col.size() == tri_val.size();
+  const std::vector<double> col_max = valid ? column_largest(cols, tri_col, tri_val) : std::vector<double>();
   for (std::size_t t = 0; valid && t < tri_val.size(); ++t) {
     const double a = std::abs(tri_val[t]);
     valid = tri_row[t] >= 0 && tri_row[t] < rows && tri_col[t] >= 0 && tri_col[t] < cols && std::isfinite(a) &&
-            a <= kLargest && (a == 0.0 || a >= kSmallest);
+            a <= kLargest;
+    if (!valid) break;
+    if (a != 0.0 && a < kSmallest && is_noise(a, col_max[tri_col[t]])) continue;  // zero but for rounding: not loaded
+    valid = a == 0.0 || a >= kSmallest;
     ia.push_back(tri_row[t] + 1);
     ja.push_back(tri_col[t] + 1);
     ar.push_back(tri_val[t]);

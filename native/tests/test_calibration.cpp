@@ -232,4 +232,9 @@ TEST_CASE("calibration: spring-back line from a synthetic table", "[calibration]
   CHECK_THROWS_WITH(fit_springback({10 * deg, 20 * deg}, {9 * deg, -18 * deg}, {2, 3}), Contains("line 3"));
   CHECK_THROWS_WITH(fit_springback({10 * deg, 10 * deg}, {9 * deg, 9 * deg}), Contains("same commanded"));
   CHECK_THROWS_WITH(fit_springback({10 * deg, 20 * deg}, {20 * deg, 10 * deg}), Contains("do not grow"));
+  // 1e300 deg overflowed the fit's sums into "every row has the same commanded angle".
+  CHECK_THROWS_WITH(fit_springback({1e300 * deg, 2e300 * deg}, {1e300 * deg, 2e300 * deg}, {2, 3}),
+                    Contains("line 2: the commanded angle (1e+300 deg) is beyond a full turn (360 deg)"));
+  CHECK_THROWS_WITH(fit_springback({10 * deg, 20 * deg}, {9 * deg, 400 * deg}, {2, 3}),
+                    Contains("line 3: the measured angle (400 deg) is beyond a full turn"));
 }

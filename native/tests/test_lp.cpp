@@ -140,7 +140,8 @@ TEST_CASE("lp: a matrix with 1e+-300 entries is refused with a reason, not an ab
     CHECK(sol.status == LpSolution::failed);
     CHECK_THAT(sol.reason, Contains("outside the range the LP solver handles (magnitudes 1e-100 to 1e100)"));
   }
-  const LpSolution first = solve_lp(with_entries(1e-300, 1.0, 1.0, 1.0));
+  // Column 0 of only 1e-300 entries: not rounding noise of a larger entry, refused.
+  const LpSolution first = solve_lp(with_entries(1e-300, 1.0, 1e-300, 1.0));
   CHECK(first.reason == "a coefficient (row 0, column 0) is 1e-300, outside the range the LP solver handles "
                         "(magnitudes 1e-100 to 1e100)");
   LinearProgram nan = textbook();
@@ -153,6 +154,34 @@ TEST_CASE("lp: a matrix with 1e+-300 entries is refused with a reason, not an ab
   const LpSolution edge = solve_lp(with_entries(1e-100, 1e-100, 1.0, 3.0));
   CHECK(edge.status == LpSolution::optimal);
   check_textbook();
+}
+
+TEST_CASE("lp: entries below 1e-100 that are rounding noise of their column solve as zeros do", "[lp][robustness]") {
+  // A plane normal [1e-99, 1, 0] gave a force-LP entry of 9e-101 beside ones of order 1, refused
+  // as out of range; [1e-300, 1, 0] stopped GLPK. Such entries are below 1e-13 of their column's
+  // largest: zeros in all but representation. By hand, with entry a = 0 the rows are y <= 4 and
+  // x + 3y <= 6, 0 <= x <= 3, maximise 3x + 2y: x = 3, then 3y <= 3, y = 1, objective 11.
+  const LpSolution zero = solve_lp(with_entries(0.0, 1.0, 1.0, 3.0));
+  REQUIRE(zero.status == LpSolution::optimal);
+  CHECK(zero.objective == Approx(11.0));
+  CHECK(zero.x[0] == Approx(3.0));
+  CHECK(zero.x[1] == Approx(1.0));
+  for (double tiny : {9e-101, 1e-200, 1e-300, -1e-300, 5e-324}) {
+    const LpSolution sol = solve_lp(with_entries(tiny, 1.0, 1.0, 3.0));
+    REQUIRE(sol.status == LpSolution::optimal);
+    CHECK(sol.objective == zero.objective);
+    CHECK(sol.x == zero.x);
+  }
+  // The stability checks' equality LP: [[1, 1e-300], [1e-300, 1]] x = (1, 2), x >= 0 is the
+  // identity's x = (1, 2), feasible (it was an internal error); a column of only tiny entries is
+  // still refused.
+  EqualityLp noisy(2, 2, {0, 0, 1, 1}, {0, 1, 0, 1}, {1.0, 1e-300, 1e-300, 1.0}, {1.0, 1.0});
+  CHECK(noisy.solve({1.0, 2.0}) == EqualityLp::Outcome::feasible);
+  CHECK(noisy.solve({1.0, -2.0}) == EqualityLp::Outcome::infeasible);
+  EqualityLp lone(2, 2, {0, 1, 1}, {0, 0, 1}, {1.0, 1e-300, 1.0}, {1.0, 1.0});
+  CHECK(lone.solve({1.0, 1.0}) == EqualityLp::Outcome::feasible);
+  EqualityLp refused(1, 2, {0, 0}, {0, 1}, {1e-300, 1.0}, {1.0, 1.0});  // column 0's only entry
+  CHECK(refused.solve({1.0}) == EqualityLp::Outcome::internal_error);
 }
 
 TEST_CASE("lp: a GLPK internal error inside the guard returns, frees GLPK's environment, and GLPK works after",

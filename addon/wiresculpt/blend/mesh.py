@@ -27,7 +27,10 @@ def object_triangles(obj, depsgraph):
         mesh.loop_triangles.foreach_get("vertices", F)
         F = F.reshape(-1, 3)
         M = np.array(evaluated.matrix_world, dtype=np.float64)
-        V = V @ M[:3, :3].T + M[:3, 3]
+        # an Inf or 1e308 coordinate makes NaN or Inf here without numpy's RuntimeWarning: the
+        # mesh checks after (core.meshcheck.check_vertices) name the vertex in one sentence
+        with np.errstate(invalid="ignore", over="ignore"):
+            V = V @ M[:3, :3].T + M[:3, 3]
         return V, F
     finally:
         evaluated.to_mesh_clear()

@@ -4,7 +4,9 @@ more than the file holds), and vertices no sculpture has (NaN/inf, absurd magnit
 millimetres read as metres). Each problem is one ValueError sentence naming the file, line or
 vertex. The limits are in docs/robustness.md.
 """
+import json
 import os
+import unicodedata
 
 import numpy as np
 
@@ -143,17 +145,64 @@ def check_vertices(V, path, size):
     return True
 
 
+# File systems whose files are the kernel's, not a user's: no run writes its outputs there.
+PSEUDO_FILESYSTEMS = {"proc", "sysfs", "devtmpfs", "devpts", "cgroup", "cgroup2", "debugfs", "tracefs",
+                      "securityfs", "pstore", "bpf", "configfs", "fusectl", "mqueue", "hugetlbfs", "efivarfs",
+                      "binfmt_misc", "autofs", "selinuxfs", "nsfs", "rpc_pipefs"}
+MAX_COMPONENT_BYTES = 255  # NAME_MAX of Linux's file systems
+MAX_PATH_BYTES = 4095  # PATH_MAX less the terminating zero
+
+
+def _mount_type(path):
+    """The file-system type of the mount holding `path` (an existing path), from
+    /proc/self/mounts; None when that cannot be read."""
+    try:
+        with open("/proc/self/mounts", encoding="utf-8", errors="replace") as f:
+            mounts = [line.split()[1:3] for line in f if len(line.split()) >= 3]
+    except OSError:
+        return None
+    real = os.path.realpath(path)
+    best, kind = "", None
+    for point, fs in mounts:
+        point = point.replace("\\040", " ")
+        inside = real == point or real.startswith(point.rstrip("/") + "/")
+        if inside and len(point) >= len(best):
+            best, kind = point, fs
+    return kind
+
+
 def check_output_folder(out):
-    """ValueError unless `out` is a folder a run can write (or create): a UTF-8 name, an existing
-    folder that is writable, or a path whose nearest existing parent is a writable folder. Creates
-    nothing."""
+    """ValueError naming --out unless `out` is a folder a run can write (or create): not empty, a
+    UTF-8 name, no component over 255 bytes (nor the path over 4095), not on a pseudo-file system
+    (/proc, /sys, /dev ...), an existing folder that is writable, or a path whose nearest existing
+    parent is a writable folder. Creates nothing."""
     raw = out if isinstance(out, bytes) else os.fsencode(out)
+    if not raw:
+        raise ValueError("--out is empty; give the folder the outputs go to (e.g. --out out/globe)")
     try:
         out = raw.decode("utf-8")
     except UnicodeDecodeError:
         shown = raw.decode("utf-8", "backslashreplace")
         raise ValueError(f"--out {shown}: the folder name is not UTF-8; choose a name in UTF-8") from None
+    if any(unicodedata.category(ch) in ("Cc", "Zl", "Zp") for ch in out):
+        shown = "".join(json.dumps(ch)[1:-1] if unicodedata.category(ch) in ("Cc", "Zl", "Zp") else ch for ch in out)
+        raise ValueError(f"--out {shown}: the folder name holds a control character; choose another name")
     path = os.path.abspath(out)
+    if len(os.fsencode(path)) > MAX_PATH_BYTES:
+        raise ValueError(f"--out {out[:60]}...: the path is {len(os.fsencode(path))} bytes long, over the "
+                         f"{MAX_PATH_BYTES} a path may have")
+    for part in path.split(os.sep):
+        size = len(os.fsencode(part))
+        if size > MAX_COMPONENT_BYTES:
+            raise ValueError(f"--out {out[:60]}...: the folder name {part[:20]}... is {size} bytes long; a name in a "
+                             f"path may have at most {MAX_COMPONENT_BYTES} bytes")
+    existing = path
+    while not os.path.lexists(existing):
+        existing = os.path.dirname(existing)
+    kind = _mount_type(existing)
+    if kind in PSEUDO_FILESYSTEMS:
+        raise ValueError(f"--out {out}: {existing} is on the kernel's {kind} file system, not a place for files; "
+                         "choose a folder on a disk")
     if os.path.lexists(path):
         if not os.path.isdir(path):
             raise ValueError(f"--out {out}: exists and is not a folder")

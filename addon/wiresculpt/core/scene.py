@@ -6,6 +6,7 @@ Every problem is one ValueError whose sentence names the key (as a path such as
 import json
 import math
 import os
+import unicodedata
 from dataclasses import dataclass, field
 
 from . import materials, settings as settings_table
@@ -16,6 +17,13 @@ PLANE_KEYS = {"name", "origin", "normal", "contours"}
 MAX_COORDINATE = 1e6  # metres (or mesh units): beyond this a number is a typo, not a sculpture
 MAX_SIZE = 100.0  # metres
 MAX_PLANES = 64  # a sculpture of more wires than this is beyond the layering's search (docs/robustness.md)
+# A plane's name becomes a Blender object's name in sculpture.blend (Blender keeps 63 bytes of
+# UTF-8 and truncates the rest) and, with its wires' numbers, file names in svg/, dxf/, ...
+MAX_NAME_BYTES = 63
+# A normal component below this fraction of the largest is zero in all but representation: it is
+# set to 0 as the scene is read, so [1e-300, 1, 0] is the plane [0, 1, 0] (docs/robustness.md).
+NORMAL_ZERO = 1e-12
+MAX_SCENE_BYTES = 16 * 1024 ** 2  # a scene of 64 planes and their cuts is a few kB; 100 MB names were solved
 
 
 @dataclass
@@ -39,8 +47,12 @@ class Scene:
 
 def _number(value, key, low=None, high=None, low_open=False):
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ValueError(f'scene key "{key}" must be a number, got {json.dumps(value)}')
-    value = float(value)
+        raise ValueError(f'scene key "{key}" must be a number, got {_json_shown(value)}')
+    try:
+        value = float(value)
+    except OverflowError:  # an integer beyond any float (JSON allows 10^400)
+        raise ValueError(f'scene key "{key}" must be a finite number, got an integer of about '
+                         f'{int(value.bit_length() * 0.30103) + 1} digits') from None
     if not math.isfinite(value):
         raise ValueError(f'scene key "{key}" must be a finite number, got {value}')
     if low is not None and (value <= low if low_open else value < low):
@@ -54,15 +66,64 @@ def _number(value, key, low=None, high=None, low_open=False):
 
 def _vector(value, key):
     if not isinstance(value, list) or len(value) != 3:
-        raise ValueError(f'scene key "{key}" must be a list of three numbers, got {json.dumps(value)}')
+        raise ValueError(f'scene key "{key}" must be a list of three numbers, got {_json_shown(value)}')
     return tuple(_number(x, f"{key}[{i}]", -MAX_COORDINATE, MAX_COORDINATE) for i, x in enumerate(value))
+
+
+def clean_normal(normal):
+    """The normal with every component below NORMAL_ZERO of the largest |component| set to 0."""
+    largest = max(abs(c) for c in normal)
+    return tuple(0.0 if abs(c) < NORMAL_ZERO * largest else c for c in normal)
+
+
+def _shown(text, limit=40):
+    """`text` for a message: control and invisible characters escaped (\\n, \\x00, \\u200b), cut to
+    `limit` characters with the length said."""
+    escaped = "".join(json.dumps(ch)[1:-1] if _hidden(ch) or ch in '"\\' else ch for ch in text[:limit])
+    return f'"{escaped}"' + (f" ... ({len(text)} characters)" if len(text) > limit else "")
+
+
+def _json_shown(value, limit=80):
+    """A JSON value for a message, on one line, cut to `limit` characters."""
+    text = json.dumps(value)
+    return text if len(text) <= limit else text[:limit] + f"... ({len(text)} characters)"
+
+
+def _path_shown(path):
+    """A path for a message: as it is, or escaped when it holds a control character."""
+    return path if not any(_hidden(ch) for ch in path) else _shown(path, 200)
+
+
+def _hidden(ch):
+    return unicodedata.category(ch) in ("Cc", "Cf", "Cs", "Co", "Cn", "Zl", "Zp")
+
+
+def _name(name, key):
+    """A plane's name, checked: a non-empty string of at most MAX_NAME_BYTES bytes of UTF-8, with no
+    control or invisible character and no path separator (/ separates the plane from the contour
+    in wire names such as "A/0")."""
+    if not isinstance(name, str) or not name.strip():
+        raise ValueError(f'scene key "{key}" must be a non-empty string')
+    size = len(name.encode("utf-8", "surrogatepass"))
+    if size > MAX_NAME_BYTES:
+        raise ValueError(f'scene key "{key}" is {size} bytes long ({_shown(name)}); a plane name may have at most '
+                         f'{MAX_NAME_BYTES} bytes of UTF-8 (Blender\'s limit for object names)')
+    bad = next((ch for ch in name if _hidden(ch)), None)
+    if bad is not None:
+        raise ValueError(f'scene key "{key}" ({_shown(name)}) holds the control character {_shown(bad)[1:-1]} '
+                         f'(U+{ord(bad):04X}); use printable characters')
+    for sep in ("/", "\\"):
+        if sep in name:
+            raise ValueError(f'scene key "{key}" ({_shown(name)}) holds "{_shown(sep)[1:-1]}"; a plane name may not '
+                             'hold / or \\ (/ separates the plane from the contour in wire names such as "A/0")')
+    return name
 
 
 def _unknown(keys, allowed, where):
     extra = sorted(set(keys) - allowed)
     if extra:
         place = f" in {where}" if where else ""
-        raise ValueError(f'unknown scene key "{extra[0]}"{place}; expected one of: {", ".join(sorted(allowed))}')
+        raise ValueError(f'unknown scene key {_shown(extra[0])}{place}; expected one of: {", ".join(sorted(allowed))}')
 
 
 def _material(value):
@@ -94,8 +155,7 @@ def _plane(value, index, names):
         if required not in value:
             raise ValueError(f'scene key "{key}.{required}" is missing')
     name = value.get("name", chr(ord("A") + index) if index < 26 else f"P{index}")
-    if not isinstance(name, str) or not name.strip():
-        raise ValueError(f'scene key "{key}.name" must be a non-empty string')
+    _name(name, f"{key}.name")
     if name in names:
         raise ValueError(f'scene key "{key}.name": the name "{name}" is used by two planes')
     names.add(name)
@@ -103,13 +163,14 @@ def _plane(value, index, names):
     normal = _vector(value["normal"], f"{key}.normal")
     if math.sqrt(sum(c * c for c in normal)) < 1e-12:
         raise ValueError(f'scene key "{key}.normal" (plane {name}) is zero; give a direction such as [0, 0, 1]')
+    normal = clean_normal(normal)
     contours = value.get("contours", "largest")
     if isinstance(contours, list):
         for i, k in enumerate(contours):
             if isinstance(k, bool) or not isinstance(k, int) or k < 0:
-                raise ValueError(f'scene key "{key}.contours[{i}]" must be a contour index (0, 1, ...), got {json.dumps(k)}')
+                raise ValueError(f'scene key "{key}.contours[{i}]" must be a contour index (0, 1, ...), got {_json_shown(k)}')
     elif contours not in ("largest", "all"):
-        raise ValueError(f'scene key "{key}.contours" must be "largest", "all" or a list of indices, got {json.dumps(contours)}')
+        raise ValueError(f'scene key "{key}.contours" must be "largest", "all" or a list of indices, got {_json_shown(contours)}')
     return PlaneSpec(name, origin, normal, contours)
 
 
@@ -118,8 +179,12 @@ def _cuts(value):
     if not isinstance(value, dict):
         raise ValueError('scene key "settings.cuts" must be an object such as {"A/0": 12}')
     for name, index in value.items():
+        if len(name.encode("utf-8", "surrogatepass")) > MAX_NAME_BYTES + 8 or any(_hidden(ch) for ch in name):
+            raise ValueError(f'scene key "settings.cuts" names the wire {_shown(name)}, which no plane can have '
+                             f'(a wire name is a plane name of at most {MAX_NAME_BYTES} bytes, "/" and the contour\'s '
+                             'number, with no control character)')
         if isinstance(index, bool) or not isinstance(index, int) or index < 0:
-            raise ValueError(f'scene key "settings.cuts.{name}" must be a vertex index (0, 1, ...), got {json.dumps(index)}')
+            raise ValueError(f'scene key "settings.cuts.{name}" must be a vertex index (0, 1, ...), got {_json_shown(index)}')
     return dict(value)
 
 
@@ -139,15 +204,15 @@ def _settings(value):
         if unit == "choice":
             if raw not in settings_table.CHOICES[key]:
                 raise ValueError(f'scene key "settings.{key}" must be one of '
-                                 f'{", ".join(json.dumps(c) for c in settings_table.CHOICES[key])}, got {json.dumps(raw)}')
+                                 f'{", ".join(json.dumps(c) for c in settings_table.CHOICES[key])}, got {_json_shown(raw)}')
             out[key] = raw
         elif unit == "bool":
             if not isinstance(raw, bool):
-                raise ValueError(f'scene key "settings.{key}" must be true or false, got {json.dumps(raw)}')
+                raise ValueError(f'scene key "settings.{key}" must be true or false, got {_json_shown(raw)}')
             out[key] = raw
         elif unit == "int":
             if isinstance(raw, bool) or not isinstance(raw, int):
-                raise ValueError(f'scene key "settings.{key}" must be a whole number, got {json.dumps(raw)}')
+                raise ValueError(f'scene key "settings.{key}" must be a whole number, got {_json_shown(raw)}')
             out[key] = int(_number(raw, f"settings.{key}", low, high))
         else:
             out[key] = None if raw is None and _default is None else _number(raw, f"settings.{key}", low, high)
@@ -167,7 +232,7 @@ def parse_scene(data, path="scene.json"):
         raise ValueError('scene key "mesh" must be a file path')
     mesh = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(path)), data["mesh"]))
     if not os.path.isfile(mesh):
-        raise ValueError(f'scene key "mesh": file not found: {mesh}')
+        raise ValueError(f'scene key "mesh": file not found: {_path_shown(mesh)}')
     size = data.get("size")
     if size is not None:
         size = _number(size, "size", 0.0, MAX_SIZE, low_open=True)
@@ -188,7 +253,7 @@ def parse_scene(data, path="scene.json"):
             raise ValueError('scene key "machine_profile" must be the path of a machine profile JSON file')
         profile = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(path)), profile))
         if not os.path.isfile(profile):
-            raise ValueError(f'scene key "machine_profile": file not found: {profile}')
+            raise ValueError(f'scene key "machine_profile": file not found: {_path_shown(profile)}')
     return Scene(os.path.abspath(path), mesh, size, _material(data.get("material")), parsed,
                  settings, profile)
 
@@ -197,6 +262,10 @@ def load_scene(path):
     """Reads and validates the scene file at `path`."""
     try:
         with open(path, encoding="utf-8") as f:
+            size = os.fstat(f.fileno()).st_size
+            if size > MAX_SCENE_BYTES:
+                raise ValueError(f"scene file {path} is {size / 1024 ** 2:.0f} MB; a scene file is at most "
+                                 f"{MAX_SCENE_BYTES // 1024 ** 2} MB (its planes, settings and cuts take a few kB)")
             text = f.read()
     except OSError as exc:
         raise ValueError(f"cannot read scene file {path}: {exc.strerror}") from None
@@ -207,4 +276,8 @@ def load_scene(path):
         data = json.loads(text)
     except json.JSONDecodeError as exc:
         raise ValueError(f"{path} line {exc.lineno}: not valid JSON ({exc.msg})") from None
+    except RecursionError:  # thousands of nested [ or {: no scene is that deep
+        raise ValueError(f"{path}: not a scene, its JSON is nested too deeply") from None
+    except ValueError as exc:  # an integer of over 4300 digits (Python's limit for reading one)
+        raise ValueError(f"{path}: not valid JSON ({str(exc).split(':')[0]})") from None
     return parse_scene(data, path)

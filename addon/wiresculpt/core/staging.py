@@ -12,11 +12,20 @@ as it was and no partial file behind. Files of the set are 0644, folders 0755.
 The named outputs (files or whole folders) belong to the run; anything else in the folder is the
 user's and is never touched.
 
+One writer per folder: `hold(DIR)` takes an exclusive lock (`flock` on `DIR/.wiresculpt-lock`,
+holding the owner's process id) before recovery and keeps it to the end; `recover` and `staged`
+take it themselves unless this process holds it already (the batch takes it before its solve).
+A second run is refused with `FolderBusy` naming the folder and the process that holds it, so no
+recovery ever removes a staging folder a live run is writing. The lock dies with its process
+(a kill leaves no stale lock) and the file is removed by whoever releases it.
+
 Fault injection for the kill test (blender_tests/pure/test_staging.py): WIRESCULPT_STAGING_FAULT
 = "kill:N" kills the process (SIGKILL) just before the N-th step of a switch (0-based: journal
 writes, moves and removals), "slow:SECONDS" sleeps before each step.
 """
 import contextlib
+import errno
+import fcntl
 import json
 import os
 import shutil
@@ -29,6 +38,7 @@ from .files import write_atomic
 STAGING_PREFIX = ".wiresculpt-new-"
 ASIDE_PREFIX = ".wiresculpt-old-"
 JOURNAL = ".wiresculpt-journal.json"
+LOCK = ".wiresculpt-lock"
 FILE_MODE, DIR_MODE = 0o644, 0o755
 
 _steps = 0
@@ -78,6 +88,118 @@ def _remove_journal(out_dir):
     if os.path.lexists(path):
         _step()
         os.unlink(path)
+
+
+# --- one writer per folder ------------------------------------------------------------------------
+
+class FolderBusy(OSError):
+    """Another process holds the folder's lock: `folder`, `pid` (None when it could not be read)."""
+
+    def __init__(self, folder, pid):
+        who = f"process {pid}" if pid else "another process"
+        super().__init__(errno.EBUSY, f"--out {folder}: another wiresculpt run ({who}) is writing to this folder; "
+                                      "wait for it to end or choose another --out")
+        self.folder, self.pid = folder, pid
+
+    def __str__(self):
+        return self.strerror
+
+
+_held = {}  # realpath of a folder -> the open lock file's descriptor, for the folders this process holds
+
+
+def _holder(fd):
+    try:
+        text = os.pread(fd, 32, 0).decode("ascii", "replace").strip()
+        return int(text) if text.isdigit() else None
+    except OSError:
+        return None
+
+
+@contextlib.contextmanager
+def hold(out_dir, shown=None):
+    """`with hold(DIR):` this process is the folder's one writer until the block ends; FolderBusy
+    (naming `shown`, default DIR) when another process is. DIR must exist. Re-entrant within a
+    process."""
+    key = os.path.realpath(out_dir)
+    if key in _held:
+        yield
+        return
+    path = os.path.join(out_dir, LOCK)
+    while True:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, FILE_MODE)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            pid = _holder(fd)
+            os.close(fd)
+            raise FolderBusy(shown or out_dir, pid) from None
+        except BaseException:
+            os.close(fd)
+            raise
+        try:  # the holder before us may have removed the file as it let go: lock the one at `path`
+            same = os.fstat(fd).st_ino == os.stat(path, follow_symlinks=False).st_ino
+        except FileNotFoundError:
+            same = False
+        if same:
+            break
+        os.close(fd)
+    try:
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+        _held[key] = fd
+        yield
+    finally:
+        _held.pop(key, None)
+        with contextlib.suppress(OSError):
+            os.unlink(path)  # still held: a process waiting on this file finds it gone and starts again
+        os.close(fd)
+
+
+@contextlib.contextmanager
+def claim(out_dir):
+    """`with claim(DIR):` DIR created when missing (with its missing parents) and held (`hold`)
+    until the block ends; folders it created are removed again when they are left empty (a refused
+    run leaves nothing behind). ValueError naming --out when DIR cannot be created or written,
+    FolderBusy when another run holds it."""
+    path = os.path.abspath(out_dir)
+    created, probe = [], path
+    while not os.path.lexists(probe):
+        created.append(probe)
+        probe = os.path.dirname(probe)
+    entered = False
+    try:
+        try:
+            os.makedirs(path, exist_ok=True)
+        except OSError as exc:
+            raise ValueError(f"--out {out_dir}: the folder cannot be created ({exc.strerror})") from None
+        with hold(path, out_dir):
+            entered = True
+            yield path
+    except OSError as exc:
+        if entered or isinstance(exc, FolderBusy):
+            raise
+        raise ValueError(f"--out {out_dir}: cannot write in the folder ({exc.strerror})") from None
+    finally:
+        for folder in created:  # deepest first
+            with contextlib.suppress(OSError):
+                os.rmdir(folder)
+
+
+def check_kinds(out_dir, files=(), folders=(), shown=None):
+    """ValueError naming the path when an entry of DIR is a folder where the run writes a file
+    (`files`) or a file where it writes a folder (`folders`): replacing it would delete the user's
+    files."""
+    shown = shown or out_dir
+    for name in files:
+        if os.path.isdir(os.path.join(out_dir, name)):
+            raise ValueError(f"--out {shown}: {os.path.join(shown, name)} is a folder, where the run writes the file "
+                             f"{name}; move it away or choose another --out")
+    for name in folders:
+        full = os.path.join(out_dir, name)
+        if os.path.lexists(full) and not os.path.isdir(full):
+            raise ValueError(f"--out {shown}: {os.path.join(shown, name)} is a file, where the run writes the folder "
+                             f"{name}/; move it away or choose another --out")
 
 
 # --- verification ------------------------------------------------------------------------------
@@ -136,7 +258,11 @@ def verify(folder, names):
 
 def commit(staging, out_dir, names):
     """Replaces out_dir's `names` by staging's (an earlier output this run did not write goes too),
-    under the journal. If a move fails, what was moved is put back and the error raised."""
+    under the journal. If a move fails, what was moved is put back and the error raised. An entry of
+    DIR that is a folder where the new set has a file, or a file where it has a folder, is not
+    replaced: ValueError naming it, DIR as it was."""
+    new_kinds = {n: os.path.isdir(os.path.join(staging, n)) for n in names if os.path.lexists(os.path.join(staging, n))}
+    check_kinds(out_dir, [n for n, d in new_kinds.items() if not d], [n for n, d in new_kinds.items() if d])
     aside = tempfile.mkdtemp(prefix=ASIDE_PREFIX, dir=out_dir)
     journal = {"staging": os.path.basename(staging), "aside": os.path.basename(aside), "names": list(names),
                "new": [n for n in names if os.path.lexists(os.path.join(staging, n))], "state": "switching"}
@@ -163,6 +289,11 @@ def recover(out_dir):
     folders. Returns "rolled back", "finished" or "" (nothing to do). Call before a new run."""
     if not os.path.isdir(out_dir):
         return ""
+    with hold(out_dir):
+        return _recover(out_dir)
+
+
+def _recover(out_dir):
     done = ""
     path = os.path.join(out_dir, JOURNAL)
     journal = None
@@ -205,13 +336,15 @@ def recover(out_dir):
 def staged(out_dir, names, check=verify):
     """`with staged(DIR, names) as tmp:` write the outputs into tmp; on leaving the block without an
     exception they are verified (`check(tmp, names)`) and replace DIR's, on an exception DIR is left
-    as it was. An interrupted earlier switch is finished or rolled back first."""
+    as it was. An interrupted earlier switch is finished or rolled back first. The folder's lock
+    (`hold`) is held throughout: FolderBusy when another process writes DIR."""
     os.makedirs(out_dir, exist_ok=True)
-    recover(out_dir)
-    staging = tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=out_dir)
-    try:
-        yield staging
-        check(staging, names)
-        commit(staging, out_dir, names)
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
+    with hold(out_dir):
+        recover(out_dir)
+        staging = tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=out_dir)
+        try:
+            yield staging
+            check(staging, names)
+            commit(staging, out_dir, names)
+        finally:
+            shutil.rmtree(staging, ignore_errors=True)

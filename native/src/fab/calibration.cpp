@@ -575,6 +575,10 @@ SpringbackFit fit_springback(const std::vector<double>& commanded, const std::ve
   for (std::size_t i = 0; i < n; ++i) {
     if (!std::isfinite(commanded[i]) || !std::isfinite(measured[i]))
       throw InputError(line(i) + "angles must be finite numbers of degrees");
+    for (const auto& [angle, what] : {std::pair{commanded[i], "commanded"}, std::pair{measured[i], "measured"}})
+      if (std::abs(angle) > 2.0 * std::numbers::pi)  // beyond it the fit's sums overflow (1e300 deg): not a bend
+        throw InputError(line(i) + "the " + what + " angle (" + num(to_deg(angle)) +
+                         " deg) is beyond a full turn (360 deg); angles are in degrees");
     if (commanded[i] * measured[i] < 0)
       throw InputError(line(i) + "the measured angle (" + num(to_deg(measured[i])) +
                        " deg) bends to the other side than the commanded one (" + num(to_deg(commanded[i])) + " deg)");
