@@ -14,7 +14,7 @@ from .core.design import NO_WIRES, ONE_WIRE, TOO_CLOSE, new_design
 from .core.sizes import mesh_size, size_warnings
 from .core.solve_context import Cancelled, OutOfTime, SolveContext, quiet  # noqa: F401 (the pipeline's names)
 from .fab import buildability
-from .stages import forces, layering, slicing, target_shape
+from .stages import forces, layering, slicing, stands3d, target_shape
 
 ALL_STAGES = ["layering", "target_shape", "forces", "rest_shape"]
 COUPLING_ROUNDS = 4  # target shape <-> rest shape iterations (Sec. 4.3)
@@ -62,6 +62,9 @@ def solve(design, material, settings, progress=None, cancel=None, stock=None, ho
         context.say("size", warning)
     try:
         solved = relayer(design, material, settings, context, hook_patterns, hook_seconds)
+        if solved["stable"]:  # the planar verdict holds: does the assembled sculpture stand in 3D?
+            context.checkpoint()
+            context.say("stands_3d", stands3d.run(solved, material, context.native_progress))
         # the warnings the design keeps: the solved wires' lengths, the figures its files give
         solved.setdefault("warnings", []).extend(size_warnings(solved, *(stock or ())))
         mesh_faults.explain(solved)  # a mesh of several parts or with holes: its faults lead the reason

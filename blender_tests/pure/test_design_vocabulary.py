@@ -22,7 +22,7 @@ FORMATS = os.path.join(ROOT, "docs", "formats.md")
 # Each bullet of the doc's design-file section and the writers (KEYS owners) it describes.
 BULLETS = {"Top": {"design", "pipeline", "every stage"}, "Slicing": {"slicing"}, "Layering": {"layering"},
            "Target shape": {"target_shape"}, "Forces and rest shape": {"forces"}, "Fabrication": {"fabrication"},
-           "Plane search": {"plane_search"}}
+           "Plane search": {"plane_search"}, "Standing in 3D": {"stands_3d"}}
 PREFIX = {"top": "", "wire": "wires[].", "crossing": "crossings[].", "stages": "stages."}
 
 
@@ -105,7 +105,7 @@ class RealDesign(unittest.TestCase):
     def test_every_stage_wrote_its_keys(self):
         d = self.design
         parts = {"top": [d], "wire": d["wires"], "crossing": d["crossings"], "stages": [d["stages"]]}
-        ran = {"design", "pipeline", "slicing", "layering", "target_shape", "forces"}
+        ran = {"design", "pipeline", "slicing", "layering", "target_shape", "forces", "stands_3d"}
         for part, items in parts.items():
             wanted = {k for k, owner in vocabulary.KEYS[part].items()
                       if owner in ran and k not in vocabulary.OPTIONAL[part]}

@@ -14,6 +14,7 @@
 #include "convert.hpp"
 #include "progress.hpp"
 #include "wiresculpt/error.hpp"
+#include "wiresculpt/forces.hpp"
 #include "wiresculpt/forces_and_rest.hpp"
 
 namespace py = pybind11;
@@ -157,8 +158,15 @@ py::dict forces_and_rest_py(const py::object& wire_list, const py::object& cross
     py::list share;
     share.append(fr.out_of_plane[c][0]);
     share.append(fr.out_of_plane[c][1]);
-    crossings.append(py::dict(py::arg("force") = to_list(fr.forces[c]), py::arg("normal_force") = fr.normal[c],
-                              py::arg("out_of_plane") = share));
+    py::dict crossing(py::arg("force") = to_list(fr.forces[c]), py::arg("normal_force") = fr.normal[c],
+                      py::arg("out_of_plane") = share);
+    if (in.hooks[c] != 0) {  // the four unit forces on wires[0] its force was chosen among
+      py::list pyramid;
+      for (const Vec3& q : target_pyramid(in.net, static_cast<int>(c), in.hooks[c], o.forces.friction))
+        pyramid.append(to_list(q));
+      crossing["pyramid"] = pyramid;
+    }
+    crossings.append(crossing);
   }
   py::list wires;
   for (std::size_t w = 0; w < r.rests.size(); ++w) {
@@ -237,7 +245,8 @@ a density; forces_and_rest.hpp), "max_bend" rad (2pi/3), "assembly_weight" (0.05
 progress(stage, fraction) -> False cancels (raises Cancelled).
 Returns the design document's own keys (docs/formats.md), for the forces stage to copy:
 {"crossings": [{"force": [3] N on wires[0] by wires[1], "normal_force": N, "out_of_plane":
-[share on wires[0], on wires[1]]}], "wires": [{"cut", "rest": [[x, y]] metres in the plane frame,
+[share on wires[0], on wires[1]], "pyramid" (hooked crossings): [4][3] the unit forces on
+wires[0] the force is a nonnegative combination of (forces.hpp, target_pyramid)}], "wires": [{"cut", "rest": [[x, y]] metres in the plane frame,
 "rest_angles", "target_angles" (rad, per rest point), "closure_gap" m, "max_torque" N m,
 "max_torque_vertex", "max_out_of_plane_torque" N m, "max_torque_3d" N m, "rest_over_bend":
 [{"vertex", "angle_deg"}], with a shear modulus "out_of_plane_deflection" m (the 3D frame,

@@ -43,7 +43,7 @@ KEYS = {
         "search_incomplete": "layering",
         "out_of_plane": "forces", "load_capacity": "forces", "load_factor": "forces", "buildability": "pipeline",
         "fabrication": "fabrication", "plane_search": "plane_search",
-        "model_size": "pipeline", "mesh_faults": "pipeline",
+        "model_size": "pipeline", "mesh_faults": "pipeline", "stands_3d": "stands_3d",
     },
     "wire": {
         "id": "slicing", "name": "slicing", "plane": "slicing", "closed": "slicing", "contour": "slicing",
@@ -54,12 +54,14 @@ KEYS = {
         "max_out_of_plane_torque": "forces", "max_torque_3d": "forces", "rest_over_bend": "forces",
         "out_of_plane_deflection": "forces", "out_of_plane_deflection_vertex": "forces",
         "cut_override": "user", "cut_point": "user",
+        "sag": "stands_3d", "as_built": "stands_3d",
     },
     "crossing": {
         "id": "layering", "wires": "layering", "contour_vertices": "layering", "point": "layering",
         "hook": "layering", "metric": "layering", "hook_metrics": "layering",
         "vertices": "target_shape",
-        "force": "forces", "normal_force": "forces", "out_of_plane": "forces",
+        "force": "forces", "normal_force": "forces", "out_of_plane": "forces", "pyramid": "forces",
+        "force_3d": "stands_3d", "admissible": "stands_3d",
     },
     "stages": {
         "slicing": "slicing", "layering": "layering", "target_shape": "target_shape",
@@ -71,9 +73,11 @@ KEYS = {
 # material without density, a user's cut, the batch's exports.
 OPTIONAL = {
     "top": {"close_crossings", "required_size", "load_capacity", "load_factor", "fabrication", "warnings",
-            "buildability", "search_incomplete", "plane_search", "reason_causes", "model_size", "mesh_faults"},
-    "wire": {"cut_override", "cut_point", "out_of_plane_deflection", "out_of_plane_deflection_vertex"},
-    "crossing": set(),
+            "buildability", "search_incomplete", "plane_search", "reason_causes", "model_size", "mesh_faults",
+            "stands_3d"},
+    "wire": {"cut_override", "cut_point", "out_of_plane_deflection", "out_of_plane_deflection_vertex", "sag",
+             "as_built"},
+    "crossing": {"pyramid", "force_3d", "admissible"},
     "stages": set(),
 }
 
