@@ -66,6 +66,7 @@ KEYS = {
     "stages": {
         "slicing": "slicing", "layering": "layering", "target_shape": "target_shape",
         "forces": "forces", "rest_shape": "forces", "hook_search": "pipeline", "relayering": "pipeline",
+        "stands_3d": "stands_3d",
     },
 }
 
@@ -78,7 +79,7 @@ OPTIONAL = {
     "wire": {"cut_override", "cut_point", "out_of_plane_deflection", "out_of_plane_deflection_vertex", "sag",
              "as_built"},
     "crossing": {"pyramid", "force_3d", "admissible"},
-    "stages": set(),
+    "stages": {"stands_3d"},
 }
 
 

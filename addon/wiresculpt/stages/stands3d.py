@@ -11,7 +11,8 @@ rigidly: how it sits on the table is `tilt_deg`, not a sag).
 
 Fills `stands_3d` (*extra*, docs/formats.md): `stands`, `cause` (one of CAUSES), `sag_limit` (m),
 `max_sag` (m) and `max_sag_wire`, `slipping` (crossing ids whose force leaves its pyramid),
-`tilt_deg` (how far it rolls on the table), `residual`, `iterations`, `seconds`; per wire `sag` (m: its largest distance from its target) and
+`tilt_deg` (how far it rolls on the table), `solver_cause` and `solver_message`; `stages.stands_3d`
+(`seconds`, `iterations`, `residual`); per wire `sag` (m: its largest distance from its target) and
 `as_built` (3D, one point per rest point, from the cut); per hooked crossing `force_3d` (N, on
 wires[0] by wires[1], in the deformed structure) and `admissible`. The words: core/standing.py.
 """
@@ -161,8 +162,7 @@ def run(design, material, native_progress=None):
     result = native.structure3d(wires, ties=ties, table={"z0": z0}, options=options(material),
                                 progress=native_progress)
     limit = sag_limit(design)
-    record = {"sag_limit": limit, "residual": result["residual"], "iterations": result["iterations"],
-              "tilt_deg": math.degrees(math.acos(max(-1.0, min(1.0, (np.trace(turn) - 1.0) / 2.0)))),
+    record = {"sag_limit": limit, "tilt_deg": math.degrees(math.acos(max(-1.0, min(1.0, (np.trace(turn) - 1.0) / 2.0)))),
               "slipping": [], "max_sag": 0.0, "max_sag_wire": None}
     if result["converged"]:
         built = np.vstack([r["points"] for r in result["wires"]])
@@ -188,8 +188,9 @@ def run(design, material, native_progress=None):
                        else SAGS if record["max_sag"] > limit else STANDS)
     record["solver_cause"], record["solver_message"] = result["cause"], result["message"]
     record["stands"] = record["cause"] == STANDS
-    record["seconds"] = time.perf_counter() - began
     design["stands_3d"] = record
+    design["stages"]["stands_3d"] = {"seconds": time.perf_counter() - began, "iterations": result["iterations"],
+                                     "residual": result["residual"]}
     return words(record)
 
 
