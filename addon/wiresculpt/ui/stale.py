@@ -44,8 +44,8 @@ def report(context):
     mesh = None
     if inputs and "mesh" in inputs and ws.target is not None and inputs.get("target") == ws.target.name:
         mesh = target_watch.mesh_state(ws.target, context.view_layer.depsgraph)
-    said = stale.changes(design, planes, ticked, inputs, target_name(ws),
-                         settings, props.material_of(ws), _recorded["labels"], _recorded["planes"], names, mesh)
+    now = stale.SceneNow(planes, ticked, names, target_name(ws), settings, props.material_of(ws), mesh)
+    said = stale.changes(design, now, inputs, _recorded["labels"], _recorded["planes"])
     return said, names
 
 
