@@ -47,7 +47,6 @@ PENDING = {
 WAITING = {
     ("scripts/corpus.py", "reason_kind"),
     ("scripts/plane_search_corpus.py", "nearby_cell"),
-    ("addon/wiresculpt/core/design.py", "setup_problem"),
     ("addon/wiresculpt/native.py", "explain_load_error"),
     ("scripts/bench_pipeline.py", "main"),
 }
