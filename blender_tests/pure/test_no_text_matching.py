@@ -48,7 +48,6 @@ WAITING = {
     ("scripts/corpus.py", "reason_kind"),
     ("scripts/plane_search_corpus.py", "nearby_cell"),
     ("addon/wiresculpt/native.py", "explain_load_error"),
-    ("scripts/bench_pipeline.py", "main"),
 }
 
 
