@@ -46,7 +46,6 @@ PENDING = {
 # module is rebuilt).
 WAITING = {
     ("scripts/corpus.py", "reason_kind"),
-    ("scripts/plane_search_corpus.py", "nearby_cell"),
     ("addon/wiresculpt/native.py", "explain_load_error"),
 }
 

@@ -268,13 +268,17 @@ class NoNearbyPlacement(unittest.TestCase):
         self.assertTrue(design["reason"].startswith("no nearby placement gives a stable design. Searched: "))
         self.assertTrue(design["reason"].endswith(f". The planes as given: {given['reason']}"))
         self.assertIn("wire A/0 on wire C/0", design["reason"])
-        # the record keeps the keys it had (FORMATS.md's and the extra ones before this change), no new one
+        # the record keeps the keys it had (FORMATS.md's and the extra ones before), and adds only
+        # not_found: how the search ended, as data beside the reason's words
         self.assertEqual(set(design["plane_search"]), {
             "mode", "planes_before", "planes_after", "changes", "candidates", "full_solves", "budget_seconds",
-            "solves_stopped", "solves_failed", "final_solve", "seconds", "score", "measure"})
+            "solves_stopped", "solves_failed", "final_solve", "seconds", "score", "measure", "not_found"})
         self.assertEqual(design["plane_search"]["planes_after"], [])
         screened = int(re.search(r"; (\d+) placements screened", design["reason"]).group(1))
         self.assertEqual(design["plane_search"]["candidates"], screened)
+        ending = design["plane_search"]["not_found"]
+        self.assertEqual((ending["screened"], ending["total"], ending["budget_ended"]), (screened, CANDIDATES, False))
+        self.assertIn("To change: " + "; or ".join(ending["advice"]) + ". The planes as given: ", design["reason"])
 
 
 if __name__ == "__main__":
