@@ -43,6 +43,17 @@ class SizeTest(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "stock_length"):
             sizes.size_warnings(d, stock_length=0)
 
+    def test_the_stock_sentences_alone(self):
+        """stock_warnings: the wires' sentences of size_warnings (what an export notes), not the model's."""
+        d = design(1.35)
+        perimeter = 64 * 2 * 1.35 * math.sin(math.pi / 64)
+        found = sizes.stock_warnings(d, 1.0, "my bender")
+        self.assertEqual(found, [f"wire {'ABC'[k]}/0 is {perimeter * 1000:.0f} mm long, longer than the 1000 mm stock "
+                                 "of my bender: it needs a longer stock or a joint" for k in range(3)])
+        self.assertEqual(found, sizes.size_warnings(d, 1.0, "my bender")[1:])
+        with self.assertRaisesRegex(ValueError, "stock_length"):
+            sizes.stock_warnings(d, stock_length=float("nan"))
+
 
 if __name__ == "__main__":
     unittest.main()

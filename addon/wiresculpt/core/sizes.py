@@ -37,15 +37,22 @@ def model_size(design):
 
 def size_warnings(design, stock_length=STOCK_LENGTH, profile_name="the default machine profile"):
     """One sentence per wire longer than `stock_length` (m) and one when the model is over
-    LARGEST_MODEL, each with its figure in millimetres or metres."""
-    if not (isinstance(stock_length, (int, float)) and math.isfinite(stock_length) and stock_length > 0):
-        raise ValueError(f"machine profile key stock_length must be a positive number of metres, got {stock_length!r}")
+    LARGEST_MODEL, each with its figure in millimetres or metres (the model's first)."""
+    stock = stock_warnings(design, stock_length, profile_name)  # a bad stock_length is refused first
     out = []
     size = model_size(design)
     if size > LARGEST_MODEL:
         shown, largest = versus(size, LARGEST_MODEL, 2)
         out.append(f"the model is {shown} m across, over {largest} m: check the mesh's units or "
                    f"the scene's size (a wire sculpture this large sags and needs very long wires)")
+    return out + stock
+
+
+def stock_warnings(design, stock_length=STOCK_LENGTH, profile_name="the default machine profile"):
+    """size_warnings' sentences of the wires longer than `stock_length` (m), one per wire."""
+    if not (isinstance(stock_length, (int, float)) and math.isfinite(stock_length) and stock_length > 0):
+        raise ValueError(f"machine profile key stock_length must be a positive number of metres, got {stock_length!r}")
+    out = []
     for w in design["wires"]:
         length = wire_length(w)
         if length > stock_length:
