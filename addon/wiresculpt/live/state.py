@@ -21,6 +21,8 @@ class LiveState:
         # core/live_verdict.verdict: "stable", "not stable — …", "cannot solve — …", … (the panel adds "Live: ")
         self.verdict = ""
         self.reason = ""  # the whole text behind `verdict` (its reason, problem or error), "" for a word alone
+        self.kind = ""  # the kind of `verdict` (core/live_verdict: STABLE, NOT_STABLE, ...), "" before the first
+        self.limits = ()  # the codes of the limits a stable verdict breaks (core/limits.limit_records)
         self.preview = []  # [(RGBA, (2k, 3) float32 segment end points)], one per wire of the shown verdict
         self.mesh_key = None  # the target's name, matrix and geometry count the cached triangles belong to
         self.geometry = 0  # changes of the target's geometry seen by the depsgraph handler (edits, modifiers)
@@ -47,12 +49,12 @@ class LiveRecord:
 STATE = LiveState()
 
 # what observed() shows of the run state, besides the whole record
-_SHOWN = ("running", "verdict", "reason", "preview", "job", "solved", "geometry")
+_SHOWN = ("running", "verdict", "reason", "kind", "limits", "preview", "job", "solved", "geometry")
 
 
 def observed(state=STATE):
     """A read-only view of Live now, for the tests and the bench: the run state's running, verdict,
-    reason, preview, job, solved and geometry, and the record's durations, results, shown_at,
+    reason, kind, limits, preview, job, solved and geometry, and the record's durations, results, shown_at,
     drawn_at, job_seconds and drawn (a copy: writing to it changes nothing)."""
     record = state.record
     return types.SimpleNamespace(
