@@ -52,12 +52,10 @@ PENDING = {
 # Offenders that wait for codes nothing gives yet: the layering's verdict as a code (the corpus
 # report's kinds of reason, and the mechanism a plane-search fault names: both need the native
 # layering to return its cause, e.g. a LayeringCause enum, and the clause naming what moves,
-# through the binding; stages/layering.py would then record them), and the dynamic loader's error
-# (explain_load_error).
+# through the binding; stages/layering.py would then record them).
 WAITING = {
     ("scripts/corpus.py", "reason_kind"),
     ("addon/wiresculpt/core/plane_faults.py", "structural_fault"),
-    ("addon/wiresculpt/native.py", "explain_load_error"),
 }
 
 
