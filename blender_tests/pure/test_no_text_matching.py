@@ -50,12 +50,12 @@ PENDING = {
     ("addon/wiresculpt/stages/target_shape.py", "crossing_words"),
 }
 # Offenders that wait for codes nothing gives yet: the layering's verdict as a code (the corpus
-# report's kinds of reason, and the mechanism a plane-search fault names: both need the native
-# layering to return its cause, e.g. a LayeringCause enum, and the clause naming what moves,
-# through the binding; stages/layering.py would then record them).
+# report's kinds of reason: the native layering would return its cause, e.g. a LayeringCause enum,
+# through the binding, and the pipeline a code for the re-layering's end; and the runs stored in
+# docs/corpus.json, which the report re-reads, carry only the reason's words until the corpus is
+# run again).
 WAITING = {
     ("scripts/corpus.py", "reason_kind"),
-    ("addon/wiresculpt/core/plane_faults.py", "structural_fault"),
 }
 
 

@@ -610,10 +610,9 @@ LayeringResult layering(const Network& net, const LayeringOptions& options, cons
       // Name what moves, from the null space of the crossings as ball joints (mechanism.hpp),
       // rather than the LP's failing load, whose wire need not be the one that moves.
       const Mechanism mechanism = find_mechanism(net);
-      r.reason = "no hook configuration can make the finished sculpture stable: even with both hook directions "
-                 "allowed at every crossing, ";
+      std::string detail;  // what moves, or what cannot be balanced, with its advice
       if (!mechanism.moving.empty()) {
-        r.reason += mechanism_message(net, mechanism);
+        detail = mechanism_message(net, mechanism);
       } else {  // rigid as ball joints, yet the allowed pyramids do not span (forbidden hooks, degenerate contact angle)
         int w = relaxed.failed_wire;
         if (w < 0) {  // the combined load failed: name the wire with the fewest crossings
@@ -626,13 +625,16 @@ LayeringResult layering(const Network& net, const LayeringOptions& options, cons
           if (net.crossings[c].wires[0] == w || net.crossings[c].wires[1] == w) cs.push_back(c);
         static const char* what[6] = {"a force along x", "a force along y", "a force along z",
                                       "a torque about x", "a torque about y", "a torque about z"};
-        r.reason += "the wires cannot balance " +
-                    (relaxed.failed_component >= 0 ? std::string(what[relaxed.failed_component])
-                                                   : std::string("every load")) +
-                    " on wire " + quoted(net, w) + " (its crossing" + (cs.size() == 1 ? " " : "s ") +
-                    crossing_list(cs) + "): the wires are held at too few crossings";
+        detail = "the wires cannot balance " +
+                 (relaxed.failed_component >= 0 ? std::string(what[relaxed.failed_component])
+                                                : std::string("every load")) +
+                 " on wire " + quoted(net, w) + " (its crossing" + (cs.size() == 1 ? " " : "s ") +
+                 crossing_list(cs) + "): the wires are held at too few crossings";
       }
-      r.reason += forbidden_note(options);
+      detail += forbidden_note(options);
+      r.reason = "no hook configuration can make the finished sculpture stable: even with both hook directions "
+                 "allowed at every crossing, " + detail;
+      r.what_moves = detail.substr(0, detail.find(';'));  // each advice follows a ';' (mechanism_message)
       r.stats.lp_solves = s.checker_.lp_solves();
       return finish();
     }

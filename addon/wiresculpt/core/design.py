@@ -36,7 +36,7 @@ KEYS = {
     "top": {
         "format": "design", "version": "design", "units": "design", "material": "design",
         "torque_fraction": "design", "machine": "design", "wires": "design", "stages": "design",
-        "stable": "layering", "reason": "layering", "reason_causes": "layering",
+        "stable": "layering", "reason": "layering", "reason_causes": "layering", "what_moves": "layering",
         "pending_stages": "pipeline", "warnings": "every stage",
         "crossings": "layering", "assembly_order": "layering", "assembly_steps": "layering",
         "two_hand_steps": "layering", "close_crossings": "layering", "required_size": "layering",
@@ -70,7 +70,7 @@ KEYS = {
 # material without density, a user's cut, the batch's exports.
 OPTIONAL = {
     "top": {"close_crossings", "required_size", "load_capacity", "load_factor", "fabrication", "warnings",
-            "buildability", "search_incomplete", "plane_search", "reason_causes"},
+            "buildability", "search_incomplete", "plane_search", "reason_causes", "what_moves"},
     "wire": {"cut_override", "cut_point", "out_of_plane_deflection", "out_of_plane_deflection_vertex"},
     "crossing": set(),
     "stages": set(),

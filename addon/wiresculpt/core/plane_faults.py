@@ -135,8 +135,9 @@ def structural_fault(design, tol=1e-6):
     reason = design.get("reason") or ""
     if not reason:
         return None
-    reason = reason.split("allowed at every crossing, ", 1)[-1].split(";", 1)[0]
-    return ("mechanism", (), (reason[:160],))
+    # what the layering's hook-relaxed check found moving (`what_moves`), else the reason's first clause
+    what = design.get("what_moves") or reason.split(";", 1)[0]
+    return ("mechanism", (), (what[:160],))
 
 
 def screen_fault(probe, decided=lambda: False):
