@@ -268,6 +268,7 @@ class LiveFollowsTheScene(BlenderCase):
         import bpy
 
         from wiresculpt import native
+        from wiresculpt.core import live_verdict
         from wiresculpt.live import engine as live
         from wiresculpt.ui import panel
 
@@ -288,9 +289,10 @@ class LiveFollowsTheScene(BlenderCase):
         self.assertEqual(labels[0].kwargs["icon"], 'INFO')
         self.assertEqual(" ".join(c.kwargs["text"] for c in labels), live.line())
         # drawn unlike a verdict: neither the stable tick nor the not-stable warning, not red
-        self.assertEqual(panel.live_look(live.observed().verdict), ('INFO', False))
-        self.assertNotIn(panel.live_look(live.observed().verdict)[0],
-                         (panel.live_look("stable")[0], panel.live_look("not stable — crossing 3 pulls")[0]))
+        self.assertEqual(live.observed().kind, live_verdict.CANNOT_SOLVE)
+        self.assertEqual(panel.live_look(live.observed().kind), ('INFO', False))
+        self.assertNotIn(panel.live_look(live.observed().kind)[0],
+                         (panel.live_look(live_verdict.STABLE)[0], panel.live_look(live_verdict.NOT_STABLE)[0]))
         for item in self.ws.contours:
             item.use = True
         self.assertStands(self.settle())
@@ -316,7 +318,7 @@ class LiveFollowsTheScene(BlenderCase):
             item.use = False
         self.assertEqual(self.settle(), "cannot solve — a sculpture needs at least two wires: add a plane or pick "
                                         "more contours")
-        self.assertEqual(panel.live_look(live.observed().verdict), ('INFO', False))
+        self.assertEqual(panel.live_look(live.observed().kind), ('INFO', False))
         for item in self.ws.contours:
             item.use = True
         self.assertStands(self.settle())
@@ -361,7 +363,7 @@ class LiveFollowsTheScene(BlenderCase):
             bpy.context.view_layer.update()
             verdict = self.settle()
         self.assertEqual(verdict, "error — internal error (KeyError: 'hook'); please report it")
-        self.assertEqual(panel.live_look(verdict), ('CANCEL', True))
+        self.assertEqual(panel.live_look(live.observed().kind), ('CANCEL', True))
         self.assertEqual(live.observed().preview, [])
         self.target.location.x -= 0.002
         bpy.context.view_layer.update()
@@ -395,7 +397,7 @@ class LiveFollowsTheScene(BlenderCase):
         self.assertTrue(first.endswith("(180° less the contact angle 120°) but the machine bends at most 30°: "
                                        "a contact angle of at least 150° fits"), first)
         self.assertEqual(verdict, "not stable — " + first + "…")
-        self.assertEqual(panel.live_look(verdict), ('ERROR', False))
+        self.assertEqual(panel.live_look(live.observed().kind), ('ERROR', False))
         self.assertEqual(live.whole_reason(), reason)
         self.assertEqual(WIRESCULPT_OT_live_reason.description(bpy.context, None), reason)
         self.assertEqual(bpy.ops.wiresculpt.live_reason(), {'FINISHED'})

@@ -526,16 +526,17 @@ class StaleReport(Case):
         from wiresculpt.ui import stale as stale_ui
         self.optimize()  # stable
         self.assertEqual(stale_ui.live_hint(bpy.context, live_verdict.STABLE), "")
-        disagree = live_verdict.verdict(live_verdict.NOT_STABLE, "crossing 2 slips")
-        self.assertIn("Optimize found these planes stable", stale_ui.live_hint(bpy.context, disagree))
+        disagree = (live_verdict.NOT_STABLE,)  # Live: "not stable — crossing 2 slips"
+        self.assertIn("Optimize found these planes stable", stale_ui.live_hint(bpy.context, *disagree))
         self.assertEqual(stale_ui.live_hint(bpy.context, live_verdict.SOLVING), "")
         # Live's own hook pattern over a limit where Optimize's is within them all
-        over = live_verdict.verdict(live_verdict.OVER_LIMITS, "wire Slice A/0 bends 77.0 mm out of its plane")
-        self.assertIn("Optimize found these planes stable within their limits", stale_ui.live_hint(bpy.context, over))
+        over = (live_verdict.OVER_LIMITS, ("deflection",))  # "… — wire Slice A/0 bends 77.0 mm out of its plane"
+        self.assertIn("Optimize found these planes stable within their limits", stale_ui.live_hint(bpy.context, *over))
         bpy.data.objects["Slice A"].location.z += 0.01
         bpy.context.view_layer.update()
-        self.assertEqual(stale_ui.live_hint(bpy.context, disagree), "")  # an earlier Optimize says nothing of these planes
-        self.assertEqual(stale_ui.live_hint(bpy.context, over), stale_ui.TRIES_MORE)  # but Optimize may do better
+        self.assertEqual(stale_ui.live_hint(bpy.context, *disagree), "")  # an earlier Optimize says nothing of these planes
+        self.assertEqual(stale_ui.live_hint(bpy.context, *over), stale_ui.TRIES_MORE)  # but Optimize may do better
+        self.assertEqual(stale_ui.live_hint(bpy.context, live_verdict.OVER_LIMITS, ("stock",)), "")  # hooks cannot help
 
     def test_removing_a_plane(self):
         self.optimize()

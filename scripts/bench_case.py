@@ -196,12 +196,21 @@ def run(scene_path, budget, max_repeats):
     }
 
 
+# The exit status when the solver module cannot be loaded (bench_pipeline retries then: the module
+# may be being rebuilt), its reason on stderr.
+NO_SOLVER_STATUS = 3
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("scene")
     parser.add_argument("--budget", type=float, default=12.0, help="seconds of solving per case (default 12)")
     parser.add_argument("--max-repeats", type=int, default=5)
     args = parser.parse_args(argv)
+    from wiresculpt import native
+    if not native.available():
+        print(f"RuntimeError: {native.LOAD_ERROR}", file=sys.stderr)
+        sys.exit(NO_SOLVER_STATUS)
     result = run(args.scene, args.budget, args.max_repeats)
     json.dump(result, sys.stdout, indent=1)
     sys.stdout.write("\n")

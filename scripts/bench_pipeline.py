@@ -18,6 +18,10 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(os.path.dirname(HERE), "addon"))
+sys.path.insert(0, HERE)
+from bench_case import NO_SOLVER_STATUS  # noqa: E402
+
+NO_SOLVER = "no_solver"  # a case's `cause` when its process could not load the solver module
 
 
 def run_case(case, folder, timeout, budget):
@@ -44,7 +48,10 @@ def run_case(case, folder, timeout, budget):
         text, errors = out.read(), err.read()
     if child.returncode != 0:
         tail = errors.strip().splitlines()[-1:] or ["no message"]
-        return {"error": f"exit status {child.returncode}: {tail[0]}", "seconds": seconds}
+        failure = {"error": f"exit status {child.returncode}: {tail[0]}", "seconds": seconds}
+        if child.returncode == NO_SOLVER_STATUS:
+            failure["cause"] = NO_SOLVER
+        return failure
     result = json.loads(text)
     result["process_seconds"] = seconds
     result["peak_rss_kib"] = usage.ru_maxrss  # KiB on Linux
@@ -68,13 +75,13 @@ def main(argv=None):
             continue
         r = run_case(case, folder, args.timeout, args.budget)
         for _retry in range(6):  # the module was being rebuilt (another build in this tree): wait for it
-            if "error" not in r or "(_wiresculpt) is not installed" not in r["error"]:
+            if r.get("cause") != NO_SOLVER:
                 break
             print(f"wiresculpt: bench {case['name']}: the solver module is not loadable, retrying in 10 s",
                   file=sys.stderr, flush=True)
             time.sleep(10)
             r = run_case(case, folder, args.timeout, args.budget)
-        entry = dict(case, **{k: v for k, v in r.items() if k not in ("scene",)})
+        entry = dict(case, **{k: v for k, v in r.items() if k not in ("scene", "cause")})
         entry["expected"] = {"P": case["P"], "C": case["C"]}
         if "error" in r:
             failed += 1

@@ -53,26 +53,26 @@ def one(V, F, planes, scene, **settings):
         r = design["plane_search"]
         out.update(changes=r["changes"], candidates=r["candidates"], full_solves=r["full_solves"], score=r["score"],
                    budget=r["budget_seconds"], final_solve=r.get("final_solve"), solves_stopped=r["solves_stopped"])
+        if "not_found" in r:
+            out["not_found"] = r["not_found"]
     return out
 
 
 BEGIN, END, NOTES = "<!-- planes:begin -->", "<!-- planes:end -->", "<!-- planes:notes -->"
 
 
-def nearby_cell(reason):
-    """An unstable nearby row's cell: whether the budget ended the search (after N of M candidates)
-    and the reason's advice (its "To change: ..."), cut at 160 characters; an older reason (the
-    planes as given first) by its first 100 characters."""
-    if not reason.startswith("no nearby placement"):
-        first = reason.split("; no nearby placement")[0]
-        return (f"*{first[:100]}{'…' if len(first) > 100 else ''}*"
-                + (" (budget reached)" if "budget" in reason else ""))
-    cut = re.search(r"budget ended the search after (\d+) of (\d+) candidates", reason)
-    every = re.search(r"Every one of the (\d+) candidates was screened", reason)
-    todo = re.search(r"To change: (.*?)(?:\. The planes as given: |$)", reason, re.S)
-    todo = todo.group(1) if todo else ""
-    head = (f"budget ended after {cut.group(1)} of {cut.group(2)} candidates" if cut else
-            f"all {every.group(1)} candidates screened" if every else "")
+def nearby_cell(nearby):
+    """An unstable nearby row's cell, from the search's record of how it ended (`not_found`,
+    docs/formats.md): whether the budget ended the search (after N of M candidates) or every
+    candidate was screened, and its advice (the reason's "To change: ..."), cut at 160 characters;
+    a row without that record (the search did not run: an error) by its reason's first 100
+    characters."""
+    ending, reason = nearby.get("not_found"), nearby.get("reason") or ""
+    if not ending:
+        return f"*{reason[:100]}{'…' if len(reason) > 100 else ''}*"
+    todo = "; or ".join(ending["advice"])
+    head = (f"budget ended after {ending['screened']} of {ending['total']} candidates" if ending["budget_ended"] else
+            f"all {ending['total']} candidates screened" if ending["screened"] == ending["total"] else "")
     return f"{head}; *{todo[:160]}{'…' if len(todo) > 160 else ''}*"
 
 
@@ -88,7 +88,7 @@ def table(rows, counts, kept=None):
              "|" + "---|" * (4 + len(autos))]
     for row in rows:
         nb = row["nearby"]
-        change = ("; ".join(nb.get("changes") or []) or "kept as given" if nb["stable"] else nearby_cell(nb["reason"]))
+        change = ("; ".join(nb.get("changes") or []) or "kept as given" if nb["stable"] else nearby_cell(nb))
         cells = (kept[1].get(row["mesh"], ["-"] * len(autos)) if kept else
                  [f"{verdict(row[f'auto{n}'])} ({row[f'auto{n}']['seconds']:.1f}, "
                   f"{row[f'auto{n}'].get('candidates', '-')} / {row[f'auto{n}'].get('full_solves', '-')})"

@@ -10,8 +10,11 @@ instead of failing to register, and every wrapper raises RuntimeError with it.
 The results are the module's dicts, in the design document's own key names (docs/formats.md):
 the stages copy them without renaming.
 """
+import ctypes
+import importlib.machinery
 import os
 import re
+import struct
 import sys
 from collections.abc import Iterator
 
@@ -50,29 +53,116 @@ def _listed(items):
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
 
 
-def explain_load_error(exc, builds, python=None, host=None):
+# Why the solver did not load, as a code (load_cause); explain_load_error words it.
+OTHER_PYTHON = "other_python"  # the zip has the solver for other Pythons only
+MISSING_LIBRARY = "missing_library"  # a shared library the module needs cannot be found or loaded
+NOT_BUILT = "not_built"  # no module for any Python
+OTHER = "other"  # something else: the import error's own text is said
+
+
+def elf_dependencies(path):
+    """(the DT_NEEDED names, the DT_RUNPATH / DT_RPATH entries) of the 64-bit little-endian ELF
+    shared object at `path`, read from its dynamic section; None when it is not one or cannot be
+    read."""
+    try:
+        with open(path, "rb") as f:
+            data = f.read()
+        if data[:4] != b"\x7fELF" or data[4] != 2 or data[5] != 1:  # ELFCLASS64, ELFDATA2LSB
+            return None
+        phoff, = struct.unpack_from("<Q", data, 0x20)
+        phentsize, phnum = struct.unpack_from("<HH", data, 0x36)
+        loads, dynamic = [], None
+        for i in range(phnum):
+            kind, _flags, offset, vaddr, _paddr, filesz = struct.unpack_from("<IIQQQQ", data, phoff + i * phentsize)
+            if kind == 1:  # PT_LOAD
+                loads.append((vaddr, offset, filesz))
+            elif kind == 2:  # PT_DYNAMIC
+                dynamic = (offset, filesz)
+        if dynamic is None:
+            return [], []
+        entries = []
+        for k in range(dynamic[1] // 16):
+            tag, value = struct.unpack_from("<qQ", data, dynamic[0] + 16 * k)
+            if tag == 0:  # DT_NULL
+                break
+            entries.append((tag, value))
+        strtab = next(v for t, v in entries if t == 5)  # DT_STRTAB, an address: its offset in the file
+        table = next(strtab - vaddr + offset for vaddr, offset, size in loads if vaddr <= strtab < vaddr + size)
+
+        def string(index):
+            return data[table + index:data.index(b"\0", table + index)].decode("utf-8", "replace")
+        return ([string(v) for t, v in entries if t == 1],  # DT_NEEDED
+                [string(v) for t, v in entries if t in (15, 29)])  # DT_RPATH, DT_RUNPATH
+    except (OSError, struct.error, StopIteration, ValueError):
+        return None
+
+
+def missing_library(path):
+    """The name of the first shared library the ELF object at `path` needs that cannot be found or
+    loaded (looked for in its run path, `$ORIGIN` expanded, else by the system's loader through
+    ctypes), following a bundled library's own needs; None when each one loads or `path` cannot be
+    read. The loader's error text is not read: which library fails is found by trying each."""
+    found = elf_dependencies(path)
+    if found is None:
+        return None
+    needed, runpath = found
+    origin = os.path.dirname(os.path.abspath(path))
+    folders = [d.replace("${ORIGIN}", origin).replace("$ORIGIN", origin)
+               for entry in runpath for d in entry.split(":") if d]
+    for name in needed:
+        local = next((os.path.join(d, name) for d in folders if os.path.isfile(os.path.join(d, name))), None)
+        try:
+            ctypes.CDLL(local or name)
+        except OSError:
+            return (missing_library(local) or name) if local else name
+    return None
+
+
+def module_file():
+    """The path of the compiled module beside this file for the running Python (its extension
+    suffixes), or None when there is none."""
+    for suffix in importlib.machinery.EXTENSION_SUFFIXES:
+        path = os.path.join(HERE, "_wiresculpt" + suffix)
+        if os.path.isfile(path):
+            return path
+    return None
+
+
+def load_cause(builds, python, missing=None):
+    """(code, figures) of why the solver did not load: OTHER_PYTHON ({"builds", "python"}) when the
+    zip's `builds` lack the running `python`, MISSING_LIBRARY ({"library"}) when `missing` names a
+    library the module cannot load, NOT_BUILT when there are no builds, else OTHER."""
+    if builds and python not in builds:
+        return OTHER_PYTHON, {"builds": list(builds), "python": python}
+    if missing:
+        return MISSING_LIBRARY, {"library": missing}
+    if not builds:
+        return NOT_BUILT, {}
+    return OTHER, {}
+
+
+def explain_load_error(exc, builds, python=None, host=None, missing=None):
     """One sentence saying why the solver did not load and what to do: the Pythons the zip carries
     the solver for against the one running (with the Blenders that embed them), or the shared
-    library the loader could not find."""
+    library `missing` that cannot be loaded (missing_library), from load_cause's code."""
     python = python or f"{sys.version_info[0]}.{sys.version_info[1]}"
     host = host or host_name()
-    text = str(exc)
-    if builds and python not in builds:
+    code, figures = load_cause(builds, python, missing)
+    if code == OTHER_PYTHON:
         blenders = [BLENDERS[b] for b in builds if b in BLENDERS]
         where = f"a Blender whose Python is {' or '.join(builds)}" + (f" ({', '.join(blenders)})" if blenders else "")
         return (f"The wiresculpt solver did not load: this zip has the solver for Python {_listed(builds)}; "
                 f"{host} uses {python}: install it in {where}, or build the zip from source with "
                 f"scripts/package on a machine that has Python {python} and its headers.")
-    missing = re.search(r"([\w.+-]+\.so[\w.]*): cannot open shared object file", text)
-    if missing:
-        return (f"The wiresculpt solver did not load: the library {missing.group(1)} is missing. The "
+    if code == MISSING_LIBRARY:
+        return (f"The wiresculpt solver did not load: the library {figures['library']} is missing. The "
                 f"packaged zip carries it in libs/ beside the module: install the zip again (Preferences > "
                 "Add-ons > Install, or Get Extensions > Install from Disk for the extension), or install it on "
                 "the system, or build from source with scripts/package.")
-    if not builds:
+    if code == NOT_BUILT:
         return ("The wiresculpt solver (_wiresculpt) is not built: build it with scripts/setup, or "
                 "install the packaged zip (scripts/package).")
-    return f"The wiresculpt solver (_wiresculpt) did not load in {host}: {text}"
+    return f"The wiresculpt solver (_wiresculpt) did not load in {host}: {exc}"
 
 
 try:
@@ -80,7 +170,7 @@ try:
     LOAD_ERROR = ""
 except ImportError as exc:  # not built, built for another Python, or a library missing
     module = None
-    LOAD_ERROR = explain_load_error(exc, built_for())
+    LOAD_ERROR = explain_load_error(exc, built_for(), missing=missing_library(module_file()) if module_file() else None)
 
 
 class _NeverRaised(Exception):

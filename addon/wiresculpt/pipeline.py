@@ -10,7 +10,7 @@ import time
 from . import native
 from .core import mesh_faults
 from .core import settings as settings_table
-from .core.design import NO_WIRES, ONE_WIRE, TOO_CLOSE, new_design
+from .core.design import NO_WIRES_CAUSE, ONE_WIRE_CAUSE, SETUP_WORDS, TOO_CLOSE, new_design
 from .core.sizes import mesh_size, size_warnings
 from .core.solve_context import Cancelled, OutOfTime, SolveContext, quiet  # noqa: F401 (the pipeline's names)
 from .fab import buildability
@@ -55,7 +55,8 @@ def solve(design, material, settings, progress=None, cancel=None, stock=None, ho
     design["pending_stages"] = list(ALL_STAGES)
     if len(design["wires"]) < 2:
         design["stable"] = False
-        design["reason"] = NO_WIRES if not design["wires"] else ONE_WIRE  # setup problems (core/design.py)
+        cause = NO_WIRES_CAUSE if not design["wires"] else ONE_WIRE_CAUSE  # setup problems (core/design.py)
+        design["reason"], design["reason_causes"] = SETUP_WORDS[cause], [cause]
         return design
     apply_cuts(design, settings.get("cuts"))
     for warning in size_warnings(design, *(stock or ())):  # before the long work: the contour's figure, at once

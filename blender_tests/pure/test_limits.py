@@ -4,6 +4,7 @@ each figure just over, at, or under its limit; the expected phrases written out.
 import unittest
 
 from wiresculpt.core import live_verdict as lv
+from wiresculpt.core import limits
 from wiresculpt.core.limits import DEFLECTION_LIMIT, OVER_LIMITS, broken_limits, hooks_may_help
 
 
@@ -16,6 +17,10 @@ def wire(name, length=0.5, deflection=0.0, side=0.2):
 def design(*wires, asked=3.0, reached=3.0, weakest="-z"):
     return {"stable": True, "reason": "", "wires": list(wires),
             "load_factor": {"asked": asked, "reached": reached, "weakest": weakest}}
+
+
+def codes(d):
+    return [code for code, _phrase in limits.limit_records(d)]
 
 
 class Limits(unittest.TestCase):
@@ -58,9 +63,18 @@ class Limits(unittest.TestCase):
         self.assertEqual(broken_limits(design(wire("A/0"), reached=2.999)), ["holds 2.999x its weight (-z), not the 3.000x asked"])
 
     def test_which_limits_another_hook_pattern_may_keep(self):
-        self.assertTrue(hooks_may_help(broken_limits(design(wire("A/0"), reached=2.0))))
-        self.assertTrue(hooks_may_help(broken_limits(design(wire("A/0", deflection=0.01)))))
-        self.assertFalse(hooks_may_help(broken_limits(design(wire("A/0", length=1.5), wire("B/0", side=2.0)))))
+        self.assertTrue(hooks_may_help(codes(design(wire("A/0"), reached=2.0))))
+        self.assertTrue(hooks_may_help(codes(design(wire("A/0", deflection=0.01)))))
+        self.assertFalse(hooks_may_help(codes(design(wire("A/0", length=1.5), wire("B/0", side=2.0)))))
+
+    def test_each_phrase_has_its_code(self):
+        over = design(wire("A/0", deflection=0.003, length=1.1), wire("B/0", side=2.0), reached=2.0)
+        self.assertEqual(limits.limit_records(over), [
+            ("load_factor", "holds 2.00x its weight (-z), not the 3.00x asked"),
+            ("deflection", "wire A/0 bends 3.0 mm out of its plane (limit 2.0 mm)"),
+            ("stock", "wire A/0 is 1100 mm long, over the 1000 mm stock"),
+            ("size", "2.00 m across, over 1.50 m")])
+        self.assertEqual(broken_limits(over), [p for _c, p in limits.limit_records(over)])
 
 
 class Verdict(unittest.TestCase):
@@ -69,7 +83,7 @@ class Verdict(unittest.TestCase):
         self.assertEqual(lv.of_design(over), (OVER_LIMITS, "wire A/0 bends 2.5 mm out of its plane (limit 2.0 mm)"))
         line = lv.verdict(*lv.of_design(over))
         self.assertEqual(line, "stable, over its limits — wire A/0 bends 2.5 mm out of its plane (limit 2.0 mm)")
-        self.assertEqual(lv.kind_of(line), lv.OVER_LIMITS)
+        self.assertEqual(codes(over), ["deflection"])  # the code Live keeps beside the line
         self.assertEqual(lv.of_design(design(wire("A/0"), wire("B/0"))), (lv.STABLE, ""))
 
     def test_a_design_not_stable_keeps_its_reason(self):

@@ -84,6 +84,15 @@ class Structural(unittest.TestCase):
         d = network(["Z/0", "X/0", "Y/0", "W/0"],
                     self.SIX + [(3, 1, (0, 0.5, 0.8)), (3, 1, (0, -0.5, 0.8)), (3, 2, (0.3, 0, 0.8))])
         self.assertEqual(plane_faults.structural_fault(d), ("mechanism", (), ("not stable",)))
+        # the layering's hook-relaxed verdict: its clause naming what moves (what_moves), the words
+        # the fault showed before (the reason after "… allowed at every crossing, " up to its advice)
+        clause = "wire 'Z2/0' is held only at crossings 6 and 7, which lie on one line, so it can turn about that line like a hinge"
+        d["reason"] = ("no hook configuration can make the finished sculpture stable: even with both hook directions "
+                       f"allowed at every crossing, {clause}; add a plane whose wire crosses it away from that line")
+        d["what_moves"] = clause
+        self.assertEqual(plane_faults.structural_fault(d), ("mechanism", (), (clause,)))
+        d["what_moves"] = "x" * 200
+        self.assertEqual(plane_faults.structural_fault(d), ("mechanism", (), ("x" * 160,)))
 
     def test_a_screen_that_fails_is_named_by_what_decided_it(self):
         # no alone, apart or hinged wire: the layering's search stopped at max_nodes is undecided, not
@@ -268,13 +277,17 @@ class NoNearbyPlacement(unittest.TestCase):
         self.assertTrue(design["reason"].startswith("no nearby placement gives a stable design. Searched: "))
         self.assertTrue(design["reason"].endswith(f". The planes as given: {given['reason']}"))
         self.assertIn("wire A/0 on wire C/0", design["reason"])
-        # the record keeps the keys it had (FORMATS.md's and the extra ones before this change), no new one
+        # the record keeps the keys it had (FORMATS.md's and the extra ones before), and adds only
+        # not_found: how the search ended, as data beside the reason's words
         self.assertEqual(set(design["plane_search"]), {
             "mode", "planes_before", "planes_after", "changes", "candidates", "full_solves", "budget_seconds",
-            "solves_stopped", "solves_failed", "final_solve", "seconds", "score", "measure"})
+            "solves_stopped", "solves_failed", "final_solve", "seconds", "score", "measure", "not_found"})
         self.assertEqual(design["plane_search"]["planes_after"], [])
         screened = int(re.search(r"; (\d+) placements screened", design["reason"]).group(1))
         self.assertEqual(design["plane_search"]["candidates"], screened)
+        ending = design["plane_search"]["not_found"]
+        self.assertEqual((ending["screened"], ending["total"], ending["budget_ended"]), (screened, CANDIDATES, False))
+        self.assertIn("To change: " + "; or ".join(ending["advice"]) + ". The planes as given: ", design["reason"])
 
 
 if __name__ == "__main__":

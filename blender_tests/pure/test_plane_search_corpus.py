@@ -81,3 +81,56 @@ class NearbyOnlySection(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+def cell_from_words(reason):
+    """The nearby cell as the table made it from the reason's words before the search recorded how
+    it ended (the reference the record must reproduce)."""
+    import re
+    if not reason.startswith("no nearby placement"):
+        first = reason.split("; no nearby placement")[0]
+        return f"*{first[:100]}{'…' if len(first) > 100 else ''}*" + (" (budget reached)" if "budget" in reason else "")
+    cut = re.search(r"budget ended the search after (\d+) of (\d+) candidates", reason)
+    every = re.search(r"Every one of the (\d+) candidates was screened", reason)
+    todo = re.search(r"To change: (.*?)(?:\. The planes as given: |$)", reason, re.S)
+    todo = todo.group(1) if todo else ""
+    head = (f"budget ended after {cut.group(1)} of {cut.group(2)} candidates" if cut else
+            f"all {every.group(1)} candidates screened" if every else "")
+    return f"{head}; *{todo[:160]}{'…' if len(todo) > 160 else ''}*"
+
+
+class NearbyCell(unittest.TestCase):
+    """The cell of a nearby search that found nothing, made from its `not_found` record, reads as the
+    one made from the reason's words did, for a search the budget ended, one that screened every
+    candidate, and one that stopped with candidates left otherwise."""
+
+    def tally(self, screened_pairs, out_of_time):
+        import types
+        from wiresculpt.core.plane_faults import Tally
+        base = [types.SimpleNamespace(name=n) for n in ("X1", "Y1")]
+        singles = {0: ["a", "b"], 1: ["c"]}
+        t = Tally(base, singles, 2)
+        t.screened("given")
+        t.fault("given", ("hinge", ("X1/0",), ("Y1/0+Z1/0",)))
+        for change, family in (("a", "X1"), ("b", "X1"), ("c", "Y1")):
+            t.screened(family)
+            t.fault(family, ("alone", ("Y1/0",), ()), [(0, change)])
+        for _ in range(screened_pairs):
+            t.screened("pairs")
+            t.fault("pairs", ("apart", ("X1/0",), ()), [(0, "a"), (1, "c")])
+        t.out_of_time, t.seconds = out_of_time, 3.5
+        return t
+
+    def test_the_record_gives_the_cell_the_words_gave(self):
+        for pairs, out_of_time, head in ((0, True, "budget ended after 4 of 6 candidates"),
+                                         (2, True, "all 6 candidates screened"),
+                                         (1, False, "")):
+            t = self.tally(pairs, out_of_time)
+            reason = t.report(25.0, 500.0, 10.0, 8.0, 0.015) + ". The planes as given: wire X1/0 turns like a hinge"
+            record = {"stable": False, "reason": reason, "not_found": t.ending(0.015)}
+            cell = corpus.nearby_cell(record)
+            self.assertEqual(cell, cell_from_words(reason))
+            self.assertTrue(cell.startswith(head + "; *"), cell)
+            self.assertGreater(len(cell), len(head) + 5)  # the advice is there
+        error = {"stable": False, "reason": "error: the solver refused the planes"}
+        self.assertEqual(corpus.nearby_cell(error), "*error: the solver refused the planes*")

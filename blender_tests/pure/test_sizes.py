@@ -87,6 +87,18 @@ class SizeTest(unittest.TestCase):
         self.assertIn("wire C/0 is 1200 mm long", warned[3])
         self.assertIn("3 wires are longer than the 1000 mm stock, C/0 1200 mm", limits)
 
+    def test_the_stock_sentences_alone(self):
+        """stock_warnings: the wires' sentences of size_warnings (what an export notes), not the model's."""
+        d = design(1.35)
+        perimeter = 64 * 2 * 1.35 * math.sin(math.pi / 64)
+        found = sizes.stock_warnings(d, 1.0, "my bender")
+        self.assertEqual(found, [f"wire {'ABC'[k]}/0 is {perimeter * 1000:.0f} mm long (its sliced contour; the solve "
+                                 "sets the wire's length), longer than the 1000 mm stock of my bender: it needs a "
+                                 "longer stock or a joint" for k in range(3)])
+        self.assertEqual(found, sizes.size_warnings(d, 1.0, "my bender")[1:])
+        with self.assertRaisesRegex(ValueError, "stock_length"):
+            sizes.stock_warnings(d, stock_length=float("nan"))
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -32,8 +32,13 @@ LABELS = {"max_bend_deg": "Max Bend", "wire_diameter": "Wire Diameter", "name": 
 
 def changes(p=None, ticked=TICKED, inputs=INPUTS, target="Globe", settings=SETTINGS, material=MATERIAL, d=None,
             names=None):
-    return stale.changes(d or design(), planes() if p is None else p, ticked, inputs, target, settings, material,
-                         LABELS, names=names)
+    now = stale.SceneNow(planes() if p is None else p, ticked, names, target, settings, material)
+    return stale.changes(d or design(), now, inputs, LABELS)
+
+
+def scene(target, mesh=None):
+    """The scene now of the fixture's planes, ticks, settings and material, with `target` and `mesh`."""
+    return stale.SceneNow(planes(), TICKED, None, target, SETTINGS, MATERIAL, mesh)
 
 
 def renamed(mapping, p=None, ticked=TICKED):
@@ -52,15 +57,14 @@ class StaleTest(unittest.TestCase):
         self.assertNotEqual(digest, stale.mesh_digest([V[0], V[1], [0.0, 1.0, 1e-12]], [[0, 1, 2]]))
         self.assertNotEqual(digest, stale.mesh_digest(V, [[0, 2, 1]]))
         inputs = dict(INPUTS, mesh=digest)
-        said = stale.changes(design(), planes(), TICKED, inputs, "Globe", SETTINGS, MATERIAL, LABELS, mesh=digest)
+        said = stale.changes(design(), scene("Globe", mesh=digest), inputs, LABELS)
         self.assertEqual(said, [])
         for now in ("0" * 24, stale.MESH_CHANGED):
-            said = stale.changes(design(), planes(), TICKED, inputs, "Globe", SETTINGS, MATERIAL, LABELS, mesh=now)
+            said = stale.changes(design(), scene("Globe", mesh=now), inputs, LABELS)
             self.assertEqual(said, ["target Globe edited or moved"])
-        self.assertEqual(stale.changes(design(), planes(), TICKED, inputs, "Globe", SETTINGS, MATERIAL, LABELS), [])
+        self.assertEqual(stale.changes(design(), scene("Globe"), inputs, LABELS), [])
         # another target: that is what is said; a record without a digest (an older add-on's) says nothing
-        self.assertEqual(stale.changes(design(), planes(), TICKED, inputs, "Cube", SETTINGS, MATERIAL, LABELS,
-                                       mesh="0" * 24), ["target changed"])
+        self.assertEqual(stale.changes(design(), scene("Cube", mesh="0" * 24), inputs, LABELS), ["target changed"])
         self.assertEqual(changes(), [])
 
     def test_unchanged_scene_is_current(self):

@@ -592,15 +592,14 @@ std::string disconnected(const Network& net) {
 
 // Why no hook configuration can make the finished sculpture stable, `relaxed` being the check
 // with both hooks' pyramids at every crossing.
-std::string never_stable(const Network& net, const StabilityResult& relaxed) {
+// What moves when even both hooks at every crossing do not hold, or what cannot be balanced, with
+// its advice: named from the null space of the crossings as ball joints (mechanism.hpp), rather
+// than the LP's failing load, whose wire need not be the one that moves.
+std::string what_moves(const Network& net, const StabilityResult& relaxed) {
   const int P = static_cast<int>(net.wires.size());
   const int C = static_cast<int>(net.crossings.size());
   std::string reason;
-  // Name what moves, from the null space of the crossings as ball joints (mechanism.hpp),
-  // rather than the LP's failing load, whose wire need not be the one that moves.
   const Mechanism mechanism = find_mechanism(net);
-  reason = "no hook configuration can make the finished sculpture stable: even with both hook directions "
-           "allowed at every crossing, ";
   if (!mechanism.moving.empty()) {
     reason += mechanism_message(net, mechanism);
   } else {  // rigid as ball joints, yet the allowed pyramids do not span (forbidden hooks, degenerate contact angle)
@@ -712,8 +711,11 @@ LayeringResult layering(const Network& net, const LayeringOptions& options, cons
     for (int w = 0; w < P; ++w) all[w] = w;
     const StabilityResult relaxed = s.checker_.check(all, s.relaxed_, P == 2);
     if (!relaxed.stable) {
-      r.reason = never_stable(net, relaxed);
-      r.reason += forbidden_note(options);
+      std::string detail = what_moves(net, relaxed);  // what moves, or what cannot be balanced, with its advice
+      detail += forbidden_note(options);
+      r.reason = "no hook configuration can make the finished sculpture stable: even with both hook directions "
+                 "allowed at every crossing, " + detail;
+      r.what_moves = detail.substr(0, detail.find(';'));  // each advice follows a ';' (mechanism_message)
       r.stats.lp_solves = s.checker_.lp_solves();
       return finish();
     }

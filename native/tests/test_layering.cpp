@@ -276,6 +276,11 @@ TEST_CASE("layering: an unstable network names the wire that cannot be added and
   // Caught before the search: not even both hooks at once can hold W.
   CHECK_THAT(r.reason, Contains("'W'") && Contains("crossing " + std::to_string(wc)) &&
                            Contains("no hook configuration"));
+  // the clause naming what moves (Y, held by X only at the two points where the great circles
+  // meet, a hinge): the reason's words after the relaxed check's, up to the first advice
+  CHECK(r.what_moves == "wire 'Y' is held only at crossings 0 and 1, which lie on one line, so it can turn about "
+                        "that line like a hinge");
+  CHECK(r.reason.find("allowed at every crossing, " + r.what_moves + ";") != std::string::npos);
   CHECK(r.assembly_order.empty());
   for (int h : r.hooks) CHECK(h == 0);
 }

@@ -36,7 +36,7 @@ KEYS = {
     "top": {
         "format": "design", "version": "design", "units": "design", "material": "design",
         "torque_fraction": "design", "machine": "design", "wires": "design", "stages": "design",
-        "stable": "layering", "reason": "layering", "reason_causes": "layering",
+        "stable": "layering", "reason": "layering", "reason_causes": "layering", "what_moves": "layering",
         "pending_stages": "pipeline", "warnings": "every stage",
         "crossings": "layering", "assembly_order": "layering", "assembly_steps": "layering",
         "two_hand_steps": "layering", "close_crossings": "layering", "required_size": "layering",
@@ -75,7 +75,7 @@ KEYS = {
 OPTIONAL = {
     "top": {"close_crossings", "required_size", "load_capacity", "load_factor", "fabrication", "warnings",
             "buildability", "search_incomplete", "plane_search", "reason_causes", "model_size", "mesh_faults",
-            "stands_3d"},
+            "stands_3d", "what_moves"},
     "wire": {"cut_override", "cut_point", "out_of_plane_deflection", "out_of_plane_deflection_vertex", "sag",
              "as_built"},
     "crossing": {"pyramid", "force_3d", "admissible"},
@@ -83,24 +83,39 @@ OPTIONAL = {
 }
 
 
-# The pipeline's reasons when slicing gave fewer than two wires (pipeline.solve stops before any
-# stage): a scene still to set up, not a verdict on a design. Written here once, so that the add-on
-# (Live's "cannot solve", the Stability box, Optimize's report: setup_problem) knows them by these
-# very words; design.json keeps them as written (`stable` false, `reason` one of these).
-NO_WIRES = "no plane cuts the mesh: move the planes through the mesh"
-ONE_WIRE = "a sculpture needs at least two wires: add a plane or pick more contours"
-SETUP_REASONS = (NO_WIRES, ONE_WIRE)
-
-
 # The codes of the causes a `reason` names (`reason_causes`), for the code that acts on a cause;
 # the reason's words are for people.
 TOO_CLOSE = "too_close"  # crossings too close along a wire for a free bending point between them
+# The pipeline's setup problems, when slicing gave fewer than two wires (pipeline.solve stops before
+# any stage): a scene still to set up, not a verdict on a design. The add-on (Live's "cannot solve",
+# the Stability box, Optimize's report) knows them by these codes (setup_problem).
+NO_WIRES_CAUSE = "no_wires"  # no plane cuts the mesh
+ONE_WIRE_CAUSE = "one_wire"  # one wire only
+SETUP_CAUSES = (NO_WIRES_CAUSE, ONE_WIRE_CAUSE)
+
+# The words of the setup problems, by code; design.json keeps them as written (`stable` false,
+# `reason` one of these, `reason_causes` its code).
+NO_WIRES = "no plane cuts the mesh: move the planes through the mesh"
+ONE_WIRE = "a sculpture needs at least two wires: add a plane or pick more contours"
+SETUP_WORDS = {NO_WIRES_CAUSE: NO_WIRES, ONE_WIRE_CAUSE: ONE_WIRE}
 
 
 def setup_problem(design):
-    """Whether `design` is not stable for a setup problem (its reason one of SETUP_REASONS): nothing
-    was solved, so it says what to set up rather than that a design does not stand."""
-    return not design.get("stable") and design.get("reason") in SETUP_REASONS
+    """Whether `design` is not stable for a setup problem (`reason_causes` holds one of
+    SETUP_CAUSES): nothing was solved, so it says what to set up rather than that a design does not
+    stand."""
+    if design.get("stable"):
+        return False
+    causes = design.get("reason_causes")
+    if causes is not None:
+        return any(code in SETUP_CAUSES for code in causes)
+    # A design without `reason_causes`: one written before the pipeline gave setup problems a code
+    # (kept in .blend files), or one whose reason names no coded cause. The pipeline stops with a
+    # setup problem exactly when slicing gave fewer than two wires, before any stage ran, so such a
+    # design is known by those facts: a reason, fewer than two wires and the layering still pending
+    # (an unstable design that the layering judged has run it).
+    return (bool(design.get("reason")) and len(design.get("wires") or ()) < 2
+            and "layering" in (design.get("pending_stages") or ()))
 
 
 def written_by(stage):

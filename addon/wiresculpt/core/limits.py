@@ -8,6 +8,7 @@ bpy-free.
 """
 import math
 
+from . import standing
 from .figures import versus
 # STOCK_LENGTH: the default stock, which callers take from here too
 from .sizes import LARGEST_MODEL, MEASURED_WIRE, OVER_STOCK, STOCK_LENGTH, TOO_LARGE, size_facts
@@ -18,8 +19,16 @@ DEFLECTION_LIMIT = 0.002
 RELATIVE = 1e-9  # a figure this close to its limit is at it, not over it (the solver's own rounding)
 
 OVER_LIMITS = "stable, over its limits"  # the verdict's words for such a design
+# The codes of the limits, in the order they are said (most decisive first).
+STANDS_3D = "stands_3d"  # the assembled sculpture does not stand in 3D (core/standing.py)
+LOAD_FACTOR = "load_factor"  # the load factor asked for not reached
+# wires bending out of their planes past DEFLECTION_LIMIT, each loaded alone (forces stage): said
+# only where the coupled 3D check did not run, whose sag it overstates
+DEFLECTION = "deflection"
+STOCK = "stock"  # wires longer than the machine's stock
+SIZE = "size"  # a model over LARGEST_MODEL
 # the limits another hook pattern may keep (the pre-stress follows the hooks): not the stock or the size
-HOOK_LIMITS = ("holds ", "out of its plane", "out of their planes")
+HOOK_LIMITS = (STANDS_3D, LOAD_FACTOR, DEFLECTION)
 
 
 def recorded_stock(inputs):
@@ -36,26 +45,38 @@ def _over(value, limit):
 
 def broken_limits(design, stock_length=STOCK_LENGTH):
     """Short phrases, each a limit `design` breaks with its figure and the limit, most decisive
-    first: the load factor not reached, wires bending out of their planes, wires longer than the
+    first: not standing in 3D, the load factor not reached, wires bending out of their planes (where
+    the 3D check did not run), wires longer than the
     stock (`stock_length`, m), a model over LARGEST_MODEL. [] for a design within them all (and for
-    one whose stages did not report these figures)."""
-    said = []
+    one whose stages did not report these figures). The phrases of limit_records."""
+    return [phrase for _code, phrase in limit_records(design, stock_length)]
+
+
+def limit_records(design, stock_length=STOCK_LENGTH):
+    """[(code, phrase)] of the limits `design` breaks (broken_limits), the phrase made from the
+    code and its figures by phrase()."""
+    return [(code, phrase(code, **figures)) for code, figures in limit_figures(design, stock_length)]
+
+
+def limit_figures(design, stock_length=STOCK_LENGTH):
+    """[(code, {figure: value})] of the limits `design` breaks, in broken_limits' order."""
+    out = []
+    checked = design.get("stands_3d")
+    checked = checked if isinstance(checked, dict) and checked.get("cause") in standing.CAUSES else None
+    if checked is not None and not checked.get("stands"):
+        out.append((STANDS_3D, {"record": checked}))
     factor = design.get("load_factor")
     factor = factor if isinstance(factor, dict) else {}
     asked, reached = factor.get("asked"), factor.get("reached")
     if isinstance(asked, (int, float)) and isinstance(reached, (int, float)) and reached < asked * (1.0 - RELATIVE):
-        weakest = f" ({factor['weakest']})" if factor.get("weakest") else ""
-        shown, limit = versus(reached, asked, 2)
-        said.append(f"holds {shown}x its weight{weakest}, not the {limit}x asked")
+        out.append((LOAD_FACTOR, {"reached": reached, "asked": asked, "weakest": factor.get("weakest") or ""}))
     wires = [w for w in design.get("wires") or [] if isinstance(w, dict)]
     bent = [(float(w["out_of_plane_deflection"]), w.get("name", "?")) for w in wires
             if isinstance(w.get("out_of_plane_deflection"), (int, float))
             and _over(float(w["out_of_plane_deflection"]), DEFLECTION_LIMIT)]
-    if bent:
+    if bent and checked is None:
         worst, name = max(bent)
-        shown, limit = versus(worst * 1000, DEFLECTION_LIMIT * 1000, 1)
-        said.append(f"wire {name} bends {shown} mm out of its plane (limit {limit} mm)" if len(bent) == 1 else
-                    f"{len(bent)} wires bend out of their planes, {name} by {shown} mm (limit {limit} mm)")
+        out.append((DEFLECTION, {"worst": worst, "name": name, "count": len(bent)}))
     # the figures of the size warnings (core/sizes.size_facts): the solved wires' lengths, the model's size
     ok = isinstance(stock_length, (int, float)) and math.isfinite(stock_length) and stock_length > 0
     stock_length = stock_length if ok else STOCK_LENGTH  # as recorded_stock: the default profile's
@@ -64,17 +85,37 @@ def broken_limits(design, stock_length=STOCK_LENGTH):
             and _over(f["length"], stock_length)]
     if long:
         worst, name = max(long)
-        shown, limit = versus(worst * 1000, stock_length * 1000, 0)
-        said.append(f"wire {name} is {shown} mm long, over the {limit} mm stock" if len(long) == 1 else
-                    f"{len(long)} wires are longer than the {limit} mm stock, {name} {shown} mm")
+        out.append((STOCK, {"worst": worst, "name": name, "count": len(long), "stock_length": stock_length}))
     for f in facts:
         if f["cause"] == TOO_LARGE and _over(f["size"], LARGEST_MODEL):
-            shown, limit = versus(f["size"], LARGEST_MODEL, 2)
-            said.append(f"{shown} m across, over {limit} m")
-    return said
+            out.append((SIZE, {"size": f["size"]}))
+    return out
 
 
-def hooks_may_help(limits):
-    """Whether another hook pattern may keep a design within `limits` (broken_limits' phrases):
-    the load factor and the out-of-plane deflection follow the pre-stress the hooks choose."""
-    return any(words in limit for limit in limits for words in HOOK_LIMITS)
+def phrase(code, **figures):
+    """The words of the limit `code` with its figures (limit_figures'): the one place they are made."""
+    if code == STANDS_3D:
+        return standing.words(figures["record"])
+    if code == LOAD_FACTOR:
+        weakest = f" ({figures['weakest']})" if figures["weakest"] else ""
+        shown, limit = versus(figures["reached"], figures["asked"], 2)
+        return f"holds {shown}x its weight{weakest}, not the {limit}x asked"
+    if code == DEFLECTION:
+        shown, limit = versus(figures["worst"] * 1000, DEFLECTION_LIMIT * 1000, 1)
+        return (f"wire {figures['name']} bends {shown} mm out of its plane (limit {limit} mm)" if figures["count"] == 1
+                else f"{figures['count']} wires bend out of their planes, {figures['name']} by {shown} mm "
+                     f"(limit {limit} mm)")
+    if code == STOCK:
+        shown, limit = versus(figures["worst"] * 1000, figures["stock_length"] * 1000, 0)
+        return (f"wire {figures['name']} is {shown} mm long, over the {limit} mm stock" if figures["count"] == 1
+                else f"{figures['count']} wires are longer than the {limit} mm stock, {figures['name']} {shown} mm")
+    if code == SIZE:
+        shown, limit = versus(figures["size"], LARGEST_MODEL, 2)
+        return f"{shown} m across, over {limit} m"
+    raise ValueError(f"no such limit: {code!r}")
+
+
+def hooks_may_help(codes):
+    """Whether another hook pattern may keep a design within the limits of `codes` (limit_records'
+    codes): the load factor and the out-of-plane deflection follow the pre-stress the hooks choose."""
+    return any(code in HOOK_LIMITS for code in codes)

@@ -85,14 +85,6 @@ def of_design(design, stock_length=STOCK_LENGTH):
     return (CANNOT_SOLVE if setup_problem(design) else NOT_STABLE), design.get("reason") or ""
 
 
-def kind_of(line):
-    """The kind of a verdict made by `verdict` (the panel picks its icon by it); "" when none."""
-    for kind in (NOT_STABLE, CANNOT_SOLVE, ERROR, OVER_LIMITS):
-        if line == kind or line.startswith(kind + DASH):
-            return kind
-    return line if line in (STABLE, SOLVING) else ""
-
-
 def shortened(text):
     """Whether the line shows only part of `text` (shown_reason)."""
     return shown_reason(text) != " ".join(text.split())

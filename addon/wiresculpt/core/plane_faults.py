@@ -135,8 +135,9 @@ def structural_fault(design, tol=1e-6):
     reason = design.get("reason") or ""
     if not reason:
         return None
-    reason = reason.split("allowed at every crossing, ", 1)[-1].split(";", 1)[0]
-    return ("mechanism", (), (reason[:160],))
+    # what the layering's hook-relaxed check found moving (`what_moves`), else the reason's first clause
+    what = design.get("what_moves") or reason.split(";", 1)[0]
+    return ("mechanism", (), (what[:160],))
 
 
 def screen_fault(probe, decided=lambda: False):
@@ -462,15 +463,28 @@ class Tally:
             out.append(max((f for f in totals if f[0] == kind), key=lambda f: (totals[f], str(f))))
         return out
 
+    def ending(self, min_segment=None):
+        """How the search ended, as data (the design's `plane_search.not_found`, docs/formats.md):
+        {"screened": candidates screened, "total": candidates in all, "budget_ended": whether the
+        budget stopped it with candidates left, "advice": [what to change, as report says each]}."""
+        fam = self.families
+        left = self.left()[0]
+        budget_ended = bool(self.out_of_time and left)
+        todo = advice(self.worst(), min_segment)[:4]
+        if budget_ended:
+            todo.append("give the search more time")
+        return {"screened": sum(f["screened"] for f in fam.values()), "total": sum(f["total"] for f in fam.values()),
+                "budget_ended": budget_ended, "advice": todo}
+
     def report(self, offset_mm, size_mm, tilt_deg, budget, min_segment=None, shown=4):
         """The sentence a nearby search that found nothing ends with: what it searched, how many
         placements it screened and solved, whether the budget cut it short and how much was left,
         each family's candidates counted by fault (the `shown` commonest, then the rest as one
         count), and what to change (advice on the commonest faults)."""
         fam = self.families
-        screened = sum(f["screened"] for f in fam.values())
+        ending = self.ending(min_segment)
+        screened, total, todo = ending["screened"], ending["total"], ending["advice"]
         solved = sum(f["solved"] for f in fam.values())
-        total = sum(f["total"] for f in fam.values())
         singles = sum(f["total"] for k, f in fam.items() if k not in ("given", "pairs"))
         out = [f"no nearby placement gives a stable design. Searched: planes {', '.join(self.names)} one at a time "
                f"({singles} changes: offsets up to {offset_mm:.0f} mm ({100 * offset_mm / size_mm:.0f} % of the "
@@ -478,7 +492,7 @@ class Tally:
                f"each way, each plane's other contour rule) and two at a time ({fam['pairs']['total']} pairs); "
                f"{screened} placements screened, {solved} fully solved, in {self.seconds:.1f} s"]
         left, left_given, left_singles, left_pairs = self.left()
-        if self.out_of_time and left:
+        if ending["budget_ended"]:
             out.append(f"the {budget:g} s budget ended the search after {screened} of {total} candidates: "
                        f"{left} left ({'the planes as given, ' if left_given else ''}{left_singles} one-plane and "
                        f"{left_pairs} two-plane changes)")
@@ -495,9 +509,6 @@ class Tally:
             count = "" if name == "given" else f" ({f['screened']} of {f['total']} screened)"
             why.append(f"{label}{count}: " + summary(f["faults"], min_segment, shown))
         out.append("why: " + "; ".join(why))
-        todo = advice(self.worst(), min_segment)[:4]
-        if self.out_of_time and left:
-            todo.append("give the search more time")
         if todo:
             out.append("to change: " + "; or ".join(todo))
         return ". ".join(out[:1] + [s[0].upper() + s[1:] for s in out[1:]])

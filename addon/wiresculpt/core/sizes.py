@@ -104,3 +104,8 @@ def size_warnings(design, stock_length=STOCK_LENGTH, profile_name="the default m
     """One sentence per wire longer than `stock_length` (m) and one when the model is over
     LARGEST_MODEL, each with its figure in millimetres or metres (size_facts, size_sentence)."""
     return [size_sentence(f) for f in size_facts(design, stock_length, profile_name)]
+
+
+def stock_warnings(design, stock_length=STOCK_LENGTH, profile_name="the default machine profile"):
+    """size_warnings' sentences of the wires longer than `stock_length` (m), one per wire."""
+    return [size_sentence(f) for f in size_facts(design, stock_length, profile_name) if f["cause"] == OVER_STOCK]

@@ -26,6 +26,7 @@ The design's wire names keep the plane names they were solved with (design.json 
 renamed_wire / renamed_text show them with the planes' names now (current_names) where the panel
 prints them.
 """
+import dataclasses
 import hashlib
 import math
 import re
@@ -162,12 +163,26 @@ def changed_keys(recorded, now):
     return [k for k in keys if k not in recorded or k not in now or not _same_value(recorded[k], now[k])]
 
 
-def changes(design, planes, ticked, inputs=None, target=None, settings=None, material=None, labels=None,
-            recorded=None, names=None, mesh=None):
+@dataclasses.dataclass(frozen=True)
+class SceneNow:
+    """What the scene holds now, for changes() to compare with what the design recorded (each field
+    as changes() describes it)."""
+
+    planes: dict
+    ticked: object = None
+    names: object = None
+    target: object = None
+    settings: object = None
+    material: object = None
+    mesh: object = None
+
+
+def changes(design, now, inputs=None, labels=None, recorded=None):
     """What changed since `design` was optimized, as short phrases ("plane Slice B moved", "plane
     Slice C removed", "plane Slice D added", "contours ticked differently (Slice A #1 unticked)",
     "target changed", "settings changed (Max Bend)"); [] while it is current.
 
+    now: a SceneNow of the scene's planes, ticks, plane names, target, settings, material and mesh:
     planes: {handle name: (origin, normal) or None (no normal)} of the slicing handles now: at
     least those the design's planes have now (`names`) and those named by the ticks (a name
     missing is a plane gone).
@@ -183,6 +198,8 @@ def changes(design, planes, ticked, inputs=None, target=None, settings=None, mat
     mesh: the digest of the target's triangles now (mesh_digest), MESH_CHANGED when they changed
     since the recorded digest but were not read again, None when not known (not compared).
     recorded: recorded_planes(design) when the caller keeps it (a panel redraws often)."""
+    planes, ticked, names, target = now.planes, now.ticked, now.names, now.target
+    settings, material, mesh = now.settings, now.material, now.mesh
     said = []
     before, ticks_before = recorded or recorded_planes(design)
     now = {name: (names or {}).get(name, name) for name in before}

@@ -24,6 +24,7 @@ from . import bendlist, tiles
 from ..core.calibration import closed_overlap, machine_dict
 from ..core.design import setup_problem
 from ..core import sizes
+from ..core.sizes import stock_warnings
 from ..core.polylines import self_crossings
 
 # Each folder with the file types an export writes there (and removes from an earlier export).
@@ -150,8 +151,7 @@ def export(design, out_dir, profile=None, paper=None, machine=None):
     paper = paper or (profile or {}).get("paper") or "A4"
     tiles.layout(1.0, 1.0, paper)  # an unknown paper is refused before anything is written
     overlap = closed_overlap(profile)  # refused before anything is written
-    stock_notes = [sizes.size_sentence(f) for f in sizes.size_facts(design, *sizes.stock(profile or {}))
-                   if f["cause"] == sizes.OVER_STOCK]
+    stock_notes = stock_warnings(design, *sizes.stock(profile or {}))
     profile, notes = machine_profile(design, profile)  # and a missing module (RuntimeError)
     made_by = profile if machine is None else machine_profile(design, machine)[0]
     native.validate_machine_profile(made_by)  # a bad model is one message before anything is written

@@ -46,6 +46,7 @@ from ..blend.machine import chosen_stock
 from ..blend.handles import contour_plane_name, handles, target_name, target_problem, ticked_planes
 from ..blend.view import redraw_3d_views
 from ..core.jobs import WorkerJob
+from ..core.limits import limit_records
 from ..core.live_verdict import CANNOT_SOLVE, ERROR, SOLVING, of_design, shortened, verdict
 from ..props import LIVE_HOOKS, material_of, solve_inputs, solver_settings
 from .state import STATE, observed  # noqa: F401 (observed: the tests' and the bench's reader)
@@ -107,9 +108,10 @@ def snapshot(scene):
             STATE.geometry)
 
 
-def _show(kind, text=""):
-    """Sets the verdict of `kind` (core/live_verdict) with its reason, problem or error `text`."""
-    STATE.verdict, STATE.reason = verdict(kind, text), text
+def _show(kind, text="", limits=()):
+    """Sets the verdict of `kind` (core/live_verdict) with its reason, problem or error `text`, and
+    the codes of the `limits` it breaks (stable, over its limits)."""
+    STATE.verdict, STATE.reason, STATE.kind, STATE.limits = verdict(kind, text), text, kind, tuple(limits)
 
 
 def whole_reason():
@@ -171,6 +173,13 @@ class LiveJob(WorkerJob):
             return (ERROR if self.unexpected else CANNOT_SOLVE), self.error
         return of_design(self.design, *(self.stock[:1] if self.stock else ()))
 
+    def limit_codes(self):
+        """The codes of the limits the design breaks when it is stable (core/limits.limit_records,
+        the phrases verdict() says), () otherwise."""
+        if self.error is not None or not self.design or not self.design.get("stable"):
+            return ()
+        return tuple(code for code, _phrase in limit_records(self.design, *(self.stock[:1] if self.stock else ())))
+
 
 class Refused(str):
     """_start's answer when the target turned out too large to read at every change."""
@@ -215,7 +224,7 @@ def _step():
     if job is not None and not job.thread.is_alive():  # finished: shown only if still current
         STATE.job = None
         if job.key == key and not job.cancelled and not job.cancel_event.is_set():
-            _show(*job.verdict())
+            _show(*job.verdict(), limits=job.limit_codes())
             STATE.solved = job.key
             STATE.preview = job.preview if job.error is None else []
             STATE.preview_ids, STATE.preview_steps = job.preview_ids, job.preview_steps
@@ -313,6 +322,16 @@ def line():
 def verdict_shown():
     """The verdict the panel shows (core/live_verdict), "" before the first."""
     return STATE.verdict
+
+
+def kind_shown():
+    """The kind of the verdict the panel shows (core/live_verdict), "" before the first."""
+    return STATE.kind
+
+
+def limits_shown():
+    """The codes of the limits the shown verdict breaks (core/limits), () unless over its limits."""
+    return STATE.limits
 
 
 def reason():

@@ -14,6 +14,7 @@ def _record(mode, before, candidate, searcher, start):
             "budget_seconds": searcher.budget, "solves_stopped": searcher.timed_out,
             "solves_failed": searcher.failed, "final_solve": searcher.final,
             "seconds": time.perf_counter() - start, "score": candidate["score"] if candidate else None,
+            **({"not_found": nearby_ending(searcher)} if mode == "nearby" and not candidate and searcher.tally else {}),
             "measure": ("cost = sum of |offset| / model size + tilt in radians + 0.05 per contour-rule change; "
                         "score = -cost" if mode == "nearby" else
                         "score = coverage (share of mesh vertices within 0.1 model size of a wire) "
@@ -26,6 +27,12 @@ def nearby_reason(searcher):
     s = searcher
     return s.tally.report(OFFSETS[-1] * s.size * 1000.0, s.size * 1000.0, TILTS_DEG[-1], s.budget,
                           float(s.settings.get("min_segment") or 0.0))
+
+
+def nearby_ending(searcher):
+    """How the nearby search `searcher` ran ended without a stable placement, as data
+    (plane_faults.Tally.ending, with the settings' min_segment as nearby_reason words it)."""
+    return searcher.tally.ending(float(searcher.settings.get("min_segment") or 0.0))
 
 
 def _summary(record):

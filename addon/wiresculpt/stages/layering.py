@@ -69,6 +69,8 @@ def run(design, material, settings, native_progress=None, forbidden=(), too_clos
     design["two_hand_steps"] = list(result["two_hand_steps"])
     design["stable"] = bool(result["stable"])
     design["reason"] = result["reason"]
+    if result["what_moves"]:  # the hook-relaxed check failed: the clause naming what moves
+        design["what_moves"] = result["what_moves"]
     if not result["complete_search"] and not design["stable"]:
         design["search_incomplete"] = True  # max_nodes stopped it: a stable design may still exist
     design.setdefault("warnings", []).extend(result["warnings"])
@@ -108,6 +110,7 @@ def recheck_verdict(design, material, settings, cause, count, native_progress=No
         step = design["assembly_steps"][verdict["failed_step"]]
         names = " and ".join(design["wires"][w]["name"] for w in step)
         design["stable"] = False
+        design.pop("what_moves", None)  # the reason is no longer the layering's own
         design["reason"] = (f"{cause}; without {'them' if count > 1 else 'it'} the assembly is no longer stable "
                             f"when adding {names}")
         if codes:

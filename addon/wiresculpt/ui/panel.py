@@ -90,20 +90,19 @@ def wrap_labels(layout, context, text, icon='NONE'):
         layout.label(text=line, icon=icon if i == 0 else 'BLANK1' if icon != 'NONE' else 'NONE')
 
 
-def live_look(verdict):
-    """(icon, alert) of the live line showing `verdict` (live.verdict_shown())."""
-    kind = live_verdict.kind_of(verdict)
+def live_look(kind):
+    """(icon, alert) of the live line showing a verdict of `kind` (live.kind_shown())."""
     return LIVE_ICONS.get(kind, 'NONE'), kind == live_verdict.ERROR
 
 
 def draw_live(layout, context):
     """The live verdict, wrapped; under it, when the line shows part of the reason, a button whose
     tooltip is the whole reason (a click copies it)."""
-    icon, alert = live_look(live.verdict_shown())
+    icon, alert = live_look(live.kind_shown())
     col = layout.column()
     col.alert = alert
     wrap_labels(col, context, live.line(), icon=icon)
-    hint = live_hint(context, live.verdict_shown())
+    hint = live_hint(context, live.kind_shown(), live.limits_shown())
     if hint:  # Live keeps the layering's own hooks; a current Optimize that says otherwise wins
         wrap_labels(layout, context, hint, icon='INFO')
     if live.whole_reason():

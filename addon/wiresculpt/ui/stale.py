@@ -44,8 +44,8 @@ def report(context):
     mesh = None
     if inputs and "mesh" in inputs and ws.target is not None and inputs.get("target") == ws.target.name:
         mesh = target_watch.mesh_state(ws.target, context.view_layer.depsgraph)
-    said = stale.changes(design, planes, ticked, inputs, target_name(ws),
-                         settings, props.material_of(ws), _recorded["labels"], _recorded["planes"], names, mesh)
+    now = stale.SceneNow(planes, ticked, names, target_name(ws), settings, props.material_of(ws), mesh)
+    said = stale.changes(design, now, inputs, _recorded["labels"], _recorded["planes"])
     return said, names
 
 
@@ -68,20 +68,20 @@ _limits = {"design": None, "said": []}
 TRIES_MORE = "Live tries the layering's hooks only: Optimize tries more and may keep these planes within their limits"
 
 
-def live_hint(context, verdict):
-    """A short line under the Live line when Live's `verdict` disagrees with the stored design while
+def live_hint(context, kind, limits=()):
+    """A short line under the Live line when Live's verdict (of `kind`, breaking the limits of the
+    codes `limits`, core/live_verdict and core/limits) disagrees with the stored design while
     that design is current: Optimize searched more hook patterns on the same planes, its verdict is
     the one to build from. Live's "stable, over its limits" without a current Optimize says that
     Optimize may do better (TRIES_MORE) when another hook pattern may help (the load factor, the
     deflection; not the stock or the size). "" otherwise (no disagreement, Live solving or unable to
     solve)."""
-    kind = live_verdict.kind_of(verdict)
     if kind not in (live_verdict.STABLE, live_verdict.OVER_LIMITS, live_verdict.NOT_STABLE):
         return ""
     design = scene_results.stored_design()
     current = design is not None and not report_changes(context)
     if not current:
-        helps = kind == live_verdict.OVER_LIMITS and hooks_may_help(verdict.split(live_verdict.DASH, 1)[-1].split("; "))
+        helps = kind == live_verdict.OVER_LIMITS and hooks_may_help(limits)
         return TRIES_MORE if helps else ""
     if design.get("stable"):
         found = live_verdict.OVER_LIMITS if design_limits(design) else live_verdict.STABLE

@@ -117,6 +117,10 @@ struct LayeringResult {
   /// Empty when stable; otherwise a sentence naming the wire that cannot be added stably and
   /// the crossings involved.
   std::string reason;
+  /// When not stable even with both hooks allowed at every crossing: the clause of `reason` that
+  /// names what moves or what cannot be balanced (after "... allowed at every crossing, ", up to
+  /// its first advice), for a program that shows or groups it; empty otherwise.
+  std::string what_moves;
   std::vector<std::string> warnings;
   // The objective keys of the returned hooks (when unstable: max and sum over the partial
   // assembly's hooks, null_crossings 0).
