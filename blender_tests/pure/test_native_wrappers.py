@@ -155,7 +155,7 @@ class Wrappers(unittest.TestCase):
                        "sweeps", "sqp_blocks", "sqp_fallbacks", "seconds", "nlopt_result", "energy", "feasible",
                        "warnings"}
         status_keys = {"status", "realised", "vertex", "bisector", "contact_angle", "contact_violation", "scale",
-                       "message"}
+                       "message", "cause", "words"}
         angle = np.linspace(0.0, 2.0 * np.pi, 40, endpoint=False)
         ring = np.column_stack([0.1 * np.cos(angle), 0.1 * np.sin(angle)])
         crossings = [{"vertex": 0, "bisector": (1.0, 0.0)}, {"vertex": 20, "bisector": (1.0, 0.0)}]
