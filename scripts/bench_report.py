@@ -21,11 +21,12 @@ sys.path.insert(0, os.path.join(os.path.dirname(HERE), "addon"))
 from wiresculpt.core.files import write_atomic  # noqa: E402
 
 LIVE_SETTLE_MS = 50  # live/engine.SETTLE_SECONDS, named in the prose
-KNOWN_STAGES = ["layering", "target_shape", "forces", "rest_shape"]
+KNOWN_STAGES = ["layering", "target_shape", "forces", "rest_shape", "stands_3d"]
 # The paper's Table 2 columns and the stages of ours they correspond to.
 PAPER_COLUMNS = [("stab_s", "Stab.", ["layering"]), ("shape_s", "S.Opt.", ["target_shape"]),
                  ("rest_s", "R.Conf.", ["forces", "rest_shape"])]
 COLORS = {"layering": "#1f77b4", "target_shape": "#d62728", "forces": "#2ca02c", "rest_shape": "#9467bd",
+          "stands_3d": "#8c564b",
           "total": "#333333"}
 
 
