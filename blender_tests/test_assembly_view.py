@@ -104,7 +104,7 @@ class PlaneCountInThePanel(BlenderCase):
         ws.plane_count = 3
         asked = []
 
-        def auto(V, F, count, material, settings, *args, **kwargs):
+        def auto(mesh, count, material, settings, *args, **kwargs):
             asked.append((count, settings.get("plane_count")))
             return [], type("Searched", (), {"screened": 0, "full_solves": 0})(), 0.0
         with mock.patch.object(plane_search, "auto", auto):

@@ -17,7 +17,8 @@ from wiresculpt.blend.handles import handle_plane, handles
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.scene import PlaneSpec
 from wiresculpt.core.settings import defaults
-from wiresculpt.blend import mesh
+from wiresculpt.blend import mesh, ownership
+from wiresculpt.core import session
 from wiresculpt.operators import plane_search as ops
 
 
@@ -45,7 +46,8 @@ class ApplySaysWhatItTicks(BlenderCase):
         self.assertEqual(len(design["wires"]), 3)
         candidate = {"planes": [plane_search.Placement(n, o, d, "largest") for n, o, d in placed],
                      "changes": [], "design": design, "figures": {}}
-        ops.RESULT = {"scene": scene.name, "mode": "nearby", "candidates": [candidate], "message": ""}
+        owner = ownership.stamp(scene, ops.OWNER_KIND, session.generation())  # made for this scene and file
+        ops.RESULT = {"owner": owner, "scene": scene.name, "mode": "nearby", "candidates": [candidate], "message": ""}
         self.addCleanup(setattr, ops, "RESULT", None)
         result, reports = run(ops.WIRESCULPT_OT_apply_planes, index=0)
         self.assertEqual(result, {'FINISHED'}, reports)

@@ -296,6 +296,7 @@ class OptimizeGlobe(Case):
         design = scene_results.stored_design()
         design["load_factor"]["reached"] = 1.5
         design["wires"][1]["out_of_plane_deflection"] = 0.0025
+        design.pop("stands_3d")  # as a design stored before the 3D check: its per-wire deflection is the limit
         bpy.data.texts[scene_results.DESIGN_TEXT].from_string(json.dumps(design))
         log = draw(results_ui.VIEW3D_PT_wiresculpt_report)
         icons = {kw.get("text"): kw.get("icon") for name, _a, kw in log if name == "label"}
@@ -338,7 +339,10 @@ class OptimizeGlobe(Case):
             self.assertFalse([n for n in os.listdir(folder) if n.endswith(".tmp") or n.startswith(".")])
             self.assertNotIn("over its limits", text)  # the globe holds its load factor, its wires in plane
         self.assertEqual(snapshot(), before, "rendering the guide must put the scene back")
-        # a wire bending 2.5 mm out of its plane (set by hand): the guide says so before the steps
+        # a wire bending 2.5 mm out of its plane (set by hand) in a design stored before the 3D check:
+        # the guide says so before the steps
+        self.assertTrue(design["stands_3d"]["stands"], design["stands_3d"])
+        checked = design.pop("stands_3d")
         design["wires"][0]["out_of_plane_deflection"] = 0.0025
         with tempfile.TemporaryDirectory() as folder:
             with open(assembly_guide.write_guide(bpy.context.scene, design, folder), encoding="utf-8") as f:
@@ -346,6 +350,15 @@ class OptimizeGlobe(Case):
         said = f"This design is stable, over its limits: wire {design['wires'][0]['name']} bends 2.5 mm out of its plane"
         self.assertIn(said, text)
         self.assertLess(text.index(said), text.index("Step 1: hold"))
+        # the 3D check ran and found crossings 3 and 5 slipping (set by hand): that is said, not the
+        # per-wire deflection, which loads each wire alone
+        design["stands_3d"] = dict(checked, stands=False, cause="slips", slipping=[3, 5])
+        with tempfile.TemporaryDirectory() as folder:
+            with open(assembly_guide.write_guide(bpy.context.scene, design, folder), encoding="utf-8") as f:
+                text = f.read()
+        said = "This design is stable, over its limits: does not stand in 3D: crossings 3, 5 would have to pull or slip"
+        self.assertIn(said, text)
+        self.assertNotIn("out of its plane", text)
 
     def test_crossing_sentence_names_the_side(self):
         design = {"wires": [{"name": "Equator/0", "plane": {"normal": [1, 0, 0]}},
