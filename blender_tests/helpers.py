@@ -352,6 +352,47 @@ def save_and_reload(name="sculpture.blend"):
         bpy.ops.wm.open_mainfile(filepath=path)
 
 
+def globe_target():
+    """globe.obj at radius GLOBE_RADIUS as the target, no slicing plane yet."""
+    import bpy
+
+    from wiresculpt.blend.mesh import import_mesh
+
+    _V, _F, objects = import_mesh(GLOBE_OBJ)
+    objects[0].scale = (GLOBE_RADIUS,) * 3
+    bpy.context.view_layer.update()
+    bpy.context.scene.wiresculpt.target = objects[0]
+
+
+# The hinged globe's five planes as (rotation, location): "Slice E" (x = 0.8 R) crosses only the
+# plane y = 0, on one line (planes z = c1 and x = c2 cut circles of the unit sphere that cross iff
+# c1^2 + c2^2 < 1, and Slice A/B are at z = +-0.7).
+HINGE = (((0, 0, 0), (0, 0, 0.7 * GLOBE_RADIUS)), ((0, 0, 0), (0, 0, -0.7 * GLOBE_RADIUS)),
+         ((0, math.pi / 2, 0), (-0.3 * GLOBE_RADIUS, 0, 0)), ((math.pi / 2, 0, 0), (0, 0, 0)),
+         ((0, math.pi / 2, 0), (0.8 * GLOBE_RADIUS, 0, 0)))
+
+
+def hinge_scene():
+    """The hinged globe: globe_target with the HINGE planes, sliced."""
+    import bpy
+
+    globe_target()
+    for rotation, location in HINGE:
+        add_handle(rotation, location)
+    bpy.context.view_layer.update()
+    assert bpy.ops.wiresculpt.slice() == {'FINISHED'}
+
+
+def placements():
+    """{handle name: its plane's placement} of the scene's slicing handles."""
+    import bpy
+
+    from wiresculpt.blend.handles import handle_plane, handles
+
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    return {h.name: handle_plane(h, depsgraph)[1:] for h in handles(bpy.context.scene)}
+
+
 def globe(rotations=((0, 0, 0), (0, math.pi / 2, 0), (math.pi / 2, 0, 0))):
     """The bundled example: globe.obj at radius 0.125 m, handles through its centre with normals
     z, x and y (by default), sliced."""

@@ -1,11 +1,10 @@
 """Nothing leaks between files or scenes (issue 48 item 1): the plane assistant's candidates are
 the file's and scene's they were made for. Each file here has the same scene name ("Scene") and the
-same slicing planes ("Slice A".."Slice E", the hinged globe of test_plane_assistant.py), so a result
+same slicing planes ("Slice A".."Slice E", the hinged globe of helpers.hinge_scene), so a result
 keyed by names alone would be listed and applied in the other file.
 
     blender --background --factory-startup --python-exit-code 1 --python blender_tests/run.py -- ownership
 """
-import math
 import os
 import tempfile
 
@@ -19,33 +18,8 @@ from wiresculpt.fab import streaming
 from wiresculpt.operators import plane_search as ops
 from wiresculpt.ui import plane_search as panel
 
-from helpers import GLOBE_OBJ, GLOBE_RADIUS as R
 from helpers import BlenderCase as Case
-from helpers import add_handle, draw
-
-# test_plane_assistant.py's hinged globe: five planes, Slice E crossing only the plane y = 0
-HINGE = (((0, 0, 0), (0, 0, 0.7 * R)), ((0, 0, 0), (0, 0, -0.7 * R)), ((0, math.pi / 2, 0), (-0.3 * R, 0, 0)),
-         ((math.pi / 2, 0, 0), (0, 0, 0)), ((0, math.pi / 2, 0), (0.8 * R, 0, 0)))
-
-
-def hinge_scene():
-    from wiresculpt.blend.mesh import import_mesh
-
-    _V, _F, objects = import_mesh(GLOBE_OBJ)
-    objects[0].scale = (R,) * 3
-    bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.target = objects[0]
-    for rotation, location in HINGE:
-        add_handle(rotation, location)
-    bpy.context.view_layer.update()
-    assert bpy.ops.wiresculpt.slice() == {'FINISHED'}
-
-
-def placements():
-    from wiresculpt.blend.handles import handle_plane, handles
-
-    depsgraph = bpy.context.evaluated_depsgraph_get()
-    return {h.name: handle_plane(h, depsgraph)[1:] for h in handles(bpy.context.scene)}
+from helpers import draw, hinge_scene, placements
 
 
 def panel_texts():

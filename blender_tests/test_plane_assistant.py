@@ -15,42 +15,16 @@ import numpy as np
 
 from wiresculpt import native
 from wiresculpt.blend import results as scene_results
-from wiresculpt.blend.handles import handle_plane, handles
+from wiresculpt.blend.handles import handles
 from wiresculpt.operators import plane_search as ops
 from wiresculpt.ui import plane_search as panel
 
 from helpers import GLOBE_RADIUS as R
 from helpers import BlenderCase as Case
-from helpers import GLOBE_OBJ, add_handle, draw
+from helpers import add_handle, draw, globe_target, hinge_scene, placements
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "pure"))
 import recheck  # noqa: E402
-
-HINGE = (((0, 0, 0), (0, 0, 0.7 * R)), ((0, 0, 0), (0, 0, -0.7 * R)), ((0, math.pi / 2, 0), (-0.3 * R, 0, 0)),
-         ((math.pi / 2, 0, 0), (0, 0, 0)), ((0, math.pi / 2, 0), (0.8 * R, 0, 0)))
-
-
-def globe_target():
-    """globe.obj at radius R as the target, no slicing plane yet."""
-    from wiresculpt.blend.mesh import import_mesh
-
-    _V, _F, objects = import_mesh(GLOBE_OBJ)
-    objects[0].scale = (R,) * 3
-    bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.target = objects[0]
-
-
-def hinge_scene():
-    globe_target()
-    for rotation, location in HINGE:
-        add_handle(rotation, location)
-    bpy.context.view_layer.update()
-    assert bpy.ops.wiresculpt.slice() == {'FINISHED'}
-
-
-def placements():
-    depsgraph = bpy.context.evaluated_depsgraph_get()
-    return {h.name: handle_plane(h, depsgraph)[1:] for h in handles(bpy.context.scene)}
 
 
 def scene_state():

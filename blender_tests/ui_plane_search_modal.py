@@ -1,10 +1,9 @@
 """Driven by test_plane_assistant_modal.py in a Blender with a window (under Xvfb): Find Stable
 Planes as the panel runs it (INVOKE: worker thread, modal timer) on the hinged globe
-(test_plane_assistant.py), cancelled mid-search, then to the end, then a candidate previewed (no
+(helpers.HINGE), cancelled mid-search, then to the end, then a candidate previewed (no
 undo step, drawn), then Apply and one Undo. Prints
 one line `MODAL {json}` with what it saw, then quits."""
 import json
-import math
 import os
 import sys
 
@@ -19,11 +18,9 @@ wiresculpt.register()
 from wiresculpt.blend.mesh import import_mesh  # noqa: E402
 from wiresculpt import plane_search  # noqa: E402
 from wiresculpt.operators import plane_search as ops  # noqa: E402
+from helpers import GLOBE_OBJ, GLOBE_RADIUS as R, HINGE  # noqa: E402
 from ui_steps import Held, guarded, report, start_watchdog  # noqa: E402
 
-R = 0.125
-HINGE = (((0, 0, 0), (0, 0, 0.7 * R)), ((0, 0, 0), (0, 0, -0.7 * R)), ((0, math.pi / 2, 0), (-0.3 * R, 0, 0)),
-         ((math.pi / 2, 0, 0), (0, 0, 0)), ((0, math.pi / 2, 0), (0.8 * R, 0, 0)))
 seen = {}
 HELD = []  # the Held search of the cancel step, while it runs
 
@@ -38,7 +35,7 @@ def state():
 def setup():
     for o in list(bpy.data.objects):
         bpy.data.objects.remove(o)
-    _V, _F, objs = import_mesh(os.path.join(os.path.dirname(HERE), "scripts", "examples", "globe", "globe.obj"))
+    _V, _F, objs = import_mesh(GLOBE_OBJ)
     objs[0].scale = (R,) * 3
     bpy.context.view_layer.update()
     bpy.context.scene.wiresculpt.target = objs[0]

@@ -8,6 +8,7 @@ lazy ones inside functions too, except those inside register()/unregister() (the
 __init__ imports its top layers there). Checked by parsing every module's source."""
 import ast
 import os
+import tempfile
 import unittest
 
 from helpers import ROOT
@@ -109,31 +110,27 @@ class Layers(unittest.TestCase):
                 visit(name, [name])
         self.assertEqual(circles, [])
 
+    def imports_of_source(self, name, source):
+        """imports() of a made-up module `name` whose text is `source`."""
+        with tempfile.NamedTemporaryFile("w", suffix=".py", delete=False) as f:
+            f.write(source)
+        try:
+            return imports(name, f.name, self.known)
+        finally:
+            os.remove(f.name)
+
     def test_the_checker_sees_a_wrong_import(self):
         """The parser resolves relative imports: a made-up module of core importing props is
         found, so the rule above can fail."""
-        import tempfile
-
-        with tempfile.NamedTemporaryFile("w", suffix=".py", delete=False) as f:
-            f.write("from ..props import material_of\nfrom . import files\n")
-        try:
-            found = imports("core.fake", f.name, self.known)
-        finally:
-            os.remove(f.name)
+        found = self.imports_of_source("core.fake", "from ..props import material_of\nfrom . import files\n")
         self.assertEqual([t for _l, t in found], ["props", "core.files"])
         self.assertGreater(LAYERS[part("props")], LAYERS[part("core.fake")])
 
     def test_the_checker_sees_an_operator_importing_another(self):
         """An operator module importing another (not the shared progress helpers) is found, so the
         rule above can fail."""
-        import tempfile
-
-        with tempfile.NamedTemporaryFile("w", suffix=".py", delete=False) as f:
-            f.write("from .optimize import running\nfrom .progress import JOIN_SECONDS\n")
-        try:
-            found = imports("operators.fake", f.name, self.known)
-        finally:
-            os.remove(f.name)
+        found = self.imports_of_source("operators.fake",
+                                       "from .optimize import running\nfrom .progress import JOIN_SECONDS\n")
         targets = [t for _l, t in found]
         self.assertEqual(targets, ["operators.optimize", "operators.progress"])
         self.assertEqual([t for t in targets if t not in OPERATORS_SHARED], ["operators.optimize"])

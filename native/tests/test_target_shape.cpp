@@ -10,12 +10,15 @@
 #include <tuple>
 #include <utility>
 
+#include "contour_fixtures.hpp"
 #include "wiresculpt/error.hpp"
 #include "wiresculpt/target_shape.hpp"
 
 using namespace wiresculpt;
 using Catch::Matchers::Contains;
 using Catch::Matchers::EndsWith;
+using fixtures::hairpin;
+using fixtures::line;
 
 namespace {
 constexpr double pi = std::numbers::pi;
@@ -28,12 +31,6 @@ Polyline2 circle(double r, int n, int start = 0, bool reverse = false) {
     const double t = 2.0 * pi * j / n;
     pts.emplace_back(r * std::cos(t), r * std::sin(t));
   }
-  return pts;
-}
-
-Polyline2 line(double length, int n) {
-  Polyline2 pts;
-  for (int k = 0; k < n; ++k) pts.emplace_back(length * k / (n - 1), 0.0);
   return pts;
 }
 
@@ -581,31 +578,6 @@ TEST_CASE("target shape: a per-point bend limit holds at that point, the others 
   o.vertex_max_bend = {std::nan("")};
   CHECK_THROWS_WITH(optimize_target_shape(contour, true, {}, o), Contains("vertex_max_bend[0]"));
 }
-
-namespace {
-
-// A hairpin right after crossing A at the origin: the wire comes along +x from -tail, runs 18 mm
-// past A, turns back by 140° and meets crossing B 21 mm later, then runs on for `tail` metres;
-// contour points every 1 mm. Returns the contour and the vertices of A and B.
-std::tuple<Polyline2, int, int> hairpin(double tail) {
-  Polyline2 contour;
-  auto run = [&](Vec2 a, Vec2 b) {
-    const int n = static_cast<int>(std::lround((b - a).norm() / 0.001));
-    for (int k = 1; k <= n; ++k) contour.push_back(a + (b - a) * (static_cast<double>(k) / n));
-  };
-  const Vec2 d2(std::cos(140.0 * pi / 180.0), std::sin(140.0 * pi / 180.0));
-  const Vec2 corner(0.018, 0.0), b = corner + 0.021 * d2;
-  contour.push_back({-tail, 0.0});
-  run({-tail, 0.0}, {0.0, 0.0});
-  const int a_vertex = static_cast<int>(contour.size()) - 1;
-  run({0.0, 0.0}, corner);
-  run(corner, b);
-  const int b_vertex = static_cast<int>(contour.size()) - 1;
-  run(b, b + tail * d2);
-  return {contour, a_vertex, b_vertex};
-}
-
-}  // namespace
 
 TEST_CASE("target shape: a kink whose neighbour breaks the bend limit is not realised", "[target]") {
   // A hairpin right after an active crossing A at the origin (kink opening towards +y): the wire

@@ -5,19 +5,16 @@
 #include <cmath>
 #include <numbers>
 
+#include "contour_fixtures.hpp"
 #include "target_shape_messages.hpp"
 #include "wiresculpt/target_shape.hpp"
 
 using namespace wiresculpt;
+using fixtures::hairpin;
+using fixtures::line;
 
 namespace {
 constexpr double pi = std::numbers::pi;
-
-Polyline2 line(double length, int n) {
-  Polyline2 pts;
-  for (int k = 0; k < n; ++k) pts.emplace_back(length * k / (n - 1), 0.0);
-  return pts;
-}
 
 TargetShapeOptions named(const char* wire) {
   TargetShapeOptions o;
@@ -93,20 +90,7 @@ TEST_CASE("target shape causes: kinks the solve cannot open name their cause", "
   }
   SECTION("a hairpin 18 mm after the kink: the free point next to it bends over 120°") {
     // along +x to the kink at the origin, 18 mm on, back by 140° and 21 mm to a null crossing
-    Polyline2 contour;
-    auto run = [&](Vec2 a, Vec2 b) {
-      const int n = static_cast<int>(std::lround((b - a).norm() / 0.001));
-      for (int k = 1; k <= n; ++k) contour.push_back(a + (b - a) * (static_cast<double>(k) / n));
-    };
-    const Vec2 d2(std::cos(140.0 * pi / 180.0), std::sin(140.0 * pi / 180.0));
-    const Vec2 corner(0.018, 0.0), b = corner + 0.021 * d2;
-    contour.push_back({-0.06, 0.0});
-    run({-0.06, 0.0}, {0.0, 0.0});
-    const int a_vertex = static_cast<int>(contour.size()) - 1;
-    run({0.0, 0.0}, corner);
-    run(corner, b);
-    const int b_vertex = static_cast<int>(contour.size()) - 1;
-    run(b, b + 0.06 * d2);
+    const auto [contour, a_vertex, b_vertex] = hairpin(0.06);
     TargetShapeOptions o = named("H");
     o.friction = 0.0;
     o.angle_tolerance = 0.1 * pi / 180.0;

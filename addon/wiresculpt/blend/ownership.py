@@ -18,6 +18,7 @@ import uuid
 import bpy
 
 from ..core import session
+from .registration import handlers_factory
 
 TOKEN_PREFIX = "wiresculpt_owner_"  # scene custom property TOKEN_PREFIX + kind: the token of that kind's result
 
@@ -71,18 +72,9 @@ def _loading(*_args):
         callback()
 
 
-HANDLERS = ("load_pre", "load_post")
-
-
-def register():
-    for kind in HANDLERS:
-        if _loading not in getattr(bpy.app.handlers, kind):
-            getattr(bpy.app.handlers, kind).append(_loading)
+register, _unregister = handlers_factory((("load_pre", _loading), ("load_post", _loading)))
 
 
 def unregister():
-    for kind in HANDLERS:
-        handlers = getattr(bpy.app.handlers, kind)
-        if _loading in handlers:
-            handlers.remove(_loading)
+    _unregister()
     _FORGET.clear()

@@ -1,5 +1,5 @@
 """One way to register: a module's classes (and the scene properties pointing at its property
-groups), and a package's modules in order."""
+groups), its handlers of bpy.app.handlers, and a package's modules in order."""
 import bpy
 
 
@@ -19,6 +19,22 @@ def classes_factory(classes, scene_properties=()):
             delattr(bpy.types.Scene, attribute)
         for cls in reversed(classes):
             bpy.utils.unregister_class(cls)
+
+    return register, unregister
+
+
+def handlers_factory(handlers):
+    """(register, unregister) for `handlers`: (name of a bpy.app.handlers list, function) pairs,
+    each function added to its list once and removed from it if there."""
+    def register():
+        for kind, handler in handlers:
+            if handler not in getattr(bpy.app.handlers, kind):
+                getattr(bpy.app.handlers, kind).append(handler)
+
+    def unregister():
+        for kind, handler in handlers:
+            if handler in getattr(bpy.app.handlers, kind):
+                getattr(bpy.app.handlers, kind).remove(handler)
 
     return register, unregister
 

@@ -20,6 +20,7 @@ import bpy
 
 from ..core.stale import MESH_CHANGED, mesh_digest
 from .mesh import MAX_REREAD_TRIANGLES, object_triangles, triangle_count
+from .registration import handlers_factory
 from .view import redraw_3d_views
 
 SETTLE_SECONDS = 0.3  # a target changed more recently is still moving: not read yet
@@ -104,18 +105,12 @@ def _load_post(*_args):
     _STATE["digest"] = None
 
 
-HANDLERS = (("depsgraph_update_post", _depsgraph_post), ("frame_change_post", _maybe_changed),
-            ("undo_post", _maybe_changed), ("redo_post", _maybe_changed), ("load_post", _load_post))
-
-
-def register():
-    for kind, handler in HANDLERS:
-        getattr(bpy.app.handlers, kind).append(handler)
+register, _remove_handlers = handlers_factory((
+    ("depsgraph_update_post", _depsgraph_post), ("frame_change_post", _maybe_changed), ("undo_post", _maybe_changed),
+    ("redo_post", _maybe_changed), ("load_post", _load_post)))
 
 
 def unregister():
     if bpy.app.timers.is_registered(_settled):
         bpy.app.timers.unregister(_settled)
-    for kind, handler in HANDLERS:
-        if handler in getattr(bpy.app.handlers, kind):
-            getattr(bpy.app.handlers, kind).remove(handler)
+    _remove_handlers()

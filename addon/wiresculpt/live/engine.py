@@ -43,6 +43,7 @@ from ..blend import cut_handles, mesh
 from ..blend.mesh import triangle_count
 from ..blend import results as scene_results
 from ..blend.machine import chosen_stock
+from ..blend.registration import handlers_factory
 from ..blend.handles import contour_plane_name, handles, target_name, target_problem, ticked_planes
 from ..blend.view import redraw_3d_views
 from ..core.jobs import WorkerJob
@@ -451,15 +452,15 @@ def _load_post(*_args):
     _sync_shown()
 
 
-HANDLERS = (("load_pre", "_load_pre"), ("load_post", "_load_post"), ("depsgraph_update_post", "_depsgraph_post"),
-            ("undo_post", "_sync_shown"), ("redo_post", "_sync_shown"))
+_add_handlers, _remove_handlers = handlers_factory((
+    ("load_pre", _load_pre), ("load_post", _load_post), ("depsgraph_update_post", _depsgraph_post),
+    ("undo_post", _sync_shown), ("redo_post", _sync_shown)))
 
 
 def install():
     """The toggle's update and the handlers that keep Live in step with the scene."""
     LIVE_HOOKS.append(live_changed)
-    for kind, name in HANDLERS:
-        getattr(bpy.app.handlers, kind).append(globals()[name])
+    _add_handlers()
     _watch_scene_switch()
 
 
@@ -467,9 +468,6 @@ def uninstall():
     """Stops Live and removes what install added."""
     stop()
     bpy.msgbus.clear_by_owner(_SCENE_SWITCH)
-    for kind, name in HANDLERS:
-        handlers = getattr(bpy.app.handlers, kind)
-        if globals()[name] in handlers:
-            handlers.remove(globals()[name])
+    _remove_handlers()
     if live_changed in LIVE_HOOKS:
         LIVE_HOOKS.remove(live_changed)

@@ -4,7 +4,7 @@ import bpy
 from ..blend import mesh
 from ..blend.contours import release_deleted, slice_scene
 from ..blend.handles import add_handle, target_problem
-from ..blend.registration import classes_factory
+from ..blend.registration import classes_factory, handlers_factory
 
 
 # --- operators ------------------------------------------------------------------------------
@@ -62,18 +62,15 @@ def _release_deleted(*_args):
         pass
 
 
-HANDLERS = ("depsgraph_update_post", "load_post")
+_add_handlers, _remove_handlers = handlers_factory((("depsgraph_update_post", _release_deleted),
+                                                    ("load_post", _release_deleted)))
 
 
 def register():
     _register()
-    for kind in HANDLERS:
-        getattr(bpy.app.handlers, kind).append(_release_deleted)
+    _add_handlers()
 
 
 def unregister():
-    for kind in HANDLERS:
-        handlers = getattr(bpy.app.handlers, kind)
-        if _release_deleted in handlers:
-            handlers.remove(_release_deleted)
+    _remove_handlers()
     _unregister()

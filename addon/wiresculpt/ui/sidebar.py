@@ -4,6 +4,7 @@ import bpy
 from bpy.app.handlers import persistent
 
 from ..blend import compat
+from ..blend.registration import handlers_factory
 
 
 def has_design(scene):
@@ -17,11 +18,4 @@ def wire_tab_on_save(*_args):
         compat.show_wire_tab()
 
 
-def register():
-    if wire_tab_on_save not in bpy.app.handlers.save_pre:
-        bpy.app.handlers.save_pre.append(wire_tab_on_save)
-
-
-def unregister():
-    if wire_tab_on_save in bpy.app.handlers.save_pre:
-        bpy.app.handlers.save_pre.remove(wire_tab_on_save)
+register, unregister = handlers_factory((("save_pre", wire_tab_on_save),))

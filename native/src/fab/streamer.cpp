@@ -376,14 +376,25 @@ void validate(const StreamOptions& o) {
     throw InputError("settle must be from 0 to 60 seconds, got " + fmt(o.settle));
 }
 
-StreamResult stream_program(SerialPort& port, const std::vector<std::string>& lines, const MachineProfile& profile,
-                            StreamState& state, const StreamOptions& options, const ProgressFn& progress) {
+namespace {
+
+// What both ways of streaming check before anything is sent: the options, the profile, the
+// program's lines and where the state would resume.
+void validate_stream(const std::vector<std::string>& lines, const MachineProfile& profile, const StreamState& state,
+                     const StreamOptions& options) {
   validate(options);
   validate(profile);
   validate_program(lines, profile);
   if (state.next_line > lines.size())
     throw InputError("the stream state's next line (" + std::to_string(state.next_line) +
                      ") is past the program's " + std::to_string(lines.size()) + " lines");
+}
+
+}  // namespace
+
+StreamResult stream_program(SerialPort& port, const std::vector<std::string>& lines, const MachineProfile& profile,
+                            StreamState& state, const StreamOptions& options, const ProgressFn& progress) {
+  validate_stream(lines, profile, state, options);
   state.confirmed = std::min(state.confirmed, state.next_line);
   return Streamer(port, lines, profile, state, options, progress).run();
 }
@@ -391,12 +402,7 @@ StreamResult stream_program(SerialPort& port, const std::vector<std::string>& li
 StreamResult stream_program(const std::string& port_name, const std::vector<std::string>& lines,
                             const MachineProfile& profile, StreamState& state, const StreamOptions& options,
                             const ProgressFn& progress) {
-  validate(options);
-  validate(profile);
-  validate_program(lines, profile);
-  if (state.next_line > lines.size())
-    throw InputError("the stream state's next line (" + std::to_string(state.next_line) +
-                     ") is past the program's " + std::to_string(lines.size()) + " lines");
+  validate_stream(lines, profile, state, options);
   if (options.dry_run) {
     StreamResult r;
     r.status = StreamStatus::dry_run;
