@@ -19,6 +19,11 @@ each reason is printed once with its count. The closing label is `bpy VERSION`. 
 not the default build's (bpy 5.1+ is Python 3.13), WIRESCULPT_MODULE names the module built for it
 (scripts/package_pythons.py, as scripts/test does), loaded as the add-on's own `_wiresculpt`.
 
+With the system Python 3.11, the Windows suites (blender_tests/windows/test_*.py: the win_amd64
+module under Wine, scripts/windows.py; `scripts/test --windows`):
+
+    /usr/bin/python3.11 blender_tests/run.py windows [PATTERN...]
+
 Only the modules whose names contain a PATTERN run when patterns are given.
 """
 import os
@@ -68,10 +73,10 @@ def main():
         argv = sys.argv[sys.argv.index("--") + 1:]
     else:
         argv = [] if inside_blender else sys.argv[1:]
-    mode = argv[0] if argv and argv[0] in ("pure", "bpy") else ""
+    mode = argv[0] if argv and argv[0] in ("pure", "bpy", "windows") else ""
     if mode:
         argv = argv[1:]
-    label, folder = ("pure", os.path.join(HERE, "pure")) if mode == "pure" else ("blender", HERE)
+    label, folder = (mode, os.path.join(HERE, mode)) if mode in ("pure", "windows") else ("blender", HERE)
     for path in (folder, HERE, os.path.join(ROOT, "addon"), os.path.join(ROOT, "scripts")):
         if path not in sys.path:
             sys.path.insert(0, path)

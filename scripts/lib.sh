@@ -40,6 +40,10 @@ BPY_CACHE=${WIRESCULPT_BPY_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/wiresculpt}
 # Python (headers and CMake files), so one copy serves them all.
 PACKAGE_PYBIND11=2.13.6
 
+# The Windows build and its tests (scripts/windows.py, scripts/test_windows): MinGW-w64 GCC with
+# posix threads (std::thread) and Wine (64-bit only; bookworm's wine64 has no wine64 on PATH).
+WINDOWS_PACKAGES=(g++-mingw-w64-x86-64-posix gcc-mingw-w64-x86-64-posix wine64 python3-pip)
+
 # The sanitizer and fuzz builds (scripts/test, scripts/fuzz).
 FUZZ_PACKAGES=(clang libclang-rt-14-dev)
 

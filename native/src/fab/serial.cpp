@@ -1,5 +1,6 @@
 #include "wiresculpt/fab/serial.hpp"
 
+#ifndef WIRESCULPT_NO_SERIAL_PORT  // the port itself (else serial_none.cpp); the protocol always
 #include <fcntl.h>
 #include <libserialport.h>
 #include <poll.h>
@@ -8,6 +9,7 @@
 #include <sys/stat.h>
 #include <termios.h>
 #include <unistd.h>
+#endif
 
 #include <cstdlib>
 #include <fstream>
@@ -28,6 +30,7 @@
 
 namespace wiresculpt::fab {
 
+#ifndef WIRESCULPT_NO_SERIAL_PORT
 // ---------------------------------------------------------------------------------------------
 // Listing
 // ---------------------------------------------------------------------------------------------
@@ -285,6 +288,7 @@ void SerialPort::drain_input(int timeout_ms) {
   while (std::chrono::steady_clock::now() < deadline)
     if (read(buf, sizeof buf, 20) <= 0) break;
 }
+#endif  // WIRESCULPT_NO_SERIAL_PORT
 
 // ---------------------------------------------------------------------------------------------
 // Program validation
