@@ -27,7 +27,12 @@ def built_for():
         names = os.listdir(HERE)
     except OSError:
         return []
-    tags = (re.match(r"_wiresculpt\.cpython-(\d)(\d+)", n) for n in names)
+    try:  # the extension zip of Windows (and macOS) carries the module as wheels in wheels/
+        names += os.listdir(os.path.join(HERE, "wheels"))
+    except OSError:
+        pass
+    # _wiresculpt.cpython-311-x86_64-linux-gnu.so, _wiresculpt.cp311-win_amd64.pyd, ...-cp311-cp311-win_amd64.whl
+    tags = (re.match(r"(?:_wiresculpt\.cpython-|_wiresculpt\.cp|wiresculpt_solver-[^-]+-cp)(\d)(\d+)", n) for n in names)
     return sorted({f"{t.group(1)}.{t.group(2)}" for t in tags if t}, key=lambda v: tuple(map(int, v.split("."))))
 
 
@@ -79,8 +84,12 @@ try:
     from . import _wiresculpt as module
     LOAD_ERROR = ""
 except ImportError as exc:  # not built, built for another Python, or a library missing
-    module = None
-    LOAD_ERROR = explain_load_error(exc, built_for())
+    try:  # the extension's wheel (blender_manifest.toml "wheels"), which Blender installs for it
+        from wiresculpt_solver import _wiresculpt as module
+        LOAD_ERROR = ""
+    except ImportError:
+        module = None
+        LOAD_ERROR = explain_load_error(exc, built_for())
 
 
 class _NeverRaised(Exception):
