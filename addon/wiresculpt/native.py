@@ -36,6 +36,39 @@ def built_for():
     return sorted({f"{t.group(1)}.{t.group(2)}" for t in tags if t}, key=lambda v: tuple(map(int, v.split("."))))
 
 
+def platform_of(name):
+    """The platform a module or wheel file is built for, from its name; None for other files."""
+    if not re.match(r"(_wiresculpt\.|wiresculpt_solver-)", name):
+        return None
+    if re.search(r"win_amd64|\.pyd$", name):
+        return "Windows x64"
+    if re.search(r"darwin|macosx", name):
+        return "macOS"
+    if re.search(r"linux", name):
+        return "Linux x86_64"
+    return None
+
+
+def running_platform():
+    """This computer's platform, named as platform_of names them."""
+    if sys.platform == "win32":
+        return "Windows x64"
+    if sys.platform == "darwin":
+        return "macOS"
+    return "Linux x86_64"
+
+
+def built_platforms(folder=HERE):
+    """The platforms of the modules beside this file and of the wheels in wheels/, e.g. ["Linux x86_64"]."""
+    names = []
+    for where in (folder, os.path.join(folder, "wheels")):
+        try:
+            names += os.listdir(where)
+        except OSError:
+            pass
+    return sorted({p for p in map(platform_of, names) if p})
+
+
 def host_name():
     """ "Blender 4.0.2" inside Blender (bpy already imported), else "this Python"."""
     bpy = sys.modules.get("bpy")
@@ -55,13 +88,18 @@ def _listed(items):
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
 
 
-def explain_load_error(exc, builds, python=None, host=None):
-    """One sentence saying why the solver did not load and what to do: the Pythons the zip carries
-    the solver for against the one running (with the Blenders that embed them), or the shared
-    library the loader could not find."""
+def explain_load_error(exc, builds, python=None, host=None, platforms=None, running=None):
+    """One sentence saying why the solver did not load and what to do: the platforms the zip
+    carries the solver for against this computer's, the Pythons against the one running (with the
+    Blenders that embed them), or the shared library the loader could not find."""
     python = python or f"{sys.version_info[0]}.{sys.version_info[1]}"
     host = host or host_name()
+    running = running or running_platform()
     text = str(exc)
+    if platforms and running not in platforms:
+        return (f"The wiresculpt solver did not load: this zip has the solver for {_listed(platforms)}; "
+                f"{host} runs on {running}: install the zip made for {running} (scripts/package writes one "
+                "per platform), or build from source with scripts/package on that computer.")
     if builds and python not in builds:
         blenders = [BLENDERS[b] for b in builds if b in BLENDERS]
         where = f"a Blender whose Python is {' or '.join(builds)}" + (f" ({', '.join(blenders)})" if blenders else "")
@@ -89,7 +127,7 @@ except ImportError as exc:  # not built, built for another Python, or a library 
         LOAD_ERROR = ""
     except ImportError:
         module = None
-        LOAD_ERROR = explain_load_error(exc, built_for())
+        LOAD_ERROR = explain_load_error(exc, built_for(), platforms=built_platforms())
 
 
 class _NeverRaised(Exception):

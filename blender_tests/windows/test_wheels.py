@@ -120,10 +120,15 @@ class LinuxWheel(unittest.TestCase):
         shutil.copytree(os.path.join(ROOT, "addon", "wiresculpt"), target,
                         ignore=shutil.ignore_patterns("__pycache__", "*.so", "libs"))
         os.makedirs(os.path.join(target, "wheels"))
-        open(os.path.join(target, "wheels", "wiresculpt_solver-0.1.0-cp313-cp313-win_amd64.whl"), "w").close()
+        wheel = os.path.join(target, "wheels", "wiresculpt_solver-0.1.0-cp313-cp313-manylinux_2_36_x86_64.whl")
+        open(wheel, "w").close()
         r = self.run_fresh("from wiresculpt import native\nprint(native.LOAD_ERROR)\n", addons)
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertIn("this zip has the solver for Python 3.13; this Python uses 3.11", r.stdout)
+        # the Windows extension's wheels on Linux: the platform is named first
+        os.rename(wheel, os.path.join(target, "wheels", "wiresculpt_solver-0.1.0-cp311-cp311-win_amd64.whl"))
+        r = self.run_fresh("from wiresculpt import native\nprint(native.LOAD_ERROR)\n", addons)
+        self.assertIn("this zip has the solver for Windows x64; this Python runs on Linux x86_64", r.stdout)
 
 
 if __name__ == "__main__":
