@@ -360,6 +360,8 @@ def module(minor):
     open(log, "w").close()
     configure = [CMAKE, "-S", ROOT, "-B", folder, f"-DCMAKE_TOOLCHAIN_FILE={TOOLCHAIN}", "-DCMAKE_BUILD_TYPE=Release",
                  f"-DWIRESCULPT_DEPS_PREFIX={prefix}", f"-DNLopt_DIR={prefix}/lib/cmake/nlopt",
+                 # named, not searched: a build folder keeps what find_library found for another prefix
+                 f"-DGLPK_LIBRARY={prefix}/lib/libglpk.a", f"-DGLPK_INCLUDE_DIR={prefix}/include",
                  "-DEigen3_DIR=/usr/share/eigen3/cmake", "-DWIRESCULPT_SERIAL_PORT=OFF", "-DWIRESCULPT_BUILD_TESTS=OFF",
                  f"-DWIRESCULPT_PYTHON_INCLUDE_DIR={headers(minor)}", f"-DWIRESCULPT_PYTHON_LIBRARY={dll}",
                  f"-DWIRESCULPT_PYBIND11_INCLUDE_DIR={pybind11_include()}", f"-DWIRESCULPT_MODULE_SUFFIX=.{tag}-win_amd64.pyd",
