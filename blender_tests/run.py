@@ -15,7 +15,14 @@ pinned version), the same Blender suites against that Blender:
     VENV/bin/python blender_tests/run.py bpy [PATTERN...]
 
 There the tests that start a blender process or need a window are skipped (the module has neither);
-each reason is printed once with its count. The closing label is `bpy VERSION`.
+each reason is printed once with its count. The closing label is `bpy VERSION`. When that Python is
+not the default build's (bpy 5.1+ is Python 3.13), WIRESCULPT_MODULE names the module built for it
+(scripts/package_pythons.py, as scripts/test does), loaded as the add-on's own `_wiresculpt`.
+
+With the system Python 3.11, the Windows suites (blender_tests/windows/test_*.py: the win_amd64
+module under Wine, scripts/windows.py; `scripts/test --windows`):
+
+    /usr/bin/python3.11 blender_tests/run.py windows [PATTERN...]
 
 Only the modules whose names contain a PATTERN run when patterns are given.
 """
@@ -25,6 +32,18 @@ import unittest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
+
+
+def preload_module(path):
+    """Loads the compiled module at `path` as wiresculpt._wiresculpt before the add-on imports it, so
+    the add-on's `from . import _wiresculpt` finds it (a module built outside the source tree for
+    another Python)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("wiresculpt._wiresculpt", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    sys.modules["wiresculpt._wiresculpt"] = module
 
 
 def native_missing():
@@ -54,15 +73,17 @@ def main():
         argv = sys.argv[sys.argv.index("--") + 1:]
     else:
         argv = [] if inside_blender else sys.argv[1:]
-    mode = argv[0] if argv and argv[0] in ("pure", "bpy") else ""
+    mode = argv[0] if argv and argv[0] in ("pure", "bpy", "windows") else ""
     if mode:
         argv = argv[1:]
-    label, folder = ("pure", os.path.join(HERE, "pure")) if mode == "pure" else ("blender", HERE)
+    label, folder = (mode, os.path.join(HERE, mode)) if mode in ("pure", "windows") else ("blender", HERE)
     for path in (folder, HERE, os.path.join(ROOT, "addon"), os.path.join(ROOT, "scripts")):
         if path not in sys.path:
             sys.path.insert(0, path)
     if mode == "bpy":
         label = bpy_module()
+    if os.environ.get("WIRESCULPT_MODULE"):
+        preload_module(os.environ["WIRESCULPT_MODULE"])
     missing = native_missing()
     if missing:
         print(f"{label}: the solver is missing: {missing}")

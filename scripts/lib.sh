@@ -20,16 +20,18 @@ PACKAGES=(
   patchelf binutils  # scripts/package bundles the solver's libraries with an $ORIGIN run path
 )
 
-# Blender as a Python module (PyPI `bpy`, built for Python 3.11 like our module), one venv per
-# pinned version under BPY_CACHE, reused when present: 4.2 LTS (the first with extensions) and the
-# newest bpy release for Python 3.11. scripts/test runs the Blender suites against each.
-BPY_VERSIONS=(4.2.23 5.0.1)
-# The numpy they run with: what bpy 5.0 requires (<2) and what Blender bundles; bpy 4.2 would take
-# numpy 2, which our module (Debian's pybind11 2.10) predates.
-BPY_NUMPY=1.26.4
-# The independent re-check (blender_tests/pure/recheck.py) that the plane-assistant suites run
-# needs scipy: a release built for numpy 1.x and Python 3.11.
-BPY_SCIPY=1.13.1
+# Blender as a Python module (PyPI `bpy`), one venv per pinned version under BPY_CACHE, reused when
+# present: 4.5 LTS (supported to July 2027), 5.0 (the newest bpy built for Python 3.11) and 5.3 (the
+# newest, Python 3.13; our module for 3.13 is built as scripts/package builds it). 4.2 LTS left
+# support in July 2026 and is no longer run. scripts/test runs the Blender suites against each.
+BPY_VERSIONS=(4.5.15 5.0.1 5.3.0)
+# The Python each is built for (its wheel's cp tag) and what it runs with: bpy 4.5 and 5.0 require
+# numpy < 2 (1.26.4, what Blender bundles); bpy 5.1+ requires numpy >= 2.2, which the 3.13 module
+# (pybind11 2.13) supports. The independent re-check (blender_tests/pure/recheck.py) that the
+# plane-assistant suites run needs scipy: a release built for that numpy and Python.
+declare -A BPY_PYTHON=([4.5.15]=3.11 [5.0.1]=3.11 [5.3.0]=3.13)
+declare -A BPY_NUMPY=([3.11]=1.26.4 [3.13]=2.2.6)
+declare -A BPY_SCIPY=([3.11]=1.13.1 [3.13]=1.15.3)
 BPY_CACHE=${WIRESCULPT_BPY_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/wiresculpt}
 
 # scripts/package builds the module for every further CPython 3.x on the machine (package_pythons.py)
@@ -37,6 +39,10 @@ BPY_CACHE=${WIRESCULPT_BPY_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/wiresculpt}
 # our bindings are written for) and supports Python 3.7 to 3.13; its wheel is the same for every
 # Python (headers and CMake files), so one copy serves them all.
 PACKAGE_PYBIND11=2.13.6
+
+# The Windows build and its tests (scripts/windows.py, scripts/test_windows): MinGW-w64 GCC with
+# posix threads (std::thread) and Wine (64-bit only; bookworm's wine64 has no wine64 on PATH).
+WINDOWS_PACKAGES=(g++-mingw-w64-x86-64-posix gcc-mingw-w64-x86-64-posix wine64 python3-pip)
 
 # The sanitizer and fuzz builds (scripts/test, scripts/fuzz).
 FUZZ_PACKAGES=(clang libclang-rt-14-dev)
@@ -122,23 +128,37 @@ summarize_outputs() {
   [ "$code" -eq 2 ] && say "  not stable: see \"reason\" in design.json or the Stability panel" || true
 }
 
-# Prints the python of a venv of $PYTHON holding bpy==$1, making it once (a ~350 MB download; the
-# wheel is kept in $BPY_CACHE/wheels); a venv is used only after its install finished.
-# .complete holds the requirements it was made with; a venv made with fewer (an older checkout)
-# gets the missing ones installed.
+# Prints an interpreter of CPython $1 ("3.13"): the system's, else pyenv's newest $1.x; fails with
+# a line saying so when there is none.
+python_of() {
+  local want=$1 p
+  [ "$want" = "3.11" ] && { echo "$PYTHON"; return; }
+  for p in "/usr/bin/python$want" "/usr/local/bin/python$want" \
+           $(ls -d "${PYENV_ROOT:-$HOME/.pyenv}/versions/$want".* 2>/dev/null | sort -V -r | sed 's|$|/bin/python3|'); do
+    [ -x "$p" ] && { echo "$p"; return; }
+  done
+  say "no Python $want on this machine (install it, e.g. with pyenv)"
+  return 1
+}
+
+# Prints the python of a venv holding bpy==$1 (made with the Python that bpy is built for,
+# BPY_PYTHON), making it once (a ~350 MB download; the wheel is kept in $BPY_CACHE/wheels); a
+# venv is used only after its install finished. .complete holds the requirements it was made
+# with; a venv made with fewer (an older checkout) gets the missing ones installed.
 bpy_python() {
-  local version=$1 venv="$BPY_CACHE/bpy-$1"
-  local want=("bpy==$version" "numpy==$BPY_NUMPY" "scipy==$BPY_SCIPY")
+  local version=$1 venv="$BPY_CACHE/bpy-$1" minor=${BPY_PYTHON[$1]:-3.11} python
+  local want=("bpy==$version" "numpy==${BPY_NUMPY[$minor]}" "scipy==${BPY_SCIPY[$minor]}")
   if [ -f "$venv/.complete" ] && [ "$(cat "$venv/.complete")" = "${want[*]}" ]; then
     echo "$venv/bin/python"
     return
   fi
-  ensure_packages python3.11-venv
+  python=$(python_of "$minor") || return 1
+  [ "$minor" = "3.11" ] && ensure_packages python3.11-venv
   if [ ! -f "$venv/.complete" ]; then
     rm -rf "$venv"
     mkdir -p "$BPY_CACHE/wheels"
     say "installing bpy $version into $venv"
-    "$PYTHON" -m venv "$venv" >&2
+    "$python" -m venv "$venv" >&2
     "$venv/bin/python" -m pip download -q --no-deps -d "$BPY_CACHE/wheels" "bpy==$version" >&2
   fi
   "$venv/bin/python" -m pip install -q --find-links "$BPY_CACHE/wheels" "${want[@]}" >&2

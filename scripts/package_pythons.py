@@ -127,3 +127,16 @@ def build(python, version, ext_suffix, cmake, pybind11_dir, core, jobs=2):
     if not os.path.isfile(module):
         raise SystemExit(f"wiresculpt: the build for Python {version} ({python}) made no {os.path.basename(module)}")
     return module
+
+
+if __name__ == "__main__":
+    # scripts/test: the module for one further Python (the bpy suites on a Blender whose Python is
+    # not the default build's), printed as its path:
+    #   package_pythons.py PYTHON CMAKE PYBIND11_DIR CORE
+    python, cmake, pybind11_dir, core = sys.argv[1:5]
+    info = probe(python)
+    if isinstance(info, str):
+        raise SystemExit(f"wiresculpt: {python} {info}")
+    if not info["headers"]:
+        raise SystemExit(f"wiresculpt: {python} has no development headers (no Python.h in {info['include']})")
+    print(build(python, "%d.%d" % tuple(info["version"]), info["ext_suffix"], cmake, pybind11_dir, core))

@@ -30,8 +30,46 @@ def built_for():
         names = os.listdir(HERE)
     except OSError:
         return []
-    tags = (re.match(r"_wiresculpt\.cpython-(\d)(\d+)", n) for n in names)
+    try:  # the extension zip of Windows (and macOS) carries the module as wheels in wheels/
+        names += os.listdir(os.path.join(HERE, "wheels"))
+    except OSError:
+        pass
+    # _wiresculpt.cpython-311-x86_64-linux-gnu.so, _wiresculpt.cp311-win_amd64.pyd, ...-cp311-cp311-win_amd64.whl
+    tags = (re.match(r"(?:_wiresculpt\.cpython-|_wiresculpt\.cp|wiresculpt_solver-[^-]+-cp)(\d)(\d+)", n) for n in names)
     return sorted({f"{t.group(1)}.{t.group(2)}" for t in tags if t}, key=lambda v: tuple(map(int, v.split("."))))
+
+
+def platform_of(name):
+    """The platform a module or wheel file is built for, from its name; None for other files."""
+    if not re.match(r"(_wiresculpt\.|wiresculpt_solver-)", name):
+        return None
+    if re.search(r"win_amd64|\.pyd$", name):
+        return "Windows x64"
+    if re.search(r"darwin|macosx", name):
+        return "macOS"
+    if re.search(r"linux", name):
+        return "Linux x86_64"
+    return None
+
+
+def running_platform():
+    """This computer's platform, named as platform_of names them."""
+    if sys.platform == "win32":
+        return "Windows x64"
+    if sys.platform == "darwin":
+        return "macOS"
+    return "Linux x86_64"
+
+
+def built_platforms(folder=HERE):
+    """The platforms of the modules beside this file and of the wheels in wheels/, e.g. ["Linux x86_64"]."""
+    names = []
+    for where in (folder, os.path.join(folder, "wheels")):
+        try:
+            names += os.listdir(where)
+        except OSError:
+            pass
+    return sorted({p for p in map(platform_of, names) if p})
 
 
 def host_name():
@@ -54,6 +92,7 @@ def _listed(items):
 
 
 # Why the solver did not load, as a code (load_cause); explain_load_error words it.
+OTHER_PLATFORM = "other_platform"  # the zip has the solver for other platforms only
 OTHER_PYTHON = "other_python"  # the zip has the solver for other Pythons only
 MISSING_LIBRARY = "missing_library"  # a shared library the module needs cannot be found or loaded
 NOT_BUILT = "not_built"  # no module for any Python
@@ -128,10 +167,14 @@ def module_file():
     return None
 
 
-def load_cause(builds, python, missing=None):
-    """(code, figures) of why the solver did not load: OTHER_PYTHON ({"builds", "python"}) when the
-    zip's `builds` lack the running `python`, MISSING_LIBRARY ({"library"}) when `missing` names a
-    library the module cannot load, NOT_BUILT when there are no builds, else OTHER."""
+def load_cause(builds, python, missing=None, platforms=None, running=None):
+    """(code, figures) of why the solver did not load: OTHER_PLATFORM ({"platforms", "running"})
+    when the zip's modules are all for `platforms` other than the `running` one, OTHER_PYTHON
+    ({"builds", "python"}) when the zip's `builds` lack the running `python`, MISSING_LIBRARY
+    ({"library"}) when `missing` names a library the module cannot load, NOT_BUILT when there are
+    no builds, else OTHER."""
+    if platforms and running not in platforms:
+        return OTHER_PLATFORM, {"platforms": list(platforms), "running": running}
     if builds and python not in builds:
         return OTHER_PYTHON, {"builds": list(builds), "python": python}
     if missing:
@@ -141,13 +184,19 @@ def load_cause(builds, python, missing=None):
     return OTHER, {}
 
 
-def explain_load_error(exc, builds, python=None, host=None, missing=None):
-    """One sentence saying why the solver did not load and what to do: the Pythons the zip carries
-    the solver for against the one running (with the Blenders that embed them), or the shared
-    library `missing` that cannot be loaded (missing_library), from load_cause's code."""
+def explain_load_error(exc, builds, python=None, host=None, missing=None, platforms=None, running=None):
+    """One sentence saying why the solver did not load and what to do: the platforms the zip
+    carries the solver for against this computer's, the Pythons against the one running (with the
+    Blenders that embed them), or the shared library `missing` that cannot be loaded
+    (missing_library), from load_cause's code."""
     python = python or f"{sys.version_info[0]}.{sys.version_info[1]}"
     host = host or host_name()
-    code, figures = load_cause(builds, python, missing)
+    running = running or running_platform()
+    code, figures = load_cause(builds, python, missing, platforms, running)
+    if code == OTHER_PLATFORM:
+        return (f"The wiresculpt solver did not load: this zip has the solver for {_listed(figures['platforms'])}; "
+                f"{host} runs on {running}: install the zip made for {running} (scripts/package writes one "
+                "per platform), or build from source with scripts/package on that computer.")
     if code == OTHER_PYTHON:
         blenders = [BLENDERS[b] for b in builds if b in BLENDERS]
         where = f"a Blender whose Python is {' or '.join(builds)}" + (f" ({', '.join(blenders)})" if blenders else "")
@@ -168,9 +217,14 @@ def explain_load_error(exc, builds, python=None, host=None, missing=None):
 try:
     from . import _wiresculpt as module
     LOAD_ERROR = ""
-except ImportError as exc:  # not built, built for another Python, or a library missing
-    module = None
-    LOAD_ERROR = explain_load_error(exc, built_for(), missing=missing_library(module_file()) if module_file() else None)
+except ImportError as exc:  # not built, built for another Python or platform, or a library missing
+    try:  # the extension's wheel (blender_manifest.toml "wheels"), which Blender installs for it
+        from wiresculpt_solver import _wiresculpt as module
+        LOAD_ERROR = ""
+    except ImportError:
+        module = None
+        LOAD_ERROR = explain_load_error(exc, built_for(), missing=missing_library(module_file()) if module_file() else None,
+                                        platforms=built_platforms())
 
 
 class _NeverRaised(Exception):

@@ -1,5 +1,6 @@
 #include "wiresculpt/fab/atomic_file.hpp"
 
+#ifndef _WIN32  // Windows: atomic_file_win.cpp
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -68,3 +69,4 @@ void write_file_atomic(const std::filesystem::path& path, std::string_view text)
 }
 
 }  // namespace wiresculpt::fab
+#endif  // _WIN32

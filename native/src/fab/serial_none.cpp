@@ -1,0 +1,39 @@
+// The serial port in a build without libserialport (WIRESCULPT_SERIAL_PORT=OFF: the Windows cross
+// build, whose libserialport source is not among the packages reached here). The protocol
+// (grbl_protocol.cpp) and the streamer are built as always (validation, dry runs, parse_answer);
+// no port is listed, and opening one throws an InputError that says why, which reaches the user
+// as the stream's message.
+#ifdef WIRESCULPT_NO_SERIAL_PORT
+#include <string>
+#include <vector>
+
+#include "wiresculpt/error.hpp"
+#include "wiresculpt/fab/serial.hpp"
+
+namespace wiresculpt::fab {
+
+std::vector<PortInfo> list_ports() { return {}; }
+
+struct SerialPort::Impl {
+  std::string name;
+};
+
+SerialPort::SerialPort(const std::string& name, const SerialSettings& /*settings*/) : impl_(std::make_unique<Impl>()) {
+  impl_->name = name;
+  throw InputError("could not open serial port '" + name + "': this build of the solver has no serial ports "
+                   "(the Windows build is made without libserialport); export the G-code files and send them "
+                   "with the machine's own sender");
+}
+
+SerialPort::~SerialPort() = default;
+
+const std::string& SerialPort::name() const { return impl_->name; }
+
+bool SerialPort::write(const std::string& /*bytes*/, int /*timeout_ms*/) { return false; }
+
+int SerialPort::read(char* /*buffer*/, int /*size*/, int /*timeout_ms*/) { return -1; }
+
+void SerialPort::drain_input(int /*timeout_ms*/) {}
+
+}  // namespace wiresculpt::fab
+#endif  // WIRESCULPT_NO_SERIAL_PORT

@@ -1,0 +1,160 @@
+"""The solver as Python wheels, and one Blender extension zip per platform made of them.
+
+    wheels.py [OUT]     (scripts/package runs it after package.py; OUT defaults to dist/)
+
+writes, for each (platform, Python) it can build here:
+
+- wheels/wiresculpt_solver-<version>-cp3XX-cp3XX-<platform>.whl: the package `wiresculpt_solver`
+  holding `_wiresculpt` (the add-on's native.py imports it from there when the module is not beside
+  it, as in an extension zip made of wheels, which Blender installs into the extension's own
+  site-packages);
+  * linux x86_64, cp311 and cp313: the modules scripts/package builds (the default build's, and
+    package_pythons.py's for 3.13), with GLPK, NLopt, libserialport and what they need copied into
+    wiresculpt_solver/libs/ with $ORIGIN run paths (package.bundle). The platform tag is
+    manylinux_2_<N>_x86_64 with N the newest glibc symbol version any file of the wheel needs
+    (read with readelf), so pip and Blender refuse it on an older glibc;
+  * win_amd64, cp311 and cp313: scripts/windows.py's cross-built .pyd files (everything static;
+    windows.module refuses one that imports a DLL other than Windows' own and pythonXY.dll);
+- wiresculpt-extension-<version>-windows-x64.zip: the extension for Blender 4.2+ on Windows, the
+  add-on's Python files with the wheels in wheels/, its blender_manifest.toml listing them under
+  `wheels` and `platforms = ["windows-x64"]` (the Linux extension zip stays package.py's, with
+  the modules beside the add-on's files).
+
+macOS wheels are not made (see docs/testing.md). WIRESCULPT_WINDOWS=0 leaves Windows out (no
+Wine, MinGW or downloads needed then).
+"""
+import base64
+import csv
+import hashlib
+import io
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import zipfile
+
+import package
+import windows
+
+ROOT = package.ROOT
+PACKAGE = "wiresculpt_solver"
+PYTHONS = ("3.11", "3.13")
+
+
+def glibc_floor(paths):
+    """The newest GLIBC_2.N symbol version the ELF files need, as (2, N)."""
+    newest = (2, 17)
+    for path in paths:
+        out = subprocess.run(["readelf", "-V", "-W", path], capture_output=True, text=True, check=True).stdout
+        for major, minor in re.findall(r"Name: GLIBC_(\d+)\.(\d+)", out):
+            newest = max(newest, (int(major), int(minor)))
+    return newest
+
+
+def record_line(arcname, data):
+    digest = base64.urlsafe_b64encode(hashlib.sha256(data).digest()).rstrip(b"=").decode()
+    return [arcname, f"sha256={digest}", str(len(data))]
+
+
+def write_wheel(out_dir, version, python_tag, platform_tag, files):
+    """The wheel holding `files` [(path on disk, path inside wiresculpt_solver/)]; returns its path."""
+    name = f"{PACKAGE}-{version}-{python_tag}-{python_tag}-{platform_tag}.whl"
+    path = os.path.join(out_dir, name)
+    info = f"{PACKAGE}-{version}.dist-info"
+    entries = [(f"{PACKAGE}/__init__.py",
+                b'"""The wiresculpt solver (_wiresculpt), as the wiresculpt Blender extension installs it."""\n')]
+    for full, rel in files:
+        with open(full, "rb") as f:
+            entries.append((f"{PACKAGE}/{rel}", f.read()))
+    entries.append((f"{info}/METADATA", (
+        f"Metadata-Version: 2.1\nName: {PACKAGE}\nVersion: {version}\n"
+        "Summary: The compiled solver of the wiresculpt Blender add-on (GLPK, NLopt inside)\n"
+        "License: GPL-3.0-or-later\n"
+        f"Requires-Python: =={python_tag[2]}.{python_tag[3:]}.*\n").encode()))
+    entries.append((f"{info}/WHEEL", (
+        "Wheel-Version: 1.0\nGenerator: wiresculpt scripts/wheels.py\nRoot-Is-Purelib: false\n"
+        f"Tag: {python_tag}-{python_tag}-{platform_tag}\n").encode()))
+    rows = [record_line(arc, data) for arc, data in entries] + [[f"{info}/RECORD", "", ""]]
+    text = io.StringIO()
+    csv.writer(text, lineterminator="\n").writerows(rows)
+    entries.append((f"{info}/RECORD", text.getvalue().encode()))
+    tmp = path + ".tmp"
+    with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
+        for arc, data in entries:
+            info_entry = zipfile.ZipInfo(arc, date_time=(2026, 1, 1, 0, 0, 0))
+            info_entry.external_attr = (0o755 if arc.endswith((".so", ".pyd")) or ".so." in arc else 0o644) << 16
+            info_entry.compress_type = zipfile.ZIP_DEFLATED
+            z.writestr(info_entry, data)
+    os.replace(tmp, path)
+    return path
+
+
+def linux_wheels(out_dir, version):
+    made = []
+    for module in package.modules():
+        m = re.match(r"_wiresculpt\.cpython-(\d)(\d+)", os.path.basename(module))
+        minor = f"{m.group(1)}.{m.group(2)}"
+        if minor not in PYTHONS:
+            continue
+        with tempfile.TemporaryDirectory() as stage:
+            staged = package.bundle(module, stage)
+            floor = glibc_floor(staged)
+            files = [(p, os.path.relpath(p, stage)) for p in staged]
+            made.append(write_wheel(out_dir, version, f"cp{m.group(1)}{m.group(2)}",
+                                    f"manylinux_{floor[0]}_{floor[1]}_x86_64", files))
+    return made
+
+
+def windows_wheels(out_dir, version):
+    made = []
+    for minor in PYTHONS:
+        pyd = windows.module(minor)
+        made.append(write_wheel(out_dir, version, "cp" + minor.replace(".", ""), "win_amd64",
+                                [(pyd, os.path.basename(pyd))]))
+    return made
+
+
+def manifest_for(platform, wheels):
+    """The add-on's blender_manifest.toml for one platform's extension zip made of `wheels`."""
+    with open(os.path.join(package.ADDON, "blender_manifest.toml"), encoding="utf-8") as f:
+        text = f.read()
+    listed = ", ".join(f'"./wheels/{os.path.basename(w)}"' for w in wheels)
+    text, n = re.subn(r"^platforms = .*$", f'platforms = ["{platform}"]\nwheels = [{listed}]', text, flags=re.M)
+    if n != 1:
+        raise SystemExit("wiresculpt: blender_manifest.toml has no platforms line to replace")
+    return text
+
+
+def extension_zip(out_dir, version, platform, wheels):
+    """The extension zip of `platform` ("windows-x64"): the add-on's Python files (no module) with
+    `wheels` in wheels/ and a manifest listing them."""
+    path = os.path.join(out_dir, f"wiresculpt-extension-{version}-{platform}.zip")
+    with tempfile.TemporaryDirectory() as stage:
+        files = [(full, rel) for full, rel in package.addon_files([], stage) if rel != "blender_manifest.toml"]
+        manifest = os.path.join(stage, "blender_manifest.toml")
+        with open(manifest, "w", encoding="utf-8") as f:
+            f.write(manifest_for(platform, wheels))
+        files.append((manifest, "blender_manifest.toml"))
+        files += [(w, "wheels/" + os.path.basename(w)) for w in wheels]
+        package.write_zip(path, "", files)
+    return path
+
+
+def main(out_dir):
+    found = package.versions()
+    if len(set(found.values())) != 1:
+        raise SystemExit("wiresculpt: versions disagree: " + ", ".join(f"{k} {v}" for k, v in found.items()))
+    version = found["CMakeLists.txt"]
+    wheel_dir = os.path.join(out_dir, "wheels")
+    os.makedirs(wheel_dir, exist_ok=True)
+    written = linux_wheels(wheel_dir, version)
+    if os.environ.get("WIRESCULPT_WINDOWS", "1") != "0":
+        win = windows_wheels(wheel_dir, version)
+        written += win + [extension_zip(out_dir, version, "windows-x64", win)]
+    return written
+
+
+if __name__ == "__main__":
+    for p in main(sys.argv[1] if len(sys.argv) > 1 else os.path.join(ROOT, "dist")):
+        print(p)
