@@ -20,8 +20,12 @@ writes, for each (platform, Python) it can build here:
   `wheels` and `platforms = ["windows-x64"]` (the Linux extension zip stays package.py's, with
   the modules beside the add-on's files).
 
-macOS wheels are not made (see docs/testing.md). WIRESCULPT_WINDOWS=0 leaves Windows out (no
-Wine, MinGW or downloads needed then).
+- macOS arm64 and x86_64 (macosx_11_0), cp311 and cp313, UNTESTED: scripts/macos.py's modules,
+  cross-built with zig (nothing of them has run on a Mac), and wiresculpt-extension-<version>-
+  macos-arm64.zip / -macos-x64.zip made of them.
+
+WIRESCULPT_WINDOWS=0 leaves Windows out (no Wine, MinGW or downloads needed then), WIRESCULPT_MACOS=0
+macOS (no zig).
 """
 import base64
 import csv
@@ -115,6 +119,20 @@ def windows_wheels(out_dir, version):
     return made
 
 
+def macos_wheels(out_dir, version):
+    """UNTESTED (nothing of it has run on a Mac): the macOS wheels scripts/macos.py cross-builds."""
+    import macos
+
+    made = {}
+    for arch in macos.ARCHS:
+        made[arch] = []
+        for minor in PYTHONS:
+            so = macos.module(arch, minor)
+            made[arch].append(write_wheel(out_dir, version, "cp" + minor.replace(".", ""), macos.WHEEL_TAG[arch],
+                                          [(so, os.path.basename(so))]))
+    return made
+
+
 def manifest_for(platform, wheels):
     """The add-on's blender_manifest.toml for one platform's extension zip made of `wheels`."""
     with open(os.path.join(package.ADDON, "blender_manifest.toml"), encoding="utf-8") as f:
@@ -152,6 +170,10 @@ def main(out_dir):
     if os.environ.get("WIRESCULPT_WINDOWS", "1") != "0":
         win = windows_wheels(wheel_dir, version)
         written += win + [extension_zip(out_dir, version, "windows-x64", win)]
+    if os.environ.get("WIRESCULPT_MACOS", "1") != "0":
+        for arch, made in macos_wheels(wheel_dir, version).items():
+            platform = {"aarch64": "macos-arm64", "x86_64": "macos-x64"}[arch]
+            written += made + [extension_zip(out_dir, version, platform, made)]
     return written
 
 

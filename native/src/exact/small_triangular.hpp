@@ -61,7 +61,9 @@ inline void lower_transpose_solve_in_place(const double* L, Eigen::Index ld, Eig
   if constexpr (!kTriangularReplica) {
     Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>> m(L, n, n, Eigen::OuterStride<>(ld));
     Eigen::Map<Eigen::VectorXd> v(x, n);
-    m.triangularView<Eigen::Lower>().transpose().solveInPlace(v);
+    // Lᵀ's upper view (what triangularView<Lower>().transpose() is): clang rejects the
+    // transpose of a read-only map's triangular view (Eigen 3.4's lvalue check)
+    m.transpose().triangularView<Eigen::Upper>().solveInPlace(v);
     return;
   }
   // Row i of Lᵀ is column i of L: u(i, j) = L[i * ld + j].
