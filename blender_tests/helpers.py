@@ -326,7 +326,7 @@ def clear_scene():
             collection.remove(block)
     ws = bpy.context.scene.wiresculpt
     ws.contours.clear()
-    ws.target = None
+    ws.model = None
     ws.assembly_step = 0
 
 
@@ -363,7 +363,7 @@ def globe(rotations=((0, 0, 0), (0, math.pi / 2, 0), (math.pi / 2, 0, 0))):
     target = objects[0]
     target.scale = (GLOBE_RADIUS,) * 3
     bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.target = target
+    bpy.context.scene.wiresculpt.model = target
     for rotation in rotations:
         add_handle(rotation)
     assert bpy.ops.wiresculpt.slice() == {'FINISHED'}

@@ -81,7 +81,7 @@ class SliceSphere(AddonCase):
 
     def three_planes(self):
         sphere = uv_sphere(self.R, self.CENTRE)
-        bpy.context.scene.wiresculpt.target = sphere
+        bpy.context.scene.wiresculpt.model = sphere
         c = Vector(self.CENTRE)
         a = add_handle(c)
         b = add_handle(c + Vector((0, 0, 0.5)))
@@ -156,7 +156,7 @@ class SliceSphere(AddonCase):
         displace = sphere.modifiers.new("Grow", 'DISPLACE')
         displace.strength = 0.4  # no texture: every vertex moves 0.5 * strength along its normal
         radius = 2 * (self.R + 0.2)
-        bpy.context.scene.wiresculpt.target = sphere
+        bpy.context.scene.wiresculpt.model = sphere
         self.assertEqual(bpy.ops.wiresculpt.add_plane(), {'FINISHED'})
         handle = bpy.context.view_layer.objects.active
         self.assertLess((handle.location - Vector((1, 2, -1))).length, 1e-4)  # world centre
@@ -168,7 +168,7 @@ class SliceSphere(AddonCase):
 
     def test_add_plane_at_target_centre(self):
         sphere = uv_sphere(0.5, (1, 2, 3))
-        bpy.context.scene.wiresculpt.target = sphere
+        bpy.context.scene.wiresculpt.model = sphere
         result, _reports = run(slicing.WIRESCULPT_OT_add_plane)
         self.assertEqual(result, {'FINISHED'})
         handle = bpy.data.objects["Slice A"]
@@ -198,7 +198,7 @@ class Ticks(AddonCase):
         bm.free()
         obj = bpy.data.objects.new("Pair", mesh)
         bpy.context.scene.collection.objects.link(obj)
-        bpy.context.scene.wiresculpt.target = obj
+        bpy.context.scene.wiresculpt.model = obj
         return obj
 
     def test_longest_ticked_by_default(self):
@@ -375,14 +375,14 @@ class Refusals(AddonCase):
             bpy.ops.wiresculpt.slice()
 
     def test_no_handles(self):
-        bpy.context.scene.wiresculpt.target = uv_sphere()
+        bpy.context.scene.wiresculpt.model = uv_sphere()
         result, reports = run(slicing.WIRESCULPT_OT_slice)
         self.assertEqual(result, {'CANCELLED'})
         self.assertIn("slicing plane", reports[-1][1].lower())
 
     @unittest.skipUnless(native.available(), "the native module is not built")
     def test_flat_handle_named(self):
-        bpy.context.scene.wiresculpt.target = uv_sphere()
+        bpy.context.scene.wiresculpt.model = uv_sphere()
         add_handle((0, 0, 0))
         flat = add_handle((0, 0, 0.3))
         flat.scale.z = 0
@@ -392,7 +392,7 @@ class Refusals(AddonCase):
         self.assertEqual(contour_objects(), [])
 
     def test_solver_error_reported(self):
-        bpy.context.scene.wiresculpt.target = uv_sphere()
+        bpy.context.scene.wiresculpt.model = uv_sphere()
         add_handle((0, 0, 0))
         saved_module, saved_slice = native.module, native.slice_mesh
 
@@ -495,7 +495,7 @@ class WithoutNative(AddonCase):
 
     def test_registers_and_slice_cancels_with_reason(self):
         self.assertTrue(hasattr(bpy.types, "WIRESCULPT_OT_slice"))
-        bpy.context.scene.wiresculpt.target = uv_sphere()
+        bpy.context.scene.wiresculpt.model = uv_sphere()
         add_handle((0, 0, 0))
         result, reports = run(slicing.WIRESCULPT_OT_slice)
         self.assertEqual(result, {'CANCELLED'})

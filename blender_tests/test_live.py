@@ -104,14 +104,14 @@ class LiveRefused(BlenderCase):
         bpy.ops.mesh.primitive_grid_add(x_subdivisions=320, y_subdivisions=320)  # 320² quads: 204,800 triangles
         target = bpy.context.view_layer.objects.active
         ws = bpy.context.scene.wiresculpt
-        ws.target = target
+        ws.model = target
         ws.live = True
         self.assertFalse(ws.live)
         self.assertFalse(bpy.app.timers.is_registered(live.tick))
         self.assertIn("204,800 triangles", live.refused_message(ws))
         self.assertIn("100,000", live.refused_message(ws))
         bpy.ops.mesh.primitive_cube_add()
-        ws.target = bpy.context.view_layer.objects.active
+        ws.model = bpy.context.view_layer.objects.active
         self.assertEqual(live.refused_message(ws), "")  # it spoke of the grid
         ws.live = True
         self.assertTrue(ws.live)
@@ -129,7 +129,7 @@ class LiveRefused(BlenderCase):
         subsurf = cube.modifiers.new("Subdivision", 'SUBSURF')
         subsurf.levels = 7  # 6 · 4⁷ quads: 196,608 triangles
         ws = bpy.context.scene.wiresculpt
-        ws.target = cube
+        ws.model = cube
         ws.live = True
         self.assertFalse(ws.live)
         self.assertIn("196,608 triangles", live.refused_message(ws))
@@ -258,7 +258,7 @@ class LiveFollowsTheScene(BlenderCase):
         for collection in self.target.users_collection:
             collection.objects.unlink(self.target)
         verdict = self.settle()
-        self.assertTrue(verdict.startswith(f"cannot solve — Target '{self.target.name}' is not in scene"), verdict)
+        self.assertTrue(verdict.startswith(f"cannot solve — Model '{self.target.name}' is not in scene"), verdict)
         self.assertEqual(live.observed().preview, [])
 
     def test_setup_problems_cannot_solve(self):
@@ -301,9 +301,9 @@ class LiveFollowsTheScene(BlenderCase):
             bpy.context.view_layer.update()
             self.assertEqual(self.settle(),
                              "cannot solve — the solver is not loaded (the panel's first box says why)")
-        target, self.ws.target = self.ws.target, None
-        self.assertEqual(self.settle(), "cannot solve — No target mesh: pick one in the Wire panel (Target)")
-        self.ws.target = target
+        target, self.ws.model = self.ws.model, None
+        self.assertEqual(self.settle(), "cannot solve — No model mesh: pick one in the Wire panel (Model)")
+        self.ws.model = target
         self.assertStands(self.settle())
 
     def test_one_wire_cannot_solve(self):

@@ -29,7 +29,7 @@ def two_spheres_target():
     obj = bpy.data.objects.new("two spheres", me)
     bpy.context.scene.collection.objects.link(obj)
     bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.target = obj
+    bpy.context.scene.wiresculpt.model = obj
     for rotation in ((0, 0, 0), (0, np.pi / 2, 0), (np.pi / 2, 0, 0)):  # z = 0 and y = 0 cut both spheres
         add_handle(rotation)
     assert bpy.ops.wiresculpt.slice() == {'FINISHED'}

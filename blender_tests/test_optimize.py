@@ -460,40 +460,40 @@ class StaleReport(Case):
     def test_editing_or_moving_the_target_and_back(self):
         """Optimize records a digest of the triangles it sliced; an edit or a move of the target
         makes the design an earlier one until the mesh is as it was (read again once the changes
-        have settled, blend/target_watch.py)."""
-        from wiresculpt.blend import target_watch
+        have settled, blend/model_watch.py)."""
+        from wiresculpt.blend import model_watch
 
         self.optimize()
         self.assertIn("mesh", scene_results.stored_inputs())
-        target = bpy.context.scene.wiresculpt.target
+        target = bpy.context.scene.wiresculpt.model
         vertex = target.data.vertices[0]
         z = vertex.co.z
         vertex.co.z = z + 0.01
         target.data.update()
         bpy.context.view_layer.update()
-        self.assert_stale(f"target {target.name} edited or moved")  # still changing: not read yet
-        target_watch._STATE["changed_at"] = 0.0  # settled
-        self.assert_stale(f"target {target.name} edited or moved")  # read again: another mesh
+        self.assert_stale(f"model {target.name} edited or moved")  # still changing: not read yet
+        model_watch._STATE["changed_at"] = 0.0  # settled
+        self.assert_stale(f"model {target.name} edited or moved")  # read again: another mesh
         vertex.co.z = z
         target.data.update()
         bpy.context.view_layer.update()
-        target_watch._STATE["changed_at"] = 0.0
+        model_watch._STATE["changed_at"] = 0.0
         self.assert_current()
         x = target.location.x
         target.location.x = x + 0.02  # the same mesh elsewhere: other contours
         bpy.context.view_layer.update()
-        target_watch._STATE["changed_at"] = 0.0
-        self.assert_stale(f"target {target.name} edited or moved")
+        model_watch._STATE["changed_at"] = 0.0
+        self.assert_stale(f"model {target.name} edited or moved")
         target.location.x = x
         bpy.context.view_layer.update()
-        target_watch._STATE["changed_at"] = 0.0
+        model_watch._STATE["changed_at"] = 0.0
         self.assert_current()
         # a frame change reports no update of an animated mesh: it counts as a possible change,
         # read again (the same mesh here: still current)
-        before = target_watch._STATE["generation"]
+        before = model_watch._STATE["generation"]
         bpy.context.scene.frame_set(bpy.context.scene.frame_current + 1)
-        self.assertGreater(target_watch._STATE["generation"], before)
-        target_watch._STATE["changed_at"] = 0.0
+        self.assertGreater(model_watch._STATE["generation"], before)
+        model_watch._STATE["changed_at"] = 0.0
         self.assert_current()
 
     def test_fabrication_says_its_files_follow_the_earlier_design(self):
@@ -569,34 +569,34 @@ class StaleReport(Case):
         self.assert_stale("settings changed (Material)")
         ws.property_unset("material_preset")
         self.assert_current()
-        target = ws.target
+        target = ws.model
         other = target.copy()
         other.data = target.data.copy()
         bpy.context.scene.collection.objects.link(other)
-        ws.target = other
-        self.assert_stale("target changed")
-        ws.target = target
+        ws.model = other
+        self.assert_stale("model changed")
+        ws.model = target
         self.assert_current()
 
     def test_the_target_s_name_is_read_one_way(self):
-        """blend/handles.target_name: the record Optimize keeps, Live's snapshot and the stale check
+        """blend/handles.model_name: the record Optimize keeps, Live's snapshot and the stale check
         read the picked target's name, "" without one, alike."""
-        from wiresculpt.blend.handles import target_name
+        from wiresculpt.blend.handles import model_name
         from wiresculpt.live import engine as live
 
         self.optimize()
         scene = bpy.context.scene
         ws = scene.wiresculpt
-        target = ws.target
-        self.assertEqual(target_name(ws), target.name)
+        target = ws.model
+        self.assertEqual(model_name(ws), target.name)
         self.assertEqual(scene_results.stored_inputs()["target"], target.name)
         self.assertEqual(live.snapshot(scene)[0], target.name)
-        ws.target = None
-        self.assertEqual(target_name(ws), "")
+        ws.model = None
+        self.assertEqual(model_name(ws), "")
         self.assertEqual(optimize.solve_record(scene, {}, {})["target"], "")
         self.assertEqual(live.snapshot(scene)[0], "")
-        self.assertIn("target changed", results_ui.report_changes(bpy.context))
-        ws.target = target
+        self.assertIn("model changed", results_ui.report_changes(bpy.context))
+        ws.model = target
         self.assert_current()
 
     def test_a_reloaded_file_is_current(self):

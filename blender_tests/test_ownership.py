@@ -34,7 +34,7 @@ def hinge_scene():
     _V, _F, objects = import_mesh(GLOBE_OBJ)
     objects[0].scale = (R,) * 3
     bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.target = objects[0]
+    bpy.context.scene.wiresculpt.model = objects[0]
     for rotation, location in HINGE:
         add_handle(rotation, location)
     bpy.context.view_layer.update()

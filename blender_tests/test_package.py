@@ -60,7 +60,7 @@ INSTALL = textwrap.dedent("""
     target = objects[0]
     target.scale = (float(radius),) * 3
     bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.target = target
+    bpy.context.scene.wiresculpt.model = target
     for rotation in ((0, 0, 0), (0, math.pi / 2, 0), (math.pi / 2, 0, 0)):
         assert bpy.ops.wiresculpt.add_plane() == {'FINISHED'}
         bpy.context.view_layer.objects.active.rotation_euler = rotation
@@ -106,7 +106,7 @@ OPTIMIZE = textwrap.dedent("""
     _V, _F, objects = import_mesh(globe_obj)
     objects[0].scale = (0.125,) * 3
     bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.target = objects[0]
+    bpy.context.scene.wiresculpt.model = objects[0]
     for rotation in ((0, 0, 0), (0, math.pi / 2, 0), (math.pi / 2, 0, 0)):
         bpy.ops.wiresculpt.add_plane()
         bpy.context.view_layer.objects.active.rotation_euler = rotation

@@ -37,7 +37,7 @@ def globe_target():
     _V, _F, objects = import_mesh(GLOBE_OBJ)
     objects[0].scale = (R,) * 3
     bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.target = objects[0]
+    bpy.context.scene.wiresculpt.model = objects[0]
 
 
 def hinge_scene():

@@ -41,7 +41,7 @@ def setup():
     _V, _F, objs = import_mesh(os.path.join(os.path.dirname(HERE), "scripts", "examples", "globe", "globe.obj"))
     objs[0].scale = (R,) * 3
     bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.target = objs[0]
+    bpy.context.scene.wiresculpt.model = objs[0]
     for rotation, location in HINGE:
         bpy.ops.wiresculpt.add_plane()
         handle = bpy.context.view_layer.objects.active
@@ -105,7 +105,7 @@ def check_full():
     # A marker step the preview must not hide: the target moved 1 m and pushed as an undo step.
     # If clicking Preview pushed a step, the Undo below would undo that step and leave the target
     # moved; with no step, it undoes the move.
-    target = bpy.context.scene.wiresculpt.target
+    target = bpy.context.scene.wiresculpt.model
     target.location.x += 1.0
     with override():
         bpy.ops.ed.undo_push(message="marker: target moved")
@@ -132,7 +132,7 @@ def check_preview_drawn():
     seen["preview_no_data"] = state() == seen.pop("moved_state")
     with override():
         bpy.ops.ed.undo()
-    target = bpy.context.scene.wiresculpt.target
+    target = bpy.context.scene.wiresculpt.model
     seen["undo_took_the_marker"] = abs(target.location.x) < 1e-9 and state() == seen["before_full"]
     seen["preview_kept_by_undo"] = ops.PREVIEW is not None
     with override():

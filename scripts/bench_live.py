@@ -58,7 +58,7 @@ def load_case(manifest_dir, case):
     objects[0].matrix_world = Matrix.Scale(factor, 4) @ objects[0].matrix_world
     bpy.context.view_layer.update()
     scene = bpy.context.scene
-    scene.wiresculpt.target = objects[0]
+    scene.wiresculpt.model = objects[0]
     add_handles(scene, scaled_planes(scene_file.planes, factor), sliced)
     handle = scene.objects[scene_file.planes[0].name]
     return handle, Vector(scene_file.planes[0].normal).normalized(), len(sliced["wires"])

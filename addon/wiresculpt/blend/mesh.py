@@ -36,8 +36,8 @@ def object_triangles(obj, depsgraph):
         evaluated.to_mesh_clear()
 
 
-# The most triangles read again on Blender's own thread whenever a target changes (Live, the
-# Stability box's check of the target): object_triangles took 52-56 ms at 199,200 triangles and
+# The most triangles read again on Blender's own thread whenever a model changes (Live, the
+# Stability box's check of the model): object_triangles took 52-56 ms at 199,200 triangles and
 # 24-26 ms at 101,888 (a UV sphere, background Blender), against the 50 ms a step may take (issue 17).
 MAX_REREAD_TRIANGLES = 100_000
 

@@ -5,7 +5,7 @@ each said with one prefix, and the part of a long reason the line shows.
 - "stable, over its limits — <limits>": stable and buildable but breaking a limit a maker asked
   for (core/limits.py: the load factor, wires bending out of their planes, the stock, the size);
 - "not stable — <reason>": a solve that ended with the design not stable (design["reason"]);
-- "cannot solve — <problem>": the scene as it is set up cannot be solved at all (no target, no
+- "cannot solve — <problem>": the scene as it is set up cannot be solved at all (no model, no
   contour ticked, a panel value the solver refuses, a ticked contour the plane no longer cuts,
   fewer than two wires: the pipeline's setup reasons, core/design.setup_problem): no verdict on
   the design, something to set up;

@@ -100,7 +100,7 @@ def live_lines(scene):
 
 def draw_live():
     """The live verdict's wires (live/engine.py) as lines in their colours, over everything: the
-    wires lie on the target's surface, where a depth test hid all but their kinks in Solid view."""
+    wires lie on the model's surface, where a depth test hid all but their kinks in Solid view."""
     shader = uniform_colour_shader()
     gpu.state.line_width_set(2.0)
     gpu.state.depth_test_set('NONE')

@@ -8,7 +8,7 @@ from ..blend import compat
 
 def has_design(scene):
     settings = getattr(scene, "wiresculpt", None)
-    return settings is not None and (settings.target is not None or len(settings.contours) > 0)
+    return settings is not None and (settings.model is not None or len(settings.contours) > 0)
 
 
 @persistent
