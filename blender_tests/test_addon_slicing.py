@@ -449,7 +449,7 @@ class Registration(AddonCase):
 
     def test_long_plane_names_show_in_full(self):
         """A plane name the sidebar would cut ("Meri…") is shown whole in the details box of the
-        active contour, wrapped to lines that fit the region (issue 21, part 6)."""
+        active contour, wrapped to lines that fit the region."""
         settings = bpy.context.scene.wiresculpt
         settings.contours.clear()
         name = "Meridian through both poles at ninety degrees"

@@ -1,4 +1,4 @@
-"""Live (issue 17 part 2) in a Blender with a window under Xvfb (timers need the event loop): a
+"""Live in a Blender with a window under Xvfb (timers need the event loop): a
 plane moved in steps turns the live verdict stable -> not stable (near the top of the mesh) ->
 cannot solve (the plane left the mesh: its ticked contour is gone) -> stable, the latest position wins over a running solve, no tick of the
 live timer blocks the UI for more than 50 ms, and turning Live off or loading a file stops the
@@ -10,7 +10,7 @@ import unittest
 from helpers import ROOT, BlenderCase, run_under_xvfb
 
 SCRIPT = os.path.join(ROOT, "blender_tests", "ui_live.py")
-TICK_LIMIT = 0.050  # issue 17: no step blocks the UI for more than 50 ms (the one time assertion)
+TICK_LIMIT = 0.050  # no step blocks the UI for more than 50 ms (the one time assertion)
 
 
 def stands(verdict):
@@ -152,7 +152,7 @@ def drawn_live():
 
 
 class LiveFollowsTheScene(BlenderCase):
-    """What Live sees besides moved planes (a maker's trial under Xvfb, issue 17): the panel's
+    """What Live sees besides moved planes (a maker's trial under Xvfb): the panel's
     settings, the target's geometry and presence, the toggle set without its update (undo, a scene
     switch), and errors. The timer's steps are run by hand (no timers run in the background)."""
 

@@ -231,7 +231,7 @@ class PackageTest(unittest.TestCase):
             self.assertGreaterEqual(wires, 3)
 
     def test_the_extension_zip_explains_itself_to_a_legacy_install(self):
-        """Blender 3.4's Add-ons > Install with the extension zip (issue 48): Blender lists exactly
+        """Blender 3.4's Add-ons > Install with the extension zip: Blender lists exactly
         one new add-on, whose name, description and warning say which zip to use; enabling it
         fails with the sentence naming the add-on zip, registers nothing of wiresculpt, and the
         add-on zip's name differs from the extension's by more than a platform spelling."""

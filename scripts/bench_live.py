@@ -1,4 +1,4 @@
-"""The live round trip of scripts/bench (issue 17): a plane moved -> the verdict shown, in a Blender
+"""The live round trip of scripts/bench: a plane moved -> the verdict shown, in a Blender
 with a window (the Live toggle's timer needs the event loop):
 
     xvfb-run -a blender --factory-startup --python-exit-code 1 --python scripts/bench_live.py -- \

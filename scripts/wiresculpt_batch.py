@@ -1,4 +1,4 @@
-"""The headless wiresculpt run (FORMATS.md):
+"""The headless wiresculpt run (docs/formats.md):
 
     blender --background --factory-startup --python scripts/wiresculpt_batch.py -- SCENE.json --out DIR [--profile P.json]
 

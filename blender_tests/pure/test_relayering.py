@@ -1,4 +1,4 @@
-"""The re-layering loop (pipeline.relayer, issue 20) on a network built so that the first layering's
+"""The re-layering loop (pipeline.relayer) on a network built so that the first layering's
 hooks cannot be bent and the opposite ones can.
 
 The network (three circles on a sphere of radius R = 0.2 m): A on the plane z = 0 (the equator),
@@ -84,7 +84,7 @@ def network_design(settings, angle=ANGLE):
 
 
 def opening_of_a(design, crossing):
-    """The direction wire A (id 0) opens to at `crossing` by the FORMATS hook convention, computed
+    """The direction wire A (id 0) opens to at `crossing` by the docs/formats.md hook convention, computed
     here from the planes: hook * d for wires[0], -hook * d for wires[1], d = n0 x n1."""
     n0, n1 = (np.asarray(design["wires"][w]["plane"]["normal"], dtype=float) for w in crossing["wires"])
     d = np.cross(n0, n1)

@@ -15,7 +15,7 @@ A reason is shown whole up to REASON_WORDS words. The solver's reasons repeat a 
 crossing or wire ("crossing 0 on wire Front/0: …; crossing 1 on wire Front/0: …"), so a longer one
 shows its first clause (up to the first ";" or full stop outside brackets) whole, where its
 deciding figure (the angle, the length, the scale) comes last, up to CLAUSE_WORDS words. The reason
-itself is never reworded (design.json keeps it; FORMATS.md). bpy-free.
+itself is never reworded (design.json keeps it; docs/formats.md). bpy-free.
 """
 from .design import setup_problem
 from .limits import OVER_LIMITS, STOCK_LENGTH, broken_limits

@@ -1,4 +1,4 @@
-"""Find Stable Planes and Suggest Planes (issue 15): the plane assistant (plane_search.py) on a
+"""Find Stable Planes and Suggest Planes: the plane assistant (plane_search/) on a
 worker thread under a modal like Optimize's (progress, Esc cancels, the scene untouched until the
 user applies a candidate), and Apply: the candidate's planes become the slicing handles' placement
 (Find) or new slicing handles (Suggest), with the candidate's design as the result, in one undo

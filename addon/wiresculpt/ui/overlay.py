@@ -5,7 +5,7 @@ each wire's predicted out-of-plane deflection as a whisker.
 
 Drawn only when the stored design has `force` per crossing and scene.wiresculpt.show_forces is
 on. The longest arrow is ARROW_SHARE of the sculpture's size; each arrow starts at the crossing
-and shows the force on wires[0] (FORMATS.md `force`). A wire with `out_of_plane_deflection` gets a
+and shows the force on wires[0] (docs/formats.md `force`). A wire with `out_of_plane_deflection` gets a
 whisker at the target vertex where it deflects most, along its plane normal, DEFLECTION_SCALE times
 the deflection long (so 1 mm shows as 1 cm), red when over the limit (DEFLECTION_LIMIT, the
 solver's default 2 mm), else blue.
