@@ -280,7 +280,7 @@ def prose(cases, names):
                    + (f" (about length^{k_t:.1f})" if k_t else "") + f". That is {min(per_m):,.0f}–{max(per_m):,.0f} "
                    f"energy evaluations per metre of wire and {statistics.median(s_per_pt):.2f} ms per point: the "
                    "windowed solve (8-point windows swept until nothing moves by 0.1 µm, each by a Newton SQP "
-                   "that converges in 4–6 iterations; docs/method-target-shape.md, "The solver") keeps each "
+                   "that converges in 4–6 iterations; docs/method-target-shape.md, The solver) keeps each "
                    "iteration small, so the cost is the number of sweeps times the number of windows. The paper saw "
                    "the same effect (its Airplane, two long wires, 51 s).")
         capped = [c for c in everything if any("MAXEVAL" in str(w) for w in [c.get("nlopt_result", "")])]

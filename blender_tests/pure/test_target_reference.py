@@ -144,7 +144,7 @@ class AgainstConvergedSweeps(unittest.TestCase):
 
 
     def test_windows_from_29_points_reach_the_one_block_optimum(self):
-        # Wires of 29 to 32 points are solved in windows (ONE_BLOCK_POINTS), no longer as one block
+        # Wires of 29 to 32 points are solved in windows (ONE_BLOCK_POINTS), not as one block
         # (the solver's default, 4 x window): the same distances (0.1 mm), hooks, nulled crossings
         # and verdict on every stand-in, and at least one such wire (the Teddy's Arms/0) so that
         # the comparison compares something.
