@@ -166,7 +166,7 @@ class SliceSphere(AddonCase):
         (item,) = items_of(handle.name)
         self.assertLengthNear(item.length, circle_length(radius, 1.5))
 
-    def test_add_plane_at_target_centre(self):
+    def test_add_plane_at_model_centre(self):
         sphere = uv_sphere(0.5, (1, 2, 3))
         bpy.context.scene.wiresculpt.model = sphere
         result, _reports = run(slicing.WIRESCULPT_OT_add_plane)
@@ -181,8 +181,8 @@ class SliceSphere(AddonCase):
         self.assertEqual(bpy.context.view_layer.objects.active, handle)
         run(slicing.WIRESCULPT_OT_add_plane)
         self.assertIn("Slice B", bpy.data.objects)
-        self.assertFalse(wiresculpt.props._poll_target(None, handle))
-        self.assertTrue(wiresculpt.props._poll_target(None, sphere))
+        self.assertFalse(wiresculpt.props._poll_model(None, handle))
+        self.assertTrue(wiresculpt.props._poll_model(None, sphere))
 
 
 @unittest.skipUnless(native.available(), "the native module is not built")
@@ -365,13 +365,13 @@ class Ticks(AddonCase):
 
 
 class Refusals(AddonCase):
-    def test_no_target(self):
+    def test_no_model(self):
         for operator in (slicing.WIRESCULPT_OT_slice, slicing.WIRESCULPT_OT_add_plane):
             result, reports = run(operator)
             self.assertEqual(result, {'CANCELLED'})
             self.assertEqual(reports[-1][0], {'ERROR'})
-            self.assertIn("target", reports[-1][1].lower())
-        with self.assertRaisesRegex(RuntimeError, "target"):  # errors reach scripts, too
+            self.assertIn("model", reports[-1][1].lower())
+        with self.assertRaisesRegex(RuntimeError, "model"):  # errors reach scripts, too
             bpy.ops.wiresculpt.slice()
 
     def test_no_handles(self):
