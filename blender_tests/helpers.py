@@ -360,14 +360,14 @@ def globe(rotations=((0, 0, 0), (0, math.pi / 2, 0), (math.pi / 2, 0, 0))):
     from wiresculpt.blend.mesh import import_mesh
 
     _V, _F, objects = import_mesh(GLOBE_OBJ)
-    target = objects[0]
-    target.scale = (GLOBE_RADIUS,) * 3
+    model = objects[0]
+    model.scale = (GLOBE_RADIUS,) * 3
     bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.model = target
+    bpy.context.scene.wiresculpt.model = model
     for rotation in rotations:
         add_handle(rotation)
     assert bpy.ops.wiresculpt.slice() == {'FINISHED'}
-    return target
+    return model
 
 
 class BlenderCase(unittest.TestCase):

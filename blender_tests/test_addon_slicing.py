@@ -150,7 +150,7 @@ class SliceSphere(AddonCase):
         self.assertEqual(len(contour_objects()), 2)
         self.assertEqual(len(items_of(a.name)), 1)
 
-    def test_modified_scaled_target_sliced_in_world_space(self):
+    def test_modified_scaled_model_sliced_in_world_space(self):
         sphere = uv_sphere(self.R, (1.0, 2.0, -1.0))
         sphere.scale = (2, 2, 2)
         displace = sphere.modifiers.new("Grow", 'DISPLACE')

@@ -94,7 +94,7 @@ class LiveAcrossScenes(unittest.TestCase):
 
 class LiveRefused(BlenderCase):
     """The toggle refuses targets over live.MAX_TRIANGLES, counted with their modifiers, with a
-    sentence the panel shows while that target is picked."""
+    sentence the panel shows while that model is picked."""
 
     def test_large_mesh_is_refused(self):
         import bpy
@@ -102,9 +102,9 @@ class LiveRefused(BlenderCase):
         from wiresculpt.live import engine as live
 
         bpy.ops.mesh.primitive_grid_add(x_subdivisions=320, y_subdivisions=320)  # 320² quads: 204,800 triangles
-        target = bpy.context.view_layer.objects.active
+        model = bpy.context.view_layer.objects.active
         ws = bpy.context.scene.wiresculpt
-        ws.model = target
+        ws.model = model
         ws.live = True
         self.assertFalse(ws.live)
         self.assertFalse(bpy.app.timers.is_registered(live.tick))
@@ -160,7 +160,7 @@ class LiveFollowsTheScene(BlenderCase):
         super().setUp()
         from helpers import globe
 
-        self.target = globe()
+        self.model = globe()
         self.ws = self.scene().wiresculpt
 
     def tearDown(self):
@@ -197,7 +197,7 @@ class LiveFollowsTheScene(BlenderCase):
 
         from wiresculpt.live import engine as live
 
-        return max(float(np.max(np.linalg.norm(lines - np.asarray(self.target.location), axis=1)))
+        return max(float(np.max(np.linalg.norm(lines - np.asarray(self.model.location), axis=1)))
                    for _colour, lines in live.observed().preview)
 
     def test_settings_are_part_of_the_verdict(self):
@@ -226,7 +226,7 @@ class LiveFollowsTheScene(BlenderCase):
         self.ws.max_bend_deg, self.ws.min_bend_deg = max_bend, min_bend
         self.assertStands(self.settle())
 
-    def test_edits_and_modifiers_of_the_target_are_seen(self):
+    def test_edits_and_modifiers_of_the_model_are_seen(self):
         import bpy
         from mathutils import Matrix
 
@@ -236,29 +236,29 @@ class LiveFollowsTheScene(BlenderCase):
         self.assertStands(self.settle())
         before, seen = self.extent(), live.observed().geometry
         self.assertAlmostEqual(before, 0.125, delta=0.01)  # the wires lie on the globe
-        self.target.data.transform(Matrix.Scale(0.6, 4))  # an edit of the mesh, its matrix unchanged
-        self.target.data.update()
+        self.model.data.transform(Matrix.Scale(0.6, 4))  # an edit of the mesh, its matrix unchanged
+        self.model.data.update()
         bpy.context.view_layer.update()
         self.assertGreater(live.observed().geometry, seen)
         self.settle()
         self.assertAlmostEqual(self.extent(), 0.6 * 0.125, delta=0.01)
         seen = live.observed().geometry
-        self.target.modifiers.new("Subdivision", 'SUBSURF')
+        self.model.modifiers.new("Subdivision", 'SUBSURF')
         bpy.context.view_layer.update()
         self.assertGreater(live.observed().geometry, seen)
         seen = live.observed().geometry
         self.settle()
         self.assertEqual(live.observed().geometry, seen)  # reading the mesh is no edit: no endless re-solving
 
-    def test_a_target_taken_out_of_the_scene(self):
+    def test_a_model_taken_out_of_the_scene(self):
         from wiresculpt.live import engine as live
 
         self.ws.live = True
         self.assertStands(self.settle())
-        for collection in self.target.users_collection:
-            collection.objects.unlink(self.target)
+        for collection in self.model.users_collection:
+            collection.objects.unlink(self.model)
         verdict = self.settle()
-        self.assertTrue(verdict.startswith(f"cannot solve — Model '{self.target.name}' is not in scene"), verdict)
+        self.assertTrue(verdict.startswith(f"cannot solve — Model '{self.model.name}' is not in scene"), verdict)
         self.assertEqual(live.observed().preview, [])
 
     def test_setup_problems_cannot_solve(self):
@@ -297,13 +297,13 @@ class LiveFollowsTheScene(BlenderCase):
             item.use = True
         self.assertStands(self.settle())
         with mock.patch.object(native, "available", return_value=False):
-            self.target.location.x += 0.001
+            self.model.location.x += 0.001
             bpy.context.view_layer.update()
             self.assertEqual(self.settle(),
                              "cannot solve — the solver is not loaded (the panel's first box says why)")
-        target, self.ws.model = self.ws.model, None
+        model, self.ws.model = self.ws.model, None
         self.assertEqual(self.settle(), "cannot solve — No model mesh: pick one in the Wire panel (Model)")
-        self.ws.model = target
+        self.ws.model = model
         self.assertStands(self.settle())
 
     def test_one_wire_cannot_solve(self):
@@ -354,18 +354,18 @@ class LiveFollowsTheScene(BlenderCase):
         self.assertStands(self.settle())
         refused = ValueError("three wires pass through one point: move one of the planes slightly")
         with mock.patch.object(live.pipeline, "solve", side_effect=refused):
-            self.target.location.x += 0.001
+            self.model.location.x += 0.001
             bpy.context.view_layer.update()
             self.assertEqual(self.settle(), "cannot solve — three wires pass through one point: move one of the "
                                             "planes slightly")
         with mock.patch.object(live.pipeline, "solve", side_effect=KeyError("hook")):
-            self.target.location.x += 0.001
+            self.model.location.x += 0.001
             bpy.context.view_layer.update()
             verdict = self.settle()
         self.assertEqual(verdict, "error — internal error (KeyError: 'hook'); please report it")
         self.assertEqual(panel.live_look(live.observed().kind), ('CANCEL', True))
         self.assertEqual(live.observed().preview, [])
-        self.target.location.x -= 0.002
+        self.model.location.x -= 0.002
         bpy.context.view_layer.update()
         self.assertStands(self.settle())
 
@@ -441,7 +441,7 @@ class LiveFollowsTheScene(BlenderCase):
             self.assertEqual(live.tick(), live.TICK_SECONDS)
             self.assertEqual(start.call_count, 1)  # tried again only once something changes
         self.assertEqual(live.line(), "Live: error — RuntimeError: the solver's thread could not start")
-        self.target.location.x += 0.001
+        self.model.location.x += 0.001
         bpy.context.view_layer.update()  # matrix_world follows (a window's event loop does it)
         self.assertStands(self.settle())
 
@@ -455,7 +455,7 @@ class LiveFollowsTheScene(BlenderCase):
 
         # As with GPU subdivision, the evaluated mesh the refusal counts is the cage (2,208
         # triangles); the triangles read for slicing are the subdivided ones, over 100,000.
-        self.target.modifiers.new("Subdivision", 'SUBSURF').levels = 3
+        self.model.modifiers.new("Subdivision", 'SUBSURF').levels = 3
         bpy.context.view_layer.update()
         with mock.patch.object(live, "triangle_count", return_value=2208):
             self.ws.live = True

@@ -57,10 +57,10 @@ INSTALL = textwrap.dedent("""
     mesh = importlib.import_module(name + ".blend.mesh")
     results = importlib.import_module(name + ".blend.results")
     _V, _F, objects = mesh.import_mesh(globe_obj)
-    target = objects[0]
-    target.scale = (float(radius),) * 3
+    model = objects[0]
+    model.scale = (float(radius),) * 3
     bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.model = target
+    bpy.context.scene.wiresculpt.model = model
     for rotation in ((0, 0, 0), (0, math.pi / 2, 0), (math.pi / 2, 0, 0)):
         assert bpy.ops.wiresculpt.add_plane() == {'FINISHED'}
         bpy.context.view_layer.objects.active.rotation_euler = rotation
