@@ -1,5 +1,5 @@
 """The target shape as the pipeline runs it (window sweeps stopped by SWEEP_FTOL, wires on threads,
-blocks by the Newton SQP) against a reference run of the old method pushed further: SLSQP,
+blocks by the Newton SQP) against a reference run pushed further: SLSQP,
 one wire at a time, no energy-based stop, sweeps until no window moves a point by 1 nm. On the bench's Table 2 stand-ins,
 the bundled globe and the 3 m wire of the length sweep, both must reach the same distances to the
 contour (within 0.1 mm) and realise the same crossings. Correctness only: no timing."""
