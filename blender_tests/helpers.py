@@ -326,7 +326,7 @@ def clear_scene():
             collection.remove(block)
     ws = bpy.context.scene.wiresculpt
     ws.contours.clear()
-    ws.target = None
+    ws.model = None
     ws.assembly_step = 0
 
 
@@ -353,7 +353,7 @@ def save_and_reload(name="sculpture.blend"):
 
 
 def globe_target():
-    """globe.obj at radius GLOBE_RADIUS as the target, no slicing plane yet."""
+    """globe.obj at radius GLOBE_RADIUS as the model, no slicing plane yet."""
     import bpy
 
     from wiresculpt.blend.mesh import import_mesh
@@ -361,7 +361,7 @@ def globe_target():
     _V, _F, objects = import_mesh(GLOBE_OBJ)
     objects[0].scale = (GLOBE_RADIUS,) * 3
     bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.target = objects[0]
+    bpy.context.scene.wiresculpt.model = objects[0]
 
 
 # The hinged globe's five planes as (rotation, location): "Slice E" (x = 0.8 R) crosses only the
@@ -401,14 +401,14 @@ def globe(rotations=((0, 0, 0), (0, math.pi / 2, 0), (math.pi / 2, 0, 0))):
     from wiresculpt.blend.mesh import import_mesh
 
     _V, _F, objects = import_mesh(GLOBE_OBJ)
-    target = objects[0]
-    target.scale = (GLOBE_RADIUS,) * 3
+    model = objects[0]
+    model.scale = (GLOBE_RADIUS,) * 3
     bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.target = target
+    bpy.context.scene.wiresculpt.model = model
     for rotation in rotations:
         add_handle(rotation)
     assert bpy.ops.wiresculpt.slice() == {'FINISHED'}
-    return target
+    return model
 
 
 class BlenderCase(unittest.TestCase):

@@ -81,7 +81,7 @@ class SliceSphere(AddonCase):
 
     def three_planes(self):
         sphere = uv_sphere(self.R, self.CENTRE)
-        bpy.context.scene.wiresculpt.target = sphere
+        bpy.context.scene.wiresculpt.model = sphere
         c = Vector(self.CENTRE)
         a = add_handle(c)
         b = add_handle(c + Vector((0, 0, 0.5)))
@@ -150,13 +150,13 @@ class SliceSphere(AddonCase):
         self.assertEqual(len(contour_objects()), 2)
         self.assertEqual(len(items_of(a.name)), 1)
 
-    def test_modified_scaled_target_sliced_in_world_space(self):
+    def test_modified_scaled_model_sliced_in_world_space(self):
         sphere = uv_sphere(self.R, (1.0, 2.0, -1.0))
         sphere.scale = (2, 2, 2)
         displace = sphere.modifiers.new("Grow", 'DISPLACE')
         displace.strength = 0.4  # no texture: every vertex moves 0.5 * strength along its normal
         radius = 2 * (self.R + 0.2)
-        bpy.context.scene.wiresculpt.target = sphere
+        bpy.context.scene.wiresculpt.model = sphere
         self.assertEqual(bpy.ops.wiresculpt.add_plane(), {'FINISHED'})
         handle = bpy.context.view_layer.objects.active
         self.assertLess((handle.location - Vector((1, 2, -1))).length, 1e-4)  # world centre
@@ -166,9 +166,9 @@ class SliceSphere(AddonCase):
         (item,) = items_of(handle.name)
         self.assertLengthNear(item.length, circle_length(radius, 1.5))
 
-    def test_add_plane_at_target_centre(self):
+    def test_add_plane_at_model_centre(self):
         sphere = uv_sphere(0.5, (1, 2, 3))
-        bpy.context.scene.wiresculpt.target = sphere
+        bpy.context.scene.wiresculpt.model = sphere
         result, _reports = run(slicing.WIRESCULPT_OT_add_plane)
         self.assertEqual(result, {'FINISHED'})
         handle = bpy.data.objects["Slice A"]
@@ -181,8 +181,8 @@ class SliceSphere(AddonCase):
         self.assertEqual(bpy.context.view_layer.objects.active, handle)
         run(slicing.WIRESCULPT_OT_add_plane)
         self.assertIn("Slice B", bpy.data.objects)
-        self.assertFalse(wiresculpt.props._poll_target(None, handle))
-        self.assertTrue(wiresculpt.props._poll_target(None, sphere))
+        self.assertFalse(wiresculpt.props._poll_model(None, handle))
+        self.assertTrue(wiresculpt.props._poll_model(None, sphere))
 
 
 @unittest.skipUnless(native.available(), "the native module is not built")
@@ -198,7 +198,7 @@ class Ticks(AddonCase):
         bm.free()
         obj = bpy.data.objects.new("Pair", mesh)
         bpy.context.scene.collection.objects.link(obj)
-        bpy.context.scene.wiresculpt.target = obj
+        bpy.context.scene.wiresculpt.model = obj
         return obj
 
     def test_longest_ticked_by_default(self):
@@ -365,24 +365,24 @@ class Ticks(AddonCase):
 
 
 class Refusals(AddonCase):
-    def test_no_target(self):
+    def test_no_model(self):
         for operator in (slicing.WIRESCULPT_OT_slice, slicing.WIRESCULPT_OT_add_plane):
             result, reports = run(operator)
             self.assertEqual(result, {'CANCELLED'})
             self.assertEqual(reports[-1][0], {'ERROR'})
-            self.assertIn("target", reports[-1][1].lower())
-        with self.assertRaisesRegex(RuntimeError, "target"):  # errors reach scripts, too
+            self.assertIn("model", reports[-1][1].lower())
+        with self.assertRaisesRegex(RuntimeError, "model"):  # errors reach scripts, too
             bpy.ops.wiresculpt.slice()
 
     def test_no_handles(self):
-        bpy.context.scene.wiresculpt.target = uv_sphere()
+        bpy.context.scene.wiresculpt.model = uv_sphere()
         result, reports = run(slicing.WIRESCULPT_OT_slice)
         self.assertEqual(result, {'CANCELLED'})
         self.assertIn("slicing plane", reports[-1][1].lower())
 
     @unittest.skipUnless(native.available(), "the native module is not built")
     def test_flat_handle_named(self):
-        bpy.context.scene.wiresculpt.target = uv_sphere()
+        bpy.context.scene.wiresculpt.model = uv_sphere()
         add_handle((0, 0, 0))
         flat = add_handle((0, 0, 0.3))
         flat.scale.z = 0
@@ -392,7 +392,7 @@ class Refusals(AddonCase):
         self.assertEqual(contour_objects(), [])
 
     def test_solver_error_reported(self):
-        bpy.context.scene.wiresculpt.target = uv_sphere()
+        bpy.context.scene.wiresculpt.model = uv_sphere()
         add_handle((0, 0, 0))
         saved_module, saved_slice = native.module, native.slice_mesh
 
@@ -449,7 +449,7 @@ class Registration(AddonCase):
 
     def test_long_plane_names_show_in_full(self):
         """A plane name the sidebar would cut ("Meri…") is shown whole in the details box of the
-        active contour, wrapped to lines that fit the region (issue 21, part 6)."""
+        active contour, wrapped to lines that fit the region."""
         settings = bpy.context.scene.wiresculpt
         settings.contours.clear()
         name = "Meridian through both poles at ninety degrees"
@@ -495,7 +495,7 @@ class WithoutNative(AddonCase):
 
     def test_registers_and_slice_cancels_with_reason(self):
         self.assertTrue(hasattr(bpy.types, "WIRESCULPT_OT_slice"))
-        bpy.context.scene.wiresculpt.target = uv_sphere()
+        bpy.context.scene.wiresculpt.model = uv_sphere()
         add_handle((0, 0, 0))
         result, reports = run(slicing.WIRESCULPT_OT_slice)
         self.assertEqual(result, {'CANCELLED'})

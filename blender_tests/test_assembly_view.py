@@ -1,5 +1,5 @@
 """What the assembly slider (Show After Step) hides, overlays included, and Suggest Planes' count
-set in the panel (issue 48 item 6), in the background (the Live timer's steps run by hand):
+set in the panel, in the background (the Live timer's steps run by hand):
     blender --background --factory-startup --python-exit-code 1 --python blender_tests/run.py -- assembly_view
 The wires each step adds are the design's own assembly_steps; what is shown is checked against them."""
 import os

@@ -1,4 +1,4 @@
-"""The headless batch run (FORMATS.md) as a user runs it: a separate Blender process per run."""
+"""The headless batch run (docs/formats.md) as a user runs it: a separate Blender process per run."""
 import json
 import math
 import os
@@ -103,7 +103,7 @@ class BatchTest(unittest.TestCase):
             self.assertNotIn("predicted", w)
 
     def check_targets(self, d):
-        """The target shapes against FORMATS.md and the machine, computed from the points alone."""
+        """The target shapes against docs/formats.md and the machine, computed from the points alone."""
         l_min, max_bend = d["machine"]["min_segment"], math.radians(d["machine"]["max_bend_deg"])
         for w in d["wires"]:
             t, n, o = w["target"], w["plane"]["normal"], w["plane"]["origin"]

@@ -1,4 +1,4 @@
-"""The batch run's scene outputs (issue 7): sculpture.blend, render.png and the assembly guide,
+"""The batch run's scene outputs: sculpture.blend, render.png and the assembly guide,
 next to design.json, from a separate headless Blender as a user runs it."""
 import json
 import os
@@ -53,7 +53,7 @@ class BatchOutputs(unittest.TestCase):
             self.assertIn(stage, stages)
 
     def test_outputs_are_0644_and_the_blend_is_complete(self):
-        """Issue 18: design.json and the guide were 0600; the .blend is verified by its end block."""
+        """design.json and the guide are 0644, not 0600; the .blend is verified by its end block."""
         import stat
         for root, dirs, files in os.walk(self.out):
             for name in files:

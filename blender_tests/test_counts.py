@@ -1,4 +1,4 @@
-"""One count, one figure (issue 48 item 4) in Blender: Apply of a plane candidate says as many
+"""One count, one figure in Blender: Apply of a plane candidate says as many
 contours "used as wires" as it ticks (the candidate's wires), not the Slice defaults it started
 from; and Optimize's messages give the design's own wire lengths.
     blender --background --factory-startup --python-exit-code 1 --python blender_tests/run.py -- counts"""

@@ -1,4 +1,4 @@
-"""Forces, rest shapes, cuts and load capacity in the headless batch run (FORMATS.md `force`, `rest`,
+"""Forces, rest shapes, cuts and load capacity in the headless batch run (docs/formats.md `force`, `rest`,
 `cut`), checked on the globe example against the contract, not against the solver's own numbers."""
 import json
 import math

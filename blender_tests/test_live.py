@@ -1,4 +1,4 @@
-"""Live (issue 17 part 2) in a Blender with a window under Xvfb (timers need the event loop): a
+"""Live in a Blender with a window under Xvfb (timers need the event loop): a
 plane moved in steps turns the live verdict stable -> not stable (near the top of the mesh) ->
 cannot solve (the plane left the mesh: its ticked contour is gone) -> stable, the latest position wins over a running solve, no tick of the
 live timer blocks the UI for more than 50 ms, and turning Live off or loading a file stops the
@@ -10,7 +10,7 @@ import unittest
 from helpers import ROOT, BlenderCase, run_under_xvfb
 
 SCRIPT = os.path.join(ROOT, "blender_tests", "ui_live.py")
-TICK_LIMIT = 0.050  # issue 17: no step blocks the UI for more than 50 ms (the one time assertion)
+TICK_LIMIT = 0.050  # no step blocks the UI for more than 50 ms (the one time assertion)
 
 
 def stands(verdict):
@@ -94,7 +94,7 @@ class LiveAcrossScenes(unittest.TestCase):
 
 class LiveRefused(BlenderCase):
     """The toggle refuses targets over live.MAX_TRIANGLES, counted with their modifiers, with a
-    sentence the panel shows while that target is picked."""
+    sentence the panel shows while that model is picked."""
 
     def test_large_mesh_is_refused(self):
         import bpy
@@ -102,16 +102,16 @@ class LiveRefused(BlenderCase):
         from wiresculpt.live import engine as live
 
         bpy.ops.mesh.primitive_grid_add(x_subdivisions=320, y_subdivisions=320)  # 320² quads: 204,800 triangles
-        target = bpy.context.view_layer.objects.active
+        model = bpy.context.view_layer.objects.active
         ws = bpy.context.scene.wiresculpt
-        ws.target = target
+        ws.model = model
         ws.live = True
         self.assertFalse(ws.live)
         self.assertFalse(bpy.app.timers.is_registered(live.tick))
         self.assertIn("204,800 triangles", live.refused_message(ws))
         self.assertIn("100,000", live.refused_message(ws))
         bpy.ops.mesh.primitive_cube_add()
-        ws.target = bpy.context.view_layer.objects.active
+        ws.model = bpy.context.view_layer.objects.active
         self.assertEqual(live.refused_message(ws), "")  # it spoke of the grid
         ws.live = True
         self.assertTrue(ws.live)
@@ -129,7 +129,7 @@ class LiveRefused(BlenderCase):
         subsurf = cube.modifiers.new("Subdivision", 'SUBSURF')
         subsurf.levels = 7  # 6 · 4⁷ quads: 196,608 triangles
         ws = bpy.context.scene.wiresculpt
-        ws.target = cube
+        ws.model = cube
         ws.live = True
         self.assertFalse(ws.live)
         self.assertIn("196,608 triangles", live.refused_message(ws))
@@ -152,7 +152,7 @@ def drawn_live():
 
 
 class LiveFollowsTheScene(BlenderCase):
-    """What Live sees besides moved planes (a maker's trial under Xvfb, issue 17): the panel's
+    """What Live sees besides moved planes (a maker's trial under Xvfb): the panel's
     settings, the target's geometry and presence, the toggle set without its update (undo, a scene
     switch), and errors. The timer's steps are run by hand (no timers run in the background)."""
 
@@ -160,7 +160,7 @@ class LiveFollowsTheScene(BlenderCase):
         super().setUp()
         from helpers import globe
 
-        self.target = globe()
+        self.model = globe()
         self.ws = self.scene().wiresculpt
 
     def tearDown(self):
@@ -197,7 +197,7 @@ class LiveFollowsTheScene(BlenderCase):
 
         from wiresculpt.live import engine as live
 
-        return max(float(np.max(np.linalg.norm(lines - np.asarray(self.target.location), axis=1)))
+        return max(float(np.max(np.linalg.norm(lines - np.asarray(self.model.location), axis=1)))
                    for _colour, lines in live.observed().preview)
 
     def test_settings_are_part_of_the_verdict(self):
@@ -226,7 +226,7 @@ class LiveFollowsTheScene(BlenderCase):
         self.ws.max_bend_deg, self.ws.min_bend_deg = max_bend, min_bend
         self.assertStands(self.settle())
 
-    def test_edits_and_modifiers_of_the_target_are_seen(self):
+    def test_edits_and_modifiers_of_the_model_are_seen(self):
         import bpy
         from mathutils import Matrix
 
@@ -236,29 +236,29 @@ class LiveFollowsTheScene(BlenderCase):
         self.assertStands(self.settle())
         before, seen = self.extent(), live.observed().geometry
         self.assertAlmostEqual(before, 0.125, delta=0.01)  # the wires lie on the globe
-        self.target.data.transform(Matrix.Scale(0.6, 4))  # an edit of the mesh, its matrix unchanged
-        self.target.data.update()
+        self.model.data.transform(Matrix.Scale(0.6, 4))  # an edit of the mesh, its matrix unchanged
+        self.model.data.update()
         bpy.context.view_layer.update()
         self.assertGreater(live.observed().geometry, seen)
         self.settle()
         self.assertAlmostEqual(self.extent(), 0.6 * 0.125, delta=0.01)
         seen = live.observed().geometry
-        self.target.modifiers.new("Subdivision", 'SUBSURF')
+        self.model.modifiers.new("Subdivision", 'SUBSURF')
         bpy.context.view_layer.update()
         self.assertGreater(live.observed().geometry, seen)
         seen = live.observed().geometry
         self.settle()
         self.assertEqual(live.observed().geometry, seen)  # reading the mesh is no edit: no endless re-solving
 
-    def test_a_target_taken_out_of_the_scene(self):
+    def test_a_model_taken_out_of_the_scene(self):
         from wiresculpt.live import engine as live
 
         self.ws.live = True
         self.assertStands(self.settle())
-        for collection in self.target.users_collection:
-            collection.objects.unlink(self.target)
+        for collection in self.model.users_collection:
+            collection.objects.unlink(self.model)
         verdict = self.settle()
-        self.assertTrue(verdict.startswith(f"cannot solve — Target '{self.target.name}' is not in scene"), verdict)
+        self.assertTrue(verdict.startswith(f"cannot solve — Model '{self.model.name}' is not in scene"), verdict)
         self.assertEqual(live.observed().preview, [])
 
     def test_setup_problems_cannot_solve(self):
@@ -297,13 +297,13 @@ class LiveFollowsTheScene(BlenderCase):
             item.use = True
         self.assertStands(self.settle())
         with mock.patch.object(native, "available", return_value=False):
-            self.target.location.x += 0.001
+            self.model.location.x += 0.001
             bpy.context.view_layer.update()
             self.assertEqual(self.settle(),
                              "cannot solve — the solver is not loaded (the panel's first box says why)")
-        target, self.ws.target = self.ws.target, None
-        self.assertEqual(self.settle(), "cannot solve — No target mesh: pick one in the Wire panel (Target)")
-        self.ws.target = target
+        model, self.ws.model = self.ws.model, None
+        self.assertEqual(self.settle(), "cannot solve — No model mesh: pick one in the Wire panel (Model)")
+        self.ws.model = model
         self.assertStands(self.settle())
 
     def test_one_wire_cannot_solve(self):
@@ -354,18 +354,18 @@ class LiveFollowsTheScene(BlenderCase):
         self.assertStands(self.settle())
         refused = ValueError("three wires pass through one point: move one of the planes slightly")
         with mock.patch.object(live.pipeline, "solve", side_effect=refused):
-            self.target.location.x += 0.001
+            self.model.location.x += 0.001
             bpy.context.view_layer.update()
             self.assertEqual(self.settle(), "cannot solve — three wires pass through one point: move one of the "
                                             "planes slightly")
         with mock.patch.object(live.pipeline, "solve", side_effect=KeyError("hook")):
-            self.target.location.x += 0.001
+            self.model.location.x += 0.001
             bpy.context.view_layer.update()
             verdict = self.settle()
         self.assertEqual(verdict, "error — internal error (KeyError: 'hook'); please report it")
         self.assertEqual(panel.live_look(live.observed().kind), ('CANCEL', True))
         self.assertEqual(live.observed().preview, [])
-        self.target.location.x -= 0.002
+        self.model.location.x -= 0.002
         bpy.context.view_layer.update()
         self.assertStands(self.settle())
 
@@ -441,7 +441,7 @@ class LiveFollowsTheScene(BlenderCase):
             self.assertEqual(live.tick(), live.TICK_SECONDS)
             self.assertEqual(start.call_count, 1)  # tried again only once something changes
         self.assertEqual(live.line(), "Live: error — RuntimeError: the solver's thread could not start")
-        self.target.location.x += 0.001
+        self.model.location.x += 0.001
         bpy.context.view_layer.update()  # matrix_world follows (a window's event loop does it)
         self.assertStands(self.settle())
 
@@ -455,7 +455,7 @@ class LiveFollowsTheScene(BlenderCase):
 
         # As with GPU subdivision, the evaluated mesh the refusal counts is the cage (2,208
         # triangles); the triangles read for slicing are the subdivided ones, over 100,000.
-        self.target.modifiers.new("Subdivision", 'SUBSURF').levels = 3
+        self.model.modifiers.new("Subdivision", 'SUBSURF').levels = 3
         bpy.context.view_layer.update()
         with mock.patch.object(live, "triangle_count", return_value=2208):
             self.ws.live = True

@@ -1,4 +1,4 @@
-"""The mesh's faults in Blender's verdicts (issue 48 item 5): a target of two separate spheres
+"""The mesh's faults in Blender's verdicts: a model of two separate spheres
 (whose wires of one cannot hold the other's) makes Optimize, Find Stable Planes and Suggest
 Planes say what is wrong with the mesh and what to do, with the figures design.json keeps.
     blender --background --factory-startup --python-exit-code 1 --python blender_tests/run.py -- mesh_diagnostics"""
@@ -29,7 +29,7 @@ def two_spheres_target():
     obj = bpy.data.objects.new("two spheres", me)
     bpy.context.scene.collection.objects.link(obj)
     bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.target = obj
+    bpy.context.scene.wiresculpt.model = obj
     for rotation in ((0, 0, 0), (0, np.pi / 2, 0), (np.pi / 2, 0, 0)):  # z = 0 and y = 0 cut both spheres
         add_handle(rotation)
     assert bpy.ops.wiresculpt.slice() == {'FINISHED'}

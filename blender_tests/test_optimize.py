@@ -470,43 +470,43 @@ class StaleReport(Case):
         self.assertEqual(results_ui.report_changes(bpy.context), [])
         self.assertIn("Stable", labels(draw(results_ui.VIEW3D_PT_wiresculpt_report)))
 
-    def test_editing_or_moving_the_target_and_back(self):
-        """Optimize records a digest of the triangles it sliced; an edit or a move of the target
+    def test_editing_or_moving_the_model_and_back(self):
+        """Optimize records a digest of the triangles it sliced; an edit or a move of the model
         makes the design an earlier one until the mesh is as it was (read again once the changes
-        have settled, blend/target_watch.py)."""
-        from wiresculpt.blend import target_watch
+        have settled, blend/model_watch.py)."""
+        from wiresculpt.blend import model_watch
 
         self.optimize()
         self.assertIn("mesh", scene_results.stored_inputs())
-        target = bpy.context.scene.wiresculpt.target
-        vertex = target.data.vertices[0]
+        model = bpy.context.scene.wiresculpt.model
+        vertex = model.data.vertices[0]
         z = vertex.co.z
         vertex.co.z = z + 0.01
-        target.data.update()
+        model.data.update()
         bpy.context.view_layer.update()
-        self.assert_stale(f"target {target.name} edited or moved")  # still changing: not read yet
-        target_watch._STATE["changed_at"] = 0.0  # settled
-        self.assert_stale(f"target {target.name} edited or moved")  # read again: another mesh
+        self.assert_stale(f"model {model.name} edited or moved")  # still changing: not read yet
+        model_watch._STATE["changed_at"] = 0.0  # settled
+        self.assert_stale(f"model {model.name} edited or moved")  # read again: another mesh
         vertex.co.z = z
-        target.data.update()
+        model.data.update()
         bpy.context.view_layer.update()
-        target_watch._STATE["changed_at"] = 0.0
+        model_watch._STATE["changed_at"] = 0.0
         self.assert_current()
-        x = target.location.x
-        target.location.x = x + 0.02  # the same mesh elsewhere: other contours
+        x = model.location.x
+        model.location.x = x + 0.02  # the same mesh elsewhere: other contours
         bpy.context.view_layer.update()
-        target_watch._STATE["changed_at"] = 0.0
-        self.assert_stale(f"target {target.name} edited or moved")
-        target.location.x = x
+        model_watch._STATE["changed_at"] = 0.0
+        self.assert_stale(f"model {model.name} edited or moved")
+        model.location.x = x
         bpy.context.view_layer.update()
-        target_watch._STATE["changed_at"] = 0.0
+        model_watch._STATE["changed_at"] = 0.0
         self.assert_current()
         # a frame change reports no update of an animated mesh: it counts as a possible change,
         # read again (the same mesh here: still current)
-        before = target_watch._STATE["generation"]
+        before = model_watch._STATE["generation"]
         bpy.context.scene.frame_set(bpy.context.scene.frame_current + 1)
-        self.assertGreater(target_watch._STATE["generation"], before)
-        target_watch._STATE["changed_at"] = 0.0
+        self.assertGreater(model_watch._STATE["generation"], before)
+        model_watch._STATE["changed_at"] = 0.0
         self.assert_current()
 
     def test_fabrication_says_its_files_follow_the_earlier_design(self):
@@ -566,7 +566,7 @@ class StaleReport(Case):
         item.use = True
         self.assert_current()
 
-    def test_changing_max_bend_and_the_target(self):
+    def test_changing_max_bend_and_the_model(self):
         self.optimize()
         ws = bpy.context.scene.wiresculpt
         before = ws.max_bend_deg
@@ -582,34 +582,34 @@ class StaleReport(Case):
         self.assert_stale("settings changed (Material)")
         ws.property_unset("material_preset")
         self.assert_current()
-        target = ws.target
-        other = target.copy()
-        other.data = target.data.copy()
+        model = ws.model
+        other = model.copy()
+        other.data = model.data.copy()
         bpy.context.scene.collection.objects.link(other)
-        ws.target = other
-        self.assert_stale("target changed")
-        ws.target = target
+        ws.model = other
+        self.assert_stale("model changed")
+        ws.model = model
         self.assert_current()
 
-    def test_the_target_s_name_is_read_one_way(self):
-        """blend/handles.target_name: the record Optimize keeps, Live's snapshot and the stale check
-        read the picked target's name, "" without one, alike."""
-        from wiresculpt.blend.handles import target_name
+    def test_the_model_s_name_is_read_one_way(self):
+        """blend/handles.model_name: the record Optimize keeps, Live's snapshot and the stale check
+        read the picked model's name, "" without one, alike."""
+        from wiresculpt.blend.handles import model_name
         from wiresculpt.live import engine as live
 
         self.optimize()
         scene = bpy.context.scene
         ws = scene.wiresculpt
-        target = ws.target
-        self.assertEqual(target_name(ws), target.name)
-        self.assertEqual(scene_results.stored_inputs()["target"], target.name)
-        self.assertEqual(live.snapshot(scene)[0], target.name)
-        ws.target = None
-        self.assertEqual(target_name(ws), "")
+        model = ws.model
+        self.assertEqual(model_name(ws), model.name)
+        self.assertEqual(scene_results.stored_inputs()["target"], model.name)
+        self.assertEqual(live.snapshot(scene)[0], model.name)
+        ws.model = None
+        self.assertEqual(model_name(ws), "")
         self.assertEqual(optimize.solve_record(scene, {}, {})["target"], "")
         self.assertEqual(live.snapshot(scene)[0], "")
-        self.assertIn("target changed", results_ui.report_changes(bpy.context))
-        ws.target = target
+        self.assertIn("model changed", results_ui.report_changes(bpy.context))
+        ws.model = model
         self.assert_current()
 
     def test_a_reloaded_file_is_current(self):

@@ -1,4 +1,4 @@
-"""Nothing leaks between files or scenes (issue 48 item 1): the plane assistant's candidates are
+"""Nothing leaks between files or scenes: the plane assistant's candidates are
 the file's and scene's they were made for. Each file here has the same scene name ("Scene") and the
 same slicing planes ("Slice A".."Slice E", the hinged globe of helpers.hinge_scene), so a result
 keyed by names alone would be listed and applied in the other file.

@@ -57,10 +57,10 @@ INSTALL = textwrap.dedent("""
     mesh = importlib.import_module(name + ".blend.mesh")
     results = importlib.import_module(name + ".blend.results")
     _V, _F, objects = mesh.import_mesh(globe_obj)
-    target = objects[0]
-    target.scale = (float(radius),) * 3
+    model = objects[0]
+    model.scale = (float(radius),) * 3
     bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.target = target
+    bpy.context.scene.wiresculpt.model = model
     for rotation in ((0, 0, 0), (0, math.pi / 2, 0), (math.pi / 2, 0, 0)):
         assert bpy.ops.wiresculpt.add_plane() == {'FINISHED'}
         bpy.context.view_layer.objects.active.rotation_euler = rotation
@@ -106,7 +106,7 @@ OPTIMIZE = textwrap.dedent("""
     _V, _F, objects = import_mesh(globe_obj)
     objects[0].scale = (0.125,) * 3
     bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.target = objects[0]
+    bpy.context.scene.wiresculpt.model = objects[0]
     for rotation in ((0, 0, 0), (0, math.pi / 2, 0), (math.pi / 2, 0, 0)):
         bpy.ops.wiresculpt.add_plane()
         bpy.context.view_layer.objects.active.rotation_euler = rotation
@@ -231,7 +231,7 @@ class PackageTest(unittest.TestCase):
             self.assertGreaterEqual(wires, 3)
 
     def test_the_extension_zip_explains_itself_to_a_legacy_install(self):
-        """Blender 3.4's Add-ons > Install with the extension zip (issue 48): Blender lists exactly
+        """Blender 3.4's Add-ons > Install with the extension zip: Blender lists exactly
         one new add-on, whose name, description and warning say which zip to use; enabling it
         fails with the sentence naming the add-on zip, registers nothing of wiresculpt, and the
         add-on zip's name differs from the extension's by more than a platform spelling."""

@@ -1,4 +1,4 @@
-"""Find Stable Planes / Suggest Planes / Apply in Blender (issue 15), background mode (the search
+"""Find Stable Planes / Suggest Planes / Apply in Blender, background mode (the search
 runs inline): the globe with five slicing planes of which "Slice E" (x = 0.8 R) crosses only the
 plane y = 0, on one line (a hinge: planes z = c1 and x = c2 cut circles of the unit sphere that
 cross iff c1^2 + c2^2 < 1, and Slice A/B are at z = +-0.7).
@@ -164,7 +164,7 @@ class FindStablePlanes(Case):
         self.assertIsNone(ops.RESULT)
 
     def test_apply_without_a_search_is_refused(self):
-        """The button stays pressable (poll) and says why it does nothing (issue 48)."""
+        """The button stays pressable (poll) and says why it does nothing."""
         before = placements()
         with self.assertRaises(ops.Refused) as ctx:
             ops.apply_candidate(bpy.context, 0)

@@ -1,4 +1,4 @@
-"""settings.plane_search in the headless batch (issue 15): exit status, design.json's record, the
+"""settings.plane_search in the headless batch: exit status, design.json's record, the
 wires' planes and the saved slicing handles are the planes used. The globe (radius 1 in the file,
 size 0.25: radius 0.125 m) with planes whose circles cross by hand (z = c1, x = c2 cross iff
 c1^2 + c2^2 < 1): W at x = 0.8 crosses only Y, on one line (a hinge)."""

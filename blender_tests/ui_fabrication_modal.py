@@ -27,7 +27,7 @@ MODES = ("G21", "G91", "G94")
 seen = {}
 links = {}
 tmp = tempfile.mkdtemp(prefix="wiresculpt_modal_")
-atexit.register(shutil.rmtree, tmp, True)  # every run used to leave its export folder in /tmp
+atexit.register(shutil.rmtree, tmp, True)  # no run leaves its export folder in /tmp
 
 
 def ring(n=12, side=0.04):

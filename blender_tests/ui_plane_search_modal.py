@@ -38,7 +38,7 @@ def setup():
     _V, _F, objs = import_mesh(GLOBE_OBJ)
     objs[0].scale = (R,) * 3
     bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.target = objs[0]
+    bpy.context.scene.wiresculpt.model = objs[0]
     for rotation, location in HINGE:
         bpy.ops.wiresculpt.add_plane()
         handle = bpy.context.view_layer.objects.active
@@ -99,13 +99,13 @@ def check_full():
         return 0.2
     seen["candidates"] = len(ops.RESULT["candidates"]) if ops.RESULT else 0
     seen["search_unchanged"] = state() == seen["before_full"]
-    # A marker step the preview must not hide: the target moved 1 m and pushed as an undo step.
-    # If clicking Preview pushed a step, the Undo below would undo that step and leave the target
+    # A marker step the preview must not hide: the model moved 1 m and pushed as an undo step.
+    # If clicking Preview pushed a step, the Undo below would undo that step and leave the model
     # moved; with no step, it undoes the move.
-    target = bpy.context.scene.wiresculpt.target
-    target.location.x += 1.0
+    model = bpy.context.scene.wiresculpt.model
+    model.location.x += 1.0
     with override():
-        bpy.ops.ed.undo_push(message="marker: target moved")
+        bpy.ops.ed.undo_push(message="marker: model moved")
         marked = state()
         # undo=True: as a click on the panel's button runs it (an operator with UNDO pushes a step)
         seen["preview"] = sorted(bpy.ops.wiresculpt.preview_planes('INVOKE_DEFAULT', True, index=0))
@@ -129,8 +129,8 @@ def check_preview_drawn():
     seen["preview_no_data"] = state() == seen.pop("moved_state")
     with override():
         bpy.ops.ed.undo()
-    target = bpy.context.scene.wiresculpt.target
-    seen["undo_took_the_marker"] = abs(target.location.x) < 1e-9 and state() == seen["before_full"]
+    model = bpy.context.scene.wiresculpt.model
+    seen["undo_took_the_marker"] = abs(model.location.x) < 1e-9 and state() == seen["before_full"]
     seen["preview_kept_by_undo"] = ops.PREVIEW is not None
     with override():
         bpy.ops.ed.undo_push(message="before Apply")

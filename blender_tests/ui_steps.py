@@ -66,7 +66,7 @@ def globe_scene():
     _V, _F, objs = import_mesh(os.path.join(root, "scripts", "examples", "globe", "globe.obj"))
     objs[0].scale = (0.125,) * 3
     bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.target = objs[0]
+    bpy.context.scene.wiresculpt.model = objs[0]
     for rotation in ((0, 0, 0), (0, math.pi / 2, 0), (math.pi / 2, 0, 0)):
         bpy.ops.wiresculpt.add_plane()
         bpy.context.view_layer.objects.active.rotation_euler = rotation

@@ -8,7 +8,7 @@ prints one JSON document on stdout: the design's P, C, longest wire, verdict, an
 median over the runs of every number the stage records in design["stages"] (stage names are read
 from the design, so new stages appear without changes here), plus the wall time between the
 pipeline's progress calls (which includes the Python glue around the native calls). Then the same design solved with the
-layering's own hooks (pipeline.solve(hook_patterns=1), as Live solves; issue 17's whole solve),
+layering's own hooks (pipeline.solve(hook_patterns=1): the whole solve as Live runs it),
 its median wall time as own_hooks_solve_seconds.
 
 Repeats: the first solve decides, so slow cases stay affordable: as many runs as fit in
@@ -130,7 +130,7 @@ def run(scene_path, budget, max_repeats):
     for _ in range(repeats - 1):
         runs.append(solve_once(sliced, scene))
 
-    # Issue 17's whole solve: layering, target shape, forces and rest shape with the layering's own
+    # The whole solve as Live runs it: layering, target shape, forces and rest shape with the layering's own
     # hooks (the hook search limited to one pattern, as Live solves), repeated like the runs above.
     first = solve_once(sliced, scene, hook_patterns=1)
     own_hooks = [first] + [solve_once(sliced, scene, hook_patterns=1)

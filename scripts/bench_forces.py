@@ -1,6 +1,7 @@
-"""Pre-stress, closure gaps and out-of-plane figures (issue 16, docs/method-forces.md §10-12): each
-scene solved twice in-process, as before issue 16 ("today": torque fraction 1, the layering's first
-hook pattern) and now (load factor 3, hooks chosen by their forces), one markdown table on stdout:
+"""Pre-stress, closure gaps and out-of-plane figures (docs/method-forces.md §10-12): each
+scene solved twice in-process, without the pre-stress and the hook choice ("today": torque fraction
+1, the layering's first hook pattern) and now (load factor 3, hooks chosen by their forces), one
+markdown table on stdout:
 
     /usr/bin/python3.11 scripts/bench_forces.py SCENE.json [SCENE.json ...]
 

@@ -1,4 +1,4 @@
-"""The live round trip of scripts/bench (issue 17): a plane moved -> the verdict shown, in a Blender
+"""The live round trip of scripts/bench: a plane moved -> the verdict shown, in a Blender
 with a window (the Live toggle's timer needs the event loop):
 
     xvfb-run -a blender --factory-startup --python-exit-code 1 --python scripts/bench_live.py -- \
@@ -58,7 +58,7 @@ def load_case(manifest_dir, case):
     objects[0].matrix_world = Matrix.Scale(factor, 4) @ objects[0].matrix_world
     bpy.context.view_layer.update()
     scene = bpy.context.scene
-    scene.wiresculpt.target = objects[0]
+    scene.wiresculpt.model = objects[0]
     add_handles(scene, scaled_planes(scene_file.planes, factor), sliced)
     handle = scene.objects[scene_file.planes[0].name]
     return handle, Vector(scene_file.planes[0].normal).normalized(), len(sliced["wires"])

@@ -153,7 +153,7 @@ def paper_table(cases):
         def ratio(x):
             return f" ({x / total:.1%})" if total and x is not None else ""
 
-        # Issue 17's whole solve: pipeline.solve with the layering's own hooks (as Live solves).
+        # The whole solve as Live runs it: pipeline.solve with the layering's own hooks (as Live solves).
         own = c.get("own_hooks_solve_seconds")
         ours.append(f"{theirs(total)} / {secs(own)}{ratio(own)}" + ("" if c.get("own_hooks_stable", True) else ", not stable"))
         trip, job = (c.get("live") or {}).get("median"), (c.get("live") or {}).get("job_median")
@@ -280,7 +280,7 @@ def prose(cases, names):
                    + (f" (about length^{k_t:.1f})" if k_t else "") + f". That is {min(per_m):,.0f}–{max(per_m):,.0f} "
                    f"energy evaluations per metre of wire and {statistics.median(s_per_pt):.2f} ms per point: the "
                    "windowed solve (8-point windows swept until nothing moves by 0.1 µm, each by a Newton SQP "
-                   "that converges in 4–6 iterations; docs/method-target-shape.md, issue 17 fifth and sixth rounds) keeps each "
+                   "that converges in 4–6 iterations; docs/method-target-shape.md, The solver) keeps each "
                    "iteration small, so the cost is the number of sweeps times the number of windows. The paper saw "
                    "the same effect (its Airplane, two long wires, 51 s).")
         capped = [c for c in everything if any("MAXEVAL" in str(w) for w in [c.get("nlopt_result", "")])]
@@ -365,7 +365,7 @@ def markdown(data):
         + f", {m['cores']} cores, {m['system']}, Python {m['python']}; wiresculpt {data['version']}; "
         f"{data.get('date', '')}.",
         "The solver's stages are single-threaded except the target shape, which solves up to two wires at "
-        "once (issue 17; its CPU seconds can then exceed its wall time). Pipeline times are medians over repeated solves of one "
+        "once (its CPU seconds can then exceed its wall time). Pipeline times are medians over repeated solves of one "
         "sliced design (1–5 runs: as many as fit in about 12 s), each case in its own process; peak memory is "
         "that process's maximum resident set (Python, numpy, the mesh and the solver).",
     ]
@@ -391,11 +391,11 @@ def markdown(data):
             "wire is as long as the paper's l_max. The generator slices and layers every scene and stops if (P, C) "
             "differ; the table shows the counts the bench measured. Paper: 3.80 GHz desktop, one thread, GLPK and "
             "KNitro, 2016. Its *R.Conf.* (rest configuration) is our forces + rest shape stages. *Hook search* "
-            "(issue 16, beyond the paper) solves the target shape and forces again for the other hook patterns "
+            "(beyond the paper) solves the target shape and forces again for the other hook patterns "
             "of equal Eq. 2 cost and keeps the one whose forces are best (docs/method-forces.md §12); its "
             "seconds include the chosen pattern's target shape and forces, so the whole solve with hook search "
             "is the wall time of pipeline.solve, not the sum of the columns. *Whole solve, layering's hooks* "
-            "(issue 17) is the wall time of pipeline.solve limited to the layering's own hook pattern "
+            "is the wall time of pipeline.solve limited to the layering's own hook pattern "
             "(`hook_patterns=1`, as Live solves): layering, target shape, forces and rest shape, with "
             "re-layering rounds where they happen; the ratio is to the sum of the paper's three stages. "
             "*Live round trip* (`scripts/bench_live.py`, Blender 3.4 with a window under Xvfb, 1280×800, "
@@ -407,7 +407,7 @@ def markdown(data):
             "about 0.2 s, the viewport's default anti-aliasing redraws it 8 times after every change, and "
             "the timer only runs between redraws, so the round trip is about four redraws (the move's, the "
             "one after the timer first sees it, the one the solve runs beside, the verdict's) plus the job; "
-            "with a GPU a redraw takes milliseconds (docs/method-target-shape.md, issue 17 seventh round). The globe "
+            "with a GPU a redraw takes milliseconds (docs/history/target-shape-rounds.md). The globe "
             "is the bundled example (scripts/examples/globe), which has no counterpart in the paper.",
             "",
         ]

@@ -3,7 +3,7 @@
     /usr/bin/python3.11 scripts/bench_scenes.py [--out out/bench] [--no-check] [NAME...]
 
 Writes OUT/meshes/*.obj (triangle meshes of implicit shapes, meshed by marching tetrahedra, or
-analytic UV ellipsoids) and OUT/<case>.json (scene files, FORMATS.md) plus OUT/manifest.json, the
+analytic UV ellipsoids) and OUT/<case>.json (scene files, docs/formats.md) plus OUT/manifest.json, the
 list of cases the bench runs:
 
 - `paper`: five stand-ins for the models of the paper's Table 2 (Duck, Teddy, Airplane, Car,

@@ -1,4 +1,4 @@
-"""The target-shape stage alone, timed as Live runs it (issue 17's measure), for comparing builds:
+"""The target-shape stage alone, timed as Live runs it, for comparing builds:
 
     /usr/bin/python3.11 scripts/bench_target.py [--root CHECKOUT] [--reps N] [--json OUT] [NAME...]
 

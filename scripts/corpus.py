@@ -305,7 +305,7 @@ def prepare(cache, only=()):
 # ---------------------------------------------------------------- bench
 
 BEGIN, END = "<!-- corpus:begin -->", "<!-- corpus:end -->"
-BEFORE = "corpus-before.json"  # the run before the re-layering of issue 20, kept for its columns
+BEFORE = "corpus-before.json"  # the run without re-layering, kept for its columns
 TIMEOUT = 600  # s per batch run
 
 
@@ -351,7 +351,7 @@ def run_scene(entry, out_root):
 
 
 # scripts/bench's Table 2 stand-ins and sphere sweep: the re-layering's cost where the first
-# layering already works (issue 20: under 2x the solve time without it)
+# layering already works (under 2x the solve time without it)
 OVERHEAD_CASES = ("duck", "teddy", "airplane", "car", "chair", "sphere-112", "sphere-222", "sphere-332",
                   "sphere-333", "sphere-443", "sphere-444", "sphere-544", "sphere-554", "sphere-555")
 
@@ -409,7 +409,7 @@ def _relayered(rows):
 def overhead_lines(rows):
     lines = ["", "### Re-layering's cost where the first layering already works", "",
              "`scripts/bench`'s Table 2 stand-ins and sphere sweep, each solved by `scripts/bench_case.py` in its "
-             "own process (median of up to 3 solves) with `relayer_rounds` 0 (layer once, as before issue 20) and "
+             "own process (median of up to 3 solves) with `relayer_rounds` 0 (layer once, without re-layering) and "
              "with the default, back to back. CPU: the solve's process CPU seconds (the machine is shared; wall "
              "times include other work). Where the first layering already works (stable once and with the loop) "
              "the loop runs one round and adds only a copy of the design: those ratios are the noise of a shared "
@@ -452,19 +452,19 @@ def first_words(text, n=9):
 
 
 def section(results, before=None):
-    """The docs section; `before`: an earlier corpus.json (docs/corpus-before.json, the run before the
-    re-layering of issue 20) whose verdicts are shown beside these."""
+    """The docs section; `before`: an earlier corpus.json (docs/corpus-before.json, the run
+    without re-layering) whose verdicts are shown beside these."""
     meshes, rows = results["meshes"], results["runs"]
     old = {r["name"]: r for r in (before or {}).get("runs", [])}
     then = (f" The \"before\" columns are docs/corpus-before.json ({before['date']}, commit {before['commit']}, "
-            "before the re-layering of issue 20); \"after\" is this run, with re-layering (rounds: layerings "
+            "without re-layering); \"after\" is this run, with re-layering (rounds: layerings "
             "run, 1 when the first one was kept; forbidden: (crossing, hook) pairs the target shape could not "
             "realise; seconds: the whole solve of every round). Forbidding a hook the target shape failed is a "
             "heuristic (it failed beside the other hooks of that round), so an unstable end after re-layering "
             "is not a proof that no design exists (docs/method-layering.md, Re-layering). The re-check is "
             "independent of the solver and also checks the machine's limits, as the solver's verdict now does "
             "(stable means buildable, fab/buildability.py); the solver also chooses hooks by their forces and "
-            "the least pre-stress for load factor 3 (issue 16), whose search is part of the solve seconds.") if before else ""
+            "the least pre-stress for load factor 3, whose search is part of the solve seconds.") if before else ""
     lines = [BEGIN, "## Real-mesh corpus", "",
              f"`scripts/bench corpus` ({results['date']}, commit {results['commit']}): "
              "the batch on every scene of `scripts/corpus.py` (meshes from Debian packages, "

@@ -1,4 +1,4 @@
-"""The plane assistant (issue 15) on the real-mesh corpus (scripts/corpus.py prepare), in-process
+"""The plane assistant on the real-mesh corpus (scripts/corpus.py prepare), in-process
 (system Python with the built module; no Blender): for every `zzxxy5` scene at the given size, the
 planes as given ("off"), then `plane_search: "nearby"`; and for every mesh `plane_search: "auto"`
 with N planes. Every stable design is re-checked (blender_tests/pure/recheck.py). Prints a
@@ -159,7 +159,7 @@ def section(path, rows, counts, args, load, commit):
                 f', and every mesh with `"auto"` (budget {plane_search.AUTO_SECONDS_PER_PLANE:g} s per plane, then at '
                 f"most {plane_search.FINAL_SECONDS:g} s for the comparison of hook patterns on the returned design)")
     counts_arg = args.counts or '""'
-    head = [BEGIN, "## Plane assistant on the real-mesh corpus (issue 15)", "",
+    head = [BEGIN, "## Plane assistant on the real-mesh corpus", "",
             f"`scripts/bench planes --size {args.size} --counts {counts_arg} --section docs/performance.md` "
             f"({datetime.date.today().isoformat()}, commit {commit}; `scripts/plane_search_corpus.py`, in-process with "
             "the system Python 3.11 and the built module, no Blender): every `zzxxy5` scene of the corpus at "

@@ -1,4 +1,4 @@
-"""Record, replay and compare the native target-shape calls of whole solves (issue 17's "same
+"""Record, replay and compare the native target-shape calls of whole solves (the "same
 optimum" check and its instruction counts, kept with the code rather than in /tmp):
 
     /usr/bin/python3.11 scripts/target_calls.py record CALLS.pkl [NAME...]

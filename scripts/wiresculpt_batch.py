@@ -1,4 +1,4 @@
-"""The headless wiresculpt run (FORMATS.md):
+"""The headless wiresculpt run (docs/formats.md):
 
     blender --background --factory-startup --python scripts/wiresculpt_batch.py -- SCENE.json --out DIR [--profile P.json]
 
@@ -95,7 +95,7 @@ def write_scene_outputs(design, objects, planes, factor, out, say, overlap=0.0):
         obj.hide_render = True
     start = time.perf_counter()
     if len(objects) == 1 and design["wires"]:
-        scene.wiresculpt.target = objects[0]
+        scene.wiresculpt.model = objects[0]
         add_handles(scene, planes, design)
     scene_results.write_results(scene, design)
     say("scene", f"{len(design['wires'])} wire curves, {len(design.get('crossings', []))} crossing markers "

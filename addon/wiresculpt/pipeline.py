@@ -102,7 +102,7 @@ def relayer(design, material, settings, context, hook_patterns=None, hook_second
     forbids up front the hooks that crossings too close along a wire rule out (layering.run's
     too_close, the target shape's own tolerance), which the loop would otherwise learn one round at a
     time; when the first layering finds no stable assembly without them, it layers again with every
-    hook and goes on as without them (the old path), so the target shape shows which hooks fail and
+    hook and goes on as without them (the every-hook path), so the target shape shows which hooks fail and
     why. Records every layering run in stages.relayering. Returns the design of
     the last round, or, when the last layering found no stable assembly under the forbidden hooks,
     of the last round that reached the target shape (its shapes and reason show why), saying so.
@@ -112,7 +112,7 @@ def relayer(design, material, settings, context, hook_patterns=None, hook_second
     extra_rounds = int(layering.knob(settings, "relayer_rounds"))
     # Layering replaces (never edits) each wire's contour, so the copies share the contours.
     pristine = _copy_sharing_contours(design) if extra_rounds else None
-    up_front = target_shape.REALISED_ANGLE if extra_rounds else None  # None: every hook (the old path)
+    up_front = target_shape.REALISED_ANGLE if extra_rounds else None  # None: every hook (the every-hook path)
     forbidden, too_close, rounds, start, shaped = set(), set(), [], time.perf_counter(), None
     hook_deadline = time.monotonic() + (HOOK_SECONDS if hook_seconds is None else hook_seconds)  # one bound for the hook searches of every round
     round_ = 0
@@ -128,7 +128,7 @@ def relayer(design, material, settings, context, hook_patterns=None, hook_second
         too_close = {tuple(p) for p in attempt.pop("too_close_forbidden", ())}  # never in a design.json
         if (up_front is not None and too_close and not attempt["stable"] and round_ == 0
                 and not attempt.get("search_incomplete")):
-            # Nothing holds without them: layer again with every hook (the old path, for every round),
+            # Nothing holds without them: layer again with every hook (the every-hook path, for every round),
             # so that the user sees the target shape's curves and its reason, as without the loop. (A
             # search that max_nodes stopped proved nothing; a larger one with every hook would rarely
             # finish either, so the loop stops on its verdict, as in any later round.)

@@ -6,6 +6,7 @@ properties below read them from there.
 import math
 
 import bpy
+from bpy.app.handlers import persistent
 from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, IntProperty,
                        PointerProperty, StringProperty)
 
@@ -19,8 +20,43 @@ from .core import materials, settings as settings_table
 from .fab import streaming
 
 
-def _poll_target(_settings, obj):
+def _poll_model(_settings, obj):
     return obj.type == 'MESH' and not is_handle(obj)
+
+
+OLD_MODEL_KEY = "target"  # the name under which a .blend saved by an earlier version keeps the model
+
+
+def adopt_old_model(scene):
+    """A scene saved while the model's property was named `target`: its pointer (an IDProperty
+    the PropertyGroup no longer declares) becomes `model`, once, and the old key goes away. A
+    model already picked wins; an old pointer to something that is not a mesh is dropped."""
+    settings = getattr(scene, "wiresculpt", None)
+    if settings is None or OLD_MODEL_KEY not in settings.keys():
+        return
+    old = settings.get(OLD_MODEL_KEY)
+    if settings.model is None and isinstance(old, bpy.types.Object) and _poll_model(settings, old):
+        settings.model = old
+    del settings[OLD_MODEL_KEY]
+
+
+def adopt_old_models():
+    """adopt_old_model for every scene of the open file."""
+    for scene in bpy.data.scenes:
+        adopt_old_model(scene)
+
+
+@persistent
+def _load_post(*_args):
+    adopt_old_models()
+
+
+def _adopt_after_register():
+    try:
+        adopt_old_models()
+    except AttributeError:  # bpy.data is restricted while add-ons register at start-up
+        pass
+    return None  # a one-shot timer
 
 
 # --- solver settings, from the one table ------------------------------------------------------
@@ -112,7 +148,7 @@ def solver_settings(settings):
 
 def solve_inputs(settings):
     """Every panel value material_of and solver_settings read, as they stand (not validated): what
-    a Live solve depends on besides the planes and the target, compared at every tick."""
+    a Live solve depends on besides the planes and the model, compared at every tick."""
     return (tuple(getattr(settings, key) for key in SETTING_PROPS + MATERIAL_PROPS + ("use_load_factor",))
             + (str(settings.id_data.get(MATERIAL_NAME_KEY, "")),))
 
@@ -188,8 +224,8 @@ class WiresculptContour(bpy.types.PropertyGroup):
 
 
 class WiresculptSettings(bpy.types.PropertyGroup):
-    target: PointerProperty(
-        name="Target", type=bpy.types.Object, poll=_poll_target,
+    model: PointerProperty(
+        name="Model", type=bpy.types.Object, poll=_poll_model,
         description="Mesh to turn into a wire sculpture (evaluated: modifiers and transform "
                     "applied)")
     contours: CollectionProperty(
@@ -243,7 +279,7 @@ class WiresculptSettings(bpy.types.PropertyGroup):
 
     live: BoolProperty(
         name="Live", default=False, update=_live_changed,
-        description="While a slicing plane or the target moves, re-slice and re-solve in the background "
+        description="While a slicing plane or the model moves, re-slice and re-solve in the background "
                     "and show stable / not stable (the layering's own hooks only; Optimize may pick "
                     "others). Refused for meshes over 100,000 triangles, counted with their modifiers")
 
@@ -322,9 +358,24 @@ class WiresculptCalibrationSettings(bpy.types.PropertyGroup):
 
 
 
-register, unregister = classes_factory(
+_register_classes, _unregister_classes = classes_factory(
     (WiresculptContour, WiresculptSettings, WiresculptCalibrationSettings),
     scene_properties=(("wiresculpt", WiresculptSettings, "Wire Sculpture",
                        "Settings and results of the wiresculpt add-on"),
                       ("wiresculpt_calibration", WiresculptCalibrationSettings, "Calibration",
                        "Settings of the calibration captures")))
+
+
+def register():
+    _register_classes()
+    bpy.app.handlers.load_post.append(_load_post)
+    try:
+        adopt_old_models()  # the add-on enabled in a file that is already open
+    except AttributeError:  # bpy.data is restricted while add-ons register at start-up: a moment later
+        bpy.app.timers.register(_adopt_after_register, first_interval=0.0)
+
+
+def unregister():
+    if _load_post in bpy.app.handlers.load_post:
+        bpy.app.handlers.load_post.remove(_load_post)
+    _unregister_classes()

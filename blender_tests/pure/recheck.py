@@ -4,7 +4,7 @@ and scipy only, apart from the solver's code path (no wiresculpt module, no nati
     recheck(design) -> list of problems (empty: the design keeps its promises)
     python3.11 blender_tests/pure/recheck.py DESIGN.json...     prints the problems, exit 1 if any
 
-What is checked (FORMATS.md "Design file"; Miguel, Lepoutre, Bickel 2016, Sec. 4.1-4.2):
+What is checked (docs/formats.md "Design file"; Miguel, Lepoutre, Bickel 2016, Sec. 4.1-4.2):
 
 (a) geometry
     - every `target` point lies on its wire's plane;
@@ -24,7 +24,7 @@ What is checked (FORMATS.md "Design file"; Miguel, Lepoutre, Bickel 2016, Sec. 4
     turned by atan(mu) towards its own arm. A wire's pyramid at crossing c is its own two
     (widened) normals and the negatives of the other wire's two (Newton's third law), the
     paper's B_c = {-b_{r-1}^(i), -b_r^(i), b_{s-1}^(j), b_s^(j)}. The hook decides which side
-    the kink opens to (FORMATS.md: hook = 1 means wires[0]'s bisector has h.d > 0 with
+    the kink opens to (docs/formats.md: hook = 1 means wires[0]'s bisector has h.d > 0 with
     d = normalize(n0 x n1), wires[1]'s h.d < 0): the geometry's bisector must agree (a problem
     otherwise); a straight kink (turn below `min_bend_deg`) takes h = +-d from the hook.
     Stable: for every column of L (a unit force or unit couple on one wire, its negative on the
@@ -320,7 +320,7 @@ def check_forces(design, pyramids):
 
 
 def recheck(design, prefixes=True):
-    """Every broken promise of a design (FORMATS.md, Sec. 4.1-4.2) as a sentence; [] if none."""
+    """Every broken promise of a design (docs/formats.md, Sec. 4.1-4.2) as a sentence; [] if none."""
     problems = check_geometry(design)
     stab, pyramids = check_stability(design, prefixes=prefixes)
     problems += stab

@@ -1,4 +1,4 @@
-"""A fuzz target over whole scene files (issue 47): JSON mutations of the seed scenes in
+"""A fuzz target over whole scene files: JSON mutations of the seed scenes in
 blender_tests/fuzz_scenes/ (the bundled globe's, corpus-style placements, plane search, settings,
 cuts) through the batch's scene reader, core.scene.load_scene.
 

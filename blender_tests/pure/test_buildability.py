@@ -1,4 +1,4 @@
-""""Stable" means buildable (FORMATS.md additions): the verdict of fab/buildability.py on designs
+""""Stable" means buildable (docs/formats.md, beyond the FORMATS contract): the verdict of fab/buildability.py on designs
 whose rest shapes are drawn by hand, so every number in the messages is known without the solver:
 a bend 0.1 deg over the machine's limit, a straight piece between two crossings shorter than the
 minimum segment, a rest shape that crosses itself (and its mark on the SVG template)."""

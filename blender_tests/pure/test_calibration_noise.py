@@ -1,4 +1,4 @@
-"""The cantilever's return check on noisy captures (issue 21 item 9): captures made IN THIS TEST
+"""The cantilever's return check on noisy captures: captures made IN THIS TEST
 from an independent elastica (a shooting solve of EI theta'' = -P cos theta, theta(0) = 0,
 theta'(L) = 0, written here; not the project's rod model or fit), with 0.5 mm Gaussian reading
 noise on every mark (fixed seeds). An elastic wire must be accepted (its unloaded shapes return)

@@ -1,4 +1,4 @@
-"""Captures that parse and fit but were probably not meant (issue 21 part 9): one load, a tilt in
+"""Captures that parse and fit but were probably not meant: one load, a tilt in
 radians, a 200° command, deflections typed in millimetres. Each gives a sentence naming the
 number; a plausible capture gives none."""
 import unittest

@@ -1,5 +1,5 @@
 """Export's message matches the design's state: an unstable result points at Stability, an
-unfinished one at Optimize (issue 21, part 6)."""
+unfinished one at Optimize."""
 import unittest
 
 from wiresculpt.fab import export

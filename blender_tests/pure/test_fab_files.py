@@ -284,7 +284,7 @@ class StreamThroughBinding(unittest.TestCase):
         self.assertEqual(again.received, ["G21", "G91", "G94"] + lines[first:])
 
     def test_strict_accounting_lenient_decoding_and_one_stream_per_port(self):
-        """Issue 18: 'ok ok' to one line stops before the next line is counted (the resume sends
+        """'ok ok' to one line stops before the next line is counted (the resume sends
         it); invalid UTF-8 in error: is a status, not UnicodeDecodeError; a second stream on a
         port in use is refused naming the holder."""
         w = native.require()

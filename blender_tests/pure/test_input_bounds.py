@@ -1,4 +1,4 @@
-"""Inputs bounded before any solve (issue 47): plane normals cleaned of components that are zero
+"""Inputs bounded before any solve: plane normals cleaned of components that are zero
 in all but representation, plane and wire names bounded and printable, --out checked, one writer
 per output folder (two real processes), a folder where a result file belongs refused, and the
 smaller cases (spring-back angles past a full turn, a pin axis of null or "\\n").

@@ -1,4 +1,4 @@
-"""Sanity before work (issue 18): the scene, the mesh file and the output folder are checked before
+"""Sanity before work: the scene, the mesh file and the output folder are checked before
 anything is solved, each problem one sentence naming the file, line, vertex or key
 (core/meshcheck.py, core/scene.py). Expected messages are written out by hand."""
 import json

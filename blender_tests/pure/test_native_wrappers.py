@@ -109,9 +109,8 @@ class Wrappers(unittest.TestCase):
         self.assertEqual(len(native.optimize_target_shapes(iter(problems))), 3)  # the other thread is free again
 
     def test_a_target_shape_problem_with_a_plane_is_placed_and_measured_as_numpy_does(self):
-        # The stage used to place each result with core.frames.to_3d and measure it with
-        # core.polylines.polyline_length (numpy); the native does it now on the solving thread: the
-        # same numbers to the bit. Wires of fewer than 8 points, of 8-128 and of more than 128 (numpy
+        # The native places each result in space and measures it on the solving thread; it must give
+        # what core.frames.to_3d and core.polylines.polyline_length (numpy) give, to the bit. Wires of fewer than 8 points, of 8-128 and of more than 128 (numpy
         # sums those in halves), open and closed, in tilted planes.
         from wiresculpt.core.frames import plane_frame, to_3d
         from wiresculpt.core.polylines import polyline_length

@@ -1,5 +1,5 @@
-"""Issue 18: every numeric option of the bindings has a documented range checked on entry
-(docs/robustness.md); values that used to hang, eat memory or abort are refused in one sentence,
+"""Every numeric option of the bindings has a documented range checked on entry
+(docs/robustness.md); values that would hang, eat memory or abort are refused in one sentence,
 and the target shape has a wall-clock budget. The messages are written out by hand."""
 import math
 import os

@@ -1,4 +1,4 @@
-"""A closed wire's overlap allowance (issue 21 item 3, profile key closed_overlap, metres): the
+"""A closed wire's overlap allowance (profile key closed_overlap, metres): the
 bend program of a closed wire feeds that much more straight wire after its last bend, so the
 loop's ends overlap; an open wire is unchanged; the template draws the overlap; a value out of
 range is one message naming the key. The feeds are read back from the files (CSV, bend list,

@@ -1,4 +1,4 @@
-"""The pin duck (issue 48 item 2), checked by running each G-code program through a small model of
+"""The pin duck, checked by running each G-code program through a small model of
 a DIWire-class bend head written here from docs/machine-protocol.md (pin axis), not from the
 writer: the bending pin stands up beside the wire and a head rotation that pushes the pin into the
 wire bends it; to bend the other way the pin must get to the wire's other side, which it can only
@@ -156,7 +156,7 @@ class PinDuck(unittest.TestCase):
             self.assertTrue(listed)
 
     def test_the_model_catches_the_old_program(self):
-        """The program as written before issue 48 (pin down, pin up, no swing) fails in the model."""
+        """A program without the duck (pin down, pin up, no swing) fails in the model."""
         profile = dict(native.validate_machine_profile({}))
         with self.assertRaises(AssertionError):
             run(["G0 Z-5.0000", "G0 Z5.0000", "G1 Y-50.0000 F5400.0"], profile)

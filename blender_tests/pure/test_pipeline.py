@@ -28,8 +28,8 @@ def largest_rest_turn_deg(design):
     return worst
 
 
-# The soft sphere below was built (issue 16) so that its rest bends go about a degree past 50 deg
-# without the coupling, with SLSQP's target shapes. The SQP (issue 17) reaches the same distances to
+# The soft sphere below was built so that its rest bends go about a degree past 50 deg
+# without the coupling, with SLSQP's target shapes. The SQP reaches the same distances to
 # the contour with the points arranged a little differently along the wires, and there the largest
 # rest bend is 50.0 deg, within the limit: the case would not need the coupling. These tests are about
 # the coupling, so they keep SLSQP's shapes.
@@ -44,7 +44,7 @@ class Coupling(unittest.TestCase):
 
     def solve(self, rounds):
         settings = defaults()
-        # the plastic limit and the force LP as before issue 16: rest bends that need the coupling
+        # the plastic limit and the force LP without pre-stress (torque fraction 1): rest bends that need the coupling
         settings.update(contact_angle_deg=140.0, max_bend_deg=50.0, torque_fraction=1.0, least_out_of_plane=False)
         V, F = sphere()
         saved, module = pipeline.COUPLING_ROUNDS, native.require()
@@ -116,7 +116,7 @@ class Cuts(unittest.TestCase):
         design = pipeline.run(V, F, PLANES, PRESETS["steel"], settings)
         wire = next(w for w in design["wires"] if w["name"] == "A/0")
         self.assertEqual(wire["cut"], 7)
-        # FORMATS: rest has the target's edge lengths walked from the cut, one point more.
+        # docs/formats.md: rest has the target's edge lengths walked from the cut, one point more.
         target, rest = np.asarray(wire["target"]), np.asarray(wire["rest"])
         m = len(target)
         self.assertEqual(len(rest), m + 1)
@@ -220,7 +220,7 @@ class StockBeforeSolving(unittest.TestCase):
         stages = [s for s, _m in said]
         self.assertLess(max(i for i, s in enumerate(stages) if s == "size"), stages.index("layering"))
         # the design keeps the solved wires' figures: each stock warning's mm is the wire's own length
-        # (FORMATS "length", what its DXF and G-code are cut to), not the contour's said above
+        # (docs/formats.md "length", what its DXF and G-code are cut to), not the contour's said above
         solved = pipeline.solve(pipeline.slice_and_pick(V, F, PLANES, PRESETS["steel"], defaults()), PRESETS["steel"],
                                 defaults(), stock=(stock, "shop bender"))
         kept = {}

@@ -1,5 +1,5 @@
-"""Why no nearby placement exists (plane_faults.py, plane_search.nearby's account; issue 15: "with
-nearby, every scene ends stable or says why no nearby placement exists"), on scenes whose answers
+"""Why no nearby placement exists (plane_faults.py, plane_search.nearby's account:
+with nearby, every scene ends stable or says why no nearby placement exists), on scenes whose answers
 are known by hand:
 
 - hand-made crossing networks: a wire crossing nothing ("alone"), two groups with no crossing
@@ -277,7 +277,7 @@ class NoNearbyPlacement(unittest.TestCase):
         self.assertTrue(design["reason"].startswith("no nearby placement gives a stable design. Searched: "))
         self.assertTrue(design["reason"].endswith(f". The planes as given: {given['reason']}"))
         self.assertIn("wire A/0 on wire C/0", design["reason"])
-        # the record keeps the keys it had (FORMATS.md's and the extra ones before), and adds only
+        # the record keeps the keys it had (the FORMATS contract's and the extra ones before), and adds only
         # not_found: how the search ended, as data beside the reason's words
         self.assertEqual(set(design["plane_search"]), {
             "mode", "planes_before", "planes_after", "changes", "candidates", "full_solves", "budget_seconds",

@@ -16,7 +16,7 @@ import plane_search_corpus as corpus  # noqa: E402
 BEFORE = """# Performance
 
 <!-- planes:begin -->
-## Plane assistant on the real-mesh corpus (issue 15)
+## Plane assistant on the real-mesh corpus
 
 `scripts/bench planes --size 0.5 --counts 4,5 --section docs/performance.md` (2026-11-30, commit abc1234; `scripts/plane_search_corpus.py`, in-process with the system Python 3.11 and the built module, no Blender): every `zzxxy5` scene of the corpus at 0.5 m, solved with the planes as given, then with `plane_search: "nearby"` (budget 8 s), and every mesh with `"auto"` (budget 6 s per plane, then at most 20 s for the comparison of hook patterns on the returned design). Load average (1 min) of the 2-core machine, shared: 3.3 at the start, 2.9 at the end. Every stable design is re-checked by `blender_tests/pure/recheck.py`: 5 stable, 0 refused by it.
 

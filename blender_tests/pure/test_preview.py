@@ -1,4 +1,4 @@
-"""The preview (issue 21 item 7): each wire's bend program run forward through a spring-back line,
+"""The preview: each wire's bend program run forward through a spring-back line,
 checked against walks computed here in closed form, not by the bend program's code.
 
 - the same profile compensates and predicts: the predicted wire is the rest shape (within 0.1 mm,

@@ -1,4 +1,4 @@
-"""The re-layering loop (pipeline.relayer, issue 20) on a network built so that the first layering's
+"""The re-layering loop (pipeline.relayer) on a network built so that the first layering's
 hooks cannot be bent and the opposite ones can.
 
 The network (three circles on a sphere of radius R = 0.2 m): A on the plane z = 0 (the equator),
@@ -16,7 +16,7 @@ sin 47.5, 0), and B's (a circle about (a, 0, 0)) towards -y; a hook makes the tw
 opposite sides of d = +-y. A to +y, B to -y costs (1 + 0.737) + 0 = 1.74; A to -y, B to +y costs
 (1 - 0.737) + 2 = 2.26; B and C cross at 2.0 whatever the hook. So the layering first picks A to
 +y at P (and likewise A to +x at Q), which the straight piece rules out. Without P
-and Q, A hangs on two crossings and can turn about the line through them: the old path (re-check
+and Q, A hangs on two crossings and can turn about the line through them: the every-hook path (re-check
 the same hooks) ends unstable. With those hooks forbidden, the layering picks the opposite ones
 (B and C then open outwards, where they have room to bend) and the design is stable; the
 independent re-check (recheck.py, numpy/scipy only) confirms it. Those two hooks are known before
@@ -84,7 +84,7 @@ def network_design(settings, angle=ANGLE):
 
 
 def opening_of_a(design, crossing):
-    """The direction wire A (id 0) opens to at `crossing` by the FORMATS hook convention, computed
+    """The direction wire A (id 0) opens to at `crossing` by the docs/formats.md hook convention, computed
     here from the planes: hook * d for wires[0], -hook * d for wires[1], d = n0 x n1."""
     n0, n1 = (np.asarray(design["wires"][w]["plane"]["normal"], dtype=float) for w in crossing["wires"])
     d = np.cross(n0, n1)
@@ -99,8 +99,8 @@ def find(design, other, axis):
 
 @contextlib.contextmanager
 def every_hook():
-    """The old path, forced: relayer's layerings forbid no hook up front (too_close dropped), as
-    before the loop knew the too-close hooks, so it learns them from the target shape."""
+    """The every-hook path, forced: relayer's layerings forbid no hook up front (too_close dropped),
+    so the loop learns the too-close hooks from the target shape."""
     real = layering.run
 
     def run(*args, **kwargs):
@@ -300,9 +300,9 @@ class Relayering(unittest.TestCase):
         self.assertFalse([m for s, m in messages if s == "relayering"])
         self.assertNotIn("too_close_forbidden", d)
 
-    def test_the_fallback_gives_the_old_paths_design(self):
+    def test_the_fallback_gives_the_every_hook_paths_design(self):
         # With relayer_rounds 1 too: the discarded layering is not one of the re-layerings, so the
-        # old path's round 1 still runs after it.
+        # every-hook path's round 1 still runs after it.
         for rounds in (1, 8):
             with self.subTest(relayer_rounds=rounds):
                 messages = []
@@ -313,10 +313,10 @@ class Relayering(unittest.TestCase):
                 self.assertFalse(old["stable"])
                 p, q = find(old, 1, 1), find(old, 2, 0)
                 pq = f"crossings {min(p['id'], q['id'])} and {max(p['id'], q['id'])}, too close"
-                # The old path's verdict, the target shape's: P and Q too close, then nothing stable without them.
+                # The every-hook path's verdict, the target shape's: P and Q too close, then nothing stable without them.
                 self.assertIn(pq, old["reason"])
                 self.assertNotIn("target_shape", old["pending_stages"])
-                # The fallback's design is the old path's, but for its record of the first layering.
+                # The fallback's design is the every-hook path's, but for its record of the first layering.
                 new_record, old_record = new["stages"].pop("relayering"), old["stages"].pop("relayering")
                 self.assertEqual(without_times(new), without_times(old))
                 self.assertEqual(len(old_record["rounds"]), 2)  # round 1 learns P and Q, then nothing holds

@@ -72,7 +72,7 @@ class SceneTest(unittest.TestCase):
         self.assertRefused('settings.torque_fraction', settings={"torque_fraction": 1.5})
 
     def test_search_knobs(self):
-        # FORMATS.md additions: in_plane_tiebreak (bool), max_nodes and relayer_rounds (integers).
+        # beyond the FORMATS contract (docs/formats.md): in_plane_tiebreak (bool), max_nodes and relayer_rounds (integers).
         s = self.parse()
         self.assertEqual((s.settings["in_plane_tiebreak"], s.settings["max_nodes"], s.settings["relayer_rounds"]),
                          (False, 200000, 8))

@@ -61,10 +61,10 @@ class StaleTest(unittest.TestCase):
         self.assertEqual(said, [])
         for now in ("0" * 24, stale.MESH_CHANGED):
             said = stale.changes(design(), scene("Globe", mesh=now), inputs, LABELS)
-            self.assertEqual(said, ["target Globe edited or moved"])
+            self.assertEqual(said, ["model Globe edited or moved"])
         self.assertEqual(stale.changes(design(), scene("Globe"), inputs, LABELS), [])
         # another target: that is what is said; a record without a digest (an older add-on's) says nothing
-        self.assertEqual(stale.changes(design(), scene("Cube", mesh="0" * 24), inputs, LABELS), ["target changed"])
+        self.assertEqual(stale.changes(design(), scene("Cube", mesh="0" * 24), inputs, LABELS), ["model changed"])
         self.assertEqual(changes(), [])
 
     def test_unchanged_scene_is_current(self):
@@ -121,7 +121,7 @@ class StaleTest(unittest.TestCase):
         self.assertEqual(changes(ticked=TICKED | {("Slice Z", 0)}), ["contours ticked differently (Slice Z #0 ticked)"])
 
     def test_target_settings_and_material(self):
-        self.assertEqual(changes(target="Duck"), ["target changed"])
+        self.assertEqual(changes(target="Duck"), ["model changed"])
         self.assertEqual(changes(settings=dict(SETTINGS, max_bend_deg=90.0)), ["settings changed (Max Bend)"])
         self.assertEqual(changes(settings=dict(SETTINGS, torque_fraction=0.5)), ["settings changed (torque_fraction)"])
         self.assertEqual(changes(settings=None), ["settings changed"])
@@ -141,7 +141,7 @@ class StaleTest(unittest.TestCase):
         p = planes()
         p["Slice B"] = ((0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
         said = changes(p, target="Duck", settings=dict(SETTINGS, max_bend_deg=90.0))
-        self.assertEqual(stale.stale_text(said), "From an earlier Optimize: plane Slice B rotated, target changed, "
+        self.assertEqual(stale.stale_text(said), "From an earlier Optimize: plane Slice B rotated, model changed, "
                                                  "settings changed (Max Bend); Optimize again")
 
     def test_a_renamed_plane_is_the_same_plane_under_its_new_name(self):

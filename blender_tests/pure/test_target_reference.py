@@ -1,5 +1,5 @@
 """The target shape as the pipeline runs it (window sweeps stopped by SWEEP_FTOL, wires on threads,
-blocks by the Newton SQP; issue 17) against a reference run of the old method pushed further: SLSQP,
+blocks by the Newton SQP) against a reference run pushed further: SLSQP,
 one wire at a time, no energy-based stop, sweeps until no window moves a point by 1 nm. On the bench's Table 2 stand-ins,
 the bundled globe and the 3 m wire of the length sweep, both must reach the same distances to the
 contour (within 0.1 mm) and realise the same crossings. Correctness only: no timing."""
@@ -87,7 +87,7 @@ class AgainstConvergedSweeps(unittest.TestCase):
 
 
     def test_no_wire_problem_is_solved_twice(self):
-        # The Chair stand-in re-layers (issue 20) and its new layering leaves some wires' crossings
+        # The Chair stand-in re-layers and its new layering leaves some wires' crossings
         # and hooks alone; their problems, identical to the first round's, are taken from the
         # shared solves (Memo `same`) instead of being solved again.
         from wiresculpt import pipeline
@@ -144,7 +144,7 @@ class AgainstConvergedSweeps(unittest.TestCase):
 
 
     def test_windows_from_29_points_reach_the_one_block_optimum(self):
-        # Wires of 29 to 32 points are solved in windows (ONE_BLOCK_POINTS), no longer as one block
+        # Wires of 29 to 32 points are solved in windows (ONE_BLOCK_POINTS), not as one block
         # (the solver's default, 4 x window): the same distances (0.1 mm), hooks, nulled crossings
         # and verdict on every stand-in, and at least one such wire (the Teddy's Arms/0) so that
         # the comparison compares something.

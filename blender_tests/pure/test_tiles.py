@@ -1,4 +1,4 @@
-"""Print templates tiled onto paper pages (fab/tiles.py, issue 21 part 3), checked by rendering
+"""Print templates tiled onto paper pages (fab/tiles.py), checked by rendering
 each page with rsvg-convert at 254 dpi (10 pixels per millimetre) and measuring the pixels: the
 page is the paper's size, the scale bar is 100 mm long, and every point of the wire lands on the
 page where the 1:1 drawing puts it."""

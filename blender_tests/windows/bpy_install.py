@@ -47,7 +47,7 @@ _V, _F, objects = mesh.import_mesh(globe_obj)
 target = objects[0]
 target.scale = (float(radius),) * 3
 bpy.context.view_layer.update()
-bpy.context.scene.wiresculpt.target = target
+bpy.context.scene.wiresculpt.model = target
 for rotation in ((0, 0, 0), (0, math.pi / 2, 0), (math.pi / 2, 0, 0)):
     bpy.ops.wiresculpt.add_plane()
     bpy.context.view_layer.objects.active.rotation_euler = rotation

@@ -23,8 +23,8 @@ namespace wiresculpt {
 namespace {
 
 // A guess of what a job costs, only to start the dearest first: two threads end a round sooner
-// when its long jobs do not come last (the Chair's 26-point one-block wire took 12 of the first
-// round's 42 ms of solving, and came last). With n the target's points (as the solver places them:
+// when its long jobs do not come last (on the Chair, its 26-point one-block wire is over a quarter
+// of a round's solving: last, it would leave the other thread idle). With n the target's points (as the solver places them:
 // detail::initial_point_count), a wire solved as one block costs about n² (a dense subproblem per
 // iteration; about 4 µs·n² on the stand-ins), one solved in windows about 12·n of the same units
 // (about 50 µs a point). The points are counted as the problem resamples them, crossings once:

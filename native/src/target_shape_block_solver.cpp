@@ -71,7 +71,7 @@ struct SolverData {
     }
     void begin(const double* x, std::size_t n) {
       settle();
-      // No finite f in the lead-in (only where the points were not finite): no SQP, as before.
+      // No finite f in the lead-in (only where the points were not finite): no SQP, SLSQP alone.
       if (!fired && evaluations == lead && !best_x.empty()) {
         fired = true;
         try {

@@ -445,7 +445,7 @@ Eigen::VectorXd sqp_lagrangian_gradient(const TargetShapeProblem& problem, const
 // for j = 0, 1, ...: 61 shifts at most, and the first that makes W positive definite is taken. Each
 // shift adds a positive semidefinite matrix to the one before, so once one succeeds all later ones
 // do: the first is found by a search from where the block's previous iteration ended (`guess`)
-// instead of one factorisation per shift (the δ of a window far from its contour took 12 of them at
+// instead of one factorisation per shift (a window far from its contour needs a dozen shifts at
 // every iteration). The shift taken is the same.
 bool convexify(Eigen::MatrixXd& W, const Eigen::MatrixXd& A, const Eigen::VectorXd& lambda,
                Eigen::LLT<Eigen::MatrixXd>& factor, std::array<int, 2>& guess, double* delta_taken,

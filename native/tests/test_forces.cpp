@@ -117,7 +117,7 @@ TEST_CASE("forces: target pyramids of symmetric kinks are contact.hpp's pyramids
       for (const Vec3& q : ideal) best = std::min(best, (b - q).norm());
       CHECK(best < 1e-12);
     }
-    // FORMATS sign: every vector on wires[0] has a -hook component along d.
+    // docs/formats.md sign: every vector on wires[0] has a -hook component along d.
     const Vec3 d = crossing_direction(s.net, c);
     for (const Vec3& b : actual) CHECK(b.dot(d) * s.hooks[c] < 0);
   }

@@ -501,7 +501,7 @@ TEST_CASE("layering: branch and bound finds the brute-force optimum of key 5 on 
   CHECK(decided >= 4);  // key 5 changed the answer (the first stable pattern found was unbalanced)
 }
 
-// The contact normal force on `wire` at crossing c (FORMATS.md `hook`: wires[0] is pushed along
+// The contact normal force on `wire` at crossing c (docs/formats.md `hook`: wires[0] is pushed along
 // -hook d, wires[1] along +hook d), its unit direction.
 Vec3 normal_direction(const Network& net, const std::vector<int>& hooks, int wire, int c) {
   const Vec3 n0 = net.wires[net.crossings[c].wires[0]].plane.normal;

@@ -452,7 +452,7 @@ TEST_CASE("serial: timeouts and settle outside their ranges are refused on entry
   StreamState state;
   const double inf = std::numeric_limits<double>::infinity();
   StreamOptions o = quick();
-  o.settle = inf;  // used to wait 11 days
+  o.settle = inf;  // unchecked, a wait with no end
   CHECK_THROWS_WITH(stream_program("/dev/null-port", lines, MachineProfile{}, state, o),
                     "settle must be from 0 to 60 seconds, got inf");
   o = quick();

@@ -637,8 +637,8 @@ std::pair<Polyline2, std::vector<TargetCrossing>> long_loop(double r0, int count
 TEST_CASE("target shape: sweep_ftol stops the sweeps with the distances and crossings of converged sweeps",
           "[target]") {
   // The reference runs the sweeps until no window moves a point by 1 nm (sweep_ftol off); the
-  // energy-based stop must give the same distances to the contour (within 0.1 mm, the tolerance of
-  // issue 17) and the same realised crossings, for fewer sweeps.
+  // energy-based stop must give the same distances to the contour (within 0.1 mm, the tolerance the
+  // method note's tests use) and the same realised crossings, for fewer sweeps.
   const auto wavy = wavy_loop();
   const auto two_metres = long_loop(0.3, 10);
   const auto three_metres = long_loop(0.47, 6);
@@ -684,7 +684,7 @@ TEST_CASE("target shape: a 3 m wire converges within the default evaluation budg
 TEST_CASE("target shape: a warm start from the looser limit's optimum reaches the cold solve's optimum", "[target]") {
   // The coupling (Sec. 4.3) lowers one vertex's bend limit and solves again. Started from the
   // previous optimum (`start`), the solve must end where a cold start ends: the same distances to
-  // the contour (0.1 mm, issue 17's tolerance), the same crossings realised, every constraint
+  // the contour (0.1 mm, the method note's tolerance), the same crossings realised, every constraint
   // held, and with fewer evaluations (what the start is for). One windowed loop with crossings
   // (2 m, ten crossings) and one one-block wire with a crossing.
   const auto two_metres = long_loop(0.3, 10);

@@ -6,7 +6,7 @@ from mathutils import Matrix
 from .. import native
 from ..core.contours import pick
 from . import mesh
-from .handles import contour_plane, drop_copied_ids, handle_plane, handles, target_problem
+from .handles import contour_plane, drop_copied_ids, handle_plane, handles, model_problem
 from .objects import remove_object, scene_collection, tagged, write_polyline
 
 CONTOUR_KEY = "wiresculpt_contour"  # custom property {"plane": name, "index": k} on curve objects
@@ -112,13 +112,13 @@ def apply_slice(scene, settings, planes, per_plane, picked=None):
 
 
 def slice_scene(context, picked=None):
-    """Cuts the target with every slicing plane into the contour list and curves. `picked`: the
+    """Cuts the model with every slicing plane into the contour list and curves. `picked`: the
     contours ("plane/index") to tick, instead of keeping the user's ticks (Apply of a plane
     candidate). Returns (report type, sentence): the counts said are the list's own (contour_counts)."""
     scene = context.scene
     settings = scene.wiresculpt
-    target = settings.target
-    problem = target_problem(scene, target)
+    model = settings.model
+    problem = model_problem(scene, model)
     if problem is None and not native.available():
         problem = native.LOAD_ERROR
     planes = handles(scene)
@@ -129,15 +129,15 @@ def slice_scene(context, picked=None):
     depsgraph = context.evaluated_depsgraph_get()
     try:
         specs = [handle_plane(h, depsgraph) for h in planes]
-        V, F = mesh.object_triangles(target, depsgraph)
+        V, F = mesh.object_triangles(model, depsgraph)
         result = native.slice_mesh(V, F, specs)
     except (ValueError, RuntimeError) as exc:
-        return {'ERROR'}, f"Cannot slice {target.name}: {exc}"
+        return {'ERROR'}, f"Cannot slice {model.name}: {exc}"
     names = [name for name, _o, _n in specs]
     _count, _ticked, removed = apply_slice(scene, settings, planes, result["contours"], picked)
     count, ticked = contour_counts(settings)
     missed = [name for name, contours in zip(names, result["contours"]) if not contours]
-    message = (f"Sliced {target.name} with {len(names)} plane{'s' * (len(names) != 1)}: "
+    message = (f"Sliced {model.name} with {len(names)} plane{'s' * (len(names) != 1)}: "
                f"{count} contour{'s' * (count != 1)}, {ticked} used as wires")
     if removed:
         message += f", {removed} old curve{'s' * (removed != 1)} removed"

@@ -1,5 +1,5 @@
 """Slicing handles: ordinary plane objects, tagged, whose world position and Z axis are a slicing
-plane; and the target mesh they cut."""
+plane; and the model mesh they cut."""
 import uuid
 
 import bpy
@@ -12,7 +12,7 @@ HANDLE_KEY = "wiresculpt_handle"  # custom property that marks an object as a sl
 # session_uid is not); Optimize records it beside the design, so a renamed plane stays the same plane
 HANDLE_ID_KEY = "wiresculpt_handle_id"
 PLANES_COLLECTION = "Slicing Planes"
-PLANE_MARGIN = 1.2  # a new handle is this much wider than the target's largest extent
+PLANE_MARGIN = 1.2  # a new handle is this much wider than the model's largest extent
 
 
 def is_handle(obj):
@@ -163,22 +163,22 @@ def add_handle(context, low, high):
     return obj
 
 
-def target_name(settings):
-    """The name of the target picked in the Wire panel (`settings`: a scene's wiresculpt), "" when
+def model_name(settings):
+    """The name of the model picked in the Wire panel (`settings`: a scene's wiresculpt), "" when
     none is: what a solve's record, Live's snapshot and the stale check compare."""
-    target = settings.target
-    return target.name if target is not None else ""
+    model = settings.model
+    return model.name if model is not None else ""
 
 
-def target_problem(scene, target):
-    """Why `target` cannot be sliced, or None."""
-    if target is None:
-        return "No target mesh: pick one in the Wire panel (Target)"
-    if target.type != 'MESH':
-        return f"Target {target.name} is not a mesh"
-    if is_handle(target):
-        return f"Target {target.name} is a slicing plane; pick the mesh to slice"
-    if scene.objects.get(target.name) != target:
-        return (f"Target '{target.name}' is not in scene '{scene.name}' (deleted or unlinked): put it back, "
-                f"or pick the mesh to slice in the Wire panel (Target)")
+def model_problem(scene, model):
+    """Why `model` cannot be sliced, or None."""
+    if model is None:
+        return "No model mesh: pick one in the Wire panel (Model)"
+    if model.type != 'MESH':
+        return f"Model {model.name} is not a mesh"
+    if is_handle(model):
+        return f"Model {model.name} is a slicing plane; pick the mesh to slice"
+    if scene.objects.get(model.name) != model:
+        return (f"Model '{model.name}' is not in scene '{scene.name}' (deleted or unlinked): put it back, "
+                f"or pick the mesh to slice in the Wire panel (Model)")
     return None

@@ -1,6 +1,6 @@
 """Blender meshes as numpy arrays for the solver (world-space, triangulated, modifiers applied), and
 mesh files read into such arrays through Blender's own importers, coordinates exactly as written in
-the file (FORMATS.md: no axis conversion, every object of the file joined into one mesh)."""
+the file (docs/formats.md: no axis conversion, every object of the file joined into one mesh)."""
 import contextlib
 import io
 import os
@@ -36,9 +36,9 @@ def object_triangles(obj, depsgraph):
         evaluated.to_mesh_clear()
 
 
-# The most triangles read again on Blender's own thread whenever a target changes (Live, the
-# Stability box's check of the target): object_triangles took 52-56 ms at 199,200 triangles and
-# 24-26 ms at 101,888 (a UV sphere, background Blender), against the 50 ms a step may take (issue 17).
+# The most triangles read again on Blender's own thread whenever a model changes (Live, the
+# Stability box's check of the model): object_triangles took 52-56 ms at 199,200 triangles and
+# 24-26 ms at 101,888 (a UV sphere, background Blender), against the 50 ms a Live step may take.
 MAX_REREAD_TRIANGLES = 100_000
 
 

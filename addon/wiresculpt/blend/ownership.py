@@ -1,4 +1,4 @@
-"""Results kept outside Blender data belong to one file and one scene (issue 48).
+"""Results kept outside Blender data belong to one file and one scene.
 
 The plane assistant's candidates (and their preview) live in module state, not in the scene: the
 scene stays untouched until a candidate is applied. Every file's first scene is called "Scene", so a

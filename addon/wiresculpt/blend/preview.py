@@ -1,4 +1,4 @@
-"""The machine preview in the viewport (issue 21 item 7): after an export, one ghost curve per
+"""The machine preview in the viewport: after an export, one ghost curve per
 wire showing the wire the machine is predicted to make (fab/export.py's "predicted", the bend
 program run through the spring-back model), laid on the wire's plane by the rigid map that best
 fits the wire's rest shape onto its target there. The ghosts live in the "Machine Preview"

@@ -20,7 +20,7 @@ DESIGN_TEXT = "wiresculpt_design.json"  # Text datablock holding the last design
 # custom property of that Text: JSON of what Optimize solved it with besides the design's own keys
 # ({"target": name, "settings": solver settings, "material": material, "planes": {plane name:
 # persistent id, handles.plane_ids}}; core/stale.py compares it with the panel and finds renamed
-# planes by it). Kept beside the design, not in it, so design.json stays as FORMATS.md says.
+# planes by it). Kept beside the design, not in it, so design.json stays as docs/formats.md says.
 INPUTS_KEY = "wiresculpt_inputs"
 WIRE_KEY = "wiresculpt_wire"  # custom property on wire curves: the wire's name
 WIRE_ID_KEY = "wiresculpt_wire_id"  # custom property on wire curves: the wire's id this run

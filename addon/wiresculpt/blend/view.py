@@ -1,4 +1,4 @@
-"""How a saved .blend opens (issue 21): every 3D view framed on the sculpture, its sidebar open on
+"""How a saved .blend opens: every 3D view framed on the sculpture, its sidebar open on
 the Wire tab, the first wire selected and active; and redraw_3d_views, which the operators use to
 show what changed in module state (Live's verdict, a previewed candidate, a dropped result).
 

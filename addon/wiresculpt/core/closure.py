@@ -1,4 +1,4 @@
-"""Closure gaps as figures users read, and how to close each loop (issue 16).
+"""Closure gaps as figures users read, and how to close each loop.
 
 A closed wire is cut (its `cut`) and bent to its rest shape, whose two ends stand `closure_gap`
 apart (m, the forces stage); assembling the sculpture springs them together, since the target

@@ -1,4 +1,4 @@
-"""Which sliced contours become wires: the `contours` rule of a plane (FORMATS.md)."""
+"""Which sliced contours become wires: the `contours` rule of a plane (docs/formats.md)."""
 
 RULES = ("largest", "all")
 

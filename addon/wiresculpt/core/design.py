@@ -1,4 +1,4 @@
-"""The design document (`design.json`, FORMATS.md): its vocabulary, built as a plain dict,
+"""The design document (`design.json`, docs/formats.md): its vocabulary, built as a plain dict,
 written atomically.
 
 This module owns the design's vocabulary: which stage writes which key (KEYS, checked by
@@ -125,7 +125,7 @@ def written_by(stage):
 
 def crossing_direction(design, crossing):
     """d = normalize(n0 x n1), n0 and n1 the plane normals of the crossing's wires as written in
-    the design (FORMATS.md `hook`: hook 1 opens the kink of wires[0] towards +d)."""
+    the design (docs/formats.md `hook`: hook 1 opens the kink of wires[0] towards +d)."""
     return np.array(crossing_axis(design, crossing))
 
 

@@ -5,7 +5,7 @@ each said with one prefix, and the part of a long reason the line shows.
 - "stable, over its limits — <limits>": stable and buildable but breaking a limit a maker asked
   for (core/limits.py: the load factor, wires bending out of their planes, the stock, the size);
 - "not stable — <reason>": a solve that ended with the design not stable (design["reason"]);
-- "cannot solve — <problem>": the scene as it is set up cannot be solved at all (no target, no
+- "cannot solve — <problem>": the scene as it is set up cannot be solved at all (no model, no
   contour ticked, a panel value the solver refuses, a ticked contour the plane no longer cuts,
   fewer than two wires: the pipeline's setup reasons, core/design.setup_problem): no verdict on
   the design, something to set up;
@@ -15,7 +15,7 @@ A reason is shown whole up to REASON_WORDS words. The solver's reasons repeat a 
 crossing or wire ("crossing 0 on wire Front/0: …; crossing 1 on wire Front/0: …"), so a longer one
 shows its first clause (up to the first ";" or full stop outside brackets) whole, where its
 deciding figure (the angle, the length, the scale) comes last, up to CLAUSE_WORDS words. The reason
-itself is never reworded (design.json keeps it; FORMATS.md). bpy-free.
+itself is never reworded (design.json keeps it; docs/formats.md). bpy-free.
 """
 from .design import setup_problem
 from .limits import OVER_LIMITS, STOCK_LENGTH, broken_limits

@@ -23,7 +23,7 @@ class ContourArrays:
     """Contours (lists of points) as float64 arrays, by the lists' identity, for the length of one
     solve: its layering hands over its new contours' arrays (the native layering's `arrays_too`)
     and its later stages read them instead of converting the same lists again (a re-layering round
-    makes new contours: docs/method-target-shape.md, issue 17 eleventh round). The lists must not be
+    makes new contours, docs/method-target-shape.md "Coupling rounds"). The lists must not be
     edited while it is in use: a solve never edits a contour, its layering replaces them."""
 
     def __init__(self):

@@ -1,4 +1,4 @@
-"""The scene file of a headless run (FORMATS.md), read and validated.
+"""The scene file of a headless run (docs/formats.md), read and validated.
 
 Every problem is one ValueError whose sentence names the key (as a path such as
 `planes[1].normal`) or the line at fault; nothing is guessed.

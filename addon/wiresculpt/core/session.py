@@ -1,4 +1,4 @@
-"""Which file is open, as a number (issue 48): the add-on keeps some state outside Blender data
+"""Which file is open, as a number: the add-on keeps some state outside Blender data
 (the plane assistant's candidates and preview, Live's verdict, a stream's stop), and such state
 belongs to the file it was made in. `generation()` changes whenever a file is loaded or a new one
 made (blend/ownership.py's load_pre and load_post handlers call `advance()`), so state stamped with

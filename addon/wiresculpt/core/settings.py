@@ -32,7 +32,7 @@ SETTINGS = {
     "max_solve_seconds": (600.0, 0.001, 86400.0, "s",
                           "Wall-clock budget of one solve, every stage and round included; past it the "
                           "solve stops with a message naming this key"),
-    # the plane assistant (issue 15, plane_search.py); unit "choice": one of CHOICES[key]
+    # the plane assistant (plane_search/); unit "choice": one of CHOICES[key]
     "plane_search": ("off", None, None, "choice",
                      "off: the planes as given; nearby: when they give no stable design, the least change "
                      "of them that does; auto: planes proposed from the mesh alone (\"planes\" may be [])"),

@@ -14,9 +14,9 @@ What is compared:
   plane cuts the same contours, so it does not make the design stale.
 - the ticked contours: the (plane, index) pairs of the design's wires against the ticked ones.
 - the inputs Optimize recorded besides the design (`inputs`, see blend/results.py
-  store_inputs): the target's name, the solver settings and the material it was solved with,
-  against the panel's values now, and a digest of the target's triangles as sliced (mesh_digest,
-  in world coordinates: an edit, a modifier or a move of the target changes it). A design without that record (the batch's, the plane
+  store_inputs): the model's name, the solver settings and the material it was solved with,
+  against the panel's values now, and a digest of the model's triangles as sliced (mesh_digest,
+  in world coordinates: an edit, a modifier or a move of the model changes it). A design without that record (the batch's, the plane
   assistant's, an older add-on's) is compared by its planes and ticks only.
 
 The tolerances are far below any edit a maker makes (a nudge is 0.1 mm at least) and far above
@@ -41,7 +41,7 @@ VALUE_TOLERANCE = 1e-9  # relative, for a setting's or the material's number
 SCALED = ("bending_stiffness", "max_torque")
 MAX_NAMED = 3  # contours named after "contours ticked differently"
 
-MESH_CHANGED = "changed"  # the target's mesh changed since its digest was taken, and is not read again yet
+MESH_CHANGED = "changed"  # the model's mesh changed since its digest was taken, and is not read again yet
 
 PREFIX = "From an earlier Optimize: "
 SUFFIX = "; Optimize again"
@@ -171,7 +171,7 @@ class SceneNow:
     planes: dict
     ticked: object = None
     names: object = None
-    target: object = None
+    model: object = None
     settings: object = None
     material: object = None
     mesh: object = None
@@ -180,9 +180,9 @@ class SceneNow:
 def changes(design, now, inputs=None, labels=None, recorded=None):
     """What changed since `design` was optimized, as short phrases ("plane Slice B moved", "plane
     Slice C removed", "plane Slice D added", "contours ticked differently (Slice A #1 unticked)",
-    "target changed", "settings changed (Max Bend)"); [] while it is current.
+    "model changed", "settings changed (Max Bend)"); [] while it is current.
 
-    now: a SceneNow of the scene's planes, ticks, plane names, target, settings, material and mesh:
+    now: a SceneNow of the scene's planes, ticks, plane names, model, settings, material and mesh:
     planes: {handle name: (origin, normal) or None (no normal)} of the slicing handles now: at
     least those the design's planes have now (`names`) and those named by the ticks (a name
     missing is a plane gone).
@@ -190,15 +190,15 @@ def changes(design, now, inputs=None, labels=None, recorded=None):
     None when they cannot be read.
     names: current_names of the design's planes: a renamed plane is compared, and named, by its
     name now; None: each plane by its recorded name.
-    inputs: what Optimize recorded ({"target", "settings", "material"}), or None: then target,
-    settings and material are not compared. target: the target's name now ("" for none);
+    inputs: what Optimize recorded ({"target": the model's name, "settings", "material"}; the key as saved), or None: then model,
+    settings and material are not compared. model: the model's name now ("" for none);
     settings / material: the dicts props.solver_settings / material_of give now (settings None:
     the panel's values are not valid, e.g. the smallest bend above the largest).
     labels: {setting or material key: the name the panel shows} for the phrase.
-    mesh: the digest of the target's triangles now (mesh_digest), MESH_CHANGED when they changed
+    mesh: the digest of the model's triangles now (mesh_digest), MESH_CHANGED when they changed
     since the recorded digest but were not read again, None when not known (not compared).
     recorded: recorded_planes(design) when the caller keeps it (a panel redraws often)."""
-    planes, ticked, names, target = now.planes, now.ticked, now.names, now.target
+    planes, ticked, names, model = now.planes, now.ticked, now.names, now.model
     settings, material, mesh = now.settings, now.material, now.mesh
     said = []
     before, ticks_before = recorded or recorded_planes(design)
@@ -228,10 +228,10 @@ def changes(design, now, inputs=None, labels=None, recorded=None):
     elif not said:  # the ticks cannot be read and no plane explains it
         said.append("contours ticked differently")
     if inputs:
-        if target is not None and inputs.get("target") is not None and str(inputs["target"]) != str(target):
-            said.append("target changed")
+        if model is not None and inputs.get("target") is not None and str(inputs["target"]) != str(model):
+            said.append("model changed")
         elif mesh is not None and isinstance(inputs.get("mesh"), str) and mesh != inputs["mesh"]:
-            said.append(f"target {target} edited or moved" if target else "target edited or moved")
+            said.append(f"model {model} edited or moved" if model else "model edited or moved")
         keys = []
         if settings is None:
             keys.append(None)

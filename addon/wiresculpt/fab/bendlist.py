@@ -1,4 +1,4 @@
-"""The bend list a DIWire-class machine runs through FabMo's Bend List app (issue 21, part 4):
+"""The bend list a DIWire-class machine runs through FabMo's Bend List app:
 
     UNIT MM
     FEED 50.000

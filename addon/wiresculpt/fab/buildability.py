@@ -1,4 +1,4 @@
-"""Can every wire be made? `stable: true` is a promise to a person holding pliers (FORMATS.md
+"""Can every wire be made? `stable: true` is a promise to a person holding pliers (docs/formats.md
 additions): every segment >= min_segment and every bend of the bend program, after spring-back
 compensation with the machine profile in use, within the machine's limits. This module asks the
 bend program itself (native bend_program_problems, the same code that writes the G-code and bend
@@ -21,7 +21,7 @@ from .export import machine_profile
 
 
 def walk(wire):
-    """Target index of each rest point (FORMATS.md: rest starts at the cut)."""
+    """Target index of each rest point (docs/formats.md: rest starts at the cut)."""
     m = len(wire["target"])
     if wire["closed"]:
         return [(wire["cut"] + k) % m for k in range(m + 1)]

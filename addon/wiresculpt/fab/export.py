@@ -143,7 +143,7 @@ def export(design, out_dir, profile=None, paper=None, machine=None):
     "preview_model": the spring-back line of the preview in words, "preview_springback": its (a, b in
     degrees)}.
 
-    The preview (issue 21 item 7): each wire's program run forward through `machine`'s spring-back
+    The preview: each wire's program run forward through `machine`'s spring-back
     line (a profile as for `profile`, e.g. the fit the Calibration panel loaded; None: the export
     profile itself, so only the small-bend rule shows), drawn dashed on the annotated template; each
     wire's summary has "predicted" ((k, 2) m, in the rest shape's frame) and "preview_distance" (m,

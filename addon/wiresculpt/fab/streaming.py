@@ -19,7 +19,7 @@ from . import export
 PENDING = {}  # wire name -> Stopped: the program a Resume continues
 JOB = None  # the StreamJob while a wire is being sent, else None
 LAST = {}  # wire name -> (report type, sentence) of its last run, for the panel
-# PENDING and LAST are the open file's (issue 48): another file's wires may have the same names.
+# PENDING and LAST are the open file's: another file's wires may have the same names.
 # forget() empties them when a file is loaded (blend/ownership's load handlers), and a stream that
 # ends after a load records nothing (its generation is the closed file's).
 

@@ -1,4 +1,4 @@
-"""A 1:1 print template tiled onto paper pages (issue 21, part 3): each page is an SVG of the
+"""A 1:1 print template tiled onto paper pages: each page is an SVG of the
 paper's size (A4 or Letter, millimetres, one user unit = 1 mm) showing one window of the
 template at 1:1, with
 

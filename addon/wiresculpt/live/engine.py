@@ -1,10 +1,10 @@
-"""Live: while a slicing plane (or the target) moves, re-slice and re-solve in the background and
+"""Live: while a slicing plane (or the model) moves, re-slice and re-solve in the background and
 show the verdict (docs/user-guide.md, Live).
 
 A bpy.app.timers callback (tick, every TICK_SECONDS while nothing changes, every
 ACTIVE_TICK_SECONDS while planes move or a job runs) compares a snapshot of what a solve depends on
-(the slicing planes' and the target's matrix_world, the ticked contours, the material and machine
-settings, whether the target is still in the scene, and how often its geometry changed: edits and
+(the slicing planes' and the model's matrix_world, the ticked contours, the material and machine
+settings, whether the model is still in the scene, and how often its geometry changed: edits and
 modifiers, counted by a depsgraph handler) with the last one it saw. A snapshot that
 stayed the same for SETTLE_SECONDS and differs from the one solved (or being solved) starts a LiveJob on
 a worker thread: slice_and_pick then pipeline.solve with the hook search limited to the
@@ -13,7 +13,7 @@ running job whose snapshot is no longer current is cancelled (its cancel event; 
 for) and a new one starts; a result is shown only when its snapshot is still the current one.
 
 The verdict's words are core/live_verdict's: "not stable — <reason>" only for a solve that ended
-not stable, "cannot solve — <what to do>" when the scene as set up cannot be solved (no target, no
+not stable, "cannot solve — <what to do>" when the scene as set up cannot be solved (no model, no
 contour ticked, a panel value or plane the solver refuses, fewer than two wires), "error — …" for our
 unexpected error; a long reason is shown to the end of its first clause, the whole one in
 the tooltip of operators/live.py's WIRESCULPT_OT_live_reason.
@@ -44,7 +44,7 @@ from ..blend.mesh import triangle_count
 from ..blend import results as scene_results
 from ..blend.machine import chosen_stock
 from ..blend.registration import handlers_factory
-from ..blend.handles import contour_plane_name, handles, target_name, target_problem, ticked_planes
+from ..blend.handles import contour_plane_name, handles, model_name, model_problem, ticked_planes
 from ..blend.view import redraw_3d_views
 from ..core.jobs import WorkerJob
 from ..core.limits import limit_records
@@ -55,22 +55,22 @@ from .state import STATE, observed  # noqa: F401 (observed: the tests' and the b
 TICK_SECONDS = 0.1  # while nothing changes
 ACTIVE_TICK_SECONDS = 0.02  # while a plane moves or a job runs: the verdict is seen sooner
 SETTLE_SECONDS = 0.05  # a position unchanged this long is solved (a drag's every frame is not)
-# Live is refused on larger targets (with their modifiers): it reads the mesh on Blender's thread
-# when Live starts and whenever the target changes (blend/mesh.MAX_REREAD_TRIANGLES says why).
+# Live is refused on larger models (with their modifiers): it reads the mesh on Blender's thread
+# when Live starts and whenever the model changes (blend/mesh.MAX_REREAD_TRIANGLES says why).
 MAX_TRIANGLES = mesh.MAX_REREAD_TRIANGLES
 LIVE_HOOK_PATTERNS = 1  # the layering's own hook pattern only: Optimize may pick other hooks
 DURATIONS_KEPT = 10_000
 
 
-def refusal(target, depsgraph=None):
-    """Why Live cannot run on `target` (its triangles counted as evaluated in `depsgraph`), or ""."""
-    if target is not None and target.type == 'MESH':
-        return too_large(target.name, triangle_count(target, depsgraph))
+def refusal(model, depsgraph=None):
+    """Why Live cannot run on `model` (its triangles counted as evaluated in `depsgraph`), or ""."""
+    if model is not None and model.type == 'MESH':
+        return too_large(model.name, triangle_count(model, depsgraph))
     return ""
 
 
 def too_large(name, triangles):
-    """The refusal of a target `name` of `triangles` triangles, or "" within MAX_TRIANGLES."""
+    """The refusal of a model `name` of `triangles` triangles, or "" within MAX_TRIANGLES."""
     if triangles <= MAX_TRIANGLES:
         return ""
     return (f"Live is off: {name} has {triangles:,} triangles with its modifiers; Live takes at most "
@@ -78,15 +78,15 @@ def too_large(name, triangles):
 
 
 def refuse(settings, message):
-    """Turns Live off with `message` for the panel (shown while the same target is picked)."""
-    STATE.message, STATE.message_target = message, target_name(settings)
+    """Turns Live off with `message` for the panel (shown while the same model is picked)."""
+    STATE.message, STATE.message_model = message, model_name(settings)
     settings.live = False  # its update stops the timer
 
 
 def refused_message(settings):
-    """Why Live was refused, while the target it speaks of is still the picked one, or ""."""
-    target = settings.target
-    return STATE.message if STATE.message and target is not None and target.name == STATE.message_target else ""
+    """Why Live was refused, while the model it speaks of is still the picked one, or ""."""
+    model = settings.model
+    return STATE.message if STATE.message and model is not None and model.name == STATE.message_model else ""
 
 
 def _rounded(matrix):
@@ -94,16 +94,16 @@ def _rounded(matrix):
 
 
 def snapshot(scene):
-    """What a live solve depends on: the target's name and matrix_world, the planes' matrix_world,
-    the ticked contours, the panel's material and machine values, whether the target is in the
+    """What a live solve depends on: the model's name and matrix_world, the planes' matrix_world,
+    the ticked contours, the panel's material and machine values, whether the model is in the
     scene, the cut handles the user moved, and the count of its geometry's changes (STATE.geometry;
     last)."""
     ws = scene.wiresculpt
-    target = ws.target
-    return (target_name(ws), _rounded(target.matrix_world) if target else (),
+    model = ws.model
+    return (model_name(ws), _rounded(model.matrix_world) if model else (),
             tuple((h.name, _rounded(h.matrix_world)) for h in handles(scene)),
             tuple((contour_plane_name(item), item.index) for item in ws.contours if item.use),
-            solve_inputs(ws), target is not None and scene.objects.get(target.name) == target,
+            solve_inputs(ws), model is not None and scene.objects.get(model.name) == model,
             tuple(sorted((name, tuple(round(x, 9) for x in point))
                          for name, point in cut_handles.user_cut_points(scene).items())),
             STATE.geometry)
@@ -183,14 +183,14 @@ class LiveJob(WorkerJob):
 
 
 class Refused(str):
-    """_start's answer when the target turned out too large to read at every change."""
+    """_start's answer when the model turned out too large to read at every change."""
 
 
 def _start(scene, key):
     """A LiveJob for snapshot `key` (the scene read here, on Blender's thread); (CANNOT_SOLVE, why)
     when the scene as set up cannot be solved at all."""
     ws = scene.wiresculpt
-    problem = target_problem(scene, ws.target)
+    problem = model_problem(scene, ws.model)
     if problem:
         return CANNOT_SOLVE, problem
     if not native.available():
@@ -201,11 +201,11 @@ def _start(scene, key):
         material, settings = material_of(ws), solver_settings(ws)  # the panel's values, checked
     except ValueError as exc:
         return CANNOT_SOLVE, str(exc)
-    mesh_key = (key[0], key[1], key[-1])  # the target's name, matrix and geometry changes
+    mesh_key = (key[0], key[1], key[-1])  # the model's name, matrix and geometry changes
     if STATE.mesh_key != mesh_key:
-        STATE.mesh = mesh.object_triangles(ws.target, depsgraph)
+        STATE.mesh = mesh.object_triangles(ws.model, depsgraph)
         STATE.mesh_key = mesh_key
-        message = too_large(ws.target.name, len(STATE.mesh[1]))  # more than refusal counted (GPU subdivision)
+        message = too_large(ws.model.name, len(STATE.mesh[1]))  # more than refusal counted (GPU subdivision)
         if message:
             return Refused(message)
     job = LiveJob(key, *STATE.mesh, planes, cut_handles.user_cut_points(scene), material, settings,
@@ -240,7 +240,7 @@ def _step():
         STATE.seen, STATE.seen_since = key, now
     settled = now - STATE.seen_since >= SETTLE_SECONDS
     if job is None and settled and key != STATE.solved:
-        message = refusal(scene.wiresculpt.target, bpy.context.evaluated_depsgraph_get())
+        message = refusal(scene.wiresculpt.model, bpy.context.evaluated_depsgraph_get())
         if message:
             refuse(scene.wiresculpt, message)
             return None
@@ -371,7 +371,7 @@ def live_changed(settings, context):
 
 
 def _turn_on(settings, depsgraph):
-    message = refusal(settings.target, depsgraph)
+    message = refusal(settings.model, depsgraph)
     if message:
         refuse(settings, message)
         return
@@ -400,17 +400,17 @@ def _sync(scene, depsgraph=None):
 
 @bpy.app.handlers.persistent
 def _depsgraph_post(scene=None, depsgraph=None, *_args):
-    """Keeps the timer in step with the toggle, and counts changes of the target's geometry (edits,
+    """Keeps the timer in step with the toggle, and counts changes of the model's geometry (edits,
     modifiers) into STATE.geometry, which the snapshot holds."""
     try:
         current = bpy.context.scene or scene
         _sync(current, depsgraph if current == scene else None)
         if not STATE.running or depsgraph is None or current is None:
             return
-        target = current.wiresculpt.target
-        if target is None:
+        model = current.wiresculpt.model
+        if model is None:
             return
-        watched = (target, target.data)
+        watched = (model, model.data)
         for update in depsgraph.updates:
             if update.is_updated_geometry and update.id.original in watched:
                 STATE.geometry += 1
@@ -443,7 +443,7 @@ def _watch_scene_switch():
 @bpy.app.handlers.persistent
 def _load_pre(*_args):
     stop()
-    STATE.message = STATE.message_target = ""  # a refusal speaks of the closed file's target
+    STATE.message = STATE.message_model = ""  # a refusal speaks of the closed file's model
 
 
 @bpy.app.handlers.persistent

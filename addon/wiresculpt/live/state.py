@@ -10,7 +10,7 @@ class LiveState:
         self.record = LiveRecord()
         self.reset()
         self.message = ""  # why Live was refused or stopped; kept across resets
-        self.message_target = ""  # the name of the target `message` speaks of
+        self.message_model = ""  # the name of the model `message` speaks of
 
     def reset(self):
         self.running = False  # the timer is registered
@@ -27,8 +27,8 @@ class LiveState:
         # the wire id of each preview entry and the verdict's assembly_steps: the slider's filter
         # (core/assembly_view.shown_lines, ui/overlay)
         self.preview_ids, self.preview_steps = [], []
-        self.mesh_key = None  # the target's name, matrix and geometry count the cached triangles belong to
-        self.geometry = 0  # changes of the target's geometry seen by the depsgraph handler (edits, modifiers)
+        self.mesh_key = None  # the model's name, matrix and geometry count the cached triangles belong to
+        self.geometry = 0  # changes of the model's geometry seen by the depsgraph handler (edits, modifiers)
         self.failed = ""  # the last unexpected error's text, printed once
         self.mesh = None  # (V, F) world coordinates
         self.record.reset()

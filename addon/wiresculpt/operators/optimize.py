@@ -18,9 +18,9 @@ import time
 import bpy
 
 from .. import native, pipeline
-from ..blend import cut_handles, mesh, target_watch
+from ..blend import cut_handles, mesh, model_watch
 from ..blend import results as scene_results
-from ..blend.handles import plane_ids, target_name, target_problem, ticked_planes
+from ..blend.handles import plane_ids, model_name, model_problem, ticked_planes
 from ..blend.machine import chosen_stock
 from ..blend.view import redraw_3d_views
 from ..blend.registration import classes_factory
@@ -37,12 +37,12 @@ STAGE_LABELS = {"slicing": "Slicing", "layering": "Layering", "target_shape": "T
 # --- small functions, no UI -------------------------------------------------------------------
 
 def build_design(context):
-    """(design, material, settings) from the scene: the evaluated target re-sliced by the handles,
+    """(design, material, settings) from the scene: the evaluated model re-sliced by the handles,
     the ticked contours as wires. ValueError (naming the plane or contour) when that is not
     possible."""
     scene = context.scene
     ws = scene.wiresculpt
-    problem = target_problem(scene, ws.target)
+    problem = model_problem(scene, ws.model)
     if problem:
         raise ValueError(problem)
     if not native.available():
@@ -50,8 +50,8 @@ def build_design(context):
     depsgraph = context.evaluated_depsgraph_get()
     planes = ticked_planes(scene, depsgraph)
     material, settings = material_of(ws), solver_settings(ws)
-    V, F = mesh.object_triangles(ws.target, depsgraph)
-    target_watch.remember(ws.target, V, F)  # solve_record's digest of what is sliced here
+    V, F = mesh.object_triangles(ws.model, depsgraph)
+    model_watch.remember(ws.model, V, F)  # solve_record's digest of what is sliced here
     try:
         design = pipeline.slice_and_pick(V, F, planes, material, settings)
     except ValueError as exc:  # a ticked contour the planes no longer cut
@@ -65,10 +65,10 @@ def solve_record(scene, material, settings):
     (handles.plane_ids: gives those missing): kept beside the stored design
     (blend/results.store_inputs) so the Stability box can tell when the panel has changed since
     and which handle a renamed plane is (core/stale.py)."""
-    record = {"target": target_name(scene.wiresculpt), "settings": dict(settings), "material": dict(material),
+    record = {"target": model_name(scene.wiresculpt), "settings": dict(settings), "material": dict(material),
               "planes": plane_ids(scene), "stock": list(chosen_stock(scene))}
-    digest = target_watch.kept_digest(scene.wiresculpt.target) if scene.wiresculpt.target is not None else None
-    if digest is not None:  # the triangles build_design sliced (blend/target_watch.py)
+    digest = model_watch.kept_digest(scene.wiresculpt.model) if scene.wiresculpt.model is not None else None
+    if digest is not None:  # the triangles build_design sliced (blend/model_watch.py)
         record["mesh"] = digest
     return record
 

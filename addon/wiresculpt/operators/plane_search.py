@@ -1,4 +1,4 @@
-"""Find Stable Planes and Suggest Planes (issue 15): the plane assistant (plane_search.py) on a
+"""Find Stable Planes and Suggest Planes: the plane assistant (plane_search/) on a
 worker thread under a modal like Optimize's (progress, Esc cancels, the scene untouched until the
 user applies a candidate), and Apply: the candidate's planes become the slicing handles' placement
 (Find) or new slicing handles (Suggest), with the candidate's design as the result, in one undo
@@ -28,7 +28,7 @@ from .. import native, pipeline, plane_search
 from ..blend import mesh, ownership
 from ..blend import results as scene_results
 from ..blend.handles import (PLANE_MARGIN, add_handle, contour_plane, handle_plane, handles,
-                             target_problem)
+                             model_problem)
 from ..blend.contours import slice_scene
 from ..blend.registration import classes_factory
 from ..blend.view import redraw_3d_views
@@ -58,12 +58,12 @@ DRAWN = [0]  # overlay draws of a preview (the tests read it)
 
 
 def gather(context, need_planes=True):
-    """(V, F, planes, material, settings) from the scene: the target's evaluated triangles, the
+    """(V, F, planes, material, settings) from the scene: the model's evaluated triangles, the
     handles as planes (each taking its ticked contours, else its largest). ValueError when not
     possible, naming what is missing."""
     scene = context.scene
     ws = scene.wiresculpt
-    problem = target_problem(scene, ws.target)
+    problem = model_problem(scene, ws.model)
     if problem:
         raise ValueError(problem)
     if not native.available():
@@ -76,7 +76,7 @@ def gather(context, need_planes=True):
     planes = [PlaneSpec(*handle_plane(h, depsgraph), contours=ticked.get(h, "largest")) for h in handles(scene)]
     if need_planes and not planes:
         raise ValueError("No slicing plane: add planes first, or use Suggest Planes")
-    V, F = mesh.object_triangles(ws.target, depsgraph)
+    V, F = mesh.object_triangles(ws.model, depsgraph)
     return V, F, planes, material_of(ws), solver_settings(ws)
 
 
@@ -368,7 +368,7 @@ def apply_candidate(context, index):
         for p in candidate["planes"]:
             _place(by_name[p.name], p.origin, p.normal)
     else:
-        V, _F = mesh.object_triangles(scene.wiresculpt.target, context.evaluated_depsgraph_get())
+        V, _F = mesh.object_triangles(scene.wiresculpt.model, context.evaluated_depsgraph_get())
         renamed = {}
         for p in candidate["planes"]:
             obj = add_handle(context, V.min(axis=0), V.max(axis=0))

@@ -1,42 +1,42 @@
-"""Slicing: drop plane handles through the target, cut it, show the contours as curves."""
+"""Slicing: drop plane handles through the model, cut it, show the contours as curves."""
 import bpy
 
 from ..blend import mesh
 from ..blend.contours import release_deleted, slice_scene
-from ..blend.handles import add_handle, target_problem
+from ..blend.handles import add_handle, model_problem
 from ..blend.registration import classes_factory, handlers_factory
 
 
 # --- operators ------------------------------------------------------------------------------
 
 class WIRESCULPT_OT_add_plane(bpy.types.Operator):
-    """Add a slicing plane through the centre of the target; move and rotate it, then Slice"""
+    """Add a slicing plane through the centre of the model; move and rotate it, then Slice"""
     bl_idname = "wiresculpt.add_plane"
     bl_label = "Add Slicing Plane"
     bl_options = {'REGISTER', 'UNDO'}
 
     def execute(self, context):
         scene = context.scene
-        target = scene.wiresculpt.target
-        problem = target_problem(scene, target)
+        model = scene.wiresculpt.model
+        problem = model_problem(scene, model)
         if problem:
             self.report({'ERROR'}, problem)
             return {'CANCELLED'}
         try:
-            V, _F = mesh.object_triangles(target, context.evaluated_depsgraph_get())
+            V, _F = mesh.object_triangles(model, context.evaluated_depsgraph_get())
         except RuntimeError as exc:
-            self.report({'ERROR'}, f"Cannot read {target.name}: {exc}")
+            self.report({'ERROR'}, f"Cannot read {model.name}: {exc}")
             return {'CANCELLED'}
         if len(V) == 0:
-            self.report({'ERROR'}, f"Target {target.name} has no vertices to slice")
+            self.report({'ERROR'}, f"Model {model.name} has no vertices to slice")
             return {'CANCELLED'}
         name = add_handle(context, V.min(axis=0), V.max(axis=0)).name
-        self.report({'INFO'}, f"Added {name} through the centre of {target.name}")
+        self.report({'INFO'}, f"Added {name} through the centre of {model.name}")
         return {'FINISHED'}
 
 
 class WIRESCULPT_OT_slice(bpy.types.Operator):
-    """Cut the target with every slicing plane; the contours become curves and list items"""
+    """Cut the model with every slicing plane; the contours become curves and list items"""
     bl_idname = "wiresculpt.slice"
     bl_label = "Slice"
     bl_options = {'REGISTER', 'UNDO'}

@@ -1,7 +1,7 @@
 """Internal forces, cuts, rest shapes and load capacity (Sec. 4.4, Eq. 6-12, and beyond the paper):
 one native call on the target shapes (docs/method-forces.md).
 
-Fills, per crossing, `force` (N, on wires[0] by wires[1], FORMATS.md), `normal_force` and
+Fills, per crossing, `force` (N, on wires[0] by wires[1], docs/formats.md), `normal_force` and
 `out_of_plane` (|f.n|/|f| for the plane of wires[0] and of wires[1]); per wire `cut`, `rest`
 (2D, metres, in the wire's plane frame, from the cut in the direction of increasing target index),
 `rest_angles` and `target_angles` (radians, one per rest point), `closure_gap` (m),

@@ -1,5 +1,5 @@
 """Target shape (Sec. 4.3): per wire, a fabricable polyline through its fixed crossings whose
-kinks open the way the layering's hooks say (FORMATS.md `hook`).
+kinks open the way the layering's hooks say (docs/formats.md `hook`).
 
 Contact angle: the layering stage assumes each kink's edges lie exactly contact_angle/2 from the
 bisector, with friction widening its pyramid by atan(mu). The paper's constraint is
@@ -41,7 +41,7 @@ REALISED_LENGTH = 1e-5  # metres
 MAX_ROUNDS = 4  # solve, null what cannot be realised, solve again (each round nulls at least one)
 # The window sweeps stop once a sweep lowers a wire's energy by less than this fraction: later sweeps
 # only creep points along the wire (TargetShapeOptions::sweep_ftol; docs/method-target-shape.md,
-# issue 17: the same distances to the contour and crossings, 3-6x fewer evaluations on long wires).
+# "The solver": the same distances to the contour and crossings, 3-6x fewer evaluations on long wires).
 SWEEP_FTOL = 1e-3
 # Wires of up to this many target points are one NLopt block, longer ones are solved in windows
 # (TargetShapeOptions::one_block_points; the solver's own default is 4 x window = 32). SLSQP's
@@ -49,23 +49,22 @@ SWEEP_FTOL = 1e-3
 # an 8-point window, and the Teddy's 32-point Arms/0 0.05 s against 0.005 s in windows, at the same
 # distances and crossings. At 28 every stand-in and real-mesh scene keeps its distances (0.1 mm),
 # crossings and verdict; at 24 or 16 some (the Chair's 26-point backrest) reach other optima
-# (docs/method-target-shape.md, issue 17).
+# (docs/method-target-shape.md, "The solver").
 ONE_BLOCK_POINTS = 28
 # Wires are independent problems: a round's are solved in one native call (optimize_target_shapes)
 # on up to this many threads, the dearest first, a windowed wire handed from one thread to the other
 # between its windows when another has more work left (three equal wires end together), with the
 # GIL released throughout; each result depends only on its own wire, so the order is kept. The call
 # reads its wires from a generator: the native helper thread (kept for the process) starts on the
-# first while this thread prepares the next. (Issue 17, ninth round: a Python thread pool per round
-# cost about a millisecond more on the Duck and the Car; fifteenth round: the hand-over;
-# seventeenth round: the generator and the kept thread.)
+# first while this thread prepares the next: a Python thread pool per call cost about a millisecond
+# more on the Duck and the Car (docs/method-target-shape.md, "A round's wires on two threads").
 MAX_THREADS = 2
 # The machine's cores, read once: os.cpu_count() reads /sys at every call (40-60 us on a VM, about
 # 1.5 % of the globe's stage).
 CORES = os.cpu_count() or 1
 # Blocks by the Newton SQP (led by SLSQP's first evaluations where a kink's arrangement is chosen,
 # SLSQP where it fails): 2-4.5x fewer instructions than SLSQP alone, the same distances and crossings
-# on the stand-ins, the globe and the corpus (docs/method-target-shape.md, issue 17 fifth round).
+# on the stand-ins, the globe and the corpus (docs/method-target-shape.md, "The solver").
 ALGORITHM = "sqp"
 
 

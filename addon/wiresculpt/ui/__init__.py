@@ -1,8 +1,8 @@
 """User interface, one module per concern, each with its own register/unregister."""
-from ..blend import target_watch
+from ..blend import model_watch
 from ..blend.registration import modules_factory
 from . import calibration, fabrication, overlay, panel, plane_search, results, sidebar
 
-# target_watch: the depsgraph's changes of the target, for the Stability box (ui/stale.py)
+# model_watch: the depsgraph's changes of the model, for the Stability box (ui/stale.py)
 register, unregister = modules_factory((panel, results, plane_search, fabrication, calibration, overlay, sidebar,
-                                        target_watch))
+                                        model_watch))

@@ -5,7 +5,7 @@ each wire's predicted out-of-plane deflection as a whisker.
 
 Drawn only when the stored design has `force` per crossing and scene.wiresculpt.show_forces is
 on. The longest arrow is ARROW_SHARE of the sculpture's size; each arrow starts at the crossing
-and shows the force on wires[0] (FORMATS.md `force`). A wire with `out_of_plane_deflection` gets a
+and shows the force on wires[0] (docs/formats.md `force`). A wire with `out_of_plane_deflection` gets a
 whisker at the target vertex where it deflects most, along its plane normal, DEFLECTION_SCALE times
 the deflection long (so 1 mm shows as 1 cm), red when over the limit (DEFLECTION_LIMIT, the
 solver's default 2 mm), else blue.
@@ -100,7 +100,7 @@ def live_lines(scene):
 
 def draw_live():
     """The live verdict's wires (live/engine.py) as lines in their colours, over everything: the
-    wires lie on the target's surface, where a depth test hid all but their kinks in Solid view."""
+    wires lie on the model's surface, where a depth test hid all but their kinks in Solid view."""
     shader = uniform_colour_shader()
     gpu.state.line_width_set(2.0)
     gpu.state.depth_test_set('NONE')

@@ -1,4 +1,4 @@
-"""The "Wire" tab of the 3D view's sidebar: target, slicing planes, the contour list."""
+"""The "Wire" tab of the 3D view's sidebar: model, slicing planes, the contour list."""
 import textwrap
 
 import bpy
@@ -120,7 +120,7 @@ class VIEW3D_PT_wiresculpt(bpy.types.Panel):
         settings = context.scene.wiresculpt
         if not native.available():
             draw_load_error(layout, context)
-        layout.prop(settings, "target")
+        layout.prop(settings, "model")
         col = layout.column(align=True)
         col.operator(WIRESCULPT_OT_add_plane.bl_idname, icon='MESH_PLANE')
         col.operator(WIRESCULPT_OT_slice.bl_idname, icon='MOD_BOOLEAN')

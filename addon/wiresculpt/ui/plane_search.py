@@ -1,4 +1,4 @@
-"""The plane assistant's panel (issue 15), under the Wire panel: Find Stable Planes, Suggest
+"""The plane assistant's panel, under the Wire panel: Find Stable Planes, Suggest
 Planes, and up to three candidates with what changes, their figures, Preview (an eye, pressed while
 shown) and Apply."""
 import bpy

@@ -42,7 +42,7 @@ def sculpture_weight(design):
 
 
 def load_capacity_rows(design):
-    """[(direction, grams or None)] from design["load_capacity"] (FORMATS: the weight multiple the
+    """[(direction, grams or None)] from design["load_capacity"] (docs/formats.md: the weight multiple the
     sculpture holds with gravity along each axis direction, "+x" ... "-z"), [] when absent.
     grams = multiple x weight / g x 1000; None where no limit was found (unbounded)."""
     capacity = design.get("load_capacity")

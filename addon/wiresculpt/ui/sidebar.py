@@ -9,7 +9,7 @@ from ..blend.registration import handlers_factory
 
 def has_design(scene):
     settings = getattr(scene, "wiresculpt", None)
-    return settings is not None and (settings.target is not None or len(settings.contours) > 0)
+    return settings is not None and (settings.model is not None or len(settings.contours) > 0)
 
 
 @persistent

@@ -3,8 +3,8 @@ scene's planes, ticks and panel values) and the Live line's hint when Live and a
 disagree. Shared by ui/results.py and ui/panel.py; no panel here."""
 from .. import props
 from ..blend import results as scene_results
-from ..blend import target_watch
-from ..blend.handles import target_name
+from ..blend import model_watch
+from ..blend.handles import model_name
 from ..core import live_verdict, stale
 from ..core.limits import broken_limits, hooks_may_help, recorded_stock
 
@@ -42,9 +42,9 @@ def report(context):
     except ValueError:  # the panel's values cannot be solved (smallest bend above the largest)
         settings = None
     mesh = None
-    if inputs and "mesh" in inputs and ws.target is not None and inputs.get("target") == ws.target.name:
-        mesh = target_watch.mesh_state(ws.target, context.view_layer.depsgraph)
-    now = stale.SceneNow(planes, ticked, names, target_name(ws), settings, props.material_of(ws), mesh)
+    if inputs and "mesh" in inputs and ws.model is not None and inputs.get("target") == ws.model.name:
+        mesh = model_watch.mesh_state(ws.model, context.view_layer.depsgraph)
+    now = stale.SceneNow(planes, ticked, names, model_name(ws), settings, props.material_of(ws), mesh)
     said = stale.changes(design, now, inputs, _recorded["labels"], _recorded["planes"])
     return said, names
 

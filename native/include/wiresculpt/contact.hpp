@@ -3,7 +3,7 @@
 // with their local geometry (Sec. 4.2, Figs. 5 and 6) and optimality metric e_c (Eq. 2) of
 // Miguel, Lepoutre, Bickel 2016. The derivation of the signs is in docs/method-layering.md.
 //
-// Conventions (FORMATS.md, `hook`): at crossing c with wires i = wires[0], j = wires[1] and plane
+// Conventions (docs/formats.md, `hook`): at crossing c with wires i = wires[0], j = wires[1] and plane
 // normals n_i, n_j, let d = normalize(n_i × n_j), the direction of the planes' common line.
 //   hook = +1: the kink of wire i opens towards +d (bisector h_i = +d) and the kink of wire j
 //              opens towards -d (h_j = -d): the wires interlock like chain links, wire i's vertex

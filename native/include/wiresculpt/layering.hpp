@@ -103,7 +103,7 @@ struct LayeringStats {
 };
 
 struct LayeringResult {
-  /// Per crossing: -1, 0 or 1 (FORMATS.md `hook`). When unstable: the hooks of the largest stable
+  /// Per crossing: -1, 0 or 1 (docs/formats.md `hook`). When unstable: the hooks of the largest stable
   /// partial assembly found, 0 elsewhere.
   std::vector<int> hooks;
   std::vector<double> metric;               ///< per crossing: e_c of the chosen hook (0 if null)

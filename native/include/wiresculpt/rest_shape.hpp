@@ -4,7 +4,7 @@
 // elastic bending torques balance the contact forces in the target shape. Method notes, the sign
 // convention of the turning angles and the derivation of Eq. 12's sign: docs/method-forces.md.
 //
-// Walk (FORMATS.md `rest`): a closed wire of n target points cut at `cut` is walked
+// Walk (docs/formats.md `rest`): a closed wire of n target points cut at `cut` is walked
 // cut, cut+1, ..., cut+n-1, cut (mod n): n+1 positions, the cut at both ends. An open wire (cut
 // -1) is walked 0 .. n-1. Every per-position array below follows the walk.
 #include <numbers>
@@ -46,7 +46,7 @@ struct RestShapeOptions {
   /// k_b of Eq. 9, N·m² (Table 1: steel 0.73, brass 0.42; fitted by the paper with this very
   /// energy, Sec. 5.2). Default 0.73.
   double bending_stiffness = 0.73;
-  /// Radians: the machine's largest bend (Sec. 4.3 c_f,angle; FORMATS `max_bend_deg`). Rest
+  /// Radians: the machine's largest bend (Sec. 4.3 c_f,angle; docs/formats.md `max_bend_deg`). Rest
   /// turning angles beyond it are reported in RestShapeResult::over_bend. Default 2π/3.
   double max_bend = 2.0 * std::numbers::pi / 3.0;
   /// Radians: a rest angle counts as over max_bend only beyond this. The target shape holds its

@@ -1,5 +1,5 @@
 #pragma once
-// The sculpture as it would stand (issue 44, item 1): a geometrically nonlinear 3D equilibrium of
+// The sculpture as it would stand: a geometrically nonlinear 3D equilibrium of
 // the assembled structure, beyond the paper (whose wires bend only in their planes).
 //
 // Model. Every wire is a discrete elastic rod (Bergou, Wardetzky, Robinson, Audoly, Grinspun 2008,

@@ -9,7 +9,7 @@
 
 namespace wiresculpt {
 
-/// One crossing on the wire, as the layering stage hands it over (FORMATS.md, `hook`).
+/// One crossing on the wire, as the layering stage hands it over (docs/formats.md, `hook`).
 struct TargetCrossing {
   /// Index into the input contour of the vertex that IS the crossing point (exactly on it).
   int vertex = -1;

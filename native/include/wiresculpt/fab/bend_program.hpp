@@ -5,7 +5,7 @@
 //
 // Conventions
 //   points   #P by 2, metres, an OPEN polyline starting at the cut (a closed wire's rest shape
-//            already repeats the cut at both ends, FORMATS.md). The wire leaves the machine
+//            already repeats the cut at both ends, docs/formats.md). The wire leaves the machine
 //            starting with points[0].
 //   feed     metres of wire pushed before a bend (the edge lengths between bend points).
 //   bend     radians, the signed turn of the wire's direction at a bend point, walking from the
@@ -111,7 +111,7 @@ BendProgram make_bend_program(const Polyline2& points, const MachineProfile& pro
 /// (before compensation), so a program without merged points rebuilds its input exactly.
 Polyline2 rebuild_polyline(const BendProgram& program, bool from_origin = false);
 
-/// What the machine makes of `program` (issue 21 item 7: the preview): the program run forward
+/// What the machine makes of `program` (the preview): the program run forward
 /// through `machine`'s spring-back line, the inverse of the compensation. Each step feeds as
 /// programmed; each commanded angle c leaves the wire turned by sign(c) * (a * |c| + b) with
 /// a = machine.springback_a, b = machine.springback_b (the fit measured = a * commanded + b).
