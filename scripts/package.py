@@ -6,7 +6,7 @@
   `blender --command extension install-file`): blender_manifest.toml and the package's files at
   the top of the zip, as Blender's own `extension build` lays them out.
 
-The wrong zip explains itself (issue 48): Blender's legacy Add-ons > Install extracts a zip into
+The wrong zip explains itself: Blender's legacy Add-ons > Install extracts a zip into
 scripts/addons/ as it is and lists as new add-ons the top-level .py files and folders whose code
 has a `bl_info` (never a top-level __init__.py). The extension zip's files are at its top, so only
 WRONG_ZIP_MODULE, a top-level module the extension itself never imports, is listed: its bl_info

@@ -1,4 +1,4 @@
-"""The limits a stable design can still break, said first and in short: `stable` (FORMATS.md) means
+"""The limits a stable design can still break, said first and in short: `stable` (docs/formats.md) means
 every segment and bend can be made and the assembly holds, but a maker also needs the sculpture to
 carry the load factor asked for, to keep its wires in their planes, to fit the machine's stock and
 to be of a size such wires make. A design that breaks one of these is never shown as plainly
