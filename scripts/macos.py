@@ -93,17 +93,8 @@ def deps(arch):
 
 
 def headers(minor):
-    folder = os.path.join(CACHE, "include", "cp" + minor.replace(".", ""))
-    with open(PYCONFIG, "rb") as f:
-        want = f.read()
-    mine = os.path.join(folder, "pyconfig.h")
-    if os.path.isfile(mine) and open(mine, "rb").read() == want:
-        return folder
-    shutil.rmtree(folder, ignore_errors=True)
-    shutil.copytree(windows.linux_headers(minor), folder)
-    with open(mine, "wb") as f:
-        f.write(want)
-    return folder
+    """The macOS headers of `minor`: a Linux header tree with cmake/macos-pyconfig.h as its pyconfig.h."""
+    return windows.headers(minor, PYCONFIG, CACHE)
 
 
 def dylibs(path):

@@ -27,7 +27,6 @@ Wine quirk: python.exe cannot start with its stdout or stderr on a regular file 
 """
 import glob
 import hashlib
-import json
 import os
 import re
 import shutil
@@ -248,10 +247,11 @@ def linux_headers(minor):
     raise SystemExit(f"wiresculpt: no headers of Python {minor} here (install python{minor}-dev or a pyenv {minor})")
 
 
-def headers(minor):
-    """The Windows headers of `minor`: a Linux header tree with cmake/windows-pyconfig.h as its pyconfig.h."""
-    folder = os.path.join(CACHE, "include", "cp" + minor.replace(".", ""))
-    with open(PYCONFIG, "rb") as f:
+def headers(minor, pyconfig=PYCONFIG, cache=CACHE):
+    """The Windows headers of `minor` (or another target's, with its `pyconfig` kept under `cache`):
+    a Linux header tree with cmake/windows-pyconfig.h as its pyconfig.h."""
+    folder = os.path.join(cache, "include", "cp" + minor.replace(".", ""))
+    with open(pyconfig, "rb") as f:
         want = f.read()
     mine = os.path.join(folder, "pyconfig.h")
     if os.path.isfile(mine) and open(mine, "rb").read() == want:
@@ -273,40 +273,35 @@ def pybind11_include():
     return os.path.join(folder, "pybind11", "include")
 
 
-def site(minor):
-    """A folder with the Windows numpy for `minor` unpacked (win_amd64 wheel)."""
+def unpacked_wheel(name, version, minor):
+    """A folder with PyPI's win_amd64 wheel of `name` `version` for `minor` unpacked, made once."""
     tag = "cp" + minor.replace(".", "")
-    folder = os.path.join(CACHE, "site", f"{tag}-numpy-{NUMPY[minor]}")
+    folder = os.path.join(CACHE, "site", f"{tag}-{name}-{version}")
     if os.path.isfile(os.path.join(folder, ".complete")):
         return folder
     wheels = os.path.join(CACHE, "wheels")
     pip("download", "-q", "--no-deps", "--only-binary", ":all:", "--platform", "win_amd64", "--python-version", minor,
-        "-d", wheels, f"numpy=={NUMPY[minor]}")
-    wheel = glob.glob(os.path.join(wheels, f"numpy-{NUMPY[minor]}-{tag}-{tag}-win_amd64.whl"))[0]
+        "-d", wheels, f"{name}=={version}")
+    wheel = glob.glob(os.path.join(wheels, f"{name}-{version}-{tag}-{tag}-win_amd64.whl"))[0]
     shutil.rmtree(folder, ignore_errors=True)
     with zipfile.ZipFile(wheel) as z:
         z.extractall(folder)
     open(os.path.join(folder, ".complete"), "w").close()
     return folder
+
+
+def site(minor):
+    """A folder with the Windows numpy for `minor` unpacked (win_amd64 wheel)."""
+    return unpacked_wheel("numpy", NUMPY[minor], minor)
 
 
 def bpy_site(version, minor="3.11"):
     """A folder with PyPI's Windows bpy `version` unpacked (its win_amd64 wheel, ~330 MB, ~600 MB
     unpacked); numpy comes from site(minor)."""
     tag = "cp" + minor.replace(".", "")
-    folder = os.path.join(CACHE, "site", f"{tag}-bpy-{version}")
-    if os.path.isfile(os.path.join(folder, ".complete")):
-        return folder
-    wheels = os.path.join(CACHE, "wheels")
-    say(f"fetching the Windows bpy {version} (about 330 MB)")
-    pip("download", "-q", "--no-deps", "--only-binary", ":all:", "--platform", "win_amd64", "--python-version", minor,
-        "-d", wheels, f"bpy=={version}")
-    wheel = glob.glob(os.path.join(wheels, f"bpy-{version}-{tag}-{tag}-win_amd64.whl"))[0]
-    shutil.rmtree(folder, ignore_errors=True)
-    with zipfile.ZipFile(wheel) as z:
-        z.extractall(folder)
-    open(os.path.join(folder, ".complete"), "w").close()
-    return folder
+    if not os.path.isfile(os.path.join(CACHE, "site", f"{tag}-bpy-{version}", ".complete")):
+        say(f"fetching the Windows bpy {version} (about 330 MB)")
+    return unpacked_wheel("bpy", version, minor)
 
 
 # ---------------------------------------------------------------------------------------------
