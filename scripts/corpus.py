@@ -32,6 +32,8 @@ import time
 import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "addon"))
+from wiresculpt.core import design as codes  # noqa: E402  (the verdicts' codes; bpy-free)
 SIZES = (0.3, 0.5, 0.75)
 
 CGAL = ("libcgal-demo", "CC0-1.0 (CGAL data without an own notice, debian/copyright of libcgal-dev)")
@@ -310,7 +312,8 @@ TIMEOUT = 600  # s per batch run
 
 
 def run_scene(entry, out_root):
-    """One batch run: rc, seconds, stable, reason, recheck problems (None when not re-checked)."""
+    """One batch run: rc, seconds, stable, reason, recheck problems (None when not re-checked), and
+    the verdict's codes (run_codes)."""
     sys.path.insert(0, os.path.join(ROOT, "blender_tests", "pure"))
     from recheck import recheck
 
@@ -331,6 +334,7 @@ def run_scene(entry, out_root):
             design = json.load(f)
         row["stable"] = bool(design.get("stable"))
         row["reason"] = design.get("reason", "")
+        row.update(run_codes(design))
         row["wires"] = len(design.get("wires", []))
         row["crossings"] = len(design.get("crossings", []))
         stages = design.get("stages", {})
@@ -428,22 +432,45 @@ def overhead_lines(rows):
     return lines
 
 
-REASON_KINDS = (  # (words in the reason, kind), the first match wins
-    ("search incomplete", "the layering search hit max_nodes"),
-    ("finds no stable assembly (stages.relayering)",
-     "no stable assembly once the hooks the target shape cannot realise are forbidden"),
-    ("hooks forbidden", "no stable assembly once the hooks the target shape cannot realise are forbidden"),
-    ("no hook configuration can make the finished sculpture stable",
-     "a mechanism: not stable with both hooks at every crossing"),
-    ("no pair of wires is stable", "no pair of wires holds under forces only"),
-    ("no stable assembly order exists", "no stable assembly order"),
-    ("the target shape cannot realise", "crossings the target shape cannot realise (re-layering stopped)"),
-    ("crosses no other wire", "a wire crosses no other"),
-)
+def run_codes(design):
+    """The codes of a run's verdict, as a corpus run stores them: `verdict_cause` (core/design.py:
+    the layering's LAYERING_CAUSES, UNREALISED, NOT_BUILDABLE, a setup cause), `relayering_end`
+    (stages.relayering.end, RELAYER_ENDS; None without the loop) and `forbidden_hooks` (the hooks
+    the returned round's layering left out, stages.layering)."""
+    stages = design.get("stages", {})
+    return {"verdict_cause": design.get("verdict_cause"),
+            "relayering_end": (stages.get("relayering") or {}).get("end"),
+            "forbidden_hooks": (stages.get("layering") or {}).get("forbidden_hooks", 0)}
 
 
-def reason_kind(reason):
-    return next((kind for words, kind in REASON_KINDS if words in reason), first_words(reason, 6))
+NO_ASSEMBLY_KIND = "no stable assembly once the hooks the target shape cannot realise are forbidden"
+CAUSE_KINDS = {  # verdict_cause -> the kind the report groups its runs by
+    codes.SEARCH_INCOMPLETE: "the layering search hit max_nodes",
+    codes.MECHANISM: "a mechanism: not stable with both hooks at every crossing",
+    codes.NO_STABLE_PAIR: "no pair of wires holds under forces only",
+    codes.NO_ASSEMBLY_ORDER: "no stable assembly order",
+    codes.NO_CROSSINGS: "no two wires cross",
+    codes.UNREALISED: "crossings the target shape cannot realise (re-layering stopped)",
+    codes.ALONE: "a wire crosses no other",
+    codes.DISCONNECTED: "the wires do not hang together",
+    codes.NOT_BUILDABLE: "the design cannot be made on the machine",
+    codes.NO_WIRES_CAUSE: "no plane cuts the mesh",
+    codes.ONE_WIRE_CAUSE: "one wire only",
+}
+
+
+def cause_kind(run):
+    """The kind of an unstable run's verdict, from its codes (run_codes): a search that max_nodes
+    stopped; the re-layering's end without a stable assembly, or a layering verdict over the
+    allowed hooks only (some forbidden because the target shape cannot realise them); otherwise its
+    verdict_cause's kind (the code itself when the table has none)."""
+    cause = run.get("verdict_cause")
+    if cause == codes.SEARCH_INCOMPLETE:
+        return CAUSE_KINDS[cause]
+    if run.get("relayering_end") == codes.RELAYER_NO_ASSEMBLY or (
+            cause in codes.HOOK_VERDICTS and run.get("forbidden_hooks")):
+        return NO_ASSEMBLY_KIND
+    return CAUSE_KINDS.get(cause, str(cause))
 
 
 def first_words(text, n=9):
@@ -510,11 +537,11 @@ def section(results, before=None):
                      f"{r.get('forbidden', '')} | {rec} |")
     unstable = [r for r in rows if r["stable"] is False]
     if unstable:
-        lines += ["", "Why the unstable runs stay unstable (by the reason's kind):", "",
+        lines += ["", "Why the unstable runs stay unstable (by the kind of the verdict's cause):", "",
                   "| kind | runs |", "|---|---:|"]
         kinds = {}
         for r in unstable:
-            kinds[reason_kind(r["reason"])] = kinds.get(reason_kind(r["reason"]), 0) + 1
+            kinds[cause_kind(r)] = kinds.get(cause_kind(r), 0) + 1
         lines += [f"| {k} | {n} |" for k, n in sorted(kinds.items(), key=lambda kv: -kv[1])]
     refused = [r for r in ok if r["recheck"]]
     if refused:

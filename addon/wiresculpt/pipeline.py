@@ -10,7 +10,8 @@ import time
 from . import native
 from .core import mesh_faults
 from .core import settings as settings_table
-from .core.design import NO_WIRES_CAUSE, ONE_WIRE_CAUSE, SETUP_WORDS, TOO_CLOSE, new_design
+from .core.design import (NO_WIRES_CAUSE, ONE_WIRE_CAUSE, RELAYER_INCOMPLETE, RELAYER_NO_ASSEMBLY, RELAYER_NOTHING_NEW,
+                          RELAYER_ROUNDS, RELAYER_STABLE, SETUP_WORDS, TOO_CLOSE, new_design)
 from .core.sizes import mesh_size, size_warnings
 from .core.solve_context import Cancelled, OutOfTime, SolveContext, quiet  # noqa: F401 (the pipeline's names)
 from .fab import buildability
@@ -56,7 +57,7 @@ def solve(design, material, settings, progress=None, cancel=None, stock=None, ho
     if len(design["wires"]) < 2:
         design["stable"] = False
         cause = NO_WIRES_CAUSE if not design["wires"] else ONE_WIRE_CAUSE  # setup problems (core/design.py)
-        design["reason"], design["reason_causes"] = SETUP_WORDS[cause], [cause]
+        design["reason"], design["reason_causes"], design["verdict_cause"] = SETUP_WORDS[cause], [cause], cause
         return design
     apply_cuts(design, settings.get("cuts"))
     for warning in size_warnings(design, *(stock or ())):  # before the long work: the contour's figure, at once
@@ -103,8 +104,8 @@ def relayer(design, material, settings, context, hook_patterns=None, hook_second
     too_close, the target shape's own tolerance), which the loop would otherwise learn one round at a
     time; when the first layering finds no stable assembly without them, it layers again with every
     hook and goes on as without them (the every-hook path), so the target shape shows which hooks fail and
-    why. Records every layering run in stages.relayering. Returns the design of
-    the last round, or, when the last layering found no stable assembly under the forbidden hooks,
+    why. Records every layering run in stages.relayering, and how the loop ended (its `end`,
+    core/design.py RELAYER_ENDS). Returns the design of the last round, or, when the last layering found no stable assembly under the forbidden hooks,
     of the last round that reached the target shape (its shapes and reason show why), saying so.
     `context`: the solve's SolveContext (core/solve_context.py: progress, cancel, deadline, and the
     memos every round shares). `hook_patterns`: hooks_by_forces' `patterns` bound (None:
@@ -154,7 +155,9 @@ def relayer(design, material, settings, context, hook_patterns=None, hook_second
         rounds.append({"forbidden": _pairs(forbidden), "too_close": _pairs(too_close), "stable": attempt["stable"],
                        "verdict": "stable" if attempt["stable"] else attempt["reason"],
                        "unrealised": _pairs(learnt), "seconds": time.perf_counter() - began})
-        if attempt["stable"] or not learnt or attempt.get("search_incomplete") or round_ == extra_rounds:
+        end = (RELAYER_STABLE if attempt["stable"] else RELAYER_INCOMPLETE if attempt.get("search_incomplete")
+               else RELAYER_NOTHING_NEW if not learnt else RELAYER_ROUNDS if round_ == extra_rounds else None)
+        if end is not None:
             break
         forbidden |= learnt
         round_ += 1
@@ -170,8 +173,8 @@ def relayer(design, material, settings, context, hook_patterns=None, hook_second
                              f"realise{close} finds no stable assembly (stages.relayering)")
         if too_close and TOO_CLOSE not in shaped.setdefault("reason_causes", []):
             shaped["reason_causes"].append(TOO_CLOSE)
-        attempt = shaped
-    attempt["stages"]["relayering"] = {"rounds": rounds, "forbidden": _pairs(forbidden),
+        attempt, end = shaped, RELAYER_NO_ASSEMBLY
+    attempt["stages"]["relayering"] = {"rounds": rounds, "forbidden": _pairs(forbidden), "end": end,
                                        "max_rounds": extra_rounds, "seconds": time.perf_counter() - start}
     if not attempt["stable"] and learnt and round_ == extra_rounds and extra_rounds:
         attempt["reason"] += (f" (re-layering stopped after relayer_rounds = {extra_rounds}; more rounds may "

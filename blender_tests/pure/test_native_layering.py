@@ -5,6 +5,7 @@ import numpy as np
 from helpers import circle
 
 from wiresculpt import native
+from wiresculpt.core.design import MECHANISM, SEARCH_INCOMPLETE, STABLE_CAUSE
 
 
 def wire(name, normal, **kw):
@@ -76,6 +77,8 @@ class LayeringBinding(unittest.TestCase):
         self.assertFalse(r["stable"])
         self.assertEqual(r["hook"], [0] * 6)
         self.assertIn("12 hooks forbidden", r["reason"])
+        # as codes: not even both hooks at every crossing hold (none is allowed), over 6 x 2 hooks left out
+        self.assertEqual((r["cause"], r["forbidden_hooks"]), (MECHANISM, 12))
         bad = [([[6, 1]], "settings['forbidden_hooks'][0]: crossing 6 does not exist (the network has 6 crossings)"),
                ([[0, 0]], "settings['forbidden_hooks'][0]: the hook must be -1 or 1 (null is always allowed), got 0"),
                ([[0, 1, 2]], "settings['forbidden_hooks'][0]: expected [crossing id, hook]")]
@@ -141,7 +144,9 @@ class LayeringBinding(unittest.TestCase):
         self.assertFalse(r["stable"])
         self.assertTrue(r["reason"].startswith("search incomplete"), r["reason"])
         self.assertNotIn("no stable", r["reason"])
+        self.assertEqual((r["cause"], r["forbidden_hooks"]), (SEARCH_INCOMPLETE, 0))
         self.assertTrue(native.layering(wires, {"max_nodes": 0})["stable"])  # 0: no limit
+        self.assertEqual(native.layering(wires, {"max_nodes": 0})["cause"], STABLE_CAUSE)
 
     def test_check_assembly_cancel(self):
         wires = [wire("X", [1, 0, 0]), wire("Y", [0, 1, 0]), wire("Z", [0, 0, 1])]

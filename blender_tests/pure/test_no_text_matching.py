@@ -43,14 +43,9 @@ SCANNED = ("addon/wiresculpt", "scripts")
 LIST_WORDS = ("warnings", "notes", "limits", "phrases", "reasons", "messages", "errors")
 SPLITS = ("split", "rsplit")
 
-# Offenders that wait for codes nothing gives yet: the layering's verdict as a code (the corpus
-# report's kinds of reason: the native layering would return its cause, e.g. a LayeringCause enum,
-# through the binding, and the pipeline a code for the re-layering's end; and the runs stored in
-# docs/corpus.json, which the report re-reads, carry only the reason's words until the corpus is
-# run again).
-WAITING = {
-    ("scripts/corpus.py", "reason_kind"),
-}
+# Offenders that wait for codes nothing gives yet (none now: the corpus report's kinds of reason
+# read the verdict's codes, scripts/corpus.py cause_kind).
+WAITING = set()
 
 
 def _word(name):

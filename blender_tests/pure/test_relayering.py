@@ -38,7 +38,8 @@ from unittest import mock
 import numpy as np
 
 from wiresculpt import native, pipeline
-from wiresculpt.core.design import TOO_CLOSE, new_design, wire_entry
+from wiresculpt.core.design import (RELAYER_INCOMPLETE, RELAYER_NO_ASSEMBLY, TOO_CLOSE, UNREALISED, new_design,
+                                    wire_entry)
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.settings import defaults
 from wiresculpt.stages import layering, target_shape
@@ -259,6 +260,9 @@ class Relayering(unittest.TestCase):
                                                f"stable assembly (stages.relayering)"),
                         new["reason"])
         self.assertEqual(new["reason_causes"], [TOO_CLOSE])  # the cause the note names, as its code
+        # as codes: the loop ended on a layering with no stable assembly, the design is the round the
+        # target shape failed
+        self.assertEqual((record["end"], new["verdict_cause"]), (RELAYER_NO_ASSEMBLY, UNREALISED))
 
     def test_the_close_geometry(self):
         # P and Q 3 deg apart along A: 10.5 mm, shorter than min_segment, so neither hook of either
@@ -294,6 +298,7 @@ class Relayering(unittest.TestCase):
         self.assertEqual(calls, [target_shape.REALISED_ANGLE])  # one layering, with the hooks forbidden
         self.assertFalse(d["stable"])
         self.assertTrue(d.get("search_incomplete"))
+        self.assertEqual(d["stages"]["relayering"]["end"], RELAYER_INCOMPLETE)
         rounds = d["stages"]["relayering"]["rounds"]
         self.assertEqual(len(rounds), 1)
         self.assertEqual(len(rounds[0]["too_close"]), 4)

@@ -155,6 +155,7 @@ py::dict layering_py(const py::object& wire_list, const py::object& settings, co
       py::arg("network") = network_dict(net, r.hooks, r.metric, options.contact, forbidden.contour_arrays), py::arg("hook") = r.hooks, py::arg("metric") = r.metric,
       py::arg("assembly_order") = r.assembly_order, py::arg("steps") = r.steps,
       py::arg("two_hand_steps") = r.two_hand_steps, py::arg("stable") = r.stable, py::arg("reason") = r.reason,
+      py::arg("cause") = cause_name(r.cause), py::arg("forbidden_hooks") = r.forbidden_hooks,
       py::arg("what_moves") = r.what_moves, py::arg("warnings") = warnings,
       py::arg("objective") = py::dict(py::arg("max_metric") = r.max_metric, py::arg("null_crossings") = r.null_crossings,
                                       py::arg("sum_metric") = r.sum_metric,
@@ -228,7 +229,9 @@ Returns {"network": {"wires": [{id, name, origin, normal, closed, contour [[x, y
 with the crossing points inserted)}], "crossings": [{id, wires, contour_vertices (indices into
 the wires' contours), point, hook, metric, hook_metrics (e_c of hook -1 and of hook +1)}] (the design document's keys, docs/formats.md), "close_crossings": [...], "min_scale", "size",
 "required_size"}, "hook": [-1|0|1 per crossing], "metric": [e_c], "assembly_order": [wire ids],
-"steps": [[ids]], "two_hand_steps": [step indices], "stable": bool, "reason": str, "what_moves": str
+"steps": [[ids]], "two_hand_steps": [step indices], "stable": bool, "reason": str, "cause": str (LayeringCause:
+"none" when stable, "alone", "disconnected", "no_crossings", "no_stable_pair", "no_assembly_order", "mechanism",
+"search_incomplete"), "forbidden_hooks": int (the hooks the verdict left out), "what_moves": str
 (LayeringResult::what_moves, "" unless the hook-relaxed check failed), "warnings": [str], "objective": {max_metric, null_crossings, sum_metric, unbalanced_in_plane},
 "complete_search": bool, "in_plane_complete": bool, "too_close_forbidden": [[crossing id, hook]] (the hooks
 forbid_too_close forbade), "stats": {seconds, lp_solves, nodes}, "arrays": [the network's

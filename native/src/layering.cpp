@@ -421,8 +421,8 @@ class Search {
   }
 };
 
-// Why no stable assembly exists, naming a wire and its crossings.
-std::string explain(const Network& net, const Search& s, bool tried_pairs) {
+// Why no stable assembly exists, naming a wire and its crossings; its cause into `cause`.
+std::string explain(const Network& net, const Search& s, bool tried_pairs, LayeringCause& cause) {
   const int P = static_cast<int>(net.wires.size());
   std::vector<char> in(P, 0);
   for (int w : s.deep_order_) in[w] = 1;
@@ -450,7 +450,11 @@ std::string explain(const Network& net, const Search& s, bool tried_pairs) {
           bc = cs;
         }
       }
-    if (ba < 0) return "no two wires cross, so no wire can hold another";
+    if (ba < 0) {
+      cause = LayeringCause::no_crossings;
+      return "no two wires cross, so no wire can hold another";
+    }
+    cause = LayeringCause::no_stable_pair;
     return "no pair of wires is stable even under forces only (Sec. 4.2), so no assembly can start: wire " +
            quoted(net, bb) + " cannot be held stably by wire " + quoted(net, ba) + " at crossing" +
            (bc.size() > 1 ? "s " : " ") + crossing_list(bc) + " in any hook configuration";
@@ -465,6 +469,7 @@ std::string explain(const Network& net, const Search& s, bool tried_pairs) {
       worst_c = cs;
     }
   }
+  cause = LayeringCause::no_assembly_order;
   const std::string base = "no stable assembly order exists under the paper's model (Sec. 4.1-4.2): after the "
                            "largest stable partial assembly (wires " + wire_list(net, s.deep_order_) + "), ";
   if (worst_c.empty())
@@ -473,13 +478,19 @@ std::string explain(const Network& net, const Search& s, bool tried_pairs) {
          (worst_c.size() > 1 ? "s " : " ") + crossing_list(worst_c) + " with them" + also;
 }
 
+// The hooks allowed_hooks forbids (LayeringResult::forbidden_hooks).
+int forbidden_count(const LayeringOptions& options) {
+  int count = 0;
+  for (const auto& a : options.allowed_hooks) count += !a[0] + !a[1];
+  return count;
+}
+
 // Appended to a reason when hooks were forbidden: the verdict is over the allowed ones only.
 std::string forbidden_note(const LayeringOptions& options) {
-  int count = 0;
+  const int count = forbidden_count(options);
   std::vector<int> at;
   for (std::size_t c = 0; c < options.allowed_hooks.size(); ++c) {
     const auto& a = options.allowed_hooks[c];
-    count += !a[0] + !a[1];
     if (!a[0] || !a[1]) at.push_back(static_cast<int>(c));
   }
   if (count == 0) return "";
@@ -489,6 +500,20 @@ std::string forbidden_note(const LayeringOptions& options) {
 }
 
 }  // namespace
+
+const char* cause_name(LayeringCause cause) {
+  switch (cause) {
+    case LayeringCause::none: return "none";
+    case LayeringCause::alone: return "alone";
+    case LayeringCause::disconnected: return "disconnected";
+    case LayeringCause::no_crossings: return "no_crossings";
+    case LayeringCause::no_stable_pair: return "no_stable_pair";
+    case LayeringCause::no_assembly_order: return "no_assembly_order";
+    case LayeringCause::mechanism: return "mechanism";
+    case LayeringCause::search_incomplete: return "search_incomplete";
+  }
+  return "none";
+}
 
 std::vector<std::array<bool, 2>> too_close_hooks(const Network& net, double contact_angle, double angle_tolerance) {
   const int C = static_cast<int>(net.crossings.size());
@@ -563,8 +588,9 @@ LayeringResult with_too_close_forbidden(const Network& net, const LayeringOption
   return r;
 }
 
-// Why the wires do not hang together through their crossings, or "" when they do.
-std::string disconnected(const Network& net) {
+// Why the wires do not hang together through their crossings, or "" when they do; its cause
+// (alone or disconnected) into `cause`.
+std::string disconnected(const Network& net, LayeringCause& cause) {
   const int P = static_cast<int>(net.wires.size());
   std::vector<int> comp(P, -1);
   std::vector<int> stack{0};
@@ -583,6 +609,7 @@ std::string disconnected(const Network& net) {
     if (comp[w] >= 0) continue;
     bool any = false;
     for (const auto& x : net.crossings) any = any || x.wires[0] == w || x.wires[1] == w;
+    cause = any ? LayeringCause::disconnected : LayeringCause::alone;
     return any ? "wire " + quoted(net, w) + " and the wires it crosses are not connected to wire " +
                      quoted(net, 0) + " through any crossing; a sculpture must hang together"
                : "wire " + quoted(net, w) + " crosses no other wire, so nothing can hold it";
@@ -665,12 +692,14 @@ void take_unstable(LayeringResult& r, const Network& net, const Search& s, const
     }
   }
   // A stopped search proves nothing: it says so, never that no stable assembly exists.
+  if (s.stopped()) r.cause = LayeringCause::search_incomplete;
   r.reason = s.stopped() ? "search incomplete: the layering stopped after " + std::to_string(s.nodes_) +
                                " nodes (max_nodes = " + std::to_string(options.max_nodes) +
                                ") before finding a stable assembly; a stable one may exist: raise max_nodes (0: no "
                                "limit) to search further"
-                         : explain(net, s, tried_pairs);
+                         : explain(net, s, tried_pairs, r.cause);
   r.reason += forbidden_note(options);
+  r.forbidden_hooks = forbidden_count(options);
 }
 
 }  // namespace
@@ -700,7 +729,7 @@ LayeringResult layering(const Network& net, const LayeringOptions& options, cons
     return finish();
   }
   // A wire sculpture must be connected through crossings.
-  r.reason = disconnected(net);
+  r.reason = disconnected(net, r.cause);
   if (!r.reason.empty()) return finish();
 
   Search s(net, options, progress);
@@ -713,6 +742,8 @@ LayeringResult layering(const Network& net, const LayeringOptions& options, cons
     if (!relaxed.stable) {
       std::string detail = what_moves(net, relaxed);  // what moves, or what cannot be balanced, with its advice
       detail += forbidden_note(options);
+      r.cause = LayeringCause::mechanism;
+      r.forbidden_hooks = forbidden_count(options);
       r.reason = "no hook configuration can make the finished sculpture stable: even with both hook directions "
                  "allowed at every crossing, " + detail;
       r.what_moves = detail.substr(0, detail.find(';'));  // each advice follows a ';' (mechanism_message)

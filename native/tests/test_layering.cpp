@@ -281,6 +281,9 @@ TEST_CASE("layering: an unstable network names the wire that cannot be added and
   CHECK(r.what_moves == "wire 'Y' is held only at crossings 0 and 1, which lie on one line, so it can turn about "
                         "that line like a hinge");
   CHECK(r.reason.find("allowed at every crossing, " + r.what_moves + ";") != std::string::npos);
+  CHECK(r.cause == LayeringCause::mechanism);
+  CHECK(std::string(cause_name(r.cause)) == "mechanism");
+  CHECK(r.forbidden_hooks == 0);
   CHECK(r.assembly_order.empty());
   for (int h : r.hooks) CHECK(h == 0);
 }
@@ -294,6 +297,8 @@ TEST_CASE("layering: a wire that crosses nothing cannot be held") {
   const LayeringResult r = layering(net);
   CHECK_FALSE(r.stable);
   CHECK_THAT(r.reason, Contains("'far'") && Contains("crosses no other wire"));
+  CHECK(r.cause == LayeringCause::alone);
+  CHECK(std::string(cause_name(r.cause)) == "alone");
 }
 
 TEST_CASE("layering: a four-wire cage needs a step with two hands") {
@@ -317,6 +322,7 @@ TEST_CASE("layering: a four-wire cage needs a step with two hands") {
   // its crossings with the pair.
   REQUIRE(one.assembly_order.size() == 2);
   CHECK_THAT(one.reason, Contains("cannot be added stably") && Contains("crossings"));
+  CHECK(one.cause == LayeringCause::no_assembly_order);  // a stable pair was found, no third wire follows
   check_prefixes(net, one, false);
 
   const LayeringResult two = layering(net);
@@ -406,6 +412,11 @@ TEST_CASE("layering: forbidden hooks never appear and the optimum over the allow
         // Stable without the mask, not with it: the reason says hooks were forbidden (networks that
         // are not connected fail before any hook matters, and say so).
         if (unmasked.stable) CHECK_THAT(r.reason, Contains("forbidden"));
+        // a verdict over the allowed hooks counts the hooks the mask leaves out
+        int masked = 0;
+        for (const auto& a : lo.allowed_hooks) masked += !a[0] + !a[1];
+        if (r.cause != LayeringCause::alone && r.cause != LayeringCause::disconnected) CHECK(r.forbidden_hooks == masked);
+        CHECK(r.cause != LayeringCause::none);
         continue;
       }
       ++stable;
@@ -656,8 +667,11 @@ TEST_CASE("layering: a search stopped by max_nodes says search incomplete, never
   CHECK_FALSE(r.complete_search);
   CHECK_THAT(r.reason, Catch::Matchers::StartsWith("search incomplete"));
   CHECK_THAT(r.reason, !Contains("no stable"));
+  CHECK(r.cause == LayeringCause::search_incomplete);
+  CHECK(std::string(cause_name(r.cause)) == "search_incomplete");
   lo.max_nodes = 0;  // no limit: the same network is stable (test "three great circles")
   CHECK(layering(net, lo).stable);
+  CHECK(layering(net, lo).cause == LayeringCause::none);
 }
 
 TEST_CASE("layering: allowed_hooks must have one entry per crossing") {

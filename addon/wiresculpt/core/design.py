@@ -37,6 +37,7 @@ KEYS = {
         "format": "design", "version": "design", "units": "design", "material": "design",
         "torque_fraction": "design", "machine": "design", "wires": "design", "stages": "design",
         "stable": "layering", "reason": "layering", "reason_causes": "layering", "what_moves": "layering",
+        "verdict_cause": "layering",
         "pending_stages": "pipeline", "warnings": "every stage",
         "crossings": "layering", "assembly_order": "layering", "assembly_steps": "layering",
         "two_hand_steps": "layering", "close_crossings": "layering", "required_size": "layering",
@@ -98,6 +99,38 @@ SETUP_CAUSES = (NO_WIRES_CAUSE, ONE_WIRE_CAUSE)
 NO_WIRES = "no plane cuts the mesh: move the planes through the mesh"
 ONE_WIRE = "a sculpture needs at least two wires: add a plane or pick more contours"
 SETUP_WORDS = {NO_WIRES_CAUSE: NO_WIRES, ONE_WIRE_CAUSE: ONE_WIRE}
+
+
+# The code of the verdict (`verdict_cause`): what makes the design not stable, written with
+# `stable` and `reason` by whoever sets them (KEYS' comment); the reason's words are for people.
+STABLE_CAUSE = "none"  # stable
+# The layering's own verdicts: the native LayeringCause, as the binding names it.
+ALONE = "alone"  # a wire crosses no other wire
+DISCONNECTED = "disconnected"  # a group of wires crosses none of the others
+NO_CROSSINGS = "no_crossings"  # no two wires cross
+NO_STABLE_PAIR = "no_stable_pair"  # no pair of wires is stable under forces only
+NO_ASSEMBLY_ORDER = "no_assembly_order"  # no wire can be added stably to the largest stable partial assembly
+MECHANISM = "mechanism"  # not stable even with both hooks at every crossing (`what_moves`)
+SEARCH_INCOMPLETE = "search_incomplete"  # max_nodes stopped the search (`search_incomplete`)
+LAYERING_CAUSES = (STABLE_CAUSE, ALONE, DISCONNECTED, NO_CROSSINGS, NO_STABLE_PAIR, NO_ASSEMBLY_ORDER, MECHANISM,
+                   SEARCH_INCOMPLETE)
+# The layering's verdicts that depend on the hooks allowed: over the allowed ones only when
+# stages.layering.forbidden_hooks is not 0.
+HOOK_VERDICTS = (NO_CROSSINGS, NO_STABLE_PAIR, NO_ASSEMBLY_ORDER, MECHANISM, SEARCH_INCOMPLETE)
+# Later stages' verdicts (and the setup problems' codes, SETUP_CAUSES, when slicing gave fewer
+# than two wires):
+UNREALISED = "unrealised"  # the target shape nulled crossings and the assembly no longer stands without them
+NOT_BUILDABLE = "not_buildable"  # a wire's bend program cannot be made (fab/buildability.apply)
+
+# How the re-layering loop ended (stages.relayering.end, pipeline.relayer).
+RELAYER_STABLE = "stable"  # the design is stable
+RELAYER_NOTHING_NEW = "nothing_new"  # not stable, and no hook the target shape failed is left to forbid
+RELAYER_INCOMPLETE = "search_incomplete"  # max_nodes stopped the last layering
+RELAYER_ROUNDS = "max_rounds"  # relayer_rounds re-layerings ran
+# The last layering found no stable assembly without the forbidden hooks: the design is the last
+# round that reached the target shape
+RELAYER_NO_ASSEMBLY = "no_assembly"
+RELAYER_ENDS = (RELAYER_STABLE, RELAYER_NOTHING_NEW, RELAYER_INCOMPLETE, RELAYER_ROUNDS, RELAYER_NO_ASSEMBLY)
 
 
 def setup_problem(design):

@@ -15,6 +15,7 @@ the G-code and row k of the bend table), and a place is also given in mm from th
 import numpy as np
 
 from .. import native
+from ..core.design import NOT_BUILDABLE
 from ..core.sizes import scale_advice
 from ..core.polylines import self_crossings
 from .export import machine_profile
@@ -100,7 +101,7 @@ def apply(design, profile=None):
                               "self_crossings": result["self_crossings"]}
     design.setdefault("warnings", []).extend(c["message"] for c in result["self_crossings"])
     if result["problems"] and design["stable"]:
-        design["stable"] = False
+        design["stable"], design["verdict_cause"] = False, NOT_BUILDABLE
         design["reason"] = ("the design cannot be made on the machine: "
                             + "; ".join(p["message"] for p in result["problems"]))
     return result

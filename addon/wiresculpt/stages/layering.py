@@ -3,6 +3,7 @@ import math
 
 from .. import native
 from ..core import settings as settings_table
+from ..core.design import UNREALISED
 from ..core.polylines import point_array
 
 
@@ -69,6 +70,7 @@ def run(design, material, settings, native_progress=None, forbidden=(), too_clos
     design["two_hand_steps"] = list(result["two_hand_steps"])
     design["stable"] = bool(result["stable"])
     design["reason"] = result["reason"]
+    design["verdict_cause"] = result["cause"]  # core/design.py LAYERING_CAUSES
     if result["what_moves"]:  # the hook-relaxed check failed: the clause naming what moves
         design["what_moves"] = result["what_moves"]
     if not result["complete_search"] and not design["stable"]:
@@ -83,7 +85,7 @@ def run(design, material, settings, native_progress=None, forbidden=(), too_clos
     design["stages"]["layering"] = {
         "seconds": stats["seconds"], "lp_solves": stats["lp_solves"], "nodes": stats["nodes"],
         "complete_search": result["complete_search"], "in_plane_complete": result["in_plane_complete"],
-        **result["objective"],
+        "forbidden_hooks": result["forbidden_hooks"], **result["objective"],
     }
     return (f"{len(design['crossings'])} crossings, {'stable' if design['stable'] else 'not stable'}, "
             f"order {design['assembly_order']}, {stats['lp_solves']} LPs, {stats['nodes']} nodes "
@@ -102,7 +104,8 @@ def recheck(design, material, settings, native_progress=None, contours=None):
 def recheck_verdict(design, material, settings, cause, count, native_progress=None, contours=None, codes=()):
     """The layering's verdict after a later stage nulled `count` crossings for `cause` (a
     sentence naming them): re-checks the assembly (recheck) and, when it no longer stands, sets
-    `stable` false with a `reason` naming the cause and the step that fails, and `reason_causes`
+    `stable` false with a `reason` naming the cause and the step that fails, `verdict_cause`
+    UNREALISED (core/design.py), and `reason_causes`
     to `codes` (those of the causes `cause` names, core/design.py) when there are any. Returns the
     number of LPs the re-check solved. `contours` as for recheck."""
     verdict = recheck(design, material, settings, native_progress, contours)
@@ -111,6 +114,7 @@ def recheck_verdict(design, material, settings, cause, count, native_progress=No
         names = " and ".join(design["wires"][w]["name"] for w in step)
         design["stable"] = False
         design.pop("what_moves", None)  # the reason is no longer the layering's own
+        design["verdict_cause"] = UNREALISED
         design["reason"] = (f"{cause}; without {'them' if count > 1 else 'it'} the assembly is no longer stable "
                             f"when adding {names}")
         if codes:

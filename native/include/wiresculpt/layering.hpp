@@ -102,6 +102,22 @@ struct LayeringStats {
   double seconds = 0.0;
 };
 
+/// Why the layering finds no stable structure (LayeringResult::cause), each with the words the
+/// reason gives for it.
+enum class LayeringCause {
+  none,               ///< stable (or a single wire)
+  alone,              ///< a wire crosses no other wire: nothing can hold it
+  disconnected,       ///< a group of wires crosses none of the others: the sculpture does not hang together
+  no_crossings,       ///< no two wires cross
+  no_stable_pair,     ///< no pair of wires is stable under forces only: no assembly can start
+  no_assembly_order,  ///< no wire can be added stably to the largest stable partial assembly
+  mechanism,          ///< not stable even with both hooks at every crossing (what_moves names what moves)
+  search_incomplete,  ///< max_nodes stopped the search before a stable assembly was found
+};
+
+/// The snake_case name of a cause, as the binding hands it over: "no_assembly_order".
+const char* cause_name(LayeringCause cause);
+
 struct LayeringResult {
   /// Per crossing: -1, 0 or 1 (docs/formats.md `hook`). When unstable: the hooks of the largest stable
   /// partial assembly found, 0 elsewhere.
@@ -117,6 +133,11 @@ struct LayeringResult {
   /// Empty when stable; otherwise a sentence naming the wire that cannot be added stably and
   /// the crossings involved.
   std::string reason;
+  /// The cause `reason` gives (none when stable).
+  LayeringCause cause = LayeringCause::none;
+  /// The hooks the verdict left out (allowed_hooks' false entries, the too-close ones of
+  /// forbid_too_close among them): a verdict over the allowed hooks only when not 0.
+  int forbidden_hooks = 0;
   /// When not stable even with both hooks allowed at every crossing: the clause of `reason` that
   /// names what moves or what cannot be balanced (after "... allowed at every crossing, ", up to
   /// its first advice), for a program that shows or groups it; empty otherwise.
