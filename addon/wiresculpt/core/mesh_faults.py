@@ -9,7 +9,12 @@ the planes: when a design is not stable, its verdict says them first (explain), 
     check(vertices, faces)  -> [fault, ...]  causes as codes with their figures (below)
     sentence(fault)         -> the words of one fault, made only here
     explain(design)         a design that is not stable and whose mesh has faults: the mesh's
-                            words lead its reason, the codes join reason_causes
+                            words lead its reason, the codes join reason_causes; a mesh closed
+                            for slicing (design["mesh_closing"]) that left an obstacle says it
+    closing_voxel(size, min_segment)  m: the voxel of the closing remesh (the rule below)
+    closing(before, after, voxel, lost)  the record of a closing (CLOSED, its figures)
+    closing_sentence(record) what was done, in words ("closed 223 boundary edges ... by a 4 mm
+                            voxel remesh")
 
 Faults (each a dict with "cause" and its figures):
 - SHELLS: "shells" separate parts (faces joined through shared edges or vertices, after welding
@@ -19,6 +24,23 @@ Faults (each a dict with "cause" and its figures):
   rung does.
 - OPEN: "edges" boundary edges (used by one face), "holes" their loops, "voxel" (m) a remesh
   size that closes them (VOXEL_SHARE of the model's size).
+- NONMANIFOLD: "edges" edges shared by more than two faces (after welding).
+
+Closing for slicing (blend/mesh.py does it, in Blender, on a temporary copy: the user's mesh object
+is never changed): every hole is capped (its boundary loop filled) and the capped mesh remeshed by
+voxels, which fuses overlapping or touching parts into one surface and mends non-manifold edges.
+The voxel (closing_voxel) is the smallest of CLOSE_SHARE of the model's size and CLOSE_SEGMENTS of
+the wire's bend spacing (settings min_segment, l_min: the wire cannot follow a detail shorter than
+that, and the remesh moves the surface by at most about half a voxel), but never under
+1/CLOSE_CELLS of the model's size (the grid's cells along its largest side: time and memory). At
+0.5 m and the default l_min of 15 mm that is 3.75 mm ("a 4 mm voxel remesh"). Parts thinner than
+about a voxel vanish in the remesh: the record's "lost" is the share of the original vertices
+farther than a voxel from the closed surface, "lost_at" the centre of their bounding box, said when
+the design fails (a thin limb is then the obstacle).
+
+The record (CLOSED) has "boundary_edges", "holes", "nonmanifold_edges", "shells" (parts before),
+"shells_after" (parts of the closed mesh), "voxel" (m), "triangles" (of the closed mesh), "lost",
+"lost_at" (None when nothing was lost).
 """
 import hashlib
 
@@ -29,13 +51,23 @@ from .sizes import mesh_size
 
 SHELLS = "mesh_shells"  # the mesh is several separate parts
 OPEN = "mesh_open"      # the mesh has boundary edges (holes)
-CODES = (SHELLS, OPEN)
+NONMANIFOLD = "mesh_nonmanifold"  # the mesh has edges shared by more than two faces
+CODES = (SHELLS, OPEN, NONMANIFOLD)
+CLOSED = "mesh_closed"  # what was done: the mesh closed for slicing (closing)
+# the obstacles a closed mesh can still hold when the design fails (explain adds them to reason_causes)
+THIN_LOST = "mesh_thin_lost"    # parts thinner than the voxel vanished in the remesh
+STILL_APART = "mesh_still_apart"  # parts too far apart for the remesh to join
 
 WELD = 1e-9              # of the model's size: vertices closer than this are one
 VOXEL_SHARE = 0.015      # of the model's size: a remesh that closes small holes and keeps the shape
 VOXEL_LADDER = (0.005, 0.01, 0.015, 0.02, 0.03, 0.05)  # of the model's size: remesh sizes tried
 SMALL_SHARE = 0.001      # of the surface area: a shell smaller than this is a speck, still counted
+CLOSE_SHARE = 0.01       # of the model's size: the closing voxel at most (keeps a small model's shape)
+CLOSE_SEGMENTS = 0.25    # of min_segment (l_min): the closing voxel at most (below what a wire shows)
+CLOSE_CELLS = 256        # cells along the model's largest side at most: the closing voxel at least
+LOST_SHARE = 0.005       # of the original vertices: more than this far from the closed surface is a part lost
 
+_closed = {}  # the last closed mesh: "V", "F", "digest", "record" (remember, closing_of)
 _memo = {}  # the last mesh: "V", "F" (the arrays asked about), "digest", "faults" (Live slices it again and again)
 
 
@@ -158,6 +190,9 @@ def check(vertices, faces):
         _l, _k = _components(count, boundary)
         holes = len(np.unique(_l[np.unique(boundary)]))
         faults.append({"cause": OPEN, "edges": int(len(boundary)), "holes": holes, "voxel": VOXEL_SHARE * size})
+    nonmanifold = int((counts > 2).sum())
+    if nonmanifold:
+        faults.append({"cause": NONMANIFOLD, "edges": nonmanifold})
     _memo.update(V=vertices, F=faces, digest=digest, faults=[dict(f) for f in faults])
     return faults
 
@@ -168,6 +203,9 @@ def _mm(metres):
 
 def sentence(fault):
     """The words of one fault of check(), with its figures and what to do."""
+    if fault["cause"] == NONMANIFOLD:
+        return (f"the mesh has {fault['edges']} non-manifold edge{'s' if fault['edges'] != 1 else ''} (shared by "
+                f"more than two faces), where a plane's contour can branch: merge or separate the faces there")
     if fault["cause"] == SHELLS:
         remesh = (f", or fuse them by a voxel remesh (about {_mm(fault['voxel'])})" if fault.get("voxel")
                   else ", or move them together and join them (they lie too far apart for a voxel remesh)")
@@ -184,14 +222,112 @@ def words(faults):
     return "; ".join(sentence(f) for f in faults)
 
 
+def closing_voxel(size, min_segment):
+    """m: the voxel of the closing remesh of a model `size` m across whose wires bend no closer than
+    `min_segment` m (module doc: the smaller of CLOSE_SHARE of the size and CLOSE_SEGMENTS of
+    min_segment, never under size / CLOSE_CELLS)."""
+    return max(min(CLOSE_SHARE * size, CLOSE_SEGMENTS * min_segment), size / CLOSE_CELLS)
+
+
+def needs_closing(faults):
+    """Whether a mesh with check()'s `faults` is closed for slicing: it has holes, several parts or
+    non-manifold edges."""
+    return bool(faults)
+
+
+def closing(before, after, voxel, triangles, lost=0.0, lost_at=None):
+    """The record (CLOSED) of a mesh closed for slicing: `before`, `after` check()'s faults of the
+    mesh and of the closed one, `voxel` (m) the remesh's, `triangles` the closed mesh's, `lost` the
+    share of the original vertices farther than a voxel from the closed surface, `lost_at` their
+    box's centre."""
+    by = {f["cause"]: f for f in before}
+    shells_after = next((f["shells"] for f in after if f["cause"] == SHELLS), 1)
+    return {"cause": CLOSED, "boundary_edges": by.get(OPEN, {}).get("edges", 0),
+            "holes": by.get(OPEN, {}).get("holes", 0), "nonmanifold_edges": by.get(NONMANIFOLD, {}).get("edges", 0),
+            "shells": by.get(SHELLS, {}).get("shells", 1), "shells_after": int(shells_after),
+            "voxel": float(voxel), "triangles": int(triangles), "lost": float(lost),
+            "lost_at": None if lost_at is None else [float(x) for x in lost_at]}
+
+
+def _digest(V, F):
+    V = np.ascontiguousarray(V, dtype=np.float64)
+    F = np.ascontiguousarray(F, dtype=np.int64)
+    return hashlib.blake2b(V.tobytes() + F.tobytes(), digest_size=16).digest()
+
+
+def remember(vertices, faces, record):
+    """The closed mesh (vertices, faces) was made by the closing `record`: closing_of says so when
+    the pipeline slices that mesh (the plane search passes the mesh on without the record)."""
+    _closed.clear()
+    _closed.update(V=vertices, F=faces, digest=_digest(vertices, faces), record=dict(record))
+
+
+def closing_of(vertices, faces):
+    """The closing record of the mesh (vertices, faces) when it is the last closed mesh (remember),
+    else None."""
+    if not _closed:
+        return None
+    if not (_closed["V"] is vertices and _closed["F"] is faces) and _closed["digest"] != _digest(vertices, faces):
+        return None
+    return dict(_closed["record"])
+
+
+def _count(n, word):
+    return f"{n} {word}{'s' if n != 1 else ''}"
+
+
+def closing_sentence(record):
+    """What closing did, in words: "closed 223 boundary edges (4 holes) by a 4 mm voxel remesh"."""
+    done = []
+    if record["boundary_edges"]:
+        done.append(f"closed {_count(record['boundary_edges'], 'boundary edge')} "
+                    f"({_count(record['holes'], 'hole')})")
+    if record["shells"] > 1:
+        joined = (f"into {record['shells_after']}" if record["shells_after"] > 1 else "into one")
+        done.append(f"joined {record['shells']} parts {joined}")
+    if record["nonmanifold_edges"]:
+        done.append(f"mended {_count(record['nonmanifold_edges'], 'non-manifold edge')}")
+    what = ", ".join(done[:-1]) + (" and " if len(done) > 1 else "") + done[-1] if done else "remeshed it"
+    return (f"{what} by a {_mm(record['voxel'])} voxel remesh for slicing "
+            f"({record['triangles']} triangles; the mesh object itself is unchanged)")
+
+
+def obstacles(record):
+    """The obstacles a closed mesh still holds, as faults with their figures ([] for none):
+    THIN_LOST (parts thinner than the voxel vanished) and STILL_APART (parts the remesh could not join)."""
+    out = []
+    if record.get("lost", 0.0) > LOST_SHARE:
+        out.append({"cause": THIN_LOST, "lost": record["lost"], "at": record.get("lost_at"), "voxel": record["voxel"]})
+    if record.get("shells_after", 1) > 1:
+        out.append({"cause": STILL_APART, "shells": record["shells_after"], "voxel": record["voxel"]})
+    return out
+
+
+def obstacle_sentence(fault):
+    """The words of one obstacle of obstacles(), with what to try."""
+    if fault["cause"] == THIN_LOST:
+        at = ("" if fault.get("at") is None else
+              " around ({})".format(", ".join(f"{1000 * c:.0f}" for c in fault["at"])) + " mm")
+        return (f"parts of the model thinner than the {_mm(fault['voxel'])} voxel ({100 * fault['lost']:.0f} % of its "
+                f"vertices{at}, a thin limb or sheet) vanished when it was closed, so no wire follows them: "
+                f"thicken them, scale the model up, or lower min_segment for a finer remesh")
+    return (f"{fault['shells']} parts of the model lie too far apart for a {_mm(fault['voxel'])} voxel remesh to "
+            f"join them, and the wires of one cannot hold another: move them together, or join them in the model")
+
+
 def explain(design):
-    """When `design` is not stable and its `mesh_faults` are not empty, the mesh's words lead its
-    reason (the solver's own reason follows) and their codes join `reason_causes`. Returns
-    whether it changed the design."""
+    """When `design` is not stable and its `mesh_faults` are not empty, or its mesh was closed for
+    slicing (`mesh_closing`) and the closed mesh still holds an obstacle (obstacles), the mesh's
+    words lead its reason (the solver's own reason follows) and their codes join `reason_causes`.
+    Returns whether it changed the design."""
     faults = design.get("mesh_faults") or []
-    if design.get("stable", True) or not faults or setup_problem(design):
+    record = design.get("mesh_closing")
+    found = obstacles(record) if record else []
+    faults = [f for f in faults if not (found and f["cause"] == SHELLS)]  # STILL_APART says it
+    if design.get("stable", True) or not (faults or found) or setup_problem(design):
         return False
-    said = words(faults)
+    said = "; ".join([obstacle_sentence(f) for f in found] + ([words(faults)] if faults else []))
+    faults = found + faults
     solver = design.get("reason") or ""
     design["reason"] = f"{said} (the solver: {solver})" if solver else said
     causes = design.setdefault("reason_causes", [])
