@@ -216,7 +216,8 @@ def _run(args, say):
     from wiresculpt.core.staging import staged
     from wiresculpt.core.scene import load_scene
     from wiresculpt.core import sizes
-    from wiresculpt.blend.mesh import import_mesh
+    from wiresculpt.blend.mesh import close_for_slicing, import_mesh
+    from wiresculpt.core import mesh_faults
 
     scene = load_scene(args.scene)
     native.require()
@@ -233,6 +234,10 @@ def _run(args, say):
         V = V * factor
     say("mesh", f"{len(V)} vertices, {len(F)} triangles, scale x{factor:g} "
                 f"({time.perf_counter() - start:.3f} s)")
+    start = time.perf_counter()  # an open or many-part mesh is closed for slicing (design.json: mesh_closing)
+    V, F, closing = close_for_slicing(V, F, scene.settings["min_segment"])
+    if closing is not None:
+        say("mesh", f"{mesh_faults.closing_sentence(closing)} ({time.perf_counter() - start:.3f} s)")
     planes = scaled_planes(scene.planes, factor)
     profile = machine_profile(scene, args, say)  # refused before the long work when it is wrong
     model = machine_model(args, say)

@@ -202,7 +202,9 @@ def _mm(metres):
 
 
 def sentence(fault):
-    """The words of one fault of check(), with its figures and what to do."""
+    """The words of one fault of check() or obstacle of obstacles(), with its figures and what to do."""
+    if fault["cause"] in (THIN_LOST, STILL_APART):
+        return obstacle_sentence(fault)
     if fault["cause"] == NONMANIFOLD:
         return (f"the mesh has {fault['edges']} non-manifold edge{'s' if fault['edges'] != 1 else ''} (shared by "
                 f"more than two faces), where a plane's contour can branch: merge or separate the faces there")
@@ -315,6 +317,16 @@ def obstacle_sentence(fault):
             f"join them, and the wires of one cannot hold another: move them together, or join them in the model")
 
 
+def failures(vertices, faces):
+    """What about the mesh (vertices, faces) can stop a stable design, as faults with their figures:
+    the obstacles of its closing (obstacles of closing_of, when it is a closed mesh) and check()'s
+    faults (its parts said once, by the obstacle STILL_APART when there is one)."""
+    record = closing_of(vertices, faces)
+    found = obstacles(record) if record else []
+    return found + [f for f in check(vertices, faces) if not (found and f["cause"] == SHELLS and
+                                                                any(o["cause"] == STILL_APART for o in found))]
+
+
 def explain(design):
     """When `design` is not stable and its `mesh_faults` are not empty, or its mesh was closed for
     slicing (`mesh_closing`) and the closed mesh still holds an obstacle (obstacles), the mesh's
@@ -323,11 +335,12 @@ def explain(design):
     faults = design.get("mesh_faults") or []
     record = design.get("mesh_closing")
     found = obstacles(record) if record else []
-    faults = [f for f in faults if not (found and f["cause"] == SHELLS)]  # STILL_APART says it
+    if any(o["cause"] == STILL_APART for o in found):  # the parts said once
+        faults = [f for f in faults if f["cause"] != SHELLS]
     if design.get("stable", True) or not (faults or found) or setup_problem(design):
         return False
-    said = "; ".join([obstacle_sentence(f) for f in found] + ([words(faults)] if faults else []))
     faults = found + faults
+    said = words(faults)
     solver = design.get("reason") or ""
     design["reason"] = f"{said} (the solver: {solver})" if solver else said
     causes = design.setdefault("reason_causes", [])
