@@ -109,6 +109,10 @@ def import_mesh(path):
 
 
 LOST_SAMPLES = 20_000  # original vertices at most measured against the closed surface (lost)
+# The remesh's grid is aligned with the origin, and its vertices lie on the grid's layers: a plane
+# through a layer (an axis-aligned plane through the origin, say) would meet faces lying in it and
+# cut specks of contours. The mesh is moved by these fractions of a voxel for the remesh and back.
+GRID_SHIFT = (0.3183098861837907, 0.2718281828459045, 0.1414213562373095)
 _closings = {}  # the last closing: "key" (digest, voxel), "V", "F", "record"
 
 
@@ -165,13 +169,15 @@ def mesh_triangles(mesh):
 
 def _lost(V, closedV, closedF, voxel):
     """(share, centre or None): the share of the vertices V (at most LOST_SAMPLES of them, evenly)
-    farther than `voxel` from the surface (closedV, closedF), and the centre of their box."""
+    outside the closed surface (closedV, closedF) and farther than `voxel` from it, and the centre of
+    their box. A vertex inside (a part's corner within another part, fused away) is not lost: the
+    remesh's faces face outwards, so a vertex behind its nearest face is inside."""
     tree = BVHTree.FromPolygons(closedV.tolist(), closedF.tolist())
     sample = V[::max(1, len(V) // LOST_SAMPLES)]
     far = []
     for p in sample:
-        hit = tree.find_nearest(p)
-        if hit[0] is None or hit[3] > voxel:
+        location, normal, _index, distance = tree.find_nearest(p)
+        if location is None or (distance > voxel and (p - np.asarray(location)) @ np.asarray(normal) > 0):
             far.append(p)
     if not far:
         return 0.0, None
@@ -193,17 +199,21 @@ def close_for_slicing(V, F, min_segment):
     voxel = mesh_faults.closing_voxel(size, min_segment)
     key = (mesh_faults._digest(V, F), voxel)
     if _closings.get("key") != key:
-        mesh = _temporary_mesh(V, F, "wiresculpt closing (temporary)")
+        shift = voxel * np.asarray(GRID_SHIFT)
+        mesh = _temporary_mesh(np.asarray(V, dtype=np.float64) + shift, F, "wiresculpt closing (temporary)")
         try:
             _capped(mesh, mesh_faults.WELD * size)
             closedV, closedF = _voxel_remesh(mesh, voxel)
         finally:
             bpy.data.meshes.remove(mesh)
+        closedV -= shift
+        closedF, specks = mesh_faults.drop_specks(closedV, closedF)
         if not len(closedF):
             raise RuntimeError(f"closing the mesh for slicing by a {voxel * 1000:.1f} mm voxel remesh left nothing "
                                "(a mesh of sheets without inside): give the parts thickness")
         lost, lost_at = _lost(np.asarray(V, dtype=np.float64), closedV, closedF, voxel)
-        record = mesh_faults.closing(faults, mesh_faults.check(closedV, closedF), voxel, len(closedF), lost, lost_at)
+        record = mesh_faults.closing(faults, mesh_faults.check(closedV, closedF), voxel, len(closedF), lost, lost_at,
+                                     specks)
         _closings.clear()
         _closings.update(key=key, V=closedV, F=closedF, record=record)
     mesh_faults.remember(_closings["V"], _closings["F"], _closings["record"])

@@ -40,7 +40,8 @@ the design fails (a thin limb is then the obstacle).
 
 The record (CLOSED) has "boundary_edges", "holes", "nonmanifold_edges", "shells" (parts before),
 "shells_after" (parts of the closed mesh), "voxel" (m), "triangles" (of the closed mesh), "lost",
-"lost_at" (None when nothing was lost).
+"lost_at" (None when nothing was lost), "specks" (parts of the closed mesh under SMALL_SHARE of
+its surface, left out: remesh debris no wire can use).
 """
 import hashlib
 
@@ -54,9 +55,9 @@ OPEN = "mesh_open"      # the mesh has boundary edges (holes)
 NONMANIFOLD = "mesh_nonmanifold"  # the mesh has edges shared by more than two faces
 CODES = (SHELLS, OPEN, NONMANIFOLD)
 CLOSED = "mesh_closed"  # what was done: the mesh closed for slicing (closing)
-# the obstacles a closed mesh can still hold when the design fails (explain adds them to reason_causes)
+# the obstacle a closed mesh can hold beyond check()'s faults of it (parts the remesh could not join
+# stay SHELLS), said when the design fails (explain adds it to reason_causes)
 THIN_LOST = "mesh_thin_lost"    # parts thinner than the voxel vanished in the remesh
-STILL_APART = "mesh_still_apart"  # parts too far apart for the remesh to join
 
 WELD = 1e-9              # of the model's size: vertices closer than this are one
 VOXEL_SHARE = 0.015      # of the model's size: a remesh that closes small holes and keeps the shape
@@ -203,7 +204,7 @@ def _mm(metres):
 
 def sentence(fault):
     """The words of one fault of check() or obstacle of obstacles(), with its figures and what to do."""
-    if fault["cause"] in (THIN_LOST, STILL_APART):
+    if fault["cause"] == THIN_LOST:
         return obstacle_sentence(fault)
     if fault["cause"] == NONMANIFOLD:
         return (f"the mesh has {fault['edges']} non-manifold edge{'s' if fault['edges'] != 1 else ''} (shared by "
@@ -228,7 +229,28 @@ def closing_voxel(size, min_segment):
     """m: the voxel of the closing remesh of a model `size` m across whose wires bend no closer than
     `min_segment` m (module doc: the smaller of CLOSE_SHARE of the size and CLOSE_SEGMENTS of
     min_segment, never under size / CLOSE_CELLS)."""
-    return max(min(CLOSE_SHARE * size, CLOSE_SEGMENTS * min_segment), size / CLOSE_CELLS)
+    voxel = max(min(CLOSE_SHARE * size, CLOSE_SEGMENTS * min_segment), size / CLOSE_CELLS)
+    return round(voxel, 6) or voxel  # to the micrometre: the panel's float32 l_min gives the batch's voxel
+
+
+def drop_specks(vertices, faces):
+    """(faces, dropped): `faces` without the parts (faces joined through shared vertices) of less
+    than SMALL_SHARE of the surface area, and how many parts went. A voxel remesh leaves such specks
+    where thin parts break up; no wire can use them."""
+    V = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
+    F = np.asarray(faces).reshape(-1, 3)
+    if not len(F):
+        return F, 0
+    labels, count = _components(len(V), np.concatenate([F[:, [0, 1]], F[:, [1, 2]]]))
+    if count < 2:
+        return F, 0
+    corner = V[F]
+    area = 0.5 * np.linalg.norm(np.cross(corner[:, 1] - corner[:, 0], corner[:, 2] - corner[:, 0]), axis=1)
+    part = labels[F[:, 0]]
+    by_part = np.bincount(part, weights=area, minlength=count)
+    present = np.bincount(part, minlength=count) > 0
+    speck = present & (by_part < SMALL_SHARE * max(float(by_part.sum()), 1e-300))
+    return F[~speck[part]], int(speck.sum())
 
 
 def needs_closing(faults):
@@ -237,18 +259,18 @@ def needs_closing(faults):
     return bool(faults)
 
 
-def closing(before, after, voxel, triangles, lost=0.0, lost_at=None):
+def closing(before, after, voxel, triangles, lost=0.0, lost_at=None, specks=0):
     """The record (CLOSED) of a mesh closed for slicing: `before`, `after` check()'s faults of the
     mesh and of the closed one, `voxel` (m) the remesh's, `triangles` the closed mesh's, `lost` the
     share of the original vertices farther than a voxel from the closed surface, `lost_at` their
-    box's centre."""
+    box's centre, `specks` the parts left out (drop_specks)."""
     by = {f["cause"]: f for f in before}
     shells_after = next((f["shells"] for f in after if f["cause"] == SHELLS), 1)
     return {"cause": CLOSED, "boundary_edges": by.get(OPEN, {}).get("edges", 0),
             "holes": by.get(OPEN, {}).get("holes", 0), "nonmanifold_edges": by.get(NONMANIFOLD, {}).get("edges", 0),
             "shells": by.get(SHELLS, {}).get("shells", 1), "shells_after": int(shells_after),
             "voxel": float(voxel), "triangles": int(triangles), "lost": float(lost),
-            "lost_at": None if lost_at is None else [float(x) for x in lost_at]}
+            "lost_at": None if lost_at is None else [float(x) for x in lost_at], "specks": int(specks)}
 
 
 def _digest(V, F):
@@ -284,47 +306,43 @@ def closing_sentence(record):
     if record["boundary_edges"]:
         done.append(f"closed {_count(record['boundary_edges'], 'boundary edge')} "
                     f"({_count(record['holes'], 'hole')})")
-    if record["shells"] > 1:
+    if record["shells"] > 1 and record["shells_after"] < record["shells"]:
         joined = (f"into {record['shells_after']}" if record["shells_after"] > 1 else "into one")
         done.append(f"joined {record['shells']} parts {joined}")
     if record["nonmanifold_edges"]:
         done.append(f"mended {_count(record['nonmanifold_edges'], 'non-manifold edge')}")
-    what = ", ".join(done[:-1]) + (" and " if len(done) > 1 else "") + done[-1] if done else "remeshed it"
+    what = ", ".join(done[:-1]) + (" and " if len(done) > 1 else "") + done[-1] if done else "remeshed the mesh"
+    apart = (f"; its {record['shells_after']} parts stay apart (too far for the remesh to join)"
+             if record["shells_after"] > 1 and record["shells_after"] >= record["shells"] else "")
     return (f"{what} by a {_mm(record['voxel'])} voxel remesh for slicing "
-            f"({record['triangles']} triangles; the mesh object itself is unchanged)")
+            f"({record['triangles']} triangles; the mesh object itself is unchanged){apart}")
 
 
 def obstacles(record):
-    """The obstacles a closed mesh still holds, as faults with their figures ([] for none):
-    THIN_LOST (parts thinner than the voxel vanished) and STILL_APART (parts the remesh could not join)."""
-    out = []
+    """The obstacles a closed mesh holds beyond check()'s faults of it, as faults with their figures
+    ([] for none): THIN_LOST when more than LOST_SHARE of the given mesh's vertices lie farther than
+    a voxel from the closed surface (parts thinner than the voxel vanished). Parts the remesh could
+    not join are check()'s SHELLS of the closed mesh."""
     if record.get("lost", 0.0) > LOST_SHARE:
-        out.append({"cause": THIN_LOST, "lost": record["lost"], "at": record.get("lost_at"), "voxel": record["voxel"]})
-    if record.get("shells_after", 1) > 1:
-        out.append({"cause": STILL_APART, "shells": record["shells_after"], "voxel": record["voxel"]})
-    return out
+        return [{"cause": THIN_LOST, "lost": record["lost"], "at": record.get("lost_at"), "voxel": record["voxel"]}]
+    return []
 
 
 def obstacle_sentence(fault):
     """The words of one obstacle of obstacles(), with what to try."""
-    if fault["cause"] == THIN_LOST:
-        at = ("" if fault.get("at") is None else
-              " around ({})".format(", ".join(f"{1000 * c:.0f}" for c in fault["at"])) + " mm")
-        return (f"parts of the model thinner than the {_mm(fault['voxel'])} voxel ({100 * fault['lost']:.0f} % of its "
-                f"vertices{at}, a thin limb or sheet) vanished when it was closed, so no wire follows them: "
-                f"thicken them, scale the model up, or lower min_segment for a finer remesh")
-    return (f"{fault['shells']} parts of the model lie too far apart for a {_mm(fault['voxel'])} voxel remesh to "
-            f"join them, and the wires of one cannot hold another: move them together, or join them in the model")
+    at = ("" if fault.get("at") is None else
+          " around ({})".format(", ".join(f"{1000 * c:.0f}" for c in fault["at"])) + " mm")
+    return (f"parts of the model thinner than the {_mm(fault['voxel'])} voxel ({100 * fault['lost']:.0f} % of its "
+            f"vertices{at}, a thin limb or sheet) vanished when it was closed for slicing, so no wire follows them: "
+            f"thicken them, scale the model up, or lower min_segment for a finer remesh")
 
 
 def failures(vertices, faces):
     """What about the mesh (vertices, faces) can stop a stable design, as faults with their figures:
     the obstacles of its closing (obstacles of closing_of, when it is a closed mesh) and check()'s
-    faults (its parts said once, by the obstacle STILL_APART when there is one)."""
+    faults of it (parts the remesh could not join are its SHELLS)."""
     record = closing_of(vertices, faces)
-    found = obstacles(record) if record else []
-    return found + [f for f in check(vertices, faces) if not (found and f["cause"] == SHELLS and
-                                                                any(o["cause"] == STILL_APART for o in found))]
+    return (obstacles(record) if record else []) + check(vertices, faces)
 
 
 def explain(design):
@@ -335,8 +353,6 @@ def explain(design):
     faults = design.get("mesh_faults") or []
     record = design.get("mesh_closing")
     found = obstacles(record) if record else []
-    if any(o["cause"] == STILL_APART for o in found):  # the parts said once
-        faults = [f for f in faults if f["cause"] != SHELLS]
     if design.get("stable", True) or not (faults or found) or setup_problem(design):
         return False
     faults = found + faults
