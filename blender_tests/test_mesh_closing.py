@@ -13,9 +13,11 @@ import unittest
 import bpy
 import numpy as np
 
-from helpers import BATCH, BlenderCase, add_handle, box_faces, box_vertices, run_blender, sphere, write_obj
+from helpers import BATCH, BlenderCase, add_handle, box_faces, box_vertices, draw, run_blender, sphere, write_obj
 from wiresculpt import native
 from wiresculpt.blend import mesh
+from wiresculpt.blend import results as scene_results
+from wiresculpt.ui import results as ui_results
 from wiresculpt.core import mesh_faults
 
 RADIUS, SEGMENTS = 0.2, 48
@@ -188,6 +190,21 @@ class Closing(BlenderCase):
         self.assertEqual({o for o in bpy.data.objects if o.type == 'MESH'}, mesh_objects)
         contours = bpy.context.scene.wiresculpt.contours
         self.assertTrue(all(item.closed for item in contours))
+        # Optimize slices the closed mesh too, records it, and the Stability box says it
+        assert bpy.ops.wiresculpt.optimize() in ({'FINISHED'}, {'CANCELLED'})
+        design = scene_results.stored_design()
+        self.assertIsNotNone(design)
+        self.assertEqual((design["mesh_closing"]["boundary_edges"], design["mesh_closing"]["holes"]), (SEGMENTS, 1))
+        lines = [" ".join(str(a) for a in args) + str(kwargs.get("text", ""))
+                 for _m, args, kwargs in draw(ui_results.VIEW3D_PT_wiresculpt_report, bpy.context)]
+        shown = " ".join(lines)  # the box wraps its lines
+        self.assertRegex(shown, rf"Mesh: closed {SEGMENTS} boundary edges \(1 hole\) by a 4 mm voxel remesh")
+        after = np.empty(3 * len(me.vertices))
+        me.vertices.foreach_get("co", after)
+        self.assertTrue(np.array_equal(before, after))
+        # the results' own meshes (crossing markers) are used by their objects; a left-over
+        # temporary mesh would have no user
+        self.assertTrue(all(m.users > 0 for m in set(bpy.data.meshes) - meshes))
 
 
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)
