@@ -232,6 +232,20 @@ class BatchSaysIt(unittest.TestCase):
         self.assertEqual(design["mesh_faults"], [])  # the closed mesh's: one closed part
         self.assertTrue(all(w["closed"] for w in design["wires"]))
 
+    def test_the_batch_records_it_for_a_design_the_plane_search_proposes(self):
+        V, _F, punched = punched_sphere()
+        with tempfile.TemporaryDirectory() as tmp:
+            write_obj(os.path.join(tmp, "punched.obj"), V.tolist(), punched.tolist())
+            scene = os.path.join(tmp, "scene.json")
+            with open(scene, "w") as f:
+                json.dump({"mesh": "punched.obj", "planes": [], "settings": {"plane_search": "auto", "plane_count": 3}}, f)
+            out = os.path.join(tmp, "out")
+            r = run_blender(BATCH, scene, "--out", out)
+            self.assertIn(r.returncode, (0, 2), r.stdout + r.stderr)
+            with open(os.path.join(out, "design.json")) as f:
+                design = json.load(f)
+        self.assertEqual((design["mesh_closing"]["boundary_edges"], design["mesh_closing"]["holes"]), (SEGMENTS, 1))
+
 
 if __name__ == "__main__":
     unittest.main()

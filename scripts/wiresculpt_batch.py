@@ -244,6 +244,8 @@ def _run(args, say):
     stock = None if profile is None else sizes.stock(profile)
     # settings.plane_search "off" is pipeline.run; "nearby"/"auto" return the planes actually used
     design, planes = plane_search.run(V, F, planes, scene.material, scene.settings, say, stock=stock)
+    if closing is not None:  # the plane search's own designs do not go through pipeline.slice_and_pick
+        design.setdefault("mesh_closing", closing)
     # Everything is written into a hidden folder first and replaces the earlier run's outputs
     # only when all of it is there: a failure half-way leaves the earlier set as it was.
     with staged(args.out, OUTPUTS) as folder:
