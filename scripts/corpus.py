@@ -14,8 +14,9 @@ The mesh files are not in the repository: `prepare` fetches the Debian packages 
 `apt-get download` (no install, no dependencies) into DIR/debs, unpacks them with `dpkg-deb -x`
 and writes every mesh as OBJ (vertex coordinates exactly as in the package's file, one object)
 into DIR/meshes, scenes into DIR/scenes and DIR/manifest.json. DIR defaults to build/corpus.
-Meshes that are not closed (boundary or non-manifold edges) are listed and skipped: their slices
-need not give closed contours.
+Meshes that are not closed (boundary or non-manifold edges, several parts) run like the others: the
+batch closes them for slicing (a voxel remesh, blend/mesh.close_for_slicing) and says so; the table
+gives their edges and the closing the batch did (design.json's mesh_closing).
 """
 import argparse
 import glob
@@ -58,7 +59,7 @@ MESHES = [
     ("helmet", "object", CGAL, "usr/share/doc/libcgal-demo/data.tar.gz!data/meshes/helmet.off", "z"),
     ("spool", "object", CGAL, "usr/share/doc/libcgal-demo/data.tar.gz!data/meshes/spool.off", "z"),
     ("cactus", "object (plant)", CGAL, "usr/share/doc/libcgal-demo/data.tar.gz!data/meshes/cactus.off", "y"),
-    # open or non-manifold: listed so that the table says why they are not run
+    # open or non-manifold: the batch closes them for slicing (a voxel remesh)
     ("horse", "animal", GLMARK, "usr/share/glmark2/models/horse.3ds", "z"),
     ("cat", "animal", GLMARK, "usr/share/glmark2/models/cat.3ds", "z"),
     ("spider", "animal", ASSIMP, "usr/share/assimp/models/OBJ/spider.obj", "z"),
@@ -276,11 +277,8 @@ def prepare(cache, only=()):
                "licence": licence, "source": "/" + path, "up": up, "vertices": len(v), "triangles": len(f),
                "boundary_edges": boundary, "nonmanifold_edges": nonmanifold,
                "bbox": [lo.tolist(), hi.tolist()]}
-        if boundary or nonmanifold:
-            row["skipped"] = f"not closed: {boundary} boundary and {nonmanifold} non-manifold edges"
-            say(f"{name}: skipped ({row['skipped']})")
-            table.append(row)
-            continue
+        if boundary or nonmanifold:  # run all the same: the batch closes it (mesh_closing)
+            row["open"] = f"closed for slicing: {boundary} boundary and {nonmanifold} non-manifold edges"
         if not os.path.exists(obj):
             write_obj(obj, name, v, f)
         for config in CONFIGS:
@@ -333,6 +331,8 @@ def run_scene(entry, out_root):
         with open(design_path) as f:
             design = json.load(f)
         row["stable"] = bool(design.get("stable"))
+        if design.get("mesh_closing"):  # an open or many-part mesh, closed by the batch
+            row["closing"] = design["mesh_closing"]
         row["reason"] = design.get("reason", "")
         row.update(run_codes(design))
         row["wires"] = len(design.get("wires", []))
@@ -504,7 +504,7 @@ def section(results, before=None):
              "|---|---|---|---|---|---|---|"]
     for m in meshes:
         lines.append(f"| {m['name']} | {m['kind']} | {m['package']} ({m.get('version', '?')}) | {m['licence']} | "
-                     f"`{m['source']}` | {m.get('vertices', '')} | {m.get('skipped', 'yes')} |")
+                     f"`{m['source']}` | {m.get('vertices', '')} | {m.get('skipped', m.get('open', 'yes'))} |")
     ok = [r for r in rows if r["stable"]]
     if old:
         lines += ["", f"Before: {sum(1 for r in old.values() if r['stable'])} of {len(old)} runs stable."]

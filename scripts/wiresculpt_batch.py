@@ -216,7 +216,8 @@ def _run(args, say):
     from wiresculpt.core.staging import staged
     from wiresculpt.core.scene import load_scene
     from wiresculpt.core import sizes
-    from wiresculpt.blend.mesh import import_mesh
+    from wiresculpt.blend.mesh import close_for_slicing, import_mesh
+    from wiresculpt.core import mesh_faults
 
     scene = load_scene(args.scene)
     native.require()
@@ -233,12 +234,18 @@ def _run(args, say):
         V = V * factor
     say("mesh", f"{len(V)} vertices, {len(F)} triangles, scale x{factor:g} "
                 f"({time.perf_counter() - start:.3f} s)")
+    start = time.perf_counter()  # an open or many-part mesh is closed for slicing (design.json: mesh_closing)
+    V, F, closing = close_for_slicing(V, F, scene.settings["min_segment"])
+    if closing is not None:
+        say("mesh", f"{mesh_faults.closing_sentence(closing)} ({time.perf_counter() - start:.3f} s)")
     planes = scaled_planes(scene.planes, factor)
     profile = machine_profile(scene, args, say)  # refused before the long work when it is wrong
     model = machine_model(args, say)
     stock = None if profile is None else sizes.stock(profile)
     # settings.plane_search "off" is pipeline.run; "nearby"/"auto" return the planes actually used
     design, planes = plane_search.run(V, F, planes, scene.material, scene.settings, say, stock=stock)
+    if closing is not None:  # the plane search's own designs do not go through pipeline.slice_and_pick
+        design.setdefault("mesh_closing", closing)
     # Everything is written into a hidden folder first and replaces the earlier run's outputs
     # only when all of it is there: a failure half-way leaves the earlier set as it was.
     with staged(args.out, OUTPUTS) as folder:

@@ -89,3 +89,73 @@ class MeshFaultsTest(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class NonManifold(unittest.TestCase):
+    def setUp(self):
+        mesh_faults._memo.clear()
+
+    def test_a_fin_on_a_box_edge_is_one_non_manifold_edge(self):
+        V, F = box()
+        # a third triangle on the edge (0, 1) of the box (x = 0, y = 0, z from 0 to 1), standing out
+        V = np.concatenate([V, [[-1.0, -1.0, 0.5]]])
+        F = np.concatenate([F, [[0, 1, 8]]])
+        faults = {f["cause"]: f for f in mesh_faults.check(V, F)}
+        self.assertEqual(faults[mesh_faults.NONMANIFOLD]["edges"], 1)
+        self.assertEqual(faults[mesh_faults.OPEN]["edges"], 2)  # the fin's own two free edges
+        self.assertIn("1 non-manifold edge (", mesh_faults.sentence(faults[mesh_faults.NONMANIFOLD]))
+
+
+class Closing(unittest.TestCase):
+    """The closing's rule, record and words (the remesh itself: blender_tests/test_mesh_closing.py)."""
+
+    def test_the_voxel_rule_by_hand(self):
+        cases = [  # (size m, min_segment m, voxel m): the smaller of 1 % and l_min / 4, at least size / 256
+            (0.5, 0.015, 0.00375), (0.3, 0.015, 0.003), (0.1, 0.015, 0.001), (2.0, 0.015, 2.0 / 256),
+            (0.5, 0.004, 0.5 / 256), (0.75, 0.015, 0.00375)]
+        for size, segment, voxel in cases:
+            with self.subTest(size=size, segment=segment):
+                self.assertAlmostEqual(mesh_faults.closing_voxel(size, segment), voxel, places=6)
+        self.assertEqual(mesh_faults.closing_voxel(0.5, float(np.float32(0.015))), 0.00375)  # the panel's float32
+
+    def test_the_record_and_its_words_carry_the_figures(self):
+        before = mesh_faults.check(*joined(box(drop_side=1), box(offset=(0.5, 0.2, 0.2))))
+        record = mesh_faults.closing(before, [], 0.00375, 1234)
+        self.assertEqual((record["boundary_edges"], record["holes"], record["shells"], record["shells_after"],
+                          record["nonmanifold_edges"]), (4, 1, 2, 1, 0))
+        self.assertEqual(mesh_faults.closing_sentence(record),
+                         "closed 4 boundary edges (1 hole) and joined 2 parts into one by a 4 mm voxel remesh "
+                         "for slicing (1234 triangles; the mesh object itself is unchanged)")
+        apart = mesh_faults.closing(before, [{"cause": mesh_faults.SHELLS, "shells": 2}], 0.003, 10)
+        self.assertEqual(mesh_faults.closing_sentence(apart),
+                         "closed 4 boundary edges (1 hole) by a 3 mm voxel remesh for slicing (10 triangles; the mesh "
+                         "object itself is unchanged); its 2 parts stay apart (too far for the remesh to join)")
+
+    def test_specks_are_left_out_and_counted(self):
+        V, F = joined(box(), box(offset=(3, 0, 0), scale=0.01), box(offset=(5, 0, 0), scale=0.5))
+        kept, dropped = mesh_faults.drop_specks(V, F)
+        # areas 6, 0.0006 and 1.5: the 0.01 box is under 0.1 % of 7.5006, the 0.5 box is not
+        self.assertEqual(dropped, 1)
+        self.assertEqual(len(kept), 24)
+        self.assertFalse(np.isin(np.arange(8, 16), kept).any())
+
+    def test_a_closed_mesh_remembers_its_closing_for_the_pipeline(self):
+        V, F = box()
+        record = mesh_faults.closing(mesh_faults.check(*box(drop_side=2)), [], 0.01, len(F))
+        mesh_faults.remember(V, F, record)
+        self.assertEqual(mesh_faults.closing_of(V, F), record)
+        self.assertEqual(mesh_faults.closing_of(V.copy(), F.copy()), record)  # the same numbers
+        self.assertIsNone(mesh_faults.closing_of(V + 1.0, F))
+
+    def test_a_lost_part_leads_the_reason_of_a_failed_design_with_where_it_was(self):
+        record = mesh_faults.closing([], [], 0.00375, 10, lost=0.12, lost_at=(0.1, 0.2, 0.3))
+        design = {"stable": False, "reason": "wire X1/0 crosses no other wire", "mesh_faults": [],
+                  "mesh_closing": record}
+        self.assertTrue(mesh_faults.explain(design))
+        self.assertEqual(design["reason_causes"], [mesh_faults.THIN_LOST])
+        self.assertTrue(design["reason"].startswith(
+            "parts of the model thinner than the 4 mm voxel (12 % of its vertices around (100, 200, 300) mm"))
+        self.assertTrue(design["reason"].endswith("(the solver: wire X1/0 crosses no other wire)"))
+        kept = {"stable": False, "reason": "r", "mesh_faults": [],
+                "mesh_closing": mesh_faults.closing([], [], 0.00375, 10, lost=mesh_faults.LOST_SHARE)}
+        self.assertFalse(mesh_faults.explain(kept))  # at the threshold nothing is said

@@ -4,6 +4,7 @@ import bpy
 from mathutils import Matrix
 
 from .. import native
+from ..core import mesh_faults
 from ..core.contours import pick
 from . import mesh
 from .handles import contour_plane, drop_copied_ids, handle_plane, handles, model_problem
@@ -129,7 +130,7 @@ def slice_scene(context, picked=None):
     depsgraph = context.evaluated_depsgraph_get()
     try:
         specs = [handle_plane(h, depsgraph) for h in planes]
-        V, F = mesh.object_triangles(model, depsgraph)
+        V, F, closing = mesh.model_triangles(model, depsgraph, settings.min_segment)
         result = native.slice_mesh(V, F, specs)
     except (ValueError, RuntimeError) as exc:
         return {'ERROR'}, f"Cannot slice {model.name}: {exc}"
@@ -141,6 +142,8 @@ def slice_scene(context, picked=None):
                f"{count} contour{'s' * (count != 1)}, {ticked} used as wires")
     if removed:
         message += f", {removed} old curve{'s' * (removed != 1)} removed"
+    if closing is not None:  # an open or many-part mesh: what was done to slice it
+        message += f"; {mesh_faults.closing_sentence(closing)}"
     if missed:
         return {'WARNING'}, message + f"; {', '.join(missed)} cut nothing"
     return {'INFO'}, message

@@ -44,7 +44,7 @@ KEYS = {
         "search_incomplete": "layering",
         "out_of_plane": "forces", "load_capacity": "forces", "load_factor": "forces", "buildability": "pipeline",
         "fabrication": "fabrication", "plane_search": "plane_search",
-        "model_size": "pipeline", "mesh_faults": "pipeline", "stands_3d": "stands_3d",
+        "model_size": "pipeline", "mesh_faults": "pipeline", "mesh_closing": "pipeline", "stands_3d": "stands_3d",
     },
     "wire": {
         "id": "slicing", "name": "slicing", "plane": "slicing", "closed": "slicing", "contour": "slicing",
@@ -76,7 +76,7 @@ KEYS = {
 OPTIONAL = {
     "top": {"close_crossings", "required_size", "load_capacity", "load_factor", "fabrication", "warnings",
             "buildability", "search_incomplete", "plane_search", "reason_causes", "model_size", "mesh_faults",
-            "stands_3d", "what_moves"},
+            "mesh_closing", "stands_3d", "what_moves"},
     "wire": {"cut_override", "cut_point", "out_of_plane_deflection", "out_of_plane_deflection_vertex", "sag",
              "as_built"},
     "crossing": {"pyramid", "force_3d", "admissible"},

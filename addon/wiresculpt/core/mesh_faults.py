@@ -9,7 +9,12 @@ the planes: when a design is not stable, its verdict says them first (explain), 
     check(vertices, faces)  -> [fault, ...]  causes as codes with their figures (below)
     sentence(fault)         -> the words of one fault, made only here
     explain(design)         a design that is not stable and whose mesh has faults: the mesh's
-                            words lead its reason, the codes join reason_causes
+                            words lead its reason, the codes join reason_causes; a mesh closed
+                            for slicing (design["mesh_closing"]) that left an obstacle says it
+    closing_voxel(size, min_segment)  m: the voxel of the closing remesh (the rule below)
+    closing(before, after, voxel, lost)  the record of a closing (CLOSED, its figures)
+    closing_sentence(record) what was done, in words ("closed 223 boundary edges ... by a 4 mm
+                            voxel remesh")
 
 Faults (each a dict with "cause" and its figures):
 - SHELLS: "shells" separate parts (faces joined through shared edges or vertices, after welding
@@ -19,6 +24,24 @@ Faults (each a dict with "cause" and its figures):
   rung does.
 - OPEN: "edges" boundary edges (used by one face), "holes" their loops, "voxel" (m) a remesh
   size that closes them (VOXEL_SHARE of the model's size).
+- NONMANIFOLD: "edges" edges shared by more than two faces (after welding).
+
+Closing for slicing (blend/mesh.py does it, in Blender, on a temporary copy: the user's mesh object
+is never changed): every hole is capped (its boundary loop filled) and the capped mesh remeshed by
+voxels, which fuses overlapping or touching parts into one surface and mends non-manifold edges.
+The voxel (closing_voxel) is the smallest of CLOSE_SHARE of the model's size and CLOSE_SEGMENTS of
+the wire's bend spacing (settings min_segment, l_min: the wire cannot follow a detail shorter than
+that, and the remesh moves the surface by at most about half a voxel), but never under
+1/CLOSE_CELLS of the model's size (the grid's cells along its largest side: time and memory). At
+0.5 m and the default l_min of 15 mm that is 3.75 mm ("a 4 mm voxel remesh"). Parts thinner than
+about a voxel vanish in the remesh: the record's "lost" is the share of the original vertices
+farther than a voxel from the closed surface, "lost_at" the centre of their bounding box, said when
+the design fails (a thin limb is then the obstacle).
+
+The record (CLOSED) has "boundary_edges", "holes", "nonmanifold_edges", "shells" (parts before),
+"shells_after" (parts of the closed mesh), "voxel" (m), "triangles" (of the closed mesh), "lost",
+"lost_at" (None when nothing was lost), "specks" (parts of the closed mesh under SMALL_SHARE of
+its surface, left out: remesh debris no wire can use).
 """
 import hashlib
 
@@ -29,13 +52,23 @@ from .sizes import mesh_size
 
 SHELLS = "mesh_shells"  # the mesh is several separate parts
 OPEN = "mesh_open"      # the mesh has boundary edges (holes)
-CODES = (SHELLS, OPEN)
+NONMANIFOLD = "mesh_nonmanifold"  # the mesh has edges shared by more than two faces
+CODES = (SHELLS, OPEN, NONMANIFOLD)
+CLOSED = "mesh_closed"  # what was done: the mesh closed for slicing (closing)
+# the obstacle a closed mesh can hold beyond check()'s faults of it (parts the remesh could not join
+# stay SHELLS), said when the design fails (explain adds it to reason_causes)
+THIN_LOST = "mesh_thin_lost"    # parts thinner than the voxel vanished in the remesh
 
 WELD = 1e-9              # of the model's size: vertices closer than this are one
 VOXEL_SHARE = 0.015      # of the model's size: a remesh that closes small holes and keeps the shape
 VOXEL_LADDER = (0.005, 0.01, 0.015, 0.02, 0.03, 0.05)  # of the model's size: remesh sizes tried
 SMALL_SHARE = 0.001      # of the surface area: a shell smaller than this is a speck, still counted
+CLOSE_SHARE = 0.01       # of the model's size: the closing voxel at most (keeps a small model's shape)
+CLOSE_SEGMENTS = 0.25    # of min_segment (l_min): the closing voxel at most (below what a wire shows)
+CLOSE_CELLS = 256        # cells along the model's largest side at most: the closing voxel at least
+LOST_SHARE = 0.005       # of the original vertices: more than this far from the closed surface is a part lost
 
+_closed = {}  # the last closed mesh: "V", "F", "digest", "record" (remember, closing_of)
 _memo = {}  # the last mesh: "V", "F" (the arrays asked about), "digest", "faults" (Live slices it again and again)
 
 
@@ -158,6 +191,9 @@ def check(vertices, faces):
         _l, _k = _components(count, boundary)
         holes = len(np.unique(_l[np.unique(boundary)]))
         faults.append({"cause": OPEN, "edges": int(len(boundary)), "holes": holes, "voxel": VOXEL_SHARE * size})
+    nonmanifold = int((counts > 2).sum())
+    if nonmanifold:
+        faults.append({"cause": NONMANIFOLD, "edges": nonmanifold})
     _memo.update(V=vertices, F=faces, digest=digest, faults=[dict(f) for f in faults])
     return faults
 
@@ -167,7 +203,12 @@ def _mm(metres):
 
 
 def sentence(fault):
-    """The words of one fault of check(), with its figures and what to do."""
+    """The words of one fault of check() or obstacle of obstacles(), with its figures and what to do."""
+    if fault["cause"] == THIN_LOST:
+        return obstacle_sentence(fault)
+    if fault["cause"] == NONMANIFOLD:
+        return (f"the mesh has {fault['edges']} non-manifold edge{'s' if fault['edges'] != 1 else ''} (shared by "
+                f"more than two faces), where a plane's contour can branch: merge or separate the faces there")
     if fault["cause"] == SHELLS:
         remesh = (f", or fuse them by a voxel remesh (about {_mm(fault['voxel'])})" if fault.get("voxel")
                   else ", or move them together and join them (they lie too far apart for a voxel remesh)")
@@ -184,13 +225,137 @@ def words(faults):
     return "; ".join(sentence(f) for f in faults)
 
 
+def closing_voxel(size, min_segment):
+    """m: the voxel of the closing remesh of a model `size` m across whose wires bend no closer than
+    `min_segment` m (module doc: the smaller of CLOSE_SHARE of the size and CLOSE_SEGMENTS of
+    min_segment, never under size / CLOSE_CELLS)."""
+    voxel = max(min(CLOSE_SHARE * size, CLOSE_SEGMENTS * min_segment), size / CLOSE_CELLS)
+    return round(voxel, 6) or voxel  # to the micrometre: the panel's float32 l_min gives the batch's voxel
+
+
+def drop_specks(vertices, faces):
+    """(faces, dropped): `faces` without the parts (faces joined through shared vertices) of less
+    than SMALL_SHARE of the surface area, and how many parts went. A voxel remesh leaves such specks
+    where thin parts break up; no wire can use them."""
+    V = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
+    F = np.asarray(faces).reshape(-1, 3)
+    if not len(F):
+        return F, 0
+    labels, count = _components(len(V), np.concatenate([F[:, [0, 1]], F[:, [1, 2]]]))
+    if count < 2:
+        return F, 0
+    corner = V[F]
+    area = 0.5 * np.linalg.norm(np.cross(corner[:, 1] - corner[:, 0], corner[:, 2] - corner[:, 0]), axis=1)
+    part = labels[F[:, 0]]
+    by_part = np.bincount(part, weights=area, minlength=count)
+    present = np.bincount(part, minlength=count) > 0
+    speck = present & (by_part < SMALL_SHARE * max(float(by_part.sum()), 1e-300))
+    return F[~speck[part]], int(speck.sum())
+
+
+def needs_closing(faults):
+    """Whether a mesh with check()'s `faults` is closed for slicing: it has holes, several parts or
+    non-manifold edges."""
+    return bool(faults)
+
+
+def closing(before, after, voxel, triangles, lost=0.0, lost_at=None, specks=0):
+    """The record (CLOSED) of a mesh closed for slicing: `before`, `after` check()'s faults of the
+    mesh and of the closed one, `voxel` (m) the remesh's, `triangles` the closed mesh's, `lost` the
+    share of the original vertices farther than a voxel from the closed surface, `lost_at` their
+    box's centre, `specks` the parts left out (drop_specks)."""
+    by = {f["cause"]: f for f in before}
+    shells_after = next((f["shells"] for f in after if f["cause"] == SHELLS), 1)
+    return {"cause": CLOSED, "boundary_edges": by.get(OPEN, {}).get("edges", 0),
+            "holes": by.get(OPEN, {}).get("holes", 0), "nonmanifold_edges": by.get(NONMANIFOLD, {}).get("edges", 0),
+            "shells": by.get(SHELLS, {}).get("shells", 1), "shells_after": int(shells_after),
+            "voxel": float(voxel), "triangles": int(triangles), "lost": float(lost),
+            "lost_at": None if lost_at is None else [float(x) for x in lost_at], "specks": int(specks)}
+
+
+def _digest(V, F):
+    V = np.ascontiguousarray(V, dtype=np.float64)
+    F = np.ascontiguousarray(F, dtype=np.int64)
+    return hashlib.blake2b(V.tobytes() + F.tobytes(), digest_size=16).digest()
+
+
+def remember(vertices, faces, record):
+    """The closed mesh (vertices, faces) was made by the closing `record`: closing_of says so when
+    the pipeline slices that mesh (the plane search passes the mesh on without the record)."""
+    _closed.clear()
+    _closed.update(V=vertices, F=faces, digest=_digest(vertices, faces), record=dict(record))
+
+
+def closing_of(vertices, faces):
+    """The closing record of the mesh (vertices, faces) when it is the last closed mesh (remember),
+    else None."""
+    if not _closed:
+        return None
+    if not (_closed["V"] is vertices and _closed["F"] is faces) and _closed["digest"] != _digest(vertices, faces):
+        return None
+    return dict(_closed["record"])
+
+
+def _count(n, word):
+    return f"{n} {word}{'s' if n != 1 else ''}"
+
+
+def closing_sentence(record):
+    """What closing did, in words: "closed 223 boundary edges (4 holes) by a 4 mm voxel remesh"."""
+    done = []
+    if record["boundary_edges"]:
+        done.append(f"closed {_count(record['boundary_edges'], 'boundary edge')} "
+                    f"({_count(record['holes'], 'hole')})")
+    if record["shells"] > 1 and record["shells_after"] < record["shells"]:
+        joined = (f"into {record['shells_after']}" if record["shells_after"] > 1 else "into one")
+        done.append(f"joined {record['shells']} parts {joined}")
+    if record["nonmanifold_edges"]:
+        done.append(f"mended {_count(record['nonmanifold_edges'], 'non-manifold edge')}")
+    what = ", ".join(done[:-1]) + (" and " if len(done) > 1 else "") + done[-1] if done else "remeshed the mesh"
+    apart = (f"; its {record['shells_after']} parts stay apart (too far for the remesh to join)"
+             if record["shells_after"] > 1 and record["shells_after"] >= record["shells"] else "")
+    return (f"{what} by a {_mm(record['voxel'])} voxel remesh for slicing "
+            f"({record['triangles']} triangles; the mesh object itself is unchanged){apart}")
+
+
+def obstacles(record):
+    """The obstacles a closed mesh holds beyond check()'s faults of it, as faults with their figures
+    ([] for none): THIN_LOST when more than LOST_SHARE of the given mesh's vertices lie farther than
+    a voxel from the closed surface (parts thinner than the voxel vanished). Parts the remesh could
+    not join are check()'s SHELLS of the closed mesh."""
+    if record.get("lost", 0.0) > LOST_SHARE:
+        return [{"cause": THIN_LOST, "lost": record["lost"], "at": record.get("lost_at"), "voxel": record["voxel"]}]
+    return []
+
+
+def obstacle_sentence(fault):
+    """The words of one obstacle of obstacles(), with what to try."""
+    at = ("" if fault.get("at") is None else
+          " around ({})".format(", ".join(f"{1000 * c:.0f}" for c in fault["at"])) + " mm")
+    return (f"parts of the model thinner than the {_mm(fault['voxel'])} voxel ({100 * fault['lost']:.0f} % of its "
+            f"vertices{at}, a thin limb or sheet) vanished when it was closed for slicing, so no wire follows them: "
+            f"thicken them, scale the model up, or lower min_segment for a finer remesh")
+
+
+def failures(vertices, faces):
+    """What about the mesh (vertices, faces) can stop a stable design, as faults with their figures:
+    the obstacles of its closing (obstacles of closing_of, when it is a closed mesh) and check()'s
+    faults of it (parts the remesh could not join are its SHELLS)."""
+    record = closing_of(vertices, faces)
+    return (obstacles(record) if record else []) + check(vertices, faces)
+
+
 def explain(design):
-    """When `design` is not stable and its `mesh_faults` are not empty, the mesh's words lead its
-    reason (the solver's own reason follows) and their codes join `reason_causes`. Returns
-    whether it changed the design."""
+    """When `design` is not stable and its `mesh_faults` are not empty, or its mesh was closed for
+    slicing (`mesh_closing`) and the closed mesh still holds an obstacle (obstacles), the mesh's
+    words lead its reason (the solver's own reason follows) and their codes join `reason_causes`.
+    Returns whether it changed the design."""
     faults = design.get("mesh_faults") or []
-    if design.get("stable", True) or not faults or setup_problem(design):
+    record = design.get("mesh_closing")
+    found = obstacles(record) if record else []
+    if design.get("stable", True) or not (faults or found) or setup_problem(design):
         return False
+    faults = found + faults
     said = words(faults)
     solver = design.get("reason") or ""
     design["reason"] = f"{said} (the solver: {solver})" if solver else said

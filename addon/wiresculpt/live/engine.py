@@ -203,11 +203,15 @@ def _start(scene, key):
         return CANNOT_SOLVE, str(exc)
     mesh_key = (key[0], key[1], key[-1])  # the model's name, matrix and geometry changes
     if STATE.mesh_key != mesh_key:
-        STATE.mesh = mesh.object_triangles(ws.model, depsgraph)
-        STATE.mesh_key = mesh_key
-        message = too_large(ws.model.name, len(STATE.mesh[1]))  # more than refusal counted (GPU subdivision)
+        V, F = mesh.object_triangles(ws.model, depsgraph)
+        message = too_large(ws.model.name, len(F))  # more than refusal counted (GPU subdivision)
         if message:
             return Refused(message)
+        try:  # an open or many-part model is closed for slicing (blend/mesh.py), once per change
+            STATE.mesh = mesh.close_for_slicing(V, F, settings["min_segment"])[:2]
+        except RuntimeError as exc:
+            return CANNOT_SOLVE, str(exc)
+        STATE.mesh_key = mesh_key
     job = LiveJob(key, *STATE.mesh, planes, cut_handles.user_cut_points(scene), material, settings,
                   chosen_stock(scene))
     job.thread.start()

@@ -51,7 +51,8 @@ def build_design(context):
     planes = ticked_planes(scene, depsgraph)
     material, settings = material_of(ws), solver_settings(ws)
     V, F = mesh.object_triangles(ws.model, depsgraph)
-    model_watch.remember(ws.model, V, F)  # solve_record's digest of what is sliced here
+    model_watch.remember(ws.model, V, F)  # solve_record's digest of the model as it is
+    V, F, _closing = mesh.close_for_slicing(V, F, settings["min_segment"])  # open or many parts: closed (mesh_closing)
     try:
         design = pipeline.slice_and_pick(V, F, planes, material, settings)
     except ValueError as exc:  # a ticked contour the planes no longer cut

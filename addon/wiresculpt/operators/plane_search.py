@@ -76,8 +76,9 @@ def gather(context, need_planes=True):
     planes = [PlaneSpec(*handle_plane(h, depsgraph), contours=ticked.get(h, "largest")) for h in handles(scene)]
     if need_planes and not planes:
         raise ValueError("No slicing plane: add planes first, or use Suggest Planes")
-    V, F = mesh.object_triangles(ws.model, depsgraph)
-    return V, F, planes, material_of(ws), solver_settings(ws)
+    settings = solver_settings(ws)
+    V, F, _closing = mesh.model_triangles(ws.model, depsgraph, settings["min_segment"])  # closed for slicing
+    return V, F, planes, material_of(ws), settings
 
 
 def describe(candidate):
@@ -120,7 +121,7 @@ class SearchJob(WorkerJob):
         self.mode, self.V, self.F, self.planes = mode, V, F, planes
         self.material, self.settings, self.count = material, settings, count
         self.found, self.searched = [], None
-        self.mesh_faults = []  # core/mesh_faults.check of the mesh when nothing was found
+        self.mesh_faults = []  # core/mesh_faults.failures of the mesh when nothing was found
         self.cancel_event = threading.Event()
         self.cancelled = False
         self.messages = []
@@ -146,7 +147,7 @@ class SearchJob(WorkerJob):
             self.cancelled = True
             return
         if not self.found:  # what is wrong with the mesh, said before what the search tried
-            self.mesh_faults = mesh_faults.check(self.V, self.F)
+            self.mesh_faults = mesh_faults.failures(self.V, self.F)
         size = mesh_size(self.V)
         for candidate in self.found:
             candidate["preview"] = candidate_preview(candidate, self.mode, size)

@@ -8,7 +8,7 @@ import bpy
 from .. import native, props
 from ..blend import results as scene_results
 from ..blend.registration import classes_factory
-from ..core import closure, stale
+from ..core import closure, mesh_faults, stale
 from ..core.design import setup_problem
 from ..core.figures import mass_text
 from ..core.limits import OVER_LIMITS
@@ -244,6 +244,8 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
                 row = col.row()
                 row.label(text=direction)
                 row.label(text=mass_text(grams) if grams is not None else "no limit found")
+        if design.get("mesh_closing"):  # an open or many-part mesh: what was done to slice it
+            _wrap(layout, context, "Mesh: " + mesh_faults.closing_sentence(design["mesh_closing"]), icon='MOD_REMESH')
         pending = design.get("pending_stages") or []
         if pending:
             _wrap(layout, context, "Pending: " + ", ".join(p.replace("_", " ") for p in pending), icon='INFO')
