@@ -128,6 +128,7 @@ def line_fault(line):
 
 # --- the test-bend program (spring-back calibration) --------------------------------------------
 
+TEST_NAME = "Test bends"  # the test piece's name where a wire's would be (stream, load step)
 TEST_ANGLES = (15.0, 30.0, 45.0, 60.0, 90.0, 120.0)  # commanded degrees, left bends
 TEST_FEED = 0.04  # m of straight wire before each bend and after the last
 
@@ -149,7 +150,7 @@ def test_bend_program(profile=None, angles=TEST_ANGLES, feed=TEST_FEED):
         if angle is not None:
             heading += math.radians(angle)
     program = native.make_bend_program(np.array(points), machine)
-    text = native.write_gcode(None, np.array(points), machine, "test bends", "")
+    text = native.write_gcode(None, np.array(points), machine, TEST_NAME, "")
     return native.stream_lines(text), machine, list(program["commanded_deg"]), float(program["wire_length"])
 
 
@@ -340,3 +341,32 @@ def _code(text):
         return int(text.partition(":")[2])
     except ValueError:
         return 0
+
+
+# --- the open session (the Machine panel's) ------------------------------------------------------
+
+SESSION = None  # the Machine the panel connected, else None; a machine, not a file's: kept across files
+
+
+def connect(port, profile=None, settle=2.0):
+    """Opens the panel's session on `port` (closing an earlier one); the Machine. ValueError
+    naming the port when it cannot be opened."""
+    global SESSION
+    disconnect()
+    SESSION = Machine(port, profile, settle)
+    return SESSION
+
+
+def disconnect():
+    global SESSION
+    if SESSION is not None:
+        SESSION.close()
+    SESSION = None
+
+
+def link_for(port):
+    """The session's open link when it is connected to `port` (a stream runs on it), else None."""
+    s = SESSION
+    if s is not None and not s.lost and s.port == port and s.link.is_open:
+        return s.link
+    return None
