@@ -11,7 +11,7 @@ import unittest
 
 from helpers import GrblEmulator
 from wiresculpt import native
-from wiresculpt.fab import grbl
+from wiresculpt.fab import grbl, streaming
 
 
 def until(predicate, timeout=3.0, machine=None):
@@ -158,6 +158,33 @@ class AgainstTheEmulator(unittest.TestCase):
             self.assertEqual((r["status"], state["next_line"]), ("completed", 6))
             self.assertEqual(m.query()["mpos"], (12.0, 0.0, 0.0))  # not reset by reopening: 7 + 5
             self.assertEqual(emu.received[1:], lines)
+
+    def test_a_streams_feed_hold_freezes_the_machine_and_resume_finishes(self):
+        import threading
+
+        with GrblEmulator(move_time=0.15) as emu:
+            m = self.machine(emu)
+            lines = ["G21", "G91", "G94"] + ["G1 X10.0000 F1200.0"] * 6 + ["G4 P0", "M2"]
+            state = {}
+            job = streaming.StreamJob("W", emu.port, lines, native.validate_machine_profile({}), state,
+                                      response_timeout=5.0, link=m.link)
+            worker = threading.Thread(target=job.run)
+            worker.start()
+            self.assertTrue(until(lambda: len(emu.received) >= 8))
+            streaming.hold(job)  # the panel's Hold during a stream on its link: at once, inside the step
+            self.assertTrue(until(lambda: emu.state() == "Hold:0"))
+            held = list(emu.position)
+            time.sleep(0.5)  # three moves' time: nothing moves in the hold
+            self.assertEqual(emu.position, held)
+            self.assertLess(held[0], 60.0)
+            streaming.go_on(job)
+            worker.join(10)
+            self.assertIsNone(job.error)
+            self.assertEqual(job.result["status"], "completed")
+            self.assertEqual(emu.position, [60.0, 0.0, 0.0])  # 6 x 10 mm, none lost, none twice
+            self.assertEqual(emu.realtime[0], "!")
+            self.assertEqual(set(emu.realtime), {"!", "~"})  # the streamer may add its own hold and resume
+            self.assertEqual(m.query()["state"], "Idle")
 
 
 if __name__ == "__main__":

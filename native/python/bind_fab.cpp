@@ -447,6 +447,8 @@ point. Writes atomically when path is not None; returns the text.)");
         py::arg("dry_run") = false, py::arg("response_timeout") = 30.0, py::arg("settle") = 2.0,
         R"(Stream G-code lines to a GRBL bender (send one line, wait for ok / error:N; ALARM stops).
 
+port: a port's name (opened, settled, closed) or an open SerialLink (streamed on as it is).
+
 state: dict whose "next_line" (0-based: where a call starts) and "confirmed" (the line after the last
 step known complete: after the last acknowledged G4/M2) are read and updated in place. GRBL answers
 ok when it queues a line; after a stop that can lose queued moves (disconnected, timeout, aborted,

@@ -293,6 +293,23 @@ def _outcome(job):
     return {'WARNING'} if r["status"] == "aborted" else {'ERROR'}, stop_text(facts)
 
 
+def hold(job):
+    """Feed hold of a running stream: no line is sent after the current one's answer (the streamer
+    then sends `!` itself), and on the panel's open link `!` goes at once, so the machine stops
+    inside a step too (GRBL acts on a realtime byte wherever it arrives)."""
+    job.control.pause()
+    if job.link is not None:
+        job.link.write(b"!", 1.0)
+
+
+def go_on(job):
+    """Resume of a held stream: `~` (at once on the panel's link; the streamer also sends it if it
+    had entered its own hold) and the lines go on."""
+    job.control.resume()
+    if job.link is not None:
+        job.link.write(b"~", 1.0)
+
+
 def running():
     return JOB is not None
 

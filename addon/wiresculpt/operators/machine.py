@@ -143,9 +143,9 @@ class WIRESCULPT_OT_machine_realtime(bpy.types.Operator):
         job = streaming.JOB
         if job is not None and self.command in ("HOLD", "RESUME"):  # the stream's own feed hold
             if self.command == "HOLD":
-                job.control.pause()
+                streaming.hold(job)
             else:
-                job.control.resume()
+                streaming.go_on(job)
             return {'FINISHED'}
         session = _session(self)
         if session is None:
