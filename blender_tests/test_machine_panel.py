@@ -50,6 +50,11 @@ def labels(log):
     return [kw.get("text", args[0] if args else "") for name, args, kw in log if name == "label"]
 
 
+def shown(log):
+    """The panel's text as one line: its labels joined (a wrapped sentence reads whole again)."""
+    return " ".join(labels(log))
+
+
 def operators(log):
     return [(args[0], kw.get("text")) for name, args, kw in log if name == "operator"]
 
@@ -92,8 +97,8 @@ class MachinePanel(unittest.TestCase):
             session = self.connect(emu)
             session.query()
             log = draw(machine_ui.VIEW3D_PT_wiresculpt_machine, bpy.context)
-            drawn = " ".join(labels(log))
-            self.assertIn("Idle · feed 0.000 mm · bend +0.00°", drawn)
+            drawn = shown(log)
+            self.assertIn("Idle · feed 0.000 mm · bend +0.00°", drawn)  # wrapped labels, read whole
             ops = [o for o, _t in operators(log)]
             for op in ("wiresculpt.machine_realtime", "wiresculpt.machine_command", "wiresculpt.machine_jog",
                        "wiresculpt.machine_console", "wiresculpt.machine_test_bends"):
@@ -136,7 +141,7 @@ class MachinePanel(unittest.TestCase):
             with self.assertRaisesRegex(RuntimeError, "realtime commands"):
                 bpy.ops.wiresculpt.machine_console()
             log = draw(machine_ui.VIEW3D_PT_wiresculpt_machine, bpy.context)
-            self.assertIn("$G  →  ok", labels(log))
+            self.assertIn("$G  →  ok", shown(log))
             self.assertEqual(emu.realtime, ["!", "~"])
 
     def test_commands_need_a_connection(self):
@@ -156,9 +161,8 @@ class MachinePanel(unittest.TestCase):
             # the length the machine feeds: the G-code header's, 12 sides of 40 mm
             self.assertAlmostEqual(load.facts["length_mm"], 480.0, places=6)
             log = draw(fabrication_ui.VIEW3D_PT_wiresculpt_fabrication, bpy.context)
-            self.assertIn("Load wire Ring/0 (1 of 2):", labels(log))
-            self.assertIn("480 mm of 3 mm steel,", labels(log))
-            self.assertIn("from stock of 1000 mm (the default machine profile).", labels(log))
+            self.assertIn("Load wire Ring/0 (1 of 2): 480 mm of 3 mm steel, from stock of 1000 mm "
+                          "(the default machine profile). Feed its end to the bend head, then Continue.", shown(log))
             self.assertIn(("wiresculpt.send_to_machine", "Continue"), operators(log))
             self.assertEqual(emu.received, [])  # nothing is sent before Continue
             # Continue: the first wire, then the panel asks for the second
@@ -198,17 +202,15 @@ class MachinePanel(unittest.TestCase):
         report = str(ctx.exception)
         self.ws.fab_wire = wire["name"]
         log = draw(fabrication_ui.VIEW3D_PT_wiresculpt_fabrication, bpy.context)
-        box = labels(log)
-        first = box.index(f"Wire {wire['name']} stopped.")
-        shown = box[first:]
-        self.assertTrue(all(len(line) <= 80 for line in shown), shown)
-        self.assertIn(f"The link to {emu.port} dropped (or GRBL restarted).", shown)
-        self.assertIn(f"Done: steps 1-{step - 1} of {len(dwells)}.", shown)
-        self.assertIn(f"Step {step} (lines {start + 1}-{step_end + 1}: feed 40.0 mm, bend +30.0°) may be half made:",
-                      shown)
-        self.assertIn(f"Resume restarts step {step} at line {start + 1}.", shown)
-        self.assertIn(("wiresculpt.send_to_machine", f"Resume from Step {step} (line {start + 1})"), operators(log))
-        self.assertEqual(report.strip().removeprefix("Error: "), " ".join(shown))  # the report says the box
+        text = shown(log)
+        self.assertTrue(all(len(line) <= 60 for line in labels(log)), labels(log))  # wrapped to the sidebar
+        box = (f"Wire {wire['name']} stopped. The link to {emu.port} dropped (or GRBL restarted). "
+               f"Done: steps 1-{step - 1} of {len(dwells)}. "
+               f"Step {step} (lines {start + 1}-{step_end + 1}: feed 40.0 mm, bend +30.0°) may be half made: "
+               f"check the wire before resuming. Resume restarts step {step} at line {start + 1}.")
+        self.assertIn(box, text)
+        self.assertIn(("wiresculpt.send_to_machine", f"Resume from Step {step}"), operators(log))
+        self.assertEqual(report.strip().removeprefix("Error: "), box)  # the report says the box, nothing else
         # the button's Resume makes the step again on a new link, to the end
         with GrblEmulator() as again:
             self.assertEqual(bpy.ops.wiresculpt.send_to_machine(wire=wire["name"], port=again.port, resume=True,
@@ -224,8 +226,8 @@ class MachinePanel(unittest.TestCase):
             self.assertEqual(bpy.ops.wiresculpt.machine_test_bends(), {'FINISHED'})
             self.assertEqual(streaming.LOAD.kind, "test")
             log = draw(machine_ui.VIEW3D_PT_wiresculpt_machine, bpy.context)
-            self.assertIn("Load a straight test piece:", labels(log))
-            self.assertIn("It gets 6 bends commanded 15, 30, 45, 60, 90, 120°.", labels(log))
+            self.assertIn("Load a straight test piece: 280 mm of 3 mm steel. It gets 6 bends commanded "
+                          "15, 30, 45, 60, 90, 120°.", shown(log))
             self.assertEqual(bpy.ops.wiresculpt.send_to_machine(test=True, loaded=True, **FAST), {'FINISHED'})
         lines, _m, _c, _l = grbl.test_bend_program()
         self.assertEqual(emu.received, lines)
@@ -250,7 +252,9 @@ class MachinePanel(unittest.TestCase):
         self.assertEqual(shown, ["Wire W stopped.", "GRBL refused line 84 with error:20 (an unsupported G-code).",
                                  "Done: steps 1-11 of 30.", "Line 84 was not run: fix it, then resume.",
                                  "Resume continues step 12 at line 84."])
-        self.assertEqual(words.resume_button(facts), "Resume from Step 12 (line 84)")
+        self.assertEqual(words.resume_button(facts), "Resume from Step 12")
+        # past the last step (the pin back and M2) there is no step to name: the line
+        self.assertEqual(words.resume_button(dict(facts, resume_step=31, resume_line=199)), "Resume at Line 199")
 
 
 if __name__ == "__main__":

@@ -1,11 +1,14 @@
 """The user guide's screenshot of the Machine panel (docs/images/panel-machine.png):
 
-    xvfb-run -a -s "-screen 0 1600x1000x24" blender --factory-startup --enable-event-simulate \
+    xvfb-run -a -s "-screen 0 1600x1400x24" blender --factory-startup --enable-event-simulate \
         --python docs/images/make_machine_screenshot.py
 
 Opens the Machine panel (the other sub-panels shut), connects it to the suite's GRBL emulator on a
 pseudo-terminal (blender_tests/helpers.GrblEmulator), jogs the feed 12.5 mm and the head 30° right,
-sends the console line `$G`, then takes the screenshot cropped to the sidebar and quits.
+sends the console line `$G`, then takes the screenshot cropped to the sidebar. Then
+docs/images/panel-stop.png: a two-wire design of 12-gons is stored, its first wire sent to an
+emulator that pulls the cable when line 22 arrives (in step 5), and the Fabrication panel shows the
+stop's box with its Resume button.
 """
 import os
 import sys
@@ -76,18 +79,45 @@ def crop(path):
     out.save()
 
 
-def take():
-    path = os.path.join(OUT, "panel-machine.png")
+def shot(name):
+    path = os.path.join(OUT, name)
     with bpy.context.temp_override(window=win, area=area):
         bpy.ops.screen.screenshot(filepath=path, check_existing=False)
     crop(path)
-    print("SHOT panel-machine.png", grbl.SESSION.status, flush=True)
+    print("SHOT", name, flush=True)
+
+
+def take():
+    session = grbl.SESSION
+    if session.busy() or (session.status or {}).get("state") != "Idle" or not session.log[-1].done:
+        return 0.5  # the panel's timer has not read every answer yet (slow under load): later
+    if not getattr(take, "settled", False):
+        take.settled = True  # one more redraw of the panel with the last answers
+        return 0.5
+    shot("panel-machine.png")
     grbl.disconnect()
     emulator.close()
+    from test_machine_panel import ring_design
+    from wiresculpt.blend import results as scene_results
+    scene_results.store_design(ring_design())
+    ws.fab_wire = "Ring/0"
+    dropping = GrblEmulator(drop_on=22)
+    try:
+        bpy.ops.wiresculpt.send_to_machine(wire="Ring/0", port=dropping.port, loaded=True, settle=0.05,
+                                           response_timeout=2.0)
+    except RuntimeError:
+        pass  # the stop is reported as an error: the panel shows it
+    dropping.close()
+    bpy.app.timers.register(take_stop, first_interval=1.0)
+    return None
+
+
+def take_stop():
+    shot("panel-stop.png")
     bpy.ops.wm.quit_blender()
 
 
 bpy.app.timers.register(lambda: close_splash(), first_interval=0.7)
 bpy.app.timers.register(lambda: click_tab(), first_interval=1.0)
 bpy.app.timers.register(lambda: drive(), first_interval=1.5)
-bpy.app.timers.register(lambda: take(), first_interval=3.5)
+bpy.app.timers.register(take, first_interval=3.5)

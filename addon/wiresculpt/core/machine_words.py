@@ -97,10 +97,10 @@ def stop_lines(facts):
 
 
 def resume_button(facts):
-    """The Resume button's text: the step (and line) it starts from."""
+    """The Resume button's text: the step it starts from (the box above names the line)."""
     if facts["resume_step"] > facts["steps"]:
         return f"Resume at Line {facts['resume_line']}"
-    return f"Resume from Step {facts['resume_step']} (line {facts['resume_line']})"
+    return f"Resume from Step {facts['resume_step']}"
 
 
 def finished_lines(facts):

@@ -61,7 +61,7 @@ class VIEW3D_PT_wiresculpt_fabrication(_Child, bpy.types.Panel):
             return
         load = streaming.LOAD
         if load is not None:  # the "load the wire" step: Continue sends it
-            draw_load(box, load)
+            draw_load(box, context, load)
             return
         stopped = streaming.PENDING.get(ws.fab_wire)
         col = box.column(align=True)
@@ -71,7 +71,7 @@ class VIEW3D_PT_wiresculpt_fabrication(_Child, bpy.types.Panel):
         send.resume = False
         row.operator(ops.WIRESCULPT_OT_send_all.bl_idname, text="Send All", icon='SEQ_STRIP_DUPLICATE')
         if stopped is not None and stopped.facts is not None:
-            draw_stop(box, stopped.facts)
+            draw_stop(box, context, stopped.facts)
             return
         if stopped is not None:
             resume = col.operator(ops.WIRESCULPT_OT_send_to_machine.bl_idname,
@@ -88,26 +88,26 @@ class VIEW3D_PT_wiresculpt_fabrication(_Child, bpy.types.Panel):
 ops_machine_realtime = "wiresculpt.machine_realtime"  # the Machine panel's Hold / Resume (operators/machine.py)
 
 
-def draw_stop(layout, facts):
-    """A stopped stream as a box of short lines and its Resume button."""
+def draw_stop(layout, context, facts):
+    """A stopped stream as a box of short lines (each wrapped to the sidebar) and its Resume button."""
     box = layout.box()
     box.alert = facts["status"] != "aborted"
     col = box.column(align=True)
     for k, line in enumerate(words.stop_lines(facts)):
-        col.label(text=line, icon='ERROR' if k == 0 else 'BLANK1')
+        _wrap(col, context, line, icon='ERROR' if k == 0 else 'BLANK1')
     resume = box.operator(ops.WIRESCULPT_OT_send_to_machine.bl_idname, text=words.resume_button(facts),
                           icon='FORWARD')
     resume.resume = True
     resume.wire = facts["wire"]
 
 
-def draw_load(layout, load):
+def draw_load(layout, context, load):
     """The "load the wire" step: which wire, stock and length; Continue sends it, Skip does not."""
     box = layout.box()
     col = box.column(align=True)
     lines = words.test_piece_lines(load.facts) if load.kind == "test" else words.load_lines(load.facts)
     for k, line in enumerate(lines):
-        col.label(text=line, icon='IMPORT' if k == 0 else 'BLANK1')
+        _wrap(col, context, line, icon='IMPORT' if k == 0 else 'BLANK1')
     row = box.row(align=True)
     go = row.operator(ops.WIRESCULPT_OT_send_to_machine.bl_idname, text="Continue", icon='PLAY')
     go.wire, go.loaded, go.resume, go.test = load.wire, True, False, load.kind == "test"

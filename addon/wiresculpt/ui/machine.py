@@ -73,11 +73,11 @@ class VIEW3D_PT_wiresculpt_machine(_Child, bpy.types.Panel):
         row.operator(ops.WIRESCULPT_OT_machine_console.bl_idname, text="", icon='CONSOLE')
         if session is not None:
             for command in session.log[-3:]:
-                col.label(text=f"{command.line}  →  {words.answer_line(command.answer, command.code, command.info)}")
+                _wrap(col, context, f"{command.line}  →  {words.answer_line(command.answer, command.code, command.info)}")
 
         load = streaming.LOAD
         if load is not None and load.kind == "test" and job is None:
-            draw_load(layout, load)  # the test piece needs no design: its Continue is here too
+            draw_load(layout, context, load)  # the test piece needs no design: its Continue is here too
         else:
             layout.operator(ops.WIRESCULPT_OT_machine_test_bends.bl_idname, icon='DRIVER_ROTATIONAL_DIFFERENCE')
 
