@@ -244,6 +244,29 @@ class MachinePanel(unittest.TestCase):
         self.assertEqual(fit["samples"], 6)
         scene.pop(scene_calibration.RESULTS_KEY, None)
 
+    def test_a_test_piece_stopped_by_a_dropped_link_resumes_from_the_machine_panel(self):
+        scene = bpy.context.scene
+        scene.wiresculpt_calibration.springback_rows.clear()
+        lines, _m, _c, _l = grbl.test_bend_program()
+        k = 10  # lines 8-9 (step 2's feed and bend out) queued when the cable is pulled
+        start = step_start(lines, k - 1)
+        self.assertLess(start, k - 1)
+        with GrblEmulator(drop_on=k) as emu:
+            self.ws.fab_port = emu.port
+            with self.assertRaisesRegex(RuntimeError, "The test piece stopped"):
+                bpy.ops.wiresculpt.send_to_machine(test=True, loaded=True, **FAST)
+        self.assertEqual(len(scene.wiresculpt_calibration.springback_rows), 0)  # not bent: no rows yet
+        log = draw(machine_ui.VIEW3D_PT_wiresculpt_machine, bpy.context)
+        self.assertIn(("wiresculpt.send_to_machine", "Resume from Step 2"), operators(log))
+        with GrblEmulator() as again:
+            self.ws.fab_port = again.port
+            self.assertEqual(bpy.ops.wiresculpt.send_to_machine(test=True, resume=True, **FAST), {'FINISHED'})
+        self.assertEqual(again.acknowledged, ["G21", "G91", "G94"] + lines[start:])
+        self.assertEqual([r.commanded_deg for r in scene.wiresculpt_calibration.springback_rows],
+                         list(grbl.TEST_ANGLES))
+        log = draw(machine_ui.VIEW3D_PT_wiresculpt_machine, bpy.context)
+        self.assertIn("The test piece done: all 7 steps", shown(log))
+
     def test_stop_words_are_short_lines_with_one_numbering(self):
         facts = {"wire": "W", "port": "/dev/ttyUSB0", "status": "error", "code": 20, "failed_line": 84,
                  "resume_line": 84, "resume_step": 12, "steps": 30, "done_steps": 11, "in_doubt": False,

@@ -71,10 +71,14 @@ def stop_cause(facts):
     return f"The stream stopped ({status})."
 
 
+def _what(facts):
+    return "The test piece" if facts.get("test") else f"Wire {facts['wire']}"
+
+
 def stop_lines(facts):
     """A stopped stream as short lines, first the cause, last what the Resume button does. Every
     number is a step (of the program's bend steps) or a line (1-based) as the box says it."""
-    out = [f"Wire {facts['wire']} stopped.", stop_cause(facts)]
+    out = [f"{_what(facts)} stopped.", stop_cause(facts)]
     done = facts["done_steps"]
     steps = facts["steps"]
     out.append(f"Done: steps 1-{done} of {steps}." if done else f"Done: no step of {steps}.")
@@ -106,16 +110,17 @@ def resume_button(facts):
 def finished_lines(facts):
     """A stream that ran to its end, or a dry run."""
     if facts["status"] == "dry_run":
-        return [f"Wire {facts['wire']}: the program checks out ({facts['total_lines']} lines, "
+        return [f"{_what(facts)}: the program checks out ({facts['total_lines']} lines, "
                 f"{facts['steps']} steps); nothing was sent."]
     start = f", resumed at line {facts['first_line']}" if facts.get("resumed") else ""
-    return [f"Wire {facts['wire']} done: all {facts['steps']} steps ({facts['total_lines']} lines) "
+    return [f"{_what(facts)} done: all {facts['steps']} steps ({facts['total_lines']} lines) "
             f"acknowledged by {facts['port']}{start}."]
 
 
 def not_started_lines(facts):
     """A stream that failed before GRBL answered anything of it (the port, the program)."""
-    return [f"Cannot send wire {facts['wire']} to {facts['port']}:", facts["why"]]
+    what = "the test piece" if facts.get("test") else f"wire {facts['wire']}"
+    return [f"Cannot send {what} to {facts['port']}:", facts["why"]]
 
 
 # --- loading a wire ------------------------------------------------------------------------------

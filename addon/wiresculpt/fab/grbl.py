@@ -274,6 +274,7 @@ class Machine:
 
     def _lose(self):
         self.lost = True
+        self.close()  # its lock file goes with it: a stream or a new Connect may open the port again
         for command in ([self._waiting] if self._waiting else []) + self._queue:
             self._end(command, LOST)
         self._waiting, self._queue = None, []

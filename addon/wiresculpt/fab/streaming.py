@@ -177,11 +177,19 @@ def prepare(design, wire, port, profile=None, resume=False, dry_run=False, settl
                      resumed=True, steps=steps, link=link)
 
 
-def prepare_program(name, lines, machine, port, steps=(), settle=2.0, response_timeout=30.0, link=None):
-    """A StreamJob for a program that is no wire of the design (the test bends)."""
+def prepare_program(name, lines, machine, port, steps=(), settle=2.0, response_timeout=30.0, link=None,
+                    resume=False):
+    """A StreamJob for a program that is no wire of the design (the test bends); Resume continues
+    its stop as prepare's does."""
     if not port:
         raise ValueError("no serial port chosen: pick one or type its path (e.g. /dev/ttyUSB0)")
-    return StreamJob(name, port, lines, machine, {}, False, settle, response_timeout, steps=steps, link=link)
+    if not resume:
+        return StreamJob(name, port, lines, machine, {}, False, settle, response_timeout, steps=steps, link=link)
+    stopped = PENDING.get(name)
+    if stopped is None or stopped.lines != lines or stopped.profile != machine:
+        raise ValueError(f"nothing to resume for {name}: send it again from the start")
+    return StreamJob(name, port, lines, machine, stopped.state, False, settle, response_timeout, resumed=True,
+                     steps=steps, link=link)
 
 
 # --- loading the wire ---------------------------------------------------------------------------
@@ -249,7 +257,8 @@ def stop_facts(job, port=None):
             "resume_line": nxt + 1, "resume_step": step, "steps": len(bounds),
             "done_steps": sum(1 for _f, b in bounds if b < confirmed), "in_doubt": in_doubt,
             "step_lines": (nxt + 1, last + 1), "feed_mm": program_step.get("feed_mm"),
-            "bend_deg": program_step.get("bend_deg"), "total_lines": len(lines), "why": job.error or ""}
+            "bend_deg": program_step.get("bend_deg"), "total_lines": len(lines), "why": job.error or "",
+            "test": job.after is not None}
 
 
 def stop_text(facts):
@@ -271,7 +280,8 @@ def _outcome(job):
     r, state = job.result, job.state
     done = int(state.get("next_line", job.first))
     finished = {"wire": job.wire, "port": job.port, "steps": len(step_bounds(job.lines)),
-                "total_lines": len(job.lines), "resumed": job.resumed and job.first > 0, "first_line": job.first + 1}
+                "total_lines": len(job.lines), "resumed": job.resumed and job.first > 0, "first_line": job.first + 1,
+                "test": job.after is not None}
     if job.error is not None and r is None:
         if job.dry_run:
             return {'ERROR'}, f"Wire {job.wire}: the dry run failed: {job.error}"

@@ -194,7 +194,8 @@ class WIRESCULPT_OT_send_to_machine(WorkerModal, bpy.types.Operator):
             profile = chosen_profile(context.scene)
             lines, machine, commanded, _length = grbl.test_bend_program(profile)
             job = streaming.prepare_program(grbl.TEST_NAME, lines, machine, port, settle=self.settle,
-                                            response_timeout=self.response_timeout, link=grbl.link_for(port))
+                                            response_timeout=self.response_timeout, link=grbl.link_for(port),
+                                            resume=self.resume)
         except (ValueError, RuntimeError) as exc:
             self.report({'ERROR'}, f"Cannot send the test bends: {exc}")
             return None

@@ -99,6 +99,7 @@ def draw_stop(layout, context, facts):
                           icon='FORWARD')
     resume.resume = True
     resume.wire = facts["wire"]
+    resume.test = facts.get("test", False)
 
 
 def draw_load(layout, context, load):

@@ -8,7 +8,7 @@ from ..blend.registration import classes_factory
 from ..core import machine_words as words
 from ..fab import grbl, streaming
 from ..operators import machine as ops
-from .fabrication import draw_load
+from .fabrication import draw_load, draw_stop
 from .results import _Child, _wrap
 
 
@@ -76,6 +76,12 @@ class VIEW3D_PT_wiresculpt_machine(_Child, bpy.types.Panel):
                 _wrap(col, context, f"{command.line}  →  {words.answer_line(command.answer, command.code, command.info)}")
 
         load = streaming.LOAD
+        stopped = streaming.PENDING.get(grbl.TEST_NAME)
+        last = streaming.LAST.get(grbl.TEST_NAME)
+        if job is None and stopped is not None and stopped.facts is not None:
+            draw_stop(layout, context, stopped.facts)  # the test piece's stop: its Resume is here
+        elif job is None and last is not None and last[0] == {'INFO'}:
+            _wrap(layout.box(), context, last[1], icon='INFO')
         if load is not None and load.kind == "test" and job is None:
             draw_load(layout, context, load)  # the test piece needs no design: its Continue is here too
         else:
