@@ -175,6 +175,16 @@ class MachinePanel(unittest.TestCase):
             self.assertFalse(session.lost)
             self.assertEqual(session.query()["state"], "Idle")  # the same link, still open
 
+    def test_no_stream_starts_on_the_link_while_a_line_waits_for_its_answer(self):
+        with GrblEmulator(answers={1: b""}) as emu:  # the first line is never answered
+            session = self.connect(emu)
+            waiting = session.send("$I")
+            with self.assertRaisesRegex(RuntimeError, "still waits for GRBL's answer"):
+                bpy.ops.wiresculpt.send_to_machine(wire="Ring/0", loaded=True, **FAST)
+            self.assertEqual(emu.received, ["$I"])
+            session.wait(waiting, 0.1)  # given up: the link is free again
+            self.assertEqual(bpy.ops.wiresculpt.send_to_machine(wire="Ring/0", loaded=True, **FAST), {'FINISHED'})
+
     def test_send_without_continue_only_asks(self):
         with GrblEmulator() as emu:
             self.ws.fab_port = emu.port

@@ -186,8 +186,11 @@ def line_fault(code):
 
 NOT_CONNECTED = "not_connected"
 STREAMING = "streaming"
+BUSY = "busy"  # a console line, jog or home still waits for GRBL's answer on the link a stream would use
 REFUSALS = {NOT_CONNECTED: "Connect to the machine first (Machine panel)",
-            STREAMING: "A wire is being sent: Hold, Resume and Cancel only"}
+            STREAMING: "A wire is being sent: Hold, Resume and Cancel only",
+            BUSY: "The Machine panel still waits for GRBL's answer (a jog, Home or a console line): send when "
+                  "it has answered"}
 
 
 def refusal(code):

@@ -365,9 +365,16 @@ def disconnect():
     SESSION = None
 
 
+BUSY = "busy"  # the session's link has a line waiting for its answer: no stream may start on it
+
+
 def link_for(port):
-    """The session's open link when it is connected to `port` (a stream runs on it), else None."""
+    """The session's open link when it is connected to `port` (a stream runs on it), else None;
+    ValueError(BUSY) while a line of the session waits for its answer (GRBL's answer would reach
+    the stream as an answer to none of its lines)."""
     s = SESSION
     if s is not None and not s.lost and s.port == port and s.link.is_open:
+        if s.busy():
+            raise ValueError(BUSY)
         return s.link
     return None

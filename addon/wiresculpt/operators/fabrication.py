@@ -36,6 +36,15 @@ def preview_machine(scene, profile):
                 name="the loaded spring-back fit")
 
 
+def _link(port):
+    """The Machine panel's open link to `port` for a stream, None when it has none; ValueError
+    with the sentence when its link is busy."""
+    try:
+        return grbl.link_for(port)
+    except ValueError:
+        raise ValueError(words.refusal(words.BUSY)) from None
+
+
 def _design_or_error(op):
     design = scene_results.stored_design()
     if design is None:
@@ -180,7 +189,7 @@ class WIRESCULPT_OT_send_to_machine(WorkerModal, bpy.types.Operator):
                 self.report({'INFO'}, " ".join(words.load_lines(streaming.LOAD.facts)))
                 return None
             job = streaming.prepare(design, wire, port, profile, self.resume, dry_run, self.settle,
-                                    self.response_timeout, link=grbl.link_for(port))
+                                    self.response_timeout, link=_link(port))
         except (ValueError, RuntimeError) as exc:
             self.report({'ERROR'}, f"Cannot send: {exc}")
             return None
@@ -194,7 +203,7 @@ class WIRESCULPT_OT_send_to_machine(WorkerModal, bpy.types.Operator):
             profile = chosen_profile(context.scene)
             lines, machine, commanded, _length = grbl.test_bend_program(profile)
             job = streaming.prepare_program(grbl.TEST_NAME, lines, machine, port, settle=self.settle,
-                                            response_timeout=self.response_timeout, link=grbl.link_for(port),
+                                            response_timeout=self.response_timeout, link=_link(port),
                                             resume=self.resume)
         except (ValueError, RuntimeError) as exc:
             self.report({'ERROR'}, f"Cannot send the test bends: {exc}")
