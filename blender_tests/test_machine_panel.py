@@ -105,7 +105,7 @@ class MachinePanel(unittest.TestCase):
                 self.assertIn(op, ops)
 
     def test_status_hold_resume_home_unlock_jog_and_console(self):
-        with GrblEmulator(alarm=True, move_time=0.3) as emu:
+        with GrblEmulator(alarm=True, move_time=0.6) as emu:
             session = self.connect(emu)
             self.assertEqual(bpy.ops.wiresculpt.machine_realtime(command="STATUS"), {'FINISHED'})
             self.assertEqual(session.status["state"], "Alarm")
@@ -118,7 +118,7 @@ class MachinePanel(unittest.TestCase):
             self.assertEqual(bpy.ops.wiresculpt.machine_jog(axis=grbl.FEED, direction=1.0), {'FINISHED'})
             self.assertEqual(bpy.ops.wiresculpt.machine_jog(axis=grbl.BEND, direction=-1.0), {'FINISHED'})
             self.assertEqual(emu.received[-2:], ["$J=G91 G21 X12.5000 F1200.0", "$J=G91 G21 Y-30.0000 F5400.0"])
-            # the jogs are queued in GRBL, 0.3 s each: a feed hold keeps them where they are
+            # the jogs are queued in GRBL, 0.6 s each: a feed hold keeps them where they are
             self.assertEqual(bpy.ops.wiresculpt.machine_realtime(command="HOLD"), {'FINISHED'})
             time.sleep(0.1)
             self.assertEqual(session.query()["state"], "Hold")
@@ -181,6 +181,9 @@ class MachinePanel(unittest.TestCase):
             waiting = session.send("$I")
             with self.assertRaisesRegex(RuntimeError, "still waits for GRBL's answer"):
                 bpy.ops.wiresculpt.send_to_machine(wire="Ring/0", loaded=True, **FAST)
+            end = time.monotonic() + 3
+            while not emu.received and time.monotonic() < end:  # the emulator's thread reads it
+                time.sleep(0.01)
             self.assertEqual(emu.received, ["$I"])
             session.wait(waiting, 0.1)  # given up: the link is free again
             self.assertEqual(bpy.ops.wiresculpt.send_to_machine(wire="Ring/0", loaded=True, **FAST), {'FINISHED'})

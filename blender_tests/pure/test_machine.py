@@ -162,7 +162,7 @@ class AgainstTheEmulator(unittest.TestCase):
     def test_a_streams_feed_hold_freezes_the_machine_and_resume_finishes(self):
         import threading
 
-        with GrblEmulator(move_time=0.15) as emu:
+        with GrblEmulator(move_time=0.3) as emu:
             m = self.machine(emu)
             lines = ["G21", "G91", "G94"] + ["G1 X10.0000 F1200.0"] * 6 + ["G4 P0", "M2"]
             state = {}
@@ -174,7 +174,7 @@ class AgainstTheEmulator(unittest.TestCase):
             streaming.hold(job)  # the panel's Hold during a stream on its link: at once, inside the step
             self.assertTrue(until(lambda: emu.state() == "Hold:0"))
             held = list(emu.position)
-            time.sleep(0.5)  # three moves' time: nothing moves in the hold
+            time.sleep(0.7)  # over two moves' time: nothing moves in the hold
             self.assertEqual(emu.position, held)
             self.assertLess(held[0], 60.0)
             streaming.go_on(job)

@@ -101,13 +101,6 @@ class Stopped:
         return int(self.state.get("next_line", 0))
 
 
-def quoted(lines, index):
-    """'line N (`text`)' with N 1-based, or 'no line' for index < 0."""
-    if index < 0:
-        return "no line yet"
-    return f"line {index + 1} (`{lines[index]}`)"
-
-
 class StreamJob(WorkerJob):
     """One run of stream_program: started fresh (Send) or from a Stopped state (Resume)."""
 
