@@ -167,19 +167,138 @@ class GrblEmulator:
     for a device that doubles its answer, b"error:\\xff9\\r\\n" for invalid UTF-8); `double_ok`
     doubles every `ok`.
 
-    received: every line as it arrived; acknowledged: the lines answered `ok`, in order."""
+    The machine, as GRBL 1.1 keeps it: a machine position (X, Y, Z in axis units) moved by G0/G1
+    lines (G90/G91 as sent) and `$J=` jogs, each move taking `move_time` seconds in a planner
+    queue (0: done at once, the moves of the earlier tests); `?` answers at once with
+    `<State|MPos:x,y,z|FS:0,0>` (state Idle, Run, Jog, Hold:0, Home or Alarm); `!` (feed hold)
+    freezes a running queue (Hold:0) and `~` (cycle start) runs it on; `$H` homes (`home_time` s in
+    state Home, then every axis at 0 and `ok`); `alarm=True` starts locked as a GRBL with homing
+    switches does (G-code and jogs get `error:9`, `$X` unlocks with `[MSG:Caution: Unlocked]`,
+    `$H` unlocks by homing). A `G4` or `M2` is answered only when the queue has run, as GRBL does.
 
-    def __init__(self, error_on=None, drop_on=None, delay=0.0, answers=None, double_ok=False):
+    received: every line as it arrived; acknowledged: the lines answered `ok`, in order;
+    status_queries: how many `?` arrived; position: the machine position now."""
+
+    def __init__(self, error_on=None, drop_on=None, delay=0.0, answers=None, double_ok=False, move_time=0.0,
+                 home_time=0.0, alarm=False):
         self.master, self.slave = os.openpty()
         tty.setraw(self.slave)
         self.port = os.ttyname(self.slave)
         self.error_on, self.drop_on, self.delay = error_on, drop_on, delay
         self.answers, self.double_ok = dict(answers or {}), double_ok
+        self.move_time, self.home_time = move_time, home_time
         self.received, self.acknowledged, self.realtime = [], [], []
+        self.status_queries = 0
+        self.position = [0.0, 0.0, 0.0]
+        self.relative = False
+        self.held = False
+        self.alarm = alarm
+        self.homed = 0  # $H cycles run
+        self._queue = []  # [seconds left, target position or None, kind ("move", "jog", "home"), answer or None]
+        self._deferred = None  # (line, bytes): a G4/M2 answered when the queue has run
         self.dropped = False
+        self._lock = threading.Lock()
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._serve, daemon=True)
         self._thread.start()
+
+    # --- the machine ---
+
+    def state(self):
+        if self.alarm:
+            return "Alarm"
+        if self._queue:
+            if self.held:
+                return "Hold:0"
+            return {"home": "Home", "jog": "Jog"}.get(self._queue[0][2], "Run")
+        return "Idle"
+
+    def report(self):
+        x, y, z = self.position
+        return f"<{self.state()}|MPos:{x:.3f},{y:.3f},{z:.3f}|FS:0,0>\r\n".encode()
+
+    def _target(self, words, relative):
+        target = list(self._queue[-1][1]) if self._queue and self._queue[-1][1] is not None else list(self.position)
+        for k, axis in enumerate("XYZ"):
+            if axis in words:
+                target[k] = target[k] + words[axis] if relative else words[axis]
+        return target
+
+    @staticmethod
+    def _words(text):
+        words, k = {}, 0
+        text = text.upper().replace(" ", "")
+        while k < len(text):
+            letter, k = text[k], k + 1
+            start = k
+            while k < len(text) and (text[k].isdigit() or text[k] in ".-+"):
+                k += 1
+            try:
+                value = float(text[start:k])
+            except ValueError:
+                value = 0.0
+            if letter.isalpha():
+                words.setdefault(letter, value)
+                if letter == "G":
+                    words.setdefault("G_all", []).append(value)
+        return words
+
+    def _machine(self, line):
+        """The answer to a line the machine model acts on (bytes), None for the plain `ok`, or
+        False when it is answered later (a sync line, a homing cycle)."""
+        upper = line.upper().replace(" ", "")
+        if upper == "$X":
+            self.alarm = False
+            return b"[MSG:Caution: Unlocked]\r\nok\r\n"
+        if upper == "$H":
+            self.alarm = False
+            self._queue.append([self.home_time, [0.0, 0.0, 0.0], "home", b"ok\r\n"])
+            return False
+        if upper.startswith("$J="):
+            if self.alarm:
+                return b"error:9\r\n"
+            words = self._words(upper[3:])
+            relative = 91.0 in words.get("G_all", []) or (self.relative and 90.0 not in words.get("G_all", []))
+            self._queue.append([self.move_time, self._target(words, relative), "jog", None])
+            return None
+        if upper.startswith("$"):
+            return None
+        words = self._words(upper)
+        gs = words.get("G_all", [])
+        if self.alarm and (any(a in words for a in "XYZ") or 4.0 in gs or "M" in words):
+            return b"error:9\r\n"
+        if 91.0 in gs:
+            self.relative = True
+        if 90.0 in gs:
+            self.relative = False
+        if any(a in words for a in "XYZ"):
+            self._queue.append([self.move_time, self._target(words, self.relative), "move", None])
+        if (4.0 in gs or words.get("M") in (2.0, 30.0)) and self._queue:
+            return False  # a sync line: answered when the queue has run
+        return None
+
+    def _run(self, seconds):
+        """The queue run on for `seconds` (not while held); answers what completes."""
+        while self._queue and not self.held:
+            head = self._queue[0]
+            if head[0] > seconds:
+                head[0] -= seconds
+                return
+            seconds -= head[0]
+            self._queue.pop(0)
+            if head[1] is not None:
+                self.position = list(head[1])
+            if head[2] == "home":
+                self.homed += 1
+            if head[3] is not None:
+                os.write(self.master, head[3])
+        if not self._queue and self._deferred is not None:
+            line, answer = self._deferred
+            self._deferred = None
+            self.acknowledged.append(line)
+            os.write(self.master, answer)
+
+    # --- the link ---
 
     def _answer(self, line):
         self.received.append(line)
@@ -189,13 +308,29 @@ class GrblEmulator:
             return False
         if self.delay and self._reset_within(self.delay):
             return True  # a soft reset discards the line before it is answered, as GRBL does
+        ok = b"ok\r\nok\r\n" if self.double_ok else b"ok\r\n"
         if len(self.received) in self.answers:
             os.write(self.master, self.answers[len(self.received)])
         elif self.error_on is not None and len(self.received) == self.error_on:
             os.write(self.master, b"error:20\r\n")
         else:
+            with self._lock:
+                answer = self._machine(line)
+            if answer is False:
+                if self._queue and self._queue[-1][2] == "home":
+                    self.acknowledged.append(line)
+                else:
+                    self._deferred = (line, ok)
+                self._run(0.0)
+                return True
+            if answer is not None:
+                if answer.endswith(b"ok\r\n"):
+                    self.acknowledged.append(line)
+                os.write(self.master, answer)
+                return True
             self.acknowledged.append(line)
-            os.write(self.master, b"ok\r\nok\r\n" if self.double_ok else b"ok\r\n")
+            os.write(self.master, ok)
+            self._run(0.0)
         return True
 
     def _read(self, timeout):
@@ -206,9 +341,20 @@ class GrblEmulator:
             return False
         reset = False
         for byte in os.read(self.master, 256):
-            if byte in b"!~\x18":
+            if byte == ord("?"):
+                self.status_queries += 1
+                os.write(self.master, self.report())
+            elif byte in b"!~\x18":
                 self.realtime.append(chr(byte))
                 reset = reset or byte == 0x18
+                if byte == ord("!") and self._queue:
+                    self.held = True
+                elif byte == ord("~"):
+                    self.held = False
+                elif byte == 0x18:
+                    if self._queue:
+                        self.alarm = True  # a reset while moving loses position: GRBL locks
+                    self._queue, self._deferred, self.held = [], None, False
             else:
                 self._buffer += bytes((byte,))
         return reset
@@ -223,10 +369,14 @@ class GrblEmulator:
 
     def _serve(self):
         self._buffer = b""
+        last = time.monotonic()
         while not self._stop.is_set():
             try:
                 self._read(0.01)
-                while b"\n" in self._buffer:
+                now = time.monotonic()
+                self._run(now - last)
+                last = now
+                while b"\n" in self._buffer and self._deferred is None:
                     line, self._buffer = self._buffer.split(b"\n", 1)
                     if not self._answer(line.decode(errors="replace").strip()):
                         return

@@ -208,7 +208,9 @@ class FabricationOperators(unittest.TestCase):
     # --- Send to Machine ---------------------------------------------------------------------
 
     def send(self, port, **kw):
-        return bpy.ops.wiresculpt.send_to_machine(wire=self.wire["name"], port=port, **FAST, **kw)
+        """Send with the wire loaded (the Continue of the "load the wire" step; test_machine_panel
+        checks the step itself)."""
+        return bpy.ops.wiresculpt.send_to_machine(wire=self.wire["name"], port=port, loaded=True, **FAST, **kw)
 
     def test_send_streams_the_whole_program_once(self):
         lines = self.program()
@@ -217,14 +219,17 @@ class FabricationOperators(unittest.TestCase):
         self.assertEqual(grbl.acknowledged, lines)
         self.assertEqual(grbl.received, lines)
         self.assertNotIn(self.wire["name"], streaming.PENDING)
-        self.assertIn(f"all {len(lines)} lines acknowledged", streaming.LAST[self.wire["name"]][1])
+        self.assertIn(f"({len(lines)} lines) acknowledged", streaming.LAST[self.wire["name"]][1])
 
     def test_dry_run_sends_nothing(self):
+        self.program()
+        self.latest = os.path.join(self.tmp.name, "program", "gcode", export.file_stem(self.wire) + ".gcode")
         with GrblEmulator() as grbl:
             self.assertEqual(self.send(grbl.port, dry_run=True), {'FINISHED'})
             time.sleep(0.1)
         self.assertEqual(grbl.received, [])
-        self.assertIn("dry run", streaming.LAST[self.wire["name"]][1])
+        self.assertIn(f"the program checks out ({len(gcode_lines(self.latest))} lines", streaming.LAST[self.wire["name"]][1])
+        self.assertIn("nothing was sent", streaming.LAST[self.wire["name"]][1])
 
     def test_a_dropped_link_names_the_step_in_doubt_and_resume_makes_it_again(self):
         lines = self.program(self.profile_path)
@@ -236,8 +241,9 @@ class FabricationOperators(unittest.TestCase):
             with self.assertRaises(RuntimeError) as ctx:
                 self.send(first.port)
         message = str(ctx.exception)
-        self.assertIn(f"the last acknowledged line is line {k - 1} (`{lines[k - 2]}`)", message)
-        self.assertIn(f"Resume restarts the step in doubt from line {start + 1} of {len(lines)}", message)
+        step = 1 + sum(1 for line in lines[:start] if line == "G4 P0")  # the step whose first line is start
+        self.assertIn(f"Step {step} (lines {start + 1}-", message)
+        self.assertIn(f"Resume restarts step {step} at line {start + 1}.", message)
         self.assertIn("check the wire", message)
         self.assertEqual(first.acknowledged, lines[:k - 1])
         self.assertEqual(first.received, lines[:k])
@@ -258,6 +264,7 @@ class FabricationOperators(unittest.TestCase):
         self.assertEqual(second.acknowledged, modes + lines[start:])
         self.assertNotIn(self.wire["name"], streaming.PENDING)
         self.assertIn(f"resumed at line {start + 1}", streaming.LAST[self.wire["name"]][1])
+        self.assertIsNone(streaming.PENDING.get(self.wire["name"]))
 
     def test_a_rejected_line_stops_there_and_resume_sends_it_again(self):
         lines = self.program()
@@ -266,9 +273,10 @@ class FabricationOperators(unittest.TestCase):
             with self.assertRaises(RuntimeError) as ctx:
                 self.send(grbl.port)
             message = str(ctx.exception)
-            self.assertIn("stopped (error)", message)
-            self.assertIn(f"the last acknowledged line is line {k - 1} (`{lines[k - 2]}`)", message)
-            self.assertIn(f"error:20", message)
+            step = 1 + sum(1 for line in lines[:k - 1] if line == "G4 P0")
+            self.assertIn(f"GRBL refused line {k} with error:20", message)
+            self.assertIn(f"Line {k} was not run", message)
+            self.assertIn(f"Resume continues step {step} at line {k}.", message)
             self.assertEqual(self.send(grbl.port, resume=True), {'FINISHED'})
         modes = [line for line in lines[:k - 1] if line in MODES]
         self.assertEqual(grbl.received, lines[:k] + modes + lines[k - 1:])
@@ -293,8 +301,10 @@ class FabricationOperators(unittest.TestCase):
         self.assertEqual(grbl.realtime, ["!", "\x18"])  # feed hold, then soft reset
         start = step_start(lines, k - 1)  # the soft reset dropped the step's queued moves
         self.assertEqual(streaming.PENDING[self.wire["name"]].next_line, start)
-        self.assertIn(f"cancelled on {grbl.port}: the last acknowledged line is line {k - 1}",
-                      streaming.LAST[self.wire["name"]][1])
+        step = 1 + sum(1 for line in lines[:start] if line == "G4 P0")
+        done = f"Done: steps 1-{step - 1} of" if step > 1 else "Done: no step of"
+        self.assertIn(f"Cancelled: feed hold and soft reset sent. {done}", streaming.LAST[self.wire["name"]][1])
+        self.assertIn(f"Resume restarts step {step} at line {start + 1}.", streaming.LAST[self.wire["name"]][1])
         self.assertFalse(streaming.running())
         self.assertFalse(streaming.cancel())
         with GrblEmulator() as again:
@@ -309,6 +319,8 @@ class FabricationOperators(unittest.TestCase):
         with self.assertRaisesRegex(RuntimeError, "no wire 'Nope/7'"):
             bpy.ops.wiresculpt.send_to_machine(wire="Nope/7", port="/dev/null", **FAST)
         with self.assertRaisesRegex(RuntimeError, "no serial port chosen"):
+            bpy.ops.wiresculpt.send_to_machine(wire=self.wire["name"], port="", loaded=True)
+        with self.assertRaisesRegex(RuntimeError, "no serial port chosen"):  # nor asked to load the wire
             bpy.ops.wiresculpt.send_to_machine(wire=self.wire["name"], port="")
 
 

@@ -60,7 +60,7 @@ def invoke(**kw):
     area = next(a for a in win.screen.areas if a.type == 'VIEW_3D')
     with bpy.context.temp_override(window=win, area=area):
         return sorted(bpy.ops.wiresculpt.send_to_machine('INVOKE_DEFAULT', wire=WIRE, settle=0.05,
-                                                         response_timeout=2.0, **kw))
+                                                         response_timeout=2.0, loaded=True, **kw))
 
 
 def start_send():

@@ -469,9 +469,16 @@ def stream_control():
     return require().StreamControl()
 
 
+def open_link(port, profile=None):
+    """An open SerialLink on `port` with the profile's serial settings (write, read, close), kept
+    between commands and usable as stream_program's port. ValueError naming the port."""
+    return require().SerialLink(port, {} if profile is None else profile)
+
+
 def stream_program(port, lines, profile=None, state=None, progress=None, control=None, dry_run=False,
                    response_timeout=30.0, settle=2.0):
-    """Streams G-code lines to a GRBL bender; `state["next_line"]` resumes. See _wiresculpt."""
+    """Streams G-code lines to a GRBL bender; `state["next_line"]` resumes; `port` is a port's name
+    (opened, settled, closed) or an open SerialLink (open_link). See _wiresculpt."""
     return require().stream_program(port, _list(lines, "lines"), {} if profile is None else profile, state,
                                     progress=progress, control=control, dry_run=dry_run,
                                     response_timeout=response_timeout, settle=settle)

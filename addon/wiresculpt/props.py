@@ -314,6 +314,16 @@ class WiresculptSettings(bpy.types.PropertyGroup):
     fab_dry_run: BoolProperty(
         name="Dry Run", default=False,
         description="Only check the program against the machine profile; nothing is sent")
+    # the Machine panel (docs/user-guide.md, Machine)
+    machine_jog_feed: FloatProperty(
+        name="Feed Step", default=10.0, min=0.01, max=1000.0, precision=2,
+        description="How far one feed jog moves the wire (millimetres)")
+    machine_jog_bend: FloatProperty(
+        name="Bend Step", default=5.0, min=0.01, max=180.0, precision=2,
+        description="How far one bend jog turns the head (degrees, left positive)")
+    machine_console: StringProperty(
+        name="Line", default="",
+        description="One line for GRBL ($$, $G, G-code; ?, ! or ~ alone go as realtime commands)")
 
 
 # --- calibration (Calibration panel) ------------------------------------------------------------
@@ -337,6 +347,14 @@ def material_items(_self, _context):
     return items
 
 
+class WiresculptSpringbackRow(bpy.types.PropertyGroup):
+    """One bend of the test piece: the angle commanded and the angle measured on the bent wire."""
+    commanded_deg: FloatProperty(name="Commanded", default=0.0, min=-180.0, max=180.0, precision=2,
+                                 description="The bend angle the test program commanded (degrees)")
+    measured_deg: FloatProperty(name="Measured", default=0.0, min=-180.0, max=180.0, precision=2,
+                                description="The angle measured on the bent test piece (degrees; 0: not yet)")
+
+
 class WiresculptCalibrationSettings(bpy.types.PropertyGroup):
     overhang: FloatProperty(
         name="Overhang", subtype='DISTANCE', unit='LENGTH', default=0.30, min=0.02, max=2.0, precision=3,
@@ -354,12 +372,13 @@ class WiresculptCalibrationSettings(bpy.types.PropertyGroup):
         name="Name", default="calibrated steel",
         description="Name of the calibrated material (saved as JSON in the user's config folder)")
     plot: EnumProperty(name="Plot", items=KINDS, default="CANTILEVER", description="Which fit the panel shows")
+    springback_rows: CollectionProperty(type=WiresculptSpringbackRow)
 
 
 
 
 _register_classes, _unregister_classes = classes_factory(
-    (WiresculptContour, WiresculptSettings, WiresculptCalibrationSettings),
+    (WiresculptContour, WiresculptSettings, WiresculptSpringbackRow, WiresculptCalibrationSettings),
     scene_properties=(("wiresculpt", WiresculptSettings, "Wire Sculpture",
                        "Settings and results of the wiresculpt add-on"),
                       ("wiresculpt_calibration", WiresculptCalibrationSettings, "Calibration",

@@ -10,7 +10,7 @@ from helpers import circle
 from wiresculpt import native
 
 # Module names whose wrapper has another name.
-RENAMED = {"StreamControl": "stream_control", "Cancelled": "Cancelled"}
+RENAMED = {"StreamControl": "stream_control", "SerialLink": "open_link", "Cancelled": "Cancelled"}
 LINE = np.array([[0.0, 0.0], [0.05, 0.0], [0.1, 0.02]])
 
 

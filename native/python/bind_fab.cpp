@@ -4,8 +4,10 @@
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cctype>
 #include <exception>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -271,7 +273,48 @@ std::string write_bend_table(const std::optional<std::string>& path, const py::o
   return text;
 }
 
-py::dict stream_program_py(const std::string& port, const std::vector<std::string>& lines, const py::object& profile,
+// An open serial link that the caller keeps between commands (the Machine panel: status reports,
+// jogs, a console line) and that a stream can run on, so GRBL is not reset by reopening the port
+// between them (an Arduino-based GRBL restarts when its port opens, and forgets it was homed).
+class SerialLink {
+ public:
+  SerialLink(const std::string& name, const MachineProfile& profile) {
+    py::gil_scoped_release release;
+    port_ = std::make_unique<SerialPort>(name, profile.serial);
+  }
+  SerialPort& port() {
+    if (!port_) throw InputError("the serial link is closed");
+    return *port_;
+  }
+  bool is_open() const { return static_cast<bool>(port_); }
+  std::string name() { return port().name(); }
+  bool write(const std::string& bytes, double timeout) {
+    SerialPort& p = port();
+    py::gil_scoped_release release;
+    return p.write(bytes, static_cast<int>(std::clamp(timeout, 0.0, 600.0) * 1000.0));
+  }
+  // What arrived within `timeout` s (b"" for nothing), or None when the link is lost.
+  py::object read(double timeout) {
+    SerialPort& p = port();
+    char buffer[1024];
+    int n;
+    {
+      py::gil_scoped_release release;
+      n = p.read(buffer, sizeof buffer, static_cast<int>(std::clamp(timeout, 0.0, 600.0) * 1000.0));
+    }
+    if (n < 0) return py::none();
+    return py::bytes(buffer, static_cast<std::size_t>(n));
+  }
+  void close() {
+    py::gil_scoped_release release;
+    port_.reset();
+  }
+
+ private:
+  std::unique_ptr<SerialPort> port_;
+};
+
+py::dict stream_program_py(const py::object& port, const std::vector<std::string>& lines, const py::object& profile,
                            std::optional<py::dict> state_arg, const py::object& progress, StreamControl* control,
                            bool dry_run, double response_timeout, double settle) {
   const MachineProfile m = to_profile(profile);
@@ -292,7 +335,14 @@ py::dict stream_program_py(const std::string& port, const std::vector<std::strin
   const ProgressFn fn = reporter.fn();
   StreamResult r;
   try {
-    r = reporter.run([&] { return stream_program(port, lines, m, s, o, fn); });
+    if (py::isinstance<SerialLink>(port)) {  // an open link: no settle, GRBL is not restarted
+      SerialLink& link = port.cast<SerialLink&>();
+      if (dry_run) r = reporter.run([&] { return stream_program(std::string(), lines, m, s, o, fn); });
+      else r = reporter.run([&] { return stream_program(link.port(), lines, m, s, o, fn); });
+    } else {
+      const std::string name = port.cast<std::string>();
+      r = reporter.run([&] { return stream_program(name, lines, m, s, o, fn); });
+    }
   } catch (...) {
     state["next_line"] = s.next_line;  // resume from here
     state["confirmed"] = s.confirmed;
@@ -317,6 +367,21 @@ void bind_fab(py::module_& m) {
       .def("abort", [](StreamControl& c) { c.abort = true; })
       .def_property_readonly("paused", [](const StreamControl& c) { return c.pause.load(); })
       .def_property_readonly("aborted", [](const StreamControl& c) { return c.abort.load(); });
+
+  py::class_<SerialLink>(m, "SerialLink",
+                         "An open serial port kept between commands (status, jog, console) and streams.")
+      .def(py::init([](const std::string& name, const py::object& profile) {
+             return new SerialLink(name, to_profile(profile));
+           }),
+           py::arg("port"), py::arg("profile") = py::dict(),
+           "Opens the port with the profile's serial settings (and its lock file); ValueError naming it.")
+      .def_property_readonly("name", &SerialLink::name)
+      .def_property_readonly("is_open", &SerialLink::is_open)
+      .def("write", &SerialLink::write, py::arg("data"), py::arg("timeout") = 2.0,
+           "Writes all bytes within timeout s; False when the link is lost or the time passed.")
+      .def("read", &SerialLink::read, py::arg("timeout") = 0.0,
+           "Bytes that arrived within timeout s (b'' for none), or None when the link is lost.")
+      .def("close", &SerialLink::close, "Closes the port and releases its lock file.");
 
   m.def("default_machine_profile", [] { return from_profile(MachineProfile{}); },
         "The default (DIWire-class) machine profile as a dict of edge units (m, deg, mm/s, deg/s).");
@@ -381,6 +446,8 @@ point. Writes atomically when path is not None; returns the text.)");
         py::arg("state") = py::none(), py::arg("progress") = py::none(), py::arg("control") = nullptr,
         py::arg("dry_run") = false, py::arg("response_timeout") = 30.0, py::arg("settle") = 2.0,
         R"(Stream G-code lines to a GRBL bender (send one line, wait for ok / error:N; ALARM stops).
+
+port: a port's name (opened, settled, closed) or an open SerialLink (streamed on as it is).
 
 state: dict whose "next_line" (0-based: where a call starts) and "confirmed" (the line after the last
 step known complete: after the last acknowledged G4/M2) are read and updated in place. GRBL answers

@@ -64,3 +64,22 @@ def use_material(scene, m):
             if key in m:
                 setattr(ws, key, m[key])
     scene[MATERIAL_NAME_KEY] = m["name"]
+
+
+def set_springback_rows(scene, commanded_deg):
+    """The Calibration panel's spring-back rows: one per commanded angle, measured 0 (not yet)."""
+    rows = scene.wiresculpt_calibration.springback_rows
+    rows.clear()
+    for angle in commanded_deg:
+        row = rows.add()
+        row.commanded_deg = angle
+        row.measured_deg = 0.0
+
+
+def springback_table(scene):
+    """{"commanded_deg", "measured_deg", "lines"} of the rows whose measured angle is typed (not 0),
+    as core.calibration.read_springback gives a CSV's ("lines": the row numbers, from 1)."""
+    rows = [(k + 1, r.commanded_deg, r.measured_deg)
+            for k, r in enumerate(scene.wiresculpt_calibration.springback_rows) if r.measured_deg != 0.0]
+    return {"lines": [k for k, _c, _m in rows], "commanded_deg": [c for _k, c, _m in rows],
+            "measured_deg": [m for _k, _c, m in rows]}

@@ -10,7 +10,8 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
 from .. import native
-from ..blend.calibration import PLOT_IMAGE, config_folder, load_plot, results, store, use_material
+from ..blend.calibration import (PLOT_IMAGE, config_folder, load_plot, results, springback_table, store,
+                                 use_material)
 from ..blend.registration import classes_factory
 from ..core import calibration as cal
 from ..props import KINDS, material_items, material_of, solver_settings
@@ -71,6 +72,38 @@ class WIRESCULPT_OT_calibration_load(bpy.types.Operator, ImportHelper):
         settings.plot = self.kind
         warnings = fit.get("warnings") or []
         self.report({'WARNING'} if warnings else {'INFO'}, "; ".join([f"{name}: {text}"] + warnings))
+        return {'FINISHED'}
+
+
+class WIRESCULPT_OT_calibration_fit_rows(bpy.types.Operator):
+    """Fit the spring-back line to the rows' commanded and measured angles (the test piece's bends;
+    rows whose measured angle is 0 are left out)"""
+    bl_idname = "wiresculpt.calibration_fit_rows"
+    bl_label = "Fit Spring-back from Rows"
+    bl_options = {'REGISTER'}
+
+    def execute(self, context):
+        if not native.available():
+            self.report({'ERROR'}, native.LOAD_ERROR)
+            return {'CANCELLED'}
+        scene = context.scene
+        table = springback_table(scene)
+        try:
+            fit = native.fit_springback(table["commanded_deg"], table["measured_deg"], table["lines"])
+        except ValueError as exc:
+            self.report({'ERROR'}, f"Spring-back rows: {exc}")
+            return {'CANCELLED'}
+        fit["warnings"] = cal.springback_warnings(table["commanded_deg"])
+        fit["source"] = "the test bends' rows"
+        store(scene, "springback", fit)
+        try:
+            load_plot("SPRINGBACK", cal.plot_springback(table, fit))
+        except (OSError, RuntimeError) as exc:
+            self.report({'WARNING'}, f"Cannot show the plot: {exc}")
+        scene.wiresculpt_calibration.plot = "SPRINGBACK"
+        text = (f"rows: measured = {fit['springback_a']:.4f} × commanded {fit['springback_b_deg']:+.3f}°, "
+                f"RMS {fit['rms_deg']:.3f}° over {fit['samples']} bends")
+        self.report({'WARNING'} if fit["warnings"] else {'INFO'}, "; ".join([text] + fit["warnings"]))
         return {'FINISHED'}
 
 
@@ -181,5 +214,5 @@ class WIRESCULPT_OT_calibration_show_plot(bpy.types.Operator):
 
 
 register, unregister = classes_factory(
-    (WIRESCULPT_OT_calibration_load, WIRESCULPT_OT_calibration_save_material, WIRESCULPT_OT_calibration_use_material,
+    (WIRESCULPT_OT_calibration_load, WIRESCULPT_OT_calibration_fit_rows, WIRESCULPT_OT_calibration_save_material, WIRESCULPT_OT_calibration_use_material,
      WIRESCULPT_OT_calibration_save_profile, WIRESCULPT_OT_calibration_show_plot))

@@ -18,8 +18,9 @@ from ..blend import ownership
 from ..blend import results as scene_results
 from ..blend.machine import chosen_profile
 from ..blend.registration import classes_factory
-from ..fab import export, streaming
+from ..fab import export, grbl, streaming
 from ..core import calibration as cal
+from ..core import machine_words as words
 from ..props import NO_WIRE
 from .progress import WorkerModal
 
@@ -33,6 +34,15 @@ def preview_machine(scene, profile):
         return None
     return dict(cal.with_springback(profile or cal.default_profile(), fit, fit.get("source", "")),
                 name="the loaded spring-back fit")
+
+
+def _link(port):
+    """The Machine panel's open link to `port` for a stream, None when it has none; ValueError
+    with the sentence when its link is busy."""
+    try:
+        return grbl.link_for(port)
+    except ValueError:
+        raise ValueError(words.refusal(words.BUSY)) from None
 
 
 def _design_or_error(op):
@@ -133,6 +143,11 @@ class WIRESCULPT_OT_send_to_machine(WorkerModal, bpy.types.Operator):
     response_timeout: FloatProperty(name="Answer Timeout", default=30.0, min=0.1, max=600.0,
                                     unit='TIME_ABSOLUTE',
                                     description="Longest wait for GRBL's answer to one line (seconds)")
+    loaded: BoolProperty(name="Loaded", default=False,
+                         description="The wire is loaded (the Continue of the \"load the wire\" step); otherwise "
+                                     "Send first asks to load it")
+    test: BoolProperty(name="Test Bends", default=False, options={'HIDDEN'},
+                       description="Send the spring-back test piece instead of a wire")
 
     @classmethod
     def description(cls, context, properties):
@@ -146,33 +161,76 @@ class WIRESCULPT_OT_send_to_machine(WorkerModal, bpy.types.Operator):
         return not streaming.running()
 
     def _job(self, context):
-        """The StreamJob, or None after reporting why not."""
+        """The StreamJob, or None after reporting why not (or after asking to load the wire first:
+        then self.asked is True)."""
+        self.asked = False
         if not native.available():
             self.report({'ERROR'}, native.LOAD_ERROR)
             return None
+        ws = context.scene.wiresculpt
+        port = (self.port or ws.fab_port).strip()
+        if self.test:
+            return self._test_job(context, port)
         design = _design_or_error(self)
         if design is None:
             return None
-        ws = context.scene.wiresculpt
         wire = self.wire or ws.fab_wire
+        dry_run = self.dry_run or ws.fab_dry_run
         try:
             if not wire or wire == NO_WIRE:
                 raise ValueError("no wire chosen (optimize until the wires have rest shapes)")
-            return streaming.prepare(design, wire, (self.port or ws.fab_port).strip(), chosen_profile(context.scene),
-                                     self.resume, self.dry_run or ws.fab_dry_run, self.settle, self.response_timeout)
+            profile = chosen_profile(context.scene)
+            load = streaming.LOAD
+            if not (self.resume or dry_run or self.loaded):  # the "load the wire" step first
+                if not port:
+                    raise ValueError("no serial port chosen: pick one or type its path (e.g. /dev/ttyUSB0)")
+                streaming.ask_load(design, [wire], profile)
+                self.asked = True
+                self.report({'INFO'}, " ".join(words.load_lines(streaming.LOAD.facts)))
+                return None
+            job = streaming.prepare(design, wire, port, profile, self.resume, dry_run, self.settle,
+                                    self.response_timeout, link=_link(port))
         except (ValueError, RuntimeError) as exc:
             self.report({'ERROR'}, f"Cannot send: {exc}")
             return None
+        if self.loaded and load is not None and load.wire == wire:  # Send All's next wires follow this one
+            job.queue, job.queue_count = list(load.queue), load.facts.get("count", 1)
+            streaming.clear_load()
+        return job
+
+    def _test_job(self, context, port):
+        try:
+            profile = chosen_profile(context.scene)
+            lines, machine, commanded, _length = grbl.test_bend_program(profile)
+            job = streaming.prepare_program(grbl.TEST_NAME, lines, machine, port, settle=self.settle,
+                                            response_timeout=self.response_timeout, link=_link(port),
+                                            resume=self.resume)
+        except (ValueError, RuntimeError) as exc:
+            self.report({'ERROR'}, f"Cannot send the test bends: {exc}")
+            return None
+        job.after = [c for c in commanded if c]  # the bends (the last step only feeds)
+        streaming.clear_load()
+        return job
 
     def _finish(self, job):
         kind, message = streaming.finish(job)
         self.report(kind, message)
+        completed = job.result is not None and job.result.get("status") == "completed"
+        if completed and job.after is not None:  # the test piece is bent: its rows wait for the measured angles
+            scene_calibration.set_springback_rows(bpy.context.scene, job.after)
+        if completed and job.queue:
+            design = scene_results.stored_design()
+            try:
+                load = streaming.next_load(design, job, chosen_profile(bpy.context.scene))
+                self.report({'INFO'}, " ".join(words.load_lines(load.facts)))
+            except (ValueError, RuntimeError) as exc:
+                self.report({'ERROR'}, f"Cannot send the next wire: {exc}")
         return {'FINISHED'} if kind == {'INFO'} else {'CANCELLED'}
 
     def execute(self, context):
         job = self._job(context)
         if job is None:
-            return {'CANCELLED'}
+            return {'FINISHED'} if self.asked else {'CANCELLED'}
         streaming.JOB = job
         try:
             job.run()  # blocking: no event loop in background mode
@@ -185,7 +243,7 @@ class WIRESCULPT_OT_send_to_machine(WorkerModal, bpy.types.Operator):
             return self.execute(context)
         job = self._job(context)
         if job is None:
-            return {'CANCELLED'}
+            return {'FINISHED'} if self.asked else {'CANCELLED'}
         streaming.JOB = job
         job.thread.start()
         self.begin_watch(context, 100)
@@ -227,6 +285,45 @@ class WIRESCULPT_OT_send_to_machine(WorkerModal, bpy.types.Operator):
             streaming.finish(job)
 
 
+class WIRESCULPT_OT_send_all(bpy.types.Operator):
+    """Send every wire with a rest shape, one after the other: before each, the panel says which wire,
+    stock and length to load, and Continue sends it"""
+    bl_idname = "wiresculpt.send_all"
+    bl_label = "Send All Wires"
+    bl_options = {'REGISTER'}
+
+    @classmethod
+    def poll(cls, context):
+        return not streaming.running()
+
+    def execute(self, context):
+        design = _design_or_error(self)
+        if design is None:
+            return {'CANCELLED'}
+        if not context.scene.wiresculpt.fab_port.strip():
+            self.report({'ERROR'}, "Cannot send: no serial port chosen: pick one or type its path (e.g. /dev/ttyUSB0)")
+            return {'CANCELLED'}
+        try:
+            load = streaming.ask_load(design, [w["name"] for w in streaming.rest_wires(design)],
+                                      chosen_profile(context.scene))
+        except (ValueError, RuntimeError) as exc:
+            self.report({'ERROR'}, f"Cannot send: {exc}")
+            return {'CANCELLED'}
+        self.report({'INFO'}, " ".join(words.load_lines(load.facts)))
+        return {'FINISHED'}
+
+
+class WIRESCULPT_OT_load_cancel(bpy.types.Operator):
+    """Do not send the wire the panel asks to load (nor the ones after it)"""
+    bl_idname = "wiresculpt.load_cancel"
+    bl_label = "Skip"
+    bl_options = {'INTERNAL'}
+
+    def execute(self, context):
+        streaming.clear_load()
+        return {'FINISHED'}
+
+
 class WIRESCULPT_OT_send_cancel(bpy.types.Operator):
     """Stop sending: the machine gets a feed hold and a soft reset; Resume continues later"""
     bl_idname = "wiresculpt.send_cancel"
@@ -243,7 +340,7 @@ class WIRESCULPT_OT_send_cancel(bpy.types.Operator):
 
 _register, unregister = classes_factory(
     (WIRESCULPT_OT_export_fabrication, WIRESCULPT_OT_pick_port, WIRESCULPT_OT_send_to_machine,
-     WIRESCULPT_OT_send_cancel))
+     WIRESCULPT_OT_send_all, WIRESCULPT_OT_load_cancel, WIRESCULPT_OT_send_cancel))
 
 
 def register():

@@ -3,6 +3,7 @@ plot, save the material and the machine profile, pick a material (presets and ca
 import bpy
 
 from .. import native
+from ..blend.calibration import MATERIAL_NAME_KEY
 from ..blend.registration import classes_factory
 from ..operators import calibration as ops
 from .panel import VIEW3D_PT_wiresculpt
@@ -53,6 +54,16 @@ class VIEW3D_PT_wiresculpt_calibration(bpy.types.Panel):
         for kind, label, _text in ops.KINDS:
             col.operator(ops.WIRESCULPT_OT_calibration_load.bl_idname, text=f"Load {label} CSV",
                          icon='IMPORT').kind = kind
+        rows = settings.springback_rows
+        if len(rows):  # the test piece's bends: type each measured angle, then fit
+            box = layout.box()
+            box.label(text="Spring-back rows (commanded → measured)")
+            col = box.column(align=True)
+            for row in rows:
+                line = col.row(align=True)
+                line.label(text=f"{row.commanded_deg:g}°")
+                line.prop(row, "measured_deg", text="")
+            box.operator(ops.WIRESCULPT_OT_calibration_fit_rows.bl_idname, icon='CHECKMARK')
         r = ops.results(scene)
         lines = summary_lines(r)
         if lines:
@@ -75,7 +86,7 @@ class VIEW3D_PT_wiresculpt_calibration(bpy.types.Panel):
         col.prop(settings, "material_name")
         col.operator(ops.WIRESCULPT_OT_calibration_save_material.bl_idname, icon='FILE_TICK')
         layout.operator_menu_enum(ops.WIRESCULPT_OT_calibration_use_material.bl_idname, "material",
-                                  text=f"Material: {scene.get(ops.MATERIAL_NAME_KEY, 'choose')}", icon='MATERIAL')
+                                  text=f"Material: {scene.get(MATERIAL_NAME_KEY, 'choose')}", icon='MATERIAL')
         layout.operator(ops.WIRESCULPT_OT_calibration_save_profile.bl_idname, icon='EXPORT')
 
 

@@ -6,6 +6,7 @@ from .. import native
 from ..blend import preview
 from ..blend import results as scene_results
 from ..blend.registration import classes_factory
+from ..core import machine_words as words
 from ..fab import streaming
 from ..operators import fabrication as ops
 from .results import _Child, _wrap
@@ -52,13 +53,26 @@ class VIEW3D_PT_wiresculpt_fabrication(_Child, bpy.types.Panel):
         if job is not None:
             status = box.box()
             _wrap(status, context, job.status().replace("wiresculpt: ", ""), icon='SORTTIME')
-            status.operator(ops.WIRESCULPT_OT_send_cancel.bl_idname, icon='CANCEL')
+            row = status.row(align=True)
+            paused = job.control.paused
+            row.operator(ops_machine_realtime, text="Resume" if paused else "Hold",
+                         icon='PLAY' if paused else 'PAUSE').command = "RESUME" if paused else "HOLD"
+            row.operator(ops.WIRESCULPT_OT_send_cancel.bl_idname, icon='CANCEL')
+            return
+        load = streaming.LOAD
+        if load is not None:  # the "load the wire" step: Continue sends it
+            draw_load(box, context, load)
             return
         stopped = streaming.PENDING.get(ws.fab_wire)
         col = box.column(align=True)
-        send = col.operator(ops.WIRESCULPT_OT_send_to_machine.bl_idname,
+        row = col.row(align=True)
+        send = row.operator(ops.WIRESCULPT_OT_send_to_machine.bl_idname,
                             text="Send from Start" if stopped else "Send", icon='PLAY')
         send.resume = False
+        row.operator(ops.WIRESCULPT_OT_send_all.bl_idname, text="Send All", icon='SEQ_STRIP_DUPLICATE')
+        if stopped is not None and stopped.facts is not None:
+            draw_stop(box, context, stopped.facts)
+            return
         if stopped is not None:
             resume = col.operator(ops.WIRESCULPT_OT_send_to_machine.bl_idname,
                                   text=f"Resume at Line {stopped.next_line + 1}", icon='FORWARD')
@@ -69,6 +83,36 @@ class VIEW3D_PT_wiresculpt_fabrication(_Child, bpy.types.Panel):
             status = box.box()
             status.alert = kind == {'ERROR'}
             _wrap(status, context, message, icon='INFO' if kind == {'INFO'} else 'ERROR')
+
+
+ops_machine_realtime = "wiresculpt.machine_realtime"  # the Machine panel's Hold / Resume (operators/machine.py)
+
+
+def draw_stop(layout, context, facts):
+    """A stopped stream as a box of short lines (each wrapped to the sidebar) and its Resume button."""
+    box = layout.box()
+    box.alert = facts["status"] != "aborted"
+    col = box.column(align=True)
+    for k, line in enumerate(words.stop_lines(facts)):
+        _wrap(col, context, line, icon='ERROR' if k == 0 else 'BLANK1')
+    resume = box.operator(ops.WIRESCULPT_OT_send_to_machine.bl_idname, text=words.resume_button(facts),
+                          icon='FORWARD')
+    resume.resume = True
+    resume.wire = facts["wire"]
+    resume.test = facts.get("test", False)
+
+
+def draw_load(layout, context, load):
+    """The "load the wire" step: which wire, stock and length; Continue sends it, Skip does not."""
+    box = layout.box()
+    col = box.column(align=True)
+    lines = words.test_piece_lines(load.facts) if load.kind == "test" else words.load_lines(load.facts)
+    for k, line in enumerate(lines):
+        _wrap(col, context, line, icon='IMPORT' if k == 0 else 'BLANK1')
+    row = box.row(align=True)
+    go = row.operator(ops.WIRESCULPT_OT_send_to_machine.bl_idname, text="Continue", icon='PLAY')
+    go.wire, go.loaded, go.resume, go.test = load.wire, True, False, load.kind == "test"
+    row.operator(ops.WIRESCULPT_OT_load_cancel.bl_idname, text="Skip", icon='X')
 
 
 register, unregister = classes_factory((VIEW3D_PT_wiresculpt_fabrication,))
