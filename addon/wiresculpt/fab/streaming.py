@@ -147,10 +147,12 @@ class StreamJob(WorkerJob):
                 f"({100 * self.fraction:.0f} %) (Esc to cancel)")
 
 
-def prepare(design, wire, port, profile=None, resume=False, dry_run=False, settle=2.0, response_timeout=30.0,
-            link=None):
+TIMING = (2.0, 30.0)  # s: the settle after opening the port, and the longest wait for an answer
+
+
+def prepare(design, wire, port, profile=None, resume=False, dry_run=False, timing=TIMING, link=None):
     """A StreamJob (not started) for `wire` to `port` (on `link`, the Machine panel's open link to
-    it, when given). Send (resume=False) starts the program at its first line and forgets an
+    it, when given); `timing` is (settle, response_timeout) in seconds. Send (resume=False) starts the program at its first line and forgets an
     earlier stop of that wire; Resume continues the stopped one and refuses when there is none or
     when the program would now be different (another design or profile). ValueError with one
     sentence otherwise."""
@@ -158,6 +160,7 @@ def prepare(design, wire, port, profile=None, resume=False, dry_run=False, settl
         raise ValueError("no serial port chosen: pick one or type its path (e.g. /dev/ttyUSB0)")
     lines, machine, _notes = wire_program(design, wire, profile)
     steps, _length = wire_steps(design, wire, machine)
+    settle, response_timeout = timing
     if not resume:
         return StreamJob(wire, port, lines, machine, {}, dry_run, settle, response_timeout, steps=steps, link=link)
     stopped = PENDING.get(wire)
@@ -170,12 +173,12 @@ def prepare(design, wire, port, profile=None, resume=False, dry_run=False, settl
                      resumed=True, steps=steps, link=link)
 
 
-def prepare_program(name, lines, machine, port, steps=(), settle=2.0, response_timeout=30.0, link=None,
-                    resume=False):
+def prepare_program(name, lines, machine, port, steps=(), timing=TIMING, link=None, resume=False):
     """A StreamJob for a program that is no wire of the design (the test bends); Resume continues
-    its stop as prepare's does."""
+    its stop as prepare's does; `timing` as prepare's."""
     if not port:
         raise ValueError("no serial port chosen: pick one or type its path (e.g. /dev/ttyUSB0)")
+    settle, response_timeout = timing
     if not resume:
         return StreamJob(name, port, lines, machine, {}, False, settle, response_timeout, steps=steps, link=link)
     stopped = PENDING.get(name)

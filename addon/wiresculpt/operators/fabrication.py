@@ -188,8 +188,8 @@ class WIRESCULPT_OT_send_to_machine(WorkerModal, bpy.types.Operator):
                 self.asked = True
                 self.report({'INFO'}, " ".join(words.load_lines(streaming.LOAD.facts)))
                 return None
-            job = streaming.prepare(design, wire, port, profile, self.resume, dry_run, self.settle,
-                                    self.response_timeout, link=_link(port))
+            job = streaming.prepare(design, wire, port, profile, self.resume, dry_run,
+                                    (self.settle, self.response_timeout), link=_link(port))
         except (ValueError, RuntimeError) as exc:
             self.report({'ERROR'}, f"Cannot send: {exc}")
             return None
@@ -202,8 +202,8 @@ class WIRESCULPT_OT_send_to_machine(WorkerModal, bpy.types.Operator):
         try:
             profile = chosen_profile(context.scene)
             lines, machine, commanded, _length = grbl.test_bend_program(profile)
-            job = streaming.prepare_program(grbl.TEST_NAME, lines, machine, port, settle=self.settle,
-                                            response_timeout=self.response_timeout, link=_link(port),
+            job = streaming.prepare_program(grbl.TEST_NAME, lines, machine, port,
+                                            timing=(self.settle, self.response_timeout), link=_link(port),
                                             resume=self.resume)
         except (ValueError, RuntimeError) as exc:
             self.report({'ERROR'}, f"Cannot send the test bends: {exc}")
