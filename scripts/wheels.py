@@ -12,7 +12,12 @@ writes, for each (platform, Python) it can build here:
     package_pythons.py's for 3.13), with GLPK, NLopt, libserialport and what they need copied into
     wiresculpt_solver/libs/ with $ORIGIN run paths (package.bundle). The platform tag is
     manylinux_2_<N>_x86_64 with N the newest glibc symbol version any file of the wheel needs
-    (read with readelf), so pip and Blender refuse it on an older glibc;
+    (read with readelf), so pip and Blender refuse it on an older glibc; `auditwheel show` (PyPI's
+    auditwheel, AUDITWHEEL, in a venv under ~/.cache/wiresculpt) must find the wheel consistent with
+    that very tag, or no wheel is written (WIRESCULPT_AUDITWHEEL=0 skips the check). Built on
+    Debian 12 the tag is manylinux_2_36: the bundled libstdc++ (GCC 12) needs arc4random@GLIBC_2.36,
+    the module hypot@GLIBC_2.35 and glibc 2.34's pthread symbols; a lower tag needs an older glibc
+    to build on;
   * win_amd64, cp311 and cp313: scripts/windows.py's cross-built .pyd files (everything static;
     windows.module refuses one that imports a DLL other than Windows' own and pythonXY.dll);
 - wiresculpt-extension-<version>-windows-x64.zip: the extension for Blender 4.2+ on Windows, the
@@ -44,6 +49,31 @@ import windows
 ROOT = package.ROOT
 PACKAGE = "wiresculpt_solver"
 PYTHONS = ("3.11", "3.13")
+AUDITWHEEL = "6.8.2"  # PyPI's auditwheel, in its own venv under the cache (auditwheel_tool)
+
+
+def auditwheel_tool():
+    """The auditwheel command, installed once into ~/.cache/wiresculpt/auditwheel-<version>/."""
+    venv = os.path.join(os.path.dirname(windows.CACHE), f"auditwheel-{AUDITWHEEL}")
+    tool = os.path.join(venv, "bin", "auditwheel")
+    if not os.path.isfile(os.path.join(venv, ".complete")):
+        import shutil
+        shutil.rmtree(venv, ignore_errors=True)
+        subprocess.run([windows.HOST_PYTHON, "-m", "venv", venv], check=True)
+        subprocess.run([os.path.join(venv, "bin", "python"), "-m", "pip", "install", "-q", "--disable-pip-version-check",
+                        f"auditwheel=={AUDITWHEEL}"], check=True)
+        open(os.path.join(venv, ".complete"), "w").close()
+    return tool
+
+
+def audited_tag(wheel):
+    """(the platform tag `auditwheel show` finds the wheel consistent with, or None; its whole
+    output). auditwheel reads every ELF file's needed libraries and versioned symbols against the
+    manylinux policies, independently of glibc_floor."""
+    r = subprocess.run([auditwheel_tool(), "show", wheel], capture_output=True, text=True)
+    text = " ".join((r.stdout + r.stderr).split())  # it wraps its lines
+    m = re.search(r'consistent with the following platform tag: "([^"]+)"', text)
+    return (m.group(1) if m and r.returncode == 0 else None), r.stdout + r.stderr
 
 
 def glibc_floor(paths):
@@ -105,8 +135,15 @@ def linux_wheels(out_dir, version):
             staged = package.bundle(module, stage)
             floor = glibc_floor(staged)
             files = [(p, os.path.relpath(p, stage)) for p in staged]
-            made.append(write_wheel(out_dir, version, f"cp{m.group(1)}{m.group(2)}",
-                                    f"manylinux_{floor[0]}_{floor[1]}_x86_64", files))
+            tag = f"manylinux_{floor[0]}_{floor[1]}_x86_64"
+            wheel = write_wheel(out_dir, version, f"cp{m.group(1)}{m.group(2)}", tag, files)
+        if os.environ.get("WIRESCULPT_AUDITWHEEL", "1") != "0":
+            found, text = audited_tag(wheel)
+            if found != tag:
+                os.remove(wheel)
+                raise SystemExit(f"wiresculpt: auditwheel finds {os.path.basename(wheel)} consistent with "
+                                 f"{found or 'no manylinux tag'}, not {tag}:\n{text}")
+        made.append(wheel)
     return made
 
 

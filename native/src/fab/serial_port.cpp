@@ -1,9 +1,10 @@
-// The serial link: the ports the system lists, the lock file that keeps two streams off one
-// port, and the two back ends (libserialport, or a plain POSIX tty for devices libserialport
-// does not know, such as pseudo-terminals), each read and write bounded by a timeout. A build
-// without libserialport (WIRESCULPT_NO_SERIAL_PORT: the Windows cross build) has serial_none.cpp
-// instead; the protocol and the streamer are built as always.
-#ifndef WIRESCULPT_NO_SERIAL_PORT
+// The serial link on Linux (and any POSIX system): the ports the system lists, the lock file that
+// keeps two streams off one port, and the two back ends (libserialport, or a plain POSIX tty for
+// devices libserialport does not know, such as pseudo-terminals), each read and write bounded by a
+// timeout. Windows has serial_win32.cpp (its own API) instead; a build without libserialport
+// (WIRESCULPT_NO_SERIAL_PORT: the macOS cross build) has serial_none.cpp. The protocol and the
+// streamer are built as always.
+#if !defined(_WIN32) && !defined(WIRESCULPT_NO_SERIAL_PORT)
 #include <fcntl.h>
 #include <libserialport.h>
 #include <poll.h>
@@ -286,4 +287,4 @@ void SerialPort::drain_input(int timeout_ms) {
 
 }  // namespace wiresculpt::fab
 
-#endif  // WIRESCULPT_NO_SERIAL_PORT
+#endif  // !_WIN32 && !WIRESCULPT_NO_SERIAL_PORT
