@@ -387,6 +387,15 @@ def structure3d(wires, ties=None, loads=None, clamps=None, pins=None, table=None
     return require().structure3d(items, ties, loads, clamps, pins, table, options, progress)
 
 
+def structure3d_tie_response(wires, ties, clamps, cases, options=None):
+    """The stress-free structure's linear response (each wire's rest is its start): for each load
+    case (a list of {"node", "force" N}), the force each tie carries on its node a (N), as
+    structure3d's `tie_forces` would in the linear range. wires, ties, clamps as structure3d's."""
+    items = [_point_item(_point_item(item, i, "wires", "rest", 3), i, "wires", "start", 3)
+             for i, item in enumerate(_list(wires, "wires"))]
+    return require().structure3d_tie_response(items, ties, clamps, cases, options)
+
+
 def pyramid_fit(force, pyramid):
     """Whether `force` (3) lies in the cone of the four rows of `pyramid` (4, 3), e.g. a crossing's
     contact pyramid: {"coefficients", "distance" N, "inside"}."""

@@ -391,11 +391,13 @@ def _without_user_cuts(design):
 
 
 def force_score(design):
-    """(load capacity, out-of-plane measure) of a solved design for hooks_by_forces: the weakest
-    direction's multiple of the weight at the plastic limit (the load factor's `at_plastic_limit`;
-    with a given torque fraction the weakest `load_capacity` multiple; +inf when unbounded, 0 without
-    a load capacity) and the paper's out-of-plane measure (`out_of_plane.mean_to_max_force`). None
-    when the forces did not run (the pattern is not stable or its target shape failed)."""
+    """(carried, load capacity, out-of-plane measure) of a solved design for hooks_by_forces:
+    whether the forces the assembled 3D structure carries lie in their pyramids (the forces
+    stage's `stages.forces.carried_3d`, docs/method-forces.md §17), the weakest direction's
+    multiple of the weight at the plastic limit (the load factor's `at_plastic_limit`; with a given
+    torque fraction the weakest `load_capacity` multiple; +inf when unbounded, 0 without a load
+    capacity) and the paper's out-of-plane measure (`out_of_plane.mean_to_max_force`). None when
+    the forces did not run (the pattern is not stable or its target shape failed)."""
     if "forces" in design.get("pending_stages", ["forces"]) or not design.get("stable"):
         return None
     if "load_factor" in design:
@@ -405,19 +407,24 @@ def force_score(design):
         capacity = min((m for m in held if m is not None), default=None)
     else:
         capacity = 0.0
-    return (float("inf") if capacity is None else capacity), design["out_of_plane"]["mean_to_max_force"]
+    return (bool(design["stages"].get("forces", {}).get("carried_3d")),
+            (float("inf") if capacity is None else capacity), design["out_of_plane"]["mean_to_max_force"])
 
 
 def choose(scores):
     """The position in `scores` (force_score values in pattern order, None for a pattern without
-    one) of the best: among the scores whose load capacity is within CAPACITY_TIE of the highest,
-    the least out-of-plane measure, ties to the earliest. Compared with the highest, not pairwise,
-    so a chain of near-ties cannot drift below it. None when no pattern has a score."""
+    one) of the best: the patterns whose carried forces lie in their pyramids if there are any
+    (they stand in 3D as the planar model says), among them those whose load capacity is within
+    CAPACITY_TIE of their highest, of those the least out-of-plane measure, ties to the earliest.
+    Compared with the highest, not pairwise, so a chain of near-ties cannot drift below it. None
+    when no pattern has a score."""
     known = [(k, s) for k, s in enumerate(scores) if s is not None]
     if not known:
         return None
-    top = max(s[0] for _k, s in known)
-    near = [(round(s[1], 12), k) for k, s in known if s[0] >= top * (1 - CAPACITY_TIE)]
+    carried = any(s[0] for _k, s in known)
+    known = [(k, s) for k, s in known if s[0] == carried]
+    top = max(s[1] for _k, s in known)
+    near = [(round(s[2], 12), k) for k, s in known if s[1] >= top * (1 - CAPACITY_TIE)]
     return min(near)[1]
 
 
@@ -488,7 +495,7 @@ def hooks_by_forces(design, material, settings, context, patterns=None, seconds=
               "solved": len(solutions), "failed": failed, "chosen": chosen, "seconds": time.monotonic() - start,
               "complete": not cut}
     if best_score is not None:
-        search["load_capacity"], search["out_of_plane"] = best_score
+        search["carried_3d"], search["load_capacity"], search["out_of_plane"] = best_score
         if search["load_capacity"] == float("inf"):
             search["load_capacity"] = None
     best["stages"]["hook_search"] = search
@@ -499,8 +506,9 @@ def hooks_by_forces(design, material, settings, context, patterns=None, seconds=
             "a better one may exist")
     if chosen and best_score is not None:
         context.say("forces", f"hooks by forces: pattern {chosen} of {checked} tried (weakest load "
-                              f"{best_score[0]:.2f}x the weight at the plastic limit, out of plane "
-                              f"{100 * best_score[1]:.1f}% of the largest force)")
+                              f"{best_score[1]:.2f}x the weight at the plastic limit, out of plane "
+                              f"{100 * best_score[2]:.1f}% of the largest force"
+                              f"{'; its 3D forces in their pyramids' if best_score[0] else ''})")
     design.clear()  # callers keep the dict they passed (operators/optimize.py)
     design.update(best)
     return design

@@ -57,20 +57,24 @@ class Patterns(unittest.TestCase):
         choose = pipeline.choose
         self.assertIsNone(choose([]))
         self.assertIsNone(choose([None, None]))
-        self.assertEqual(choose([None, (3.0, 0.2)]), 1)
-        self.assertEqual(choose([(3.0, 0.2), (3.1, 0.5)]), 1)    # 3.3% more capacity
-        self.assertEqual(choose([(3.0, 0.2), (3.03, 0.5)]), 0)   # equal capacity, more out of plane
-        self.assertEqual(choose([(3.0, 0.2), (2.97, 0.0)]), 1)   # equal capacity, less out of plane
-        self.assertEqual(choose([(3.0, 0.2), (2.5, 0.0)]), 0)    # less capacity
-        self.assertEqual(choose([(3.0, 0.2), (float("inf"), 0.3)]), 1)
-        self.assertEqual(choose([(3.0, 0.2), (3.0, 0.2)]), 0)    # a tie goes to the earlier pattern
+        self.assertEqual(choose([None, (False, 3.0, 0.2)]), 1)
+        self.assertEqual(choose([(False, 3.0, 0.2), (False, 3.1, 0.5)]), 1)    # 3.3% more capacity
+        self.assertEqual(choose([(False, 3.0, 0.2), (False, 3.03, 0.5)]), 0)   # equal capacity, more out of plane
+        self.assertEqual(choose([(False, 3.0, 0.2), (False, 2.97, 0.0)]), 1)   # equal capacity, less out of plane
+        self.assertEqual(choose([(False, 3.0, 0.2), (False, 2.5, 0.0)]), 0)    # less capacity
+        self.assertEqual(choose([(False, 3.0, 0.2), (False, float("inf"), 0.3)]), 1)
+        self.assertEqual(choose([(False, 3.0, 0.2), (False, 3.0, 0.2)]), 0)    # a tie goes to the earlier pattern
+        # a pattern whose 3D forces stay in their pyramids wins over any that does not
+        self.assertEqual(choose([(False, 3.0, 0.2), (True, 1.0, 0.5)]), 1)
+        self.assertEqual(choose([(True, 1.0, 0.5), (False, 3.0, 0.0), (True, 1.05, 0.6)]), 2)
+        self.assertEqual(choose([(True, 1.0, 0.5), (True, 0.99, 0.1)]), 1)  # then as before
         # a chain of near-ties, each within 2% of the one before: measured against the highest
         # (1.00), only 0.985 is within 2%; 0.955 is 4.5% below it
-        self.assertEqual(choose([(1.00, 0.10), (0.985, 0.05), (0.97, 0.01), (0.955, 0.005)]), 1)
+        self.assertEqual(choose([(False, 1.00, 0.10), (False, 0.985, 0.05), (False, 0.97, 0.01), (False, 0.955, 0.005)]), 1)
         # the order of the patterns does not change the chosen one
-        scores = [(1.00, 0.10), (0.985, 0.05), (0.97, 0.01), (0.955, 0.005)]
+        scores = [(False, 1.00, 0.10), (False, 0.985, 0.05), (False, 0.97, 0.01), (False, 0.955, 0.005)]
         backwards = scores[::-1]
-        self.assertEqual(backwards[choose(backwards)], (0.985, 0.05))
+        self.assertEqual(backwards[choose(backwards)], (False, 0.985, 0.05))
 
 
 def paper_measure(design):

@@ -138,6 +138,15 @@ py::dict forces_and_rest_py(const py::object& wire_list, const py::object& cross
                field::number("load_factor", o.load_factor), field::number("tie_tolerance", o.forces.tie_tolerance),
                field::number("load_capacity_within", o.load_capacity_within),
                field::boolean("least_out_of_plane", o.forces.least_out_of_plane), field::number("deflection_limit", o.deflection_limit),
+               field::boolean("carried_3d", o.forces.carried_3d), field::number("carried_margin", o.forces.carried_margin),
+               field::number("carried_share", o.forces.carried_share),
+               {"carried_gravity", [&](py::handle v, const std::string& at) { o.forces.carried.gravity = to_vector<3>(v, at); }},
+               {"carried_supports", [&](py::handle v, const std::string& at) {
+                  for (const std::vector<int>& s : to_integer_lists(v, at)) {
+                    if (s.size() != 2) throw InputError(at + ": each support is [wire, target vertex]");
+                    o.forces.carried.supports.push_back({s[0], s[1]});
+                  }
+                }},
                field::integer("max_iterations", o.forces.max_iterations),
                field::choice("torque_bound", o.forces.torque_bound,
                              {{"3d", TorqueBound::full_3d}, {"in_plane", TorqueBound::in_plane}}),
@@ -165,6 +174,10 @@ py::dict forces_and_rest_py(const py::object& wire_list, const py::object& cross
       for (const Vec3& q : target_pyramid(in.net, static_cast<int>(c), in.hooks[c], o.forces.friction))
         pyramid.append(to_list(q));
       crossing["pyramid"] = pyramid;
+      if (!fr.carried_forces.empty()) {
+        crossing["carried_force"] = to_list(fr.carried_forces[c]);
+        crossing["carried_weight"] = to_list(fr.carried_weights[c]);
+      }
     }
     crossings.append(crossing);
   }
@@ -196,7 +209,8 @@ py::dict forces_and_rest_py(const py::object& wire_list, const py::object& cross
       py::arg("nlopt_result") = fr.nlopt_result, py::arg("g_stb") = fr.g_stb, py::arg("g_asm") = fr.g_asm,
       py::arg("assembly_residual") = fr.assembly_residual, py::arg("equilibrium_residual") = fr.equilibrium_residual,
       py::arg("t_max") = fr.t_max, py::arg("torque_active") = fr.torque_active,
-      py::arg("torque_bound") = torque_bound_name(fr.torque_bound), py::arg("load_capacity_seconds") = load_seconds);
+      py::arg("torque_bound") = torque_bound_name(fr.torque_bound), py::arg("load_capacity_seconds") = load_seconds,
+      py::arg("carried_3d") = fr.carried_3d);
   py::dict rest_stage(py::arg("seconds") = r.rest_seconds, py::arg("max_closure_gap") = r.max_closure_gap,
                       py::arg("over_bend") = r.over_bend);
   if (o.deflection) rest_stage["deflection_seconds"] = r.deflection_seconds;

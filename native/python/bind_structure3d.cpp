@@ -152,6 +152,30 @@ py::dict structure3d_py(const py::object& wires, const py::object& ties, const p
   return result_dict(r);
 }
 
+py::list tie_response_py(const py::object& wires, const py::object& ties, const py::object& clamps,
+                         const py::object& cases, const py::object& options) {
+  const Structure3dInput in = read_input(wires, ties, py::none(), clamps, py::none(), py::none());
+  std::vector<std::vector<Structure3dLoad>> list;
+  each_item(cases, "cases", [&](py::handle item, const std::string& at) {
+    list.push_back(read_input(wires, py::none(), py::reinterpret_borrow<py::object>(item), py::none(), py::none(),
+                              py::none()).loads);
+    (void)at;
+  });
+  const Structure3dOptions o = read_options(options);
+  std::vector<std::vector<Vec3>> r;
+  {
+    py::gil_scoped_release release;
+    r = structure3d_tie_response(in, list, o);
+  }
+  py::list out;
+  for (const std::vector<Vec3>& one : r) {
+    py::list forces;
+    for (const Vec3& v : one) forces.append(vec(v));
+    out.append(forces);
+  }
+  return out;
+}
+
 py::dict pyramid_fit_py(const py::object& force, const py::object& pyramid) {
   const std::vector<Vec3> rows = to_points<3>(pyramid, "pyramid");
   if (rows.size() != 4) throw InputError("pyramid: expected 4 vectors, got " + std::to_string(rows.size()));
@@ -170,6 +194,9 @@ void bind_structure3d(py::module_& m) {
         py::arg("clamps") = py::none(), py::arg("pins") = py::none(), py::arg("table") = py::none(),
         py::arg("options") = py::none(), py::arg("progress") = py::none(),
         "The 3D equilibrium of an assembled structure of discrete elastic rods (structure3d.hpp).");
+  m.def("structure3d_tie_response", &tie_response_py, py::arg("wires"), py::arg("ties"), py::arg("clamps"),
+        py::arg("cases"), py::arg("options") = py::none(),
+        "Per load case, the tie forces of the stress-free structure's linear response (structure3d.hpp).");
   m.def("pyramid_fit", &pyramid_fit_py, py::arg("force"), py::arg("pyramid"),
         "Whether a force lies in the cone of four vectors, and its nearest nonnegative combination.");
 }

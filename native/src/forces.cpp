@@ -31,6 +31,8 @@ void validate(const ForceOptions& o) {
   if (!std::isfinite(o.assembly_weight) || o.assembly_weight < 0)
     throw InputError("assembly_weight must be a finite number >= 0");
   if (o.max_iterations < 1) throw InputError("max_iterations must be at least 1");
+  if (!(o.carried_margin >= 0 && o.carried_margin < 1)) throw InputError("carried_margin must be in [0, 1)");
+  if (!(o.carried_share >= 0 && o.carried_share <= 1)) throw InputError("carried_share must be in [0, 1]");
   if (!(o.working_set_margin >= 0) || !(o.working_set_margin_3d >= 0) || !std::isfinite(o.working_set_margin) ||
       !std::isfinite(o.working_set_margin_3d))
     throw InputError("working_set_margin and working_set_margin_3d must be finite numbers >= 0");
@@ -268,6 +270,60 @@ ForceProblem::ForceProblem(const Network& net, const std::vector<int>& hooks,
     }
     Q_.noalias() += R.transpose() * R;
   }
+  if (options.carried_3d && K > 0) carried_rows(net, hooks, cuts, options);
+}
+
+// The carried forces F3_ a + W_ (F3_ = R J) and the rows C_ a >= C_lo_ that keep each of them
+// in its pyramid shrunk by carried_margin (the facets of the cone its four moved vectors span)
+// and its normal force at least carried_share of their mean.
+void ForceProblem::carried_rows(const Network& net, const std::vector<int>& hooks, const std::vector<int>& cuts,
+                                const ForceOptions& options) {
+  const int K = columns(), H = K / 4;
+  const CarriedForces carried = carried_forces(net, hooks, cuts, options.carried);
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(3 * H, K);
+  for (int j = 0; j < K; ++j) J.block<3, 1>(3 * (j / 4), j) = pyramid_[column_crossing_[j]][j % 4];
+  F3_ = carried.R * J;
+  W_ = carried.weight;
+  std::vector<Eigen::RowVectorXd> rows;
+  std::vector<double> lo;
+  for (int h = 0; h < H; ++h) {
+    const std::array<Vec3, 4>& b = pyramid_[column_crossing_[4 * h]];
+    const Vec3 mean = 0.25 * (b[0] + b[1] + b[2] + b[3]);
+    std::array<Vec3, 4> g;
+    for (int i = 0; i < 4; ++i) g[i] = (1.0 - options.carried_margin) * b[i] + options.carried_margin * mean;
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) {
+        Vec3 n = g[i].cross(g[j]);
+        if (n.norm() < 1e-12) continue;
+        n.normalize();
+        double below = 0.0, above = 0.0;
+        for (int k = 0; k < 4; ++k) below = std::min(below, n.dot(g[k])), above = std::max(above, n.dot(g[k]));
+        if (below < -1e-12 && above > 1e-12) continue;  // the other vectors on both sides: not a facet
+        if (below < -1e-12) n = -n;
+        rows.push_back(n.transpose() * F3_.middleRows<3>(3 * h));
+        lo.push_back(-n.dot(W_.segment<3>(3 * h)));
+      }
+  }
+  // Each carried normal force at least carried_share of their mean: a crossing the pre-stress
+  // leaves unloaded has nothing to hold the weight's share with.
+  Eigen::MatrixXd normal(H, K);
+  Eigen::VectorXd weight_normal(H);
+  for (int h = 0; h < H; ++h) {
+    const int c = column_crossing_[4 * h];
+    const Crossing& x = net.crossings[c];
+    const Vec3 d = net.wires[x.wires[0]].plane.normal.cross(net.wires[x.wires[1]].plane.normal).normalized();
+    normal.row(h) = -static_cast<double>(hooks[c]) * d.transpose() * F3_.middleRows<3>(3 * h);
+    weight_normal(h) = -static_cast<double>(hooks[c]) * d.dot(W_.segment<3>(3 * h));
+  }
+  const Eigen::RowVectorXd mean = normal.colwise().sum() / static_cast<double>(H);
+  const double weight_mean = weight_normal.mean();
+  for (int h = 0; h < H; ++h) {
+    rows.push_back(normal.row(h) - options.carried_share * mean);
+    lo.push_back(options.carried_share * weight_mean - weight_normal(h));
+  }
+  C_ = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), K);
+  for (std::size_t r = 0; r < rows.size(); ++r) C_.row(static_cast<Eigen::Index>(r)) = rows[r];
+  C_lo_ = Eigen::Map<const Eigen::VectorXd>(lo.data(), static_cast<Eigen::Index>(lo.size()));
 }
 
 double ForceProblem::objective(const Eigen::VectorXd& a, Eigen::VectorXd* grad) const {
@@ -391,7 +447,7 @@ void least_out_of_plane(const ForceProblem& problem, const Network& net, const F
 // The force LP (Eq. 6-8 with the bound's polytope rows added as they are violated), and the
 // least-out-of-plane LP after it when asked: the coefficients into a, the counts into r.
 void solve_by_lp(const ForceProblem& problem, const Network& net, const ForceOptions& options, bool least,
-                 const ProgressFn& progress, ForceResult& r, Eigen::VectorXd& a) {
+                 bool carried, const ProgressFn& progress, ForceResult& r, Eigen::VectorXd& a) {
   const int K = problem.columns();
   const double F_ref = problem.t_max() / problem.length_scale();
   const Eigen::MatrixXd& M = problem.equilibrium();
@@ -406,6 +462,11 @@ void solve_by_lp(const ForceProblem& problem, const Network& net, const ForceOpt
   detail::append_rows(lp, M, 0.0, 0.0);
   detail::append_rows(lp, T, -problem.t_max(), problem.t_max());  // |n·t_v| <= t_max: implied by either bound
   detail::append_rows(lp, Nk, 0.0, kInf);
+  if (carried) {
+    const std::size_t first = lp.row_lo.size();
+    detail::append_rows(lp, problem.carried_rows(), 0.0, kInf);
+    for (Eigen::Index i = 0; i < problem.carried_lower().size(); ++i) lp.row_lo[first + i] = problem.carried_lower()(i);
+  }
   // The other rows of the bound's polytope join as solutions violate them.
   const detail::TorqueBlocks blocks{problem.torque_frame_rows(), Eigen::VectorXd::Zero(problem.torque_frame_rows().rows())};
   std::set<std::pair<int, int>> added;
@@ -666,10 +727,25 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
 
   const bool use_lp = options.algorithm != ForceAlgorithm::slsqp;
   const bool least = options.least_out_of_plane && options.algorithm != ForceAlgorithm::slsqp;
+  bool carried = use_lp && problem.carried_rows().rows() > 0;
   const bool use_nlp = options.algorithm == ForceAlgorithm::slsqp ||
-                       (options.algorithm == ForceAlgorithm::lp_then_slsqp && !least && problem.weight() > 0 &&
-                        problem.assembly_matrix().squaredNorm() > 0);
-  if (K > 0 && use_lp) solve_by_lp(problem, net, options, least, progress, r, a);
+                       (options.algorithm == ForceAlgorithm::lp_then_slsqp && !least && !carried &&
+                        problem.weight() > 0 && problem.assembly_matrix().squaredNorm() > 0);
+  if (K > 0 && use_lp) {
+    bool held = false;
+    if (carried) {
+      try {
+        solve_by_lp(problem, net, options, least, true, progress, r, a);
+        held = problem.normal_weights().dot(a) > 1e-9 * problem.t_max() / problem.length_scale();
+      } catch (const SolverError&) {
+        held = false;  // no forces keep the carried ones in their pyramids
+      }
+    }
+    // Only zero forces, or none, keep the carried ones in their pyramids: the planar model's forces.
+    if (!held) solve_by_lp(problem, net, options, least, false, progress, r, a);
+    carried = held;
+  }
+  r.carried_3d = carried;
   report_progress(progress, "forces", 0.5);
 
   if (K > 0 && use_nlp) {
@@ -705,6 +781,15 @@ ForceResult optimize_forces(const Network& net, const std::vector<int>& hooks, c
   r.torque_active = gauges.size() > 0 && gauges.maxCoeff() >= 1.0 - 1e-6;
 
   fill_results(problem, net, hooks, cuts, a, progress, r);
+  if (problem.carried_map().rows() > 0) {
+    r.carried_forces.assign(net.crossings.size(), Vec3::Zero());
+    const Eigen::VectorXd f3 = problem.carried_map() * a + problem.carried_weight();
+    r.carried_weights.assign(net.crossings.size(), Vec3::Zero());
+    for (int h = 0; h < K / 4; ++h) {
+      r.carried_forces[r.column_crossing[4 * h]] = f3.segment<3>(3 * h);
+      r.carried_weights[r.column_crossing[4 * h]] = problem.carried_weight().segment<3>(3 * h);
+    }
+  }
   r.seconds = since(start);
   report_progress(progress, "forces", 1.0);
   return r;

@@ -20,6 +20,11 @@ ForcesAndRestResult forces_and_rest(const Network& net, const std::vector<int>& 
     throw InputError("load_capacity_within must be a finite number of radians >= 0 (0: always compute the load capacity)");
   out.cuts = choose_cuts(net, requested_cuts);
   ForceOptions force_options = options.forces;
+  force_options.carried.bending_stiffness = options.rest.bending_stiffness;
+  force_options.carried.wire_diameter = options.load.wire_diameter;
+  force_options.carried.shear_modulus = options.deflection_options.shear_modulus;
+  force_options.carried.linear_density = !options.load_capacity ? 0.0 : options.load.density * 0.25 * 3.141592653589793 * options.load.wire_diameter *
+                                         options.load.wire_diameter;
   LoadCapacityOptions load = options.load;
   std::optional<LoadCapacityResult> at_plastic_limit;  // with a load factor
   load.torque_bound = options.forces.torque_bound;  // the same bound as the forces
@@ -33,6 +38,7 @@ ForcesAndRestResult forces_and_rest(const Network& net, const std::vector<int>& 
     // λ_d(1): the load capacity at the plastic limit; the pre-stress does not enter it (a0 = 0).
     ForceOptions full = options.forces;
     full.torque_fraction = 1.0;
+    full.carried_3d = false;  // the load capacity does not use the carried forces
     const ForceProblem problem(net, hooks, steps, out.cuts, full);
     const LoadCapacityResult at_one =
         load_capacity(net, out.cuts, problem, Eigen::VectorXd::Zero(problem.columns()), load, progress);
@@ -114,7 +120,9 @@ ForcesAndRestResult forces_and_rest(const Network& net, const std::vector<int>& 
     }
     out.load_capacity->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   } else if (options.load_capacity && rests_within) {
-    const ForceProblem problem(net, hooks, steps, out.cuts, force_options);
+    ForceOptions plain = force_options;
+    plain.carried_3d = false;  // the load capacity does not use the carried forces
+    const ForceProblem problem(net, hooks, steps, out.cuts, plain);
     out.load_capacity = load_capacity(net, out.cuts, problem, out.forces.coefficients, load, progress);
   }
   if (out.load_capacity) {

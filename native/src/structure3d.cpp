@@ -23,6 +23,30 @@ namespace {
 /// near 1e-9.
 constexpr double singular_pivot = 1e-12;
 
+}  // namespace
+
+namespace detail {
+
+bool factor_positive(const SpMat& h, Eigen::SimplicialLDLT<SpMat>& ldlt) {
+  const double diag = std::max(h.diagonal().cwiseAbs().maxCoeff(), 1e-300);
+  SpMat identity(h.rows(), h.cols());
+  identity.setIdentity();
+  double shift = 0.0;
+  for (int attempt = 0; attempt < 40; ++attempt) {
+    ldlt.compute(shift > 0 ? SpMat(h + shift * identity) : h);
+    if (ldlt.info() == Eigen::Success) {
+      const Eigen::VectorXd d = ldlt.vectorD();
+      if (d.allFinite() && d.minCoeff() > singular_pivot * d.cwiseAbs().maxCoeff()) return true;
+    }
+    shift = shift > 0 ? 10.0 * shift : 1e-10 * diag;
+  }
+  return false;
+}
+
+}  // namespace detail
+
+namespace {
+
 Eigen::VectorXd reduce(const Model& m, const Eigen::VectorXd& full) {
   Eigen::VectorXd r = Eigen::VectorXd::Zero(m.reduced_dofs);
   for (int i = 0; i < m.full_dofs; ++i)
@@ -44,29 +68,11 @@ SpMat reduced_hessian(const Model& m, const std::vector<Eigen::Triplet<double>>&
   return h;
 }
 
-/// Factorises H + shift·I with the smallest shift in {0, 1e-10·d, 1e-9·d, ...} (d the largest
-/// diagonal entry) whose every pivot exceeds singular_pivot of the largest. False if none does.
-bool factor_positive(const SpMat& h, Eigen::SimplicialLDLT<SpMat>& ldlt) {
-  const double diag = std::max(h.diagonal().cwiseAbs().maxCoeff(), 1e-300);
-  SpMat identity(h.rows(), h.cols());
-  identity.setIdentity();
-  double shift = 0.0;
-  for (int attempt = 0; attempt < 40; ++attempt) {
-    ldlt.compute(shift > 0 ? SpMat(h + shift * identity) : h);
-    if (ldlt.info() == Eigen::Success) {
-      const Eigen::VectorXd d = ldlt.vectorD();
-      if (d.allFinite() && d.minCoeff() > singular_pivot * d.cwiseAbs().maxCoeff()) return true;
-    }
-    shift = shift > 0 ? 10.0 * shift : 1e-10 * diag;
-  }
-  return false;
-}
-
 /// The Newton direction on the full DOFs, capped to a quarter of the size (nodes) and 1 rad
 /// (angles). False when no shift makes the Hessian positive definite.
 bool newton_direction(const Model& m, const Eigen::VectorXd& g, const SpMat& h, Eigen::VectorXd& step) {
   Eigen::SimplicialLDLT<SpMat> ldlt;
-  if (!factor_positive(h, ldlt)) return false;
+  if (!detail::factor_positive(h, ldlt)) return false;
   const Eigen::VectorXd reduced = -ldlt.solve(g);
   if (!reduced.allFinite()) return false;
   step = Eigen::VectorXd::Zero(m.full_dofs);

@@ -93,6 +93,13 @@ void dof_map(const Structure3dInput& in, Model& m) {
     m.start.segment<3>(b) -= 0.5 * gap;
     for (int k = 0; k < 3; ++k) share[b + k] = a + k, tied[a + k] = tied[b + k] = 1;
   }
+  if (in.table.enabled && in.table.hold_vertical) {  // the linear response's supports (structure3d.hpp)
+    for (const int dof : m.table_nodes) held[dof + 2] = 1;
+    for (const Structure3dTie& t : in.ties) {  // a tied node held: its partner shares the hold
+      const int a = m.rods[t.a.wire].x(t.a.vertex, 2), b = m.rods[t.b.wire].x(t.b.vertex, 2);
+      held[a] = held[b] = held[a] || held[b];
+    }
+  }
   if (in.table.enabled && in.table.hold_horizontal) hold_table(m, tied, held);
   m.map.assign(held.size(), -1);
   m.reduced_length.clear();

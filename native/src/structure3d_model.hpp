@@ -3,6 +3,7 @@
 // dropped, tied nodes sharing DOFs), energy, exact gradient and sparse Hessian. Private to the
 // core.
 #include <Eigen/Core>
+#include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <vector>
 
@@ -64,6 +65,11 @@ bool followable(const Model& model, const Eigen::VectorXd& q);
 
 /// Re-bases every reference frame on the tangents of q (time-parallel transport).
 void rebase_frames(Model& model, const Eigen::VectorXd& q);
+
+/// Factorises H + shift·I with the smallest shift in {0, 1e-10·d, 1e-9·d, ...} (d the largest
+/// diagonal entry) whose every pivot exceeds singular_pivot (structure3d.cpp) of the largest.
+/// False if none does.
+bool factor_positive(const Eigen::SparseMatrix<double>& h, Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& ldlt);
 
 /// Node k's position of rod r in q.
 inline Vec3 node(const Model& model, const Eigen::VectorXd& q, int r, int k) {

@@ -62,7 +62,7 @@ KEYS = {
         "hook": "layering", "metric": "layering", "hook_metrics": "layering",
         "vertices": "target_shape",
         "force": "forces", "normal_force": "forces", "out_of_plane": "forces", "pyramid": "forces",
-        "force_3d": "stands_3d", "admissible": "stands_3d",
+        "carried_force": "forces", "carried_weight": "forces", "force_3d": "stands_3d", "admissible": "stands_3d",
     },
     "stages": {
         "slicing": "slicing", "layering": "layering", "target_shape": "target_shape",
@@ -79,7 +79,7 @@ OPTIONAL = {
             "mesh_closing", "stands_3d", "what_moves"},
     "wire": {"cut_override", "cut_point", "out_of_plane_deflection", "out_of_plane_deflection_vertex", "sag",
              "as_built"},
-    "crossing": {"pyramid", "force_3d", "admissible"},
+    "crossing": {"pyramid", "carried_force", "carried_weight", "force_3d", "admissible"},
     "stages": {"stands_3d"},
 }
 

@@ -25,6 +25,7 @@ import math
 import numpy as np
 
 from .. import native
+from .stands3d import resting
 
 AXES = ("+x", "-x", "+y", "-y", "+z", "-z")
 
@@ -100,9 +101,17 @@ def run(design, material, settings, native_progress=None, load_capacity_within=N
                # to compare with the earlier model); not a scene-file key
                "torque_bound": settings.get("torque_bound", "3d"),
                # within 3% of the optimal G_stb, the least out-of-plane force (docs/method-forces.md §12)
-               "least_out_of_plane": settings.get("least_out_of_plane", True)}
+               "least_out_of_plane": settings.get("least_out_of_plane", True),
+               # the forces the assembled 3D structure carries kept in their pyramids (§17)
+               "carried_3d": settings.get("carried_3d", True),
+               "carried_margin": settings.get("carried_margin", 0.2),
+               "carried_share": settings.get("carried_share", 0.25)}
     if load_capacity_within is not None:
         options["load_capacity_within"] = load_capacity_within
+    if options["carried_3d"]:  # the weight's share, as the sculpture rests on its table
+        turn, supports = resting(design)
+        options["carried_gravity"] = list(turn.T @ np.array([0.0, 0.0, -9.81]))
+        options["carried_supports"] = supports
     steps = [list(s) for s in design.get("assembly_steps", [])]
     r = native.forces_and_rest(wires, crossings, steps, mat, options, native_progress)
 

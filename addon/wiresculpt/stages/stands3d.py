@@ -152,6 +152,19 @@ def options(material, gravity=(0.0, 0.0, -9.81), weight_factor=1.0):
             "max_iterations": MAX_ITERATIONS}
 
 
+def resting(design):
+    """How the sculpture rests on its table, from its targets alone: (turn, supports), the rigid
+    rotation that settles it (settle) and the (wire, target vertex) pairs touching the table."""
+    targets = [np.asarray(w["target"], dtype=np.float64) for w in design["wires"]]
+    points = np.vstack(targets)
+    turn = settle(points, np.concatenate([_lumped(t) for t in targets]), 1e-9 * model_size(design))
+    z = [t @ turn.T for t in targets]
+    z0 = min(float(np.min(p[:, 2])) for p in z)
+    tolerance = 1e-6 * model_size(design)
+    supports = [[k, int(v)] for k, p in enumerate(z) for v in np.flatnonzero(p[:, 2] <= z0 + tolerance)]
+    return turn, supports
+
+
 def run(design, material, native_progress=None):
     """Solves the standing structure of a design whose rest shapes exist and writes `stands_3d`
     and the per-wire and per-crossing figures. Returns the progress line."""

@@ -46,6 +46,7 @@
 #include <string>
 #include <vector>
 
+#include "wiresculpt/carried_forces.hpp"
 #include "wiresculpt/network.hpp"
 #include "wiresculpt/progress.hpp"
 #include "wiresculpt/rest_shape.hpp"
@@ -105,6 +106,21 @@ struct ForceOptions {
   /// problem GLPK holds from the last basis (lp.hpp, solve_lp_with_torque_rows). false: every
   /// round rebuilds it from scratch, as before (for tests, which compare the two). Default true.
   bool lp_warm_start = true;
+  /// Beyond the paper (carried_forces.hpp, docs/method-forces.md §17): keep the force each hooked
+  /// crossing carries once the structure is assembled in 3D (F3 = R f, linear) inside its
+  /// pyramid shrunk by carried_margin, as rows of the force LPs; SLSQP does not run (it does not
+  /// hold them). When only zero forces keep them, the LP is solved again without them
+  /// (ForceResult::carried_3d false). Default false; the pipeline's forces stage turns it on.
+  bool carried_3d = false;
+  /// [0, 1): each pyramid vector is moved this far towards the pyramid's mean vector before the
+  /// carried forces are held in the cone they span (0: the pyramid itself), so that what the
+  /// linear map leaves out (the weight, the pre-stress's own stiffening) does not push a force
+  /// out at once. Default 0.2.
+  double carried_margin = 0.2;
+  /// [0, 1]: every hooked crossing's carried normal force at least this share of their mean, so
+  /// that the pre-stress, not the weight, loads each crossing. Default 0.25.
+  double carried_share = 0.25;
+  CarriedForceOptions carried;  ///< the material of the 3D structure
 };
 
 /// The four unit pyramid vectors of hooked crossing `c` (hook ±1) from the actual incident
@@ -184,6 +200,13 @@ struct ForceResult {
   int working_set_rows = 0;    ///< constraint rows in the last of them
   double lp_seconds = 0.0, nlp_seconds = 0.0, seconds = 0.0;
   std::vector<std::string> warnings;
+  /// ForceOptions::carried_3d held: every hooked crossing's carried force lies in its shrunk pyramid.
+  bool carried_3d = false;
+  /// Per crossing: the force it carries in the assembled 3D structure (on wires[0], N; linear,
+  /// carried_forces.hpp); zero for a null crossing. Empty unless ForceOptions::carried_3d.
+  std::vector<Vec3> carried_forces;
+  /// Per crossing: the weight's share in carried_forces (N; zero without a density).
+  std::vector<Vec3> carried_weights;
 };
 
 /// The force problem of a network, exposed for tests: columns, M, torque rows, objective.
@@ -220,15 +243,26 @@ class ForceProblem {
   /// Per crossing: its force on wires[0] for coefficients a.
   std::vector<Vec3> forces(const Eigen::VectorXd& a) const;
   const std::array<Vec3, 4>& pyramid(int crossing) const { return pyramid_[crossing]; }
+  /// 3H × K: each hooked crossing's carried 3D force per unit a_j (empty unless carried_3d).
+  const Eigen::MatrixXd& carried_map() const { return F3_; }
+  /// 3H, N: each hooked crossing's carried share of the weight (F3 = carried_map() a + this).
+  const Eigen::VectorXd& carried_weight() const { return W_; }
+  /// #rows × K: rows >= carried_lower() keep every carried force in its shrunk pyramid and its
+  /// normal force at least carried_share of their mean (empty unless carried_3d).
+  const Eigen::MatrixXd& carried_rows() const { return C_; }
+  const Eigen::VectorXd& carried_lower() const { return C_lo_; }
 
  private:
+  void carried_rows(const Network& net, const std::vector<int>& hooks, const std::vector<int>& cuts,
+                    const ForceOptions& options);
+
   const Network* net_;
   std::vector<int> hooks_;
   std::vector<int> column_crossing_;
   std::vector<std::array<Vec3, 4>> pyramid_;
-  Eigen::MatrixXd M_, T_, T3_, Q_, Nk_;
+  Eigen::MatrixXd M_, T_, T3_, Q_, Nk_, F3_, C_;
   TorqueBound bound_ = TorqueBound::full_3d;
-  Eigen::VectorXd c_;
+  Eigen::VectorXd c_, W_, C_lo_;
   std::vector<std::array<int, 2>> torque_vertex_;
   Vec3 reference_ = Vec3::Zero();
   double L_ = 1.0, t_max_ = 0.0, w_ = 0.0;

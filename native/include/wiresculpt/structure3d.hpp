@@ -103,6 +103,9 @@ struct Structure3dTable {
   /// Hold the lowest table node horizontally and the farthest one along one axis (see above).
   /// Default true.
   bool hold_horizontal = true;
+  /// Hold every table node at its height too (a support, not a contact): structure3d_tie_response's
+  /// table, whose linear response has no contact stiffness to lean on. Default false.
+  bool hold_vertical = false;
 };
 
 struct Structure3dInput {
@@ -178,6 +181,19 @@ Structure3dResult solve_structure3d(const Structure3dInput& input, const Structu
                                     const ProgressFn& progress = {});
 
 /// The nearest nonnegative combination of `pyramid` (contact.hpp's contact_pyramid) to `force`.
+/// The linear response of the assembled structure about its start, stress-free (each wire's rest
+/// is its start): per load case (forces on nodes, N), the force each tie carries on its node a
+/// (N), in the order of input.ties, from K Δq = P (K the stiffness at the start with the ties
+/// made to hold and the clamps held; no weight, no table) and the tie's share of it,
+/// H_a Δq - P_a (H_a the elastic stiffness of node a's own rod). Within the linear range this
+/// is what solve_structure3d's ties carry under the same loads. For self-balanced loads a clamp
+/// (any one node) only removes the rigid motions; a table (Structure3dTable::hold_vertical) holds
+/// its nodes at their heights and as hold_horizontal says. One factorisation for every case. Throws
+/// InputError as solve_structure3d, and SolverError when the tied structure is a mechanism.
+std::vector<std::vector<Vec3>> structure3d_tie_response(const Structure3dInput& input,
+                                                        const std::vector<std::vector<Structure3dLoad>>& cases,
+                                                        const Structure3dOptions& options = {});
+
 struct PyramidFit {
   std::array<double, 4> coefficients{};  ///< >= 0
   double distance = 0.0;  ///< |Σ c_i p_i - force|, N
