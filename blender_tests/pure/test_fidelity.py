@@ -13,6 +13,7 @@ import numpy as np
 from wiresculpt import native, pipeline
 from wiresculpt.core import fidelity
 from wiresculpt.core.materials import PRESETS
+from wiresculpt.core.scene import PlaneSpec
 from wiresculpt.core.settings import defaults
 
 from helpers import PLANES, box_faces, box_vertices, sphere
@@ -189,6 +190,22 @@ class Meshes(unittest.TestCase):
         self.assertEqual(s.fidelity(circles)["share"], 1.0)
         # a circle of half the radius in each plane: 62.5 mm inside a tolerance of 7.5 mm
         self.assertEqual(s.fidelity([(0.5 * p, True) for p, _ in circles])["share"], 0.0)
+
+    @unittest.skipUnless(native.available(), native.LOAD_ERROR)
+    def test_a_sliced_cross_with_and_without_its_limb(self):
+        # a 1.0 x 0.2 m bar along x (z 0.4-0.6) and a 0.2 x 0.8 m bar along z (x 0.4-0.6, z 0.1-0.9),
+        # both y 0-0.2, cut by y = 0.1: the x bar's rectangle is the largest contour, the z bar's the
+        # limb. Front outline 2 (1.0 + 0.8) = 3.6 m; the x bar's alone traces its ends (0.4), its
+        # sides beside the z bar (1.6) and 0.03 m of each of the z bar's four sides: 2.12 m
+        V = np.array(box_vertices((0.0, 0.0, 0.4), (1.0, 0.2, 0.6)) + box_vertices((0.4, 0.0, 0.1), (0.6, 0.2, 0.9)))
+        F = np.array(box_faces() + [tuple(i + 8 for i in t) for t in box_faces()])
+        shares = {}
+        for rule in ("largest", "all"):
+            design = pipeline.slice_and_pick(V, F, [PlaneSpec("Y", (0, 0.1, 0), (0, 1, 0), contours=rule)],
+                                             PRESETS["steel"], defaults())
+            shares[rule] = fidelity.record(design, V, F)["views"]["front"]
+        self.assertEqual(shares["all"], 1.0)
+        self.assertAlmostEqual(shares["largest"], 2.12 / 3.6, places=9)
 
     @unittest.skipUnless(native.available(), native.LOAD_ERROR)
     def test_a_sliced_sphere(self):
