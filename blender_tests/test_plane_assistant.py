@@ -225,6 +225,16 @@ class SuggestPlanes(Case):
         for c in candidates:
             self.assertEqual(len(c["planes"]), 4)
             self.assertEqual(recheck.recheck(json.loads(json.dumps(c["design"]))), [])
+        # each candidate shows its fidelity (by view) beside its coverage; they are ranked by fidelity
+        texts = [kw.get("text", "") for _name, _a, kw in draw(panel.VIEW3D_PT_wiresculpt_planes, bpy.context)]
+        for c in candidates:
+            f = c["figures"]
+            self.assertEqual(f["fidelity"], c["design"]["fidelity"]["share"])
+            line = (f"traces {f['fidelity']:.0%} of the outline (front {f['views']['front']:.0%}, side "
+                    f"{f['views']['side']:.0%}, top {f['views']['top']:.0%}), covers {f['coverage']:.0%} of the mesh")
+            self.assertIn(line, " ".join(texts))  # wrapped over labels
+        self.assertEqual([c["score"] for c in candidates],
+                         sorted((c["score"] for c in candidates), reverse=True))
         # the preview of a suggestion outlines every plane it would add, and adds none
         self.assertEqual(bpy.ops.wiresculpt.preview_planes(index=0), {'FINISHED'})
         self.assertEqual(handles(bpy.context.scene), [])

@@ -64,6 +64,11 @@ class PlaneSearchBatch(unittest.TestCase):
         self.assertTrue(rec["changes"])
         for key in ("candidates", "full_solves", "seconds", "score"):
             self.assertIn(key, rec)
+        # the design's looks (core/fidelity.py), also in the record and the batch's line
+        self.assertEqual(rec["fidelity"], d["fidelity"]["share"])
+        self.assertEqual(set(d["fidelity"]["views"]), {"front", "side", "top"})
+        self.assertTrue(0.0 < rec["coverage"] <= 1.0)
+        self.assertTrue(any(f"traces {rec['fidelity']:.0%} of the outline" in line for line in wiresculpt_lines(r.stdout)))
         after = {p["name"]: p for p in rec["planes_after"]}
         for w in d["wires"]:
             p = after[w["name"].split("/")[0]]

@@ -25,7 +25,9 @@ VERSION = 1
 # Who writes each key: "design" (new_design), a stage of the pipeline ("slicing", "layering",
 # "target_shape", "forces" with the rest shape and load capacity, all from one native call),
 # "pipeline" (pipeline.py itself), "user" (what the user asked for, kept for the next solve),
-# "fabrication" (the batch's exports) or "every stage" (appended to by each).
+# "fabrication" (the batch's exports) or "every stage" (appended to by each). `fidelity` is
+# written by the plane search's batch entry for every batch design and by the searches for each
+# candidate (core/fidelity.py: it needs the mesh, which the pipeline's stages do not see).
 # `stable`/`reason` are the layering's verdict (new_design's default until it runs; the pipeline
 # answers when there are fewer than two wires; layering.recheck_verdict after a later stage nulls
 # crossings; fab/buildability.apply, through the pipeline, when a wire's bend program cannot be
@@ -45,6 +47,7 @@ KEYS = {
         "out_of_plane": "forces", "load_capacity": "forces", "load_factor": "forces", "buildability": "pipeline",
         "fabrication": "fabrication", "plane_search": "plane_search",
         "model_size": "pipeline", "mesh_faults": "pipeline", "mesh_closing": "pipeline", "stands_3d": "stands_3d",
+        "fidelity": "plane_search",
     },
     "wire": {
         "id": "slicing", "name": "slicing", "plane": "slicing", "closed": "slicing", "contour": "slicing",
@@ -76,7 +79,7 @@ KEYS = {
 OPTIONAL = {
     "top": {"close_crossings", "required_size", "load_capacity", "load_factor", "fabrication", "warnings",
             "buildability", "search_incomplete", "plane_search", "reason_causes", "model_size", "mesh_faults",
-            "mesh_closing", "stands_3d", "what_moves"},
+            "mesh_closing", "stands_3d", "what_moves", "fidelity"},
     "wire": {"cut_override", "cut_point", "out_of_plane_deflection", "out_of_plane_deflection_vertex", "sag",
              "as_built"},
     "crossing": {"pyramid", "carried_force", "carried_weight", "force_3d", "admissible"},

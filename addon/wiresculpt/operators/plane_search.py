@@ -89,6 +89,18 @@ def describe(candidate):
             f"closure gap {f['closure_gap'] * 1000:.1f} mm")
 
 
+def looks(candidate):
+    """How the candidate looks like the model, as one line for the panel: the share of the outline
+    its wires trace (its fidelity, core/fidelity.py; by view) and its coverage; None when its
+    figures have neither."""
+    f = candidate["figures"]
+    if f.get("fidelity") is None:
+        return None
+    views = ", ".join(f"{name} {share:.0%}" for name, share in (f.get("views") or {}).items() if share is not None)
+    line = f"traces {f['fidelity']:.0%} of the outline ({views})" if views else f"traces {f['fidelity']:.0%} of the outline"
+    return line + (f", covers {f['coverage']:.0%} of the mesh" if f.get("coverage") is not None else "")
+
+
 def plane_outline(origin, normal, half):
     """(8, 3) float32 segment end points of the square of side 2 * half centred at `origin` in the
     plane with unit `normal`."""

@@ -26,7 +26,8 @@ Two searches:
   axes (balanced first) and every spread of SPREADS; each with the largest contour of every plane,
   and, when that fails the screen, the contours of the crossing network's largest connected part
   without hinged wires (Searcher.connected). Screened proposals are verified fewest crossings
-  closer than 2 * min_segment along a wire first (close_gaps), then by coverage; budget
+  closer than 2 * min_segment along a wire first (close_gaps), then by the fidelity of their
+  contours (highest first); budget
   auto_budget(count) = AUTO_SECONDS_PER_PLANE * count. When no proposal of the first screening
   round keeps its crossings 2 * min_segment apart, sets grown from count - 1 planes (grow: a
   family proposal plus one plane at an area quantile along one of its axes) are screened and
@@ -47,14 +48,17 @@ is kept.
 
 Score of a returned candidate (documented in docs/formats.md, higher is better):
 
-    score = coverage - 10 * max_deviation / S          (auto; a design with two-hand assembly
+    score = fidelity                                   (auto; a design with two-hand assembly
                                                         steps ranks after every one without)
     score = -cost                                      (nearby)
 
-coverage: the share of the mesh's vertices within 0.1 S of some wire's contour; max_deviation:
-the largest distance of a target shape from its contour (target_max_distance).
+fidelity: the share of the model's outline from the front, the side and the top that the solved
+wires trace (core/fidelity.py: within 0.03 S of a projected wire, on rendered masks), written into
+the design as `fidelity`. Every returned candidate of either search also carries it, and coverage
+(the share of the mesh's vertices within 0.1 S of some wire's contour), in its figures
+(Searcher.looks): what the panel shows beside each candidate.
 """
-from .auto import (AUTO_SECONDS_PER_PLANE, EARLY_SOLVES, FIDELITY_WEIGHT, GROW_BASES, GROW_QUANTILES,  # noqa: F401
+from .auto import (AUTO_SECONDS_PER_PLANE, EARLY_SOLVES, GROW_BASES, GROW_QUANTILES,  # noqa: F401
                    SPREADS, area_quantile_plane, auto, auto_budget, family_planes, grow, splits_of)
 from .batch import MODES, run  # noqa: F401
 from .nearby import BUDGET_SECONDS, PAIR_SINGLES, SLICE_AHEAD, nearby  # noqa: F401

@@ -12,7 +12,6 @@ from ..core.plane_faults import close_gaps
 from .placements import Placement
 from .searcher import Searcher, _figures
 
-FIDELITY_WEIGHT = 10.0
 AUTO_SECONDS_PER_PLANE = 6.0  # auto's search budget: this many seconds per plane (24 s for N = 4)
 EARLY_SOLVES = 3  # auto verifies as soon as this many screened proposals have no close gap
 
@@ -158,8 +157,9 @@ def auto(mesh, count, material, settings, want=2, budget=None, context=None, sto
     screen, with the contours of the network's largest connected part (Searcher.connected).
     Screening (up to half the budget) keeps the proposals the layering finds stable; they are
     verified by full solves with the layering's hooks in order of how many crossings come closer
-    than 2 * min_segment along a wire (fewest first), then coverage; the best found gets the
-    comparison of hook patterns (Searcher.finish)."""
+    than 2 * min_segment along a wire (fewest first), then the fidelity of their contours (highest
+    first); the stable ones are ranked by the fidelity of their solved wires (the score) and the
+    best gets the comparison of hook patterns (Searcher.finish)."""
     s = Searcher(mesh, material, settings, context, stock)
     start = time.perf_counter()
     budget = auto_budget(count) if budget is None else budget
@@ -191,8 +191,9 @@ def auto(mesh, count, material, settings, want=2, budget=None, context=None, sto
                     placements = joined
                     ok, design, probe = s.screen_layered(placements)
             if ok:
-                batch.append((close_gaps(probe, min_segment), -s.coverage(design), counts, axes, placements, design,
-                              ""))
+                # --- fidelity: verified highest fidelity of the contours first (core/fidelity.py) ---
+                batch.append((close_gaps(probe, min_segment), -(s.fidelity(design)["share"] or 0.0), counts, axes,
+                              placements, design, ""))
                 clean += batch[-1][0] == 0
             if clean >= EARLY_SOLVES or time.perf_counter() > limit or (not clean and time.perf_counter() > soft):
                 passed += len(batch)
@@ -220,17 +221,16 @@ def auto(mesh, count, material, settings, want=2, budget=None, context=None, sto
             s.deadline = start + budget
             s.say("plane_search", f"{len(grown)} sets grown from {count - 1} planes pass the screen")
         while (grown or pool) and len(found) < want and time.perf_counter() - start < budget:
-            close, cover, counts, axes, placements, design, extra = (grown or pool).pop(0)
+            close, _looks, counts, axes, placements, design, extra = (grown or pool).pop(0)
             solved = s.solve(copy.deepcopy(design))
             if solved is None or not solved["stable"]:
                 continue
-            cover = -cover
-            score = cover - FIDELITY_WEIGHT * s.max_deviation(solved) / s.size
             rule = "" if all(p.contours == "largest" for p in placements) else ", the connected contours"
             found.append({"planes": placements, "changes": [f"{len(placements)} planes: " + ", ".join(
                 f"{n} along {_axis_word(axes[k], k)}" for k, n in enumerate(counts) if n) + rule + extra],
-                "cost": 0.0, "score": score, "coverage": cover, "design": solved, "figures": _figures(solved),
-                "sliced": design})
+                "cost": 0.0, "design": solved, "figures": _figures(solved), "sliced": design})
+            found[-1]["score"] = score = s.looks(found[-1])  # score = fidelity (of the solved wires)
+            # --- end of fidelity ---
             s.say("plane_search", f"candidate {len(found)}: {found[-1]['changes'][0]} (score {score:.3f})")
     # a design whose assembly needs two wires placed at once (two_hand_steps) comes after every
     # design that can be built one wire at a time, whatever its score

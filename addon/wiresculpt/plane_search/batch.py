@@ -1,5 +1,6 @@
 """The headless pipeline with settings.plane_search (the batch script's entry)."""
 from .. import pipeline
+from ..core import fidelity
 from ..core.solve_context import SolveContext
 from .auto import auto, family_planes
 from .nearby import nearby
@@ -9,10 +10,19 @@ from .records import _record, _summary, nearby_reason
 MODES = ("off", "nearby", "auto")
 
 
+def _looks(design, vertices, faces):
+    """The design with its `fidelity` record (core/fidelity.py) against the mesh, when it has wires
+    and no record yet (a candidate of a search has its own)."""
+    if "fidelity" not in design and design.get("wires"):
+        fidelity.record(design, vertices, faces)
+    return design
+
+
 def run(vertices, faces, planes, material, settings, progress=None, cancel=None, stock=None):
     """The headless pipeline with settings.plane_search: "off" -> pipeline.run; "nearby" -> the
     given planes first, the nearby search when they give no stable design; "auto" -> planes
-    from the mesh. The design carries `plane_search` whenever a search ran; when none is found the
+    from the mesh. The design carries `plane_search` whenever a search ran, and `fidelity` whenever it
+    has wires (core/fidelity.py); when none is found the
     design of the given planes (nearby) or of the first proposal (auto) is returned, not stable,
     with the reason saying what was tried. `stock`: as pipeline.solve's. Returns (design, planes
     actually used)."""
@@ -20,7 +30,8 @@ def run(vertices, faces, planes, material, settings, progress=None, cancel=None,
     context = SolveContext(progress, cancel)  # the search's progress and cancel
     mode = settings.get("plane_search", "off")
     if mode == "off":
-        return pipeline.run(vertices, faces, planes, material, settings, progress, cancel, stock), list(planes)
+        return _looks(pipeline.run(vertices, faces, planes, material, settings, progress, cancel, stock), vertices,
+                      faces), list(planes)
     if mode == "nearby":
         if not planes:
             raise ValueError('settings.plane_search "nearby" needs planes to start from; give "planes" or use "auto"')
@@ -34,6 +45,7 @@ def run(vertices, faces, planes, material, settings, progress=None, cancel=None,
             if not design["stable"]:
                 design["reason"] = (f"{nearby_reason(s)}. The planes as given: {design['reason']}"
                                     if design["reason"] else nearby_reason(s))
+        _looks(design, vertices, faces)
         design["plane_search"] = _record("nearby", planes, best, s, start)
         used = [p.spec() for p in best["planes"]] if best else list(planes)
         say("plane_search", _summary(design["plane_search"]))
@@ -52,8 +64,10 @@ def run(vertices, faces, planes, material, settings, progress=None, cancel=None,
             if not design["stable"]:
                 design["reason"] += (f"; no proposed set of {count} planes ({s.screened} tried) gives a "
                                      f"stable design")
+        _looks(design, vertices, faces)
         design["plane_search"] = _record("auto", planes, best or ({"planes": [
-            Placement(p.name, p.origin, p.normal, p.contours) for p in used], "changes": [], "score": None}
+            Placement(p.name, p.origin, p.normal, p.contours) for p in used], "changes": [], "score": None,
+            "fidelity": design["fidelity"]["share"] if "fidelity" in design else None}
             if design["stable"] else None), s, start)
         say("plane_search", _summary(design["plane_search"]))
         return design, used

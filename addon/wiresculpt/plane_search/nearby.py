@@ -96,4 +96,6 @@ def nearby(mesh, planes, material, settings, want=1, budget=BUDGET_SECONDS, cont
     found.sort(key=lambda c: c["cost"])
     if found:
         s.finish(found[0])
+    for candidate in found[:want]:  # fidelity and coverage, shown with each candidate (after the budget)
+        s.looks(candidate)
     return found[:want], s, start

@@ -14,11 +14,13 @@ def _record(mode, before, candidate, searcher, start):
             "budget_seconds": searcher.budget, "solves_stopped": searcher.timed_out,
             "solves_failed": searcher.failed, "final_solve": searcher.final,
             "seconds": time.perf_counter() - start, "score": candidate["score"] if candidate else None,
+            # the returned candidate's looks (Searcher.looks): fidelity (the design's `fidelity` share) and coverage
+            "fidelity": (candidate or {}).get("fidelity"), "coverage": (candidate or {}).get("coverage"),
             **({"not_found": nearby_ending(searcher)} if mode == "nearby" and not candidate and searcher.tally else {}),
             "measure": ("cost = sum of |offset| / model size + tilt in radians + 0.05 per contour-rule change; "
                         "score = -cost" if mode == "nearby" else
-                        "score = coverage (share of mesh vertices within 0.1 model size of a wire) "
-                        "- 10 * max target deviation / model size")}
+                        "score = fidelity (mean share over the front, side and top views of the model's outline "
+                        "within 0.03 model size of a projected wire)")}
 
 
 def nearby_reason(searcher):
@@ -37,5 +39,7 @@ def nearby_ending(searcher):
 
 def _summary(record):
     what = "; ".join(record["changes"]) or ("the planes as given" if record["planes_after"] else "nothing stable")
-    return (f"{record['mode']}: {what} ({record['candidates']} candidates screened, {record['full_solves']} "
+    looks = "".join(f"; {words} {record[key]:.0%} of the {what}" for key, words, what in (
+        ("fidelity", "traces", "outline"), ("coverage", "covers", "mesh")) if record.get(key) is not None)
+    return (f"{record['mode']}: {what}{looks} ({record['candidates']} candidates screened, {record['full_solves']} "
             f"full solves, {record['seconds']:.2f} s)")

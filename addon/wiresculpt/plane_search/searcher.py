@@ -8,7 +8,7 @@ import time
 import numpy as np
 
 from .. import native, pipeline
-from ..core import plane_faults
+from ..core import fidelity, plane_faults
 from ..core.solve_context import SolveContext
 from ..stages import layering, slicing, target_shape
 from .placements import Placement, _unit, mesh_frame
@@ -50,6 +50,7 @@ class Searcher:
         self.empty = None  # the plane of the last _sliced() that found no contour
         self.tally = None  # the nearby search's account of its candidates (plane_faults.Tally)
         self.surface = None  # (triangle centroids, areas) of the mesh, made by _surface when first needed
+        self.outlines = None  # the mesh's three views (core/fidelity.Silhouettes), made by fidelity() when first needed
         self.deadline = math.inf  # perf_counter() time at which a full solve is stopped (the budget)
         self.budget = None  # seconds
         self.centre, self.axes, self.size = mesh_frame(self.V, self.F)
@@ -305,6 +306,7 @@ class Searcher:
                             deadline=began + FINAL_SECONDS)
         if solved is not None and solved["stable"]:
             candidate["design"], candidate["figures"] = solved, _figures(solved)
+            self.looks(candidate)
             self.final = {"hook_search": "by forces", "seconds": time.perf_counter() - began}
         else:
             why = (f"stopped at {FINAL_SECONDS:g} s" if self.timed_out > stopped else
@@ -321,6 +323,25 @@ class Searcher:
             d2 = ((self.sample[:, None, :] - chunk[None, :, :]) ** 2).sum(axis=2)
             near |= (d2 <= radius * radius).any(axis=1)
         return float(near.mean())
+
+    # --- how the design looks like the model (core/fidelity.py) ---
+    def fidelity(self, design):
+        """The design's `fidelity` record (core/fidelity.py) against the mesh's three views, rendered
+        on the first call (0.2-1 s on the corpus' meshes)."""
+        if self.outlines is None:
+            self.outlines = fidelity.Silhouettes(self.V, self.F, self.size)
+        return self.outlines.of_design(design)
+
+    def looks(self, candidate):
+        """Writes the candidate design's `fidelity` record, and its coverage and fidelity (the record's
+        share, 0 when no view has an outline) into the candidate and its figures; returns the share."""
+        design = candidate["design"]
+        record = design["fidelity"] = self.fidelity(design)
+        candidate["coverage"] = cover = candidate["coverage"] if "coverage" in candidate else self.coverage(design)
+        candidate["fidelity"] = share = record["share"] or 0.0
+        candidate["figures"].update(coverage=cover, fidelity=share, views=dict(record["views"]))
+        return share
+    # --- end of fidelity ---
 
     def max_deviation(self, design):
         return max((w.get("target_max_distance", 0.0) for w in design["wires"]), default=0.0)

@@ -10,8 +10,10 @@ from .panel import VIEW3D_PT_wiresculpt, wrap_labels
 
 
 def candidate_lines(candidate):
-    """What the panel says of a candidate: its changes (or the planes' families) and its figures."""
-    return (candidate["changes"] or ["the planes as they are"]) + [ops.describe(candidate)]
+    """What the panel says of a candidate: its changes (or the planes' families), its figures and how
+    it looks like the model (fidelity beside coverage)."""
+    return ((candidate["changes"] or ["the planes as they are"]) + [ops.describe(candidate)]
+            + [line for line in (ops.looks(candidate),) if line])
 
 
 class VIEW3D_PT_wiresculpt_planes(bpy.types.Panel):
