@@ -346,6 +346,7 @@ def run_scene(entry, out_root):
             row["rounds"] = len(relayering["rounds"])
             row["forbidden"] = len(relayering["forbidden"])
             row["relayering_seconds"] = round(relayering["seconds"], 2)
+        row.update(standing_figures(design))
         if row["stable"]:
             row["recheck"] = recheck(design)
     elif rc != "timeout":
@@ -432,6 +433,31 @@ def overhead_lines(rows):
     return lines
 
 
+def standing_figures(design):
+    """The 3D check's figures of a design (docs/formats.md, Standing in 3D) and the ones beside them:
+    `stands_3d` (its cause), `sag_mm`, `slipping` (crossings), `carried` (the forces stage kept the
+    carried forces in their pyramids), `out_of_plane` (the paper's mean share) and `load` (the
+    weakest direction's multiple of the weight); {} when the check did not run."""
+    record = design.get("stands_3d")
+    if not record:
+        return {}
+    capacity = design.get("load_capacity") or {}
+    held = [capacity.get(a) for a in ("+x", "-x", "+y", "-y", "+z", "-z") if capacity.get(a) is not None]
+    return {"stands_3d": record["cause"], "sag_mm": round(1000.0 * record["max_sag"], 2),
+            "slipping": len(record["slipping"]),
+            "carried": bool(design.get("stages", {}).get("forces", {}).get("carried_3d")),
+            "out_of_plane": round((design.get("out_of_plane") or {}).get("mean_to_max_force", 0.0), 4),
+            "load": round(min(held), 2) if held else None}
+
+
+def standing_cell(r):
+    """The table's 3D column: the check's cause, the crossings that slip, the sag (mm)."""
+    if "stands_3d" not in r:
+        return "—"
+    slips = f" {r['slipping']}" if r["slipping"] else ""
+    return f"{r['stands_3d']}{slips} ({r['sag_mm']:.2f})"
+
+
 def run_codes(design):
     """The codes of a run's verdict, as a corpus run stores them: `verdict_cause` (core/design.py:
     the layering's LAYERING_CAUSES, UNREALISED, NOT_BUILDABLE, a setup cause), `relayering_end`
@@ -512,6 +538,19 @@ def section(results, before=None):
               f"{sum(1 for r in ok if r['recheck'] == [])} of {len(ok)} stable designs; "
               f"{sum(1 for r in rows if r['stable'] is None)} runs without a verdict (bad input, failure or "
               f"timeout); total {sum(r['seconds'] for r in rows) / 60:.1f} min.", ""]
+    checked = [r for r in ok if "stands_3d" in r]
+    if checked:
+        counts = {}
+        for r in checked:
+            counts[r["stands_3d"]] = counts.get(r["stands_3d"], 0) + 1
+        lines += ["The 3D check of the assembled sculpture (docs/method-structure3d.md; the forces stage keeps "
+                  "the forces the structure carries in 3D, docs/method-forces.md §17): of the "
+                  f"{len(checked)} stable designs {counts.get('stands', 0)} stand, "
+                  + ", ".join(f"{n} {k}" for k, n in sorted(counts.items()) if k != "stands")
+                  + f" (their verdict names the 3D limit: stable, over its limits); the carried forces held on "
+                  f"{sum(1 for r in checked if r['carried'])}. The 3D column: the check's cause, the crossings that "
+                  "slip, and the sag in mm; out of plane: the paper's mean measure; load: the weakest direction's "
+                  "multiple of the weight.", ""]
     by_size = {}
     for r in rows:
         by_size.setdefault(r["size"], []).append((bool(r["stable"]), bool(old.get(r["name"], {}).get("stable"))))
@@ -522,8 +561,9 @@ def section(results, before=None):
         lines.append(f"| {s:g} | {sum(b for _a, b in v)} / {len(v)} | {after} |" if old else f"| {s:g} | {after} |")
     verdict = {True: "yes", False: "no"}
     lines += ["", "| mesh | planes | size (m) | wires / crossings | " + ("stable before (solve s) | " if old else "")
-              + "stable? | reason (first words) | seconds (solve) | rounds | forbidden | recheck ok? |",
-              "|---|---|---|---|" + ("---|" if old else "") + "---|---|---|---|---|---|"]
+              + "stable? | reason (first words) | seconds (solve) | rounds | forbidden | recheck ok? | 3D (sag mm) | "
+              "out of plane | load |",
+              "|---|---|---|---|" + ("---|" if old else "") + "---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         stable = verdict.get(r["stable"], f"exit {r['rc']}")
         rec = "—" if r["recheck"] is None else ("ok" if not r["recheck"] else "NO: " + first_words(r["recheck"][0], 14))
@@ -534,7 +574,8 @@ def section(results, before=None):
         solve = r.get("relayering_seconds", r.get("solve_seconds", ""))
         lines.append(f"| {r['mesh']} | {r['config']} ({r['planes']}) | {r['size']:g} | {wc} | {then_col}{stable} | "
                      f"{first_words(r['reason'])} | {r['seconds']:.1f} ({solve}) | {r.get('rounds', '')} | "
-                     f"{r.get('forbidden', '')} | {rec} |")
+                     f"{r.get('forbidden', '')} | {rec} | {standing_cell(r)} | {r.get('out_of_plane', '')} | "
+                     f"{'' if r.get('load') is None else r['load']} |")
     unstable = [r for r in rows if r["stable"] is False]
     if unstable:
         lines += ["", "Why the unstable runs stay unstable (by the kind of the verdict's cause):", "",

@@ -48,6 +48,19 @@ class CauseKind(unittest.TestCase):
         self.assertEqual(corpus.run_codes({"stages": {}}), run(None, None, 0))
 
 
+class Standing(unittest.TestCase):
+    def test_the_3d_figures_by_hand(self):
+        design = {"stands_3d": {"cause": "slips", "max_sag": 0.00123456, "slipping": [3, 7]},
+                  "stages": {"forces": {"carried_3d": True}}, "out_of_plane": {"mean_to_max_force": 0.051234},
+                  "load_capacity": {"+x": 2.5, "-x": None, "+y": 1.25, "-y": 3.0, "+z": None, "-z": 4.0}}
+        row = corpus.standing_figures(design)
+        self.assertEqual(row, {"stands_3d": "slips", "sag_mm": 1.23, "slipping": 2, "carried": True,
+                               "out_of_plane": 0.0512, "load": 1.25})
+        self.assertEqual(corpus.standing_cell(row), "slips 2 (1.23)")
+        self.assertEqual(corpus.standing_figures({"stable": False}), {})
+        self.assertEqual(corpus.standing_cell({}), "—")
+
+
 class StoredRuns(unittest.TestCase):
     def test_every_stored_run_carries_its_codes(self):
         with open(os.path.join(ROOT, "docs", "corpus.json")) as f:
