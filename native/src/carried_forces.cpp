@@ -1,6 +1,8 @@
 // The forces the assembled structure carries (carried_forces.hpp).
 #include "wiresculpt/carried_forces.hpp"
 
+#include "structure3d_model.hpp"
+
 #include <Eigen/Geometry>
 
 #include "wiresculpt/error.hpp"
@@ -22,6 +24,25 @@ NodeRef free_clamp(const Structure3dInput& in) {
       if (!tied[k] && !tied[k + 1]) return {static_cast<int>(w), static_cast<int>(k)};
   }
   throw SolverError("every wire is tied at every other node: no node is left to hold the structure still by");
+}
+
+/// The free rods' Hessian h of `in`'s rods turned rigidly by `turn`: B h Bᵀ, B turning each
+/// node's coordinates (the twist angles are the same in a turned frame).
+Eigen::SparseMatrix<double> turned(const Eigen::SparseMatrix<double>& h, const Structure3dInput& in,
+                                   const Eigen::Matrix3d& turn) {
+  std::vector<Eigen::Triplet<double>> b;
+  int base = 0;
+  for (const Structure3dWire& w : in.wires) {
+    const int n = static_cast<int>(w.start.size());
+    for (int k = 0; k < n; ++k)
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) b.emplace_back(base + 3 * k + i, base + 3 * k + j, turn(i, j));
+    for (int e = 0; e + 1 < n; ++e) b.emplace_back(base + 3 * n + e, base + 3 * n + e, 1.0);
+    base += 4 * n - 1;
+  }
+  Eigen::SparseMatrix<double> B(h.rows(), h.cols());
+  B.setFromTriplets(b.begin(), b.end());
+  return B * h * B.transpose();
 }
 
 }  // namespace
@@ -69,7 +90,8 @@ CarriedForces carried_forces(const Network& net, const std::vector<int>& hooks, 
   Structure3dOptions o;
   o.bending_stiffness = options.bending_stiffness, o.wire_diameter = options.wire_diameter;
   o.shear_modulus = options.shear_modulus, o.linear_density = 0.0;
-  const std::vector<std::vector<Vec3>> answer = structure3d_tie_response(in, cases, o);
+  const Eigen::SparseMatrix<double> h = detail::free_hessian(in, o);  // one assembly for both systems
+  const std::vector<std::vector<Vec3>> answer = detail::tie_response(in, h, cases, o);
   for (int col = 0; col < 3 * H; ++col)
     for (int h = 0; h < H; ++h)
       out.R.block<3, 1>(3 * h, col) = -answer[static_cast<std::size_t>(col)][static_cast<std::size_t>(closures + h)];
@@ -101,7 +123,7 @@ CarriedForces carried_forces(const Network& net, const std::vector<int>& hooks, 
                        ") is not a wire's target vertex");
     held.table.nodes.push_back({s[0], position[static_cast<std::size_t>(s[0])][static_cast<std::size_t>(s[1])]});
   }
-  const std::vector<Vec3> share = structure3d_tie_response(held, {weight}, o)[0];
+  const std::vector<Vec3> share = detail::tie_response(held, turned(h, held, turn), {weight}, o)[0];
   // The tie answers the weight itself (not a design force standing for it): its force, as it is.
   for (int h = 0; h < H; ++h)
     out.weight.segment<3>(3 * h) = turn.transpose() * share[static_cast<std::size_t>(closures + h)];

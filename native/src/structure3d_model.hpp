@@ -71,6 +71,16 @@ void rebase_frames(Model& model, const Eigen::VectorXd& q);
 /// False if none does.
 bool factor_positive(const Eigen::SparseMatrix<double>& h, Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& ldlt);
 
+/// The rods' elastic Hessian on the full DOFs, each rod free and stress-free (rest = start):
+/// structure3d_tie_response's stiffness, before its ties and supports.
+Eigen::SparseMatrix<double> free_hessian(const Structure3dInput& input, const Structure3dOptions& options);
+
+/// structure3d_tie_response with the free rods' Hessian `h` given (free_hessian of the same rods,
+/// or of them turned rigidly, turned with them).
+std::vector<std::vector<Vec3>> tie_response(const Structure3dInput& input, const Eigen::SparseMatrix<double>& h,
+                                            const std::vector<std::vector<Structure3dLoad>>& cases,
+                                            const Structure3dOptions& options);
+
 /// Node k's position of rod r in q.
 inline Vec3 node(const Model& model, const Eigen::VectorXd& q, int r, int k) {
   return q.segment<3>(model.rods[static_cast<std::size_t>(r)].x(k, 0));

@@ -13,31 +13,41 @@ namespace wiresculpt {
 
 using SpMat = Eigen::SparseMatrix<double>;
 
-std::vector<std::vector<Vec3>> structure3d_tie_response(const Structure3dInput& input,
-                                                        const std::vector<std::vector<Structure3dLoad>>& cases,
-                                                        const Structure3dOptions& options) {
+namespace detail {
+
+SpMat free_hessian(const Structure3dInput& input, const Structure3dOptions& options) {
+  Structure3dInput free = input;
+  free.loads.clear(), free.ties.clear(), free.clamps.clear(), free.pins.clear(), free.table = {};
+  for (Structure3dWire& w : free.wires) w.rest = w.start;
+  validate(free, options);
+  const Model f = build_model(free, options);
+  Eigen::VectorXd g;
+  std::vector<Eigen::Triplet<double>> triplets;
+  assemble(f, f.start, g, triplets);
+  SpMat h(f.full_dofs, f.full_dofs);
+  h.setFromTriplets(triplets.begin(), triplets.end());
+  return h;
+}
+
+std::vector<std::vector<Vec3>> tie_response(const Structure3dInput& input, const SpMat& h,
+                                            const std::vector<std::vector<Structure3dLoad>>& cases,
+                                            const Structure3dOptions& options) {
   Structure3dInput tied = input;
   tied.loads.clear();
   for (Structure3dWire& w : tied.wires) w.rest = w.start;
-  detail::validate(tied, options);
-  const detail::Model m = detail::build_model(tied, options);
-  // The same rods untied and free: the full DOFs are numbered alike, so its Hessian is each rod's own.
-  Structure3dInput free = tied;
-  free.ties.clear(), free.clamps.clear(), free.pins.clear(), free.table = {};
-  const detail::Model f = detail::build_model(free, options);
-
-  // One assembly: the free rods' Hessian on the full DOFs, summed through the tied map into K.
-  Eigen::VectorXd g;
-  std::vector<Eigen::Triplet<double>> triplets, summed;
-  detail::assemble(f, f.start, g, triplets);
-  SpMat h(f.full_dofs, f.full_dofs);
-  h.setFromTriplets(triplets.begin(), triplets.end());
-  for (const Eigen::Triplet<double>& t : triplets)
-    if (m.map[t.row()] >= 0 && m.map[t.col()] >= 0) summed.emplace_back(m.map[t.row()], m.map[t.col()], t.value());
+  validate(tied, options);
+  const Model m = build_model(tied, options);
+  if (h.rows() != m.full_dofs || h.cols() != m.full_dofs)
+    throw InputError("tie response: the rods' Hessian does not match the structure");
+  // The free rods' Hessian summed through the tied map into K (held DOFs dropped).
+  std::vector<Eigen::Triplet<double>> summed;
+  for (int c = 0; c < h.outerSize(); ++c)
+    for (SpMat::InnerIterator it(h, c); it; ++it)
+      if (m.map[it.row()] >= 0 && m.map[it.col()] >= 0) summed.emplace_back(m.map[it.row()], m.map[it.col()], it.value());
   SpMat k(m.reduced_dofs, m.reduced_dofs);
   k.setFromTriplets(summed.begin(), summed.end());
   Eigen::SimplicialLDLT<SpMat> ldlt;
-  if (!detail::factor_positive(k, ldlt))
+  if (!factor_positive(k, ldlt))
     throw SolverError("the tied structure is a mechanism: no stiffness resists some motion of it");
 
   std::vector<std::vector<Vec3>> out;
@@ -64,6 +74,14 @@ std::vector<std::vector<Vec3>> structure3d_tie_response(const Structure3dInput& 
     out.push_back(std::move(ties));
   }
   return out;
+}
+
+}  // namespace detail
+
+std::vector<std::vector<Vec3>> structure3d_tie_response(const Structure3dInput& input,
+                                                        const std::vector<std::vector<Structure3dLoad>>& cases,
+                                                        const Structure3dOptions& options) {
+  return detail::tie_response(input, detail::free_hessian(input, options), cases, options);
 }
 
 }  // namespace wiresculpt
