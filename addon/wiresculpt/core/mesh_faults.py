@@ -168,6 +168,7 @@ def check(vertices, faces):
     size = mesh_size(V)
     index, count = _weld(V, size)
     F = index[F]
+    F = np.unique(np.sort(F, axis=1), axis=0)  # a repeated triangle is dropped, as the slicer drops it
     P = np.zeros((count, 3))
     P[index] = V
     faults = []
