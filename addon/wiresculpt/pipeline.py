@@ -40,7 +40,8 @@ def slice_and_pick(vertices, faces, planes, material, settings, progress=None):
     return design
 
 
-def solve(design, material, settings, progress=None, cancel=None, stock=None, hook_patterns=None, hook_seconds=None):
+def solve(design, material, settings, progress=None, cancel=None, stock=None, hook_patterns=None, hook_seconds=None,
+          context=None):
     """Runs every stage after slicing on `design` (its wires' contours set), re-layering while the
     target shape cannot realise a hook (relayer). `progress(stage, message)` is called once per
     finished stage; `cancel()` returning True stops at the next safe point with Cancelled.
@@ -49,9 +50,14 @@ def solve(design, material, settings, progress=None, cancel=None, stock=None, ho
     the default profile's). `hook_patterns`: at most this many hook patterns per round in
     hooks_by_forces (None: HOOK_PATTERNS; 1: the layering's own, as Live does); `hook_seconds`: no
     new pattern after this many seconds (None: HOOK_SECONDS; the plane search's final solve). Past settings.max_solve_seconds (wall
-    clock) the solve stops the same way and raises OutOfTime, naming the key and the stage."""
-    budget = float(settings.get("max_solve_seconds") or settings_table.SETTINGS["max_solve_seconds"][0])
-    context = SolveContext(progress, cancel, budget)
+    clock) the solve stops the same way and raises OutOfTime, naming the key and the stage. `context`:
+    the SolveContext of a longer run this solve is part of (the plane search's): the solve keeps
+    its deadline (one budget for the whole run) instead of starting its own (None: its own)."""
+    if context is None:
+        budget = float(settings.get("max_solve_seconds") or settings_table.SETTINGS["max_solve_seconds"][0])
+        context = SolveContext(progress, cancel, budget)
+    else:
+        context = context.for_solve(progress, cancel)
     design["pending_stages"] = list(ALL_STAGES)
     if len(design["wires"]) < 2:
         design["stable"] = False
@@ -489,7 +495,8 @@ def hooks_by_forces(design, material, settings, context, patterns=None, seconds=
     if cut:
         best.setdefault("warnings", []).append(
             f"hooks by forces: {checked} of {total} hook patterns of equal Eq. 2 cost were tried (bounded to "
-            f"{patterns} patterns and {seconds:g} s{' over every re-layering round' if deadline is not None else ''}); "
+            f"{patterns} patterns{f' and {seconds:g} s' if math.isfinite(seconds) else ''}"
+            f"{' over every re-layering round' if deadline is not None else ''}); "
             "a better one may exist")
     if chosen and best_score is not None:
         context.say("forces", f"hooks by forces: pattern {chosen} of {checked} tried (weakest load "
@@ -500,7 +507,7 @@ def hooks_by_forces(design, material, settings, context, patterns=None, seconds=
     return design
 
 
-def run(vertices, faces, planes, material, settings, progress=None, cancel=None, stock=None):
-    """slice_and_pick then solve: the whole pipeline from a mesh and planes."""
+def run(vertices, faces, planes, material, settings, progress=None, cancel=None, stock=None, context=None):
+    """slice_and_pick then solve: the whole pipeline from a mesh and planes (`context`: as solve's)."""
     design = slice_and_pick(vertices, faces, planes, material, settings, progress)
-    return solve(design, material, settings, progress, cancel, stock)
+    return solve(design, material, settings, progress, cancel, stock, context=context)
