@@ -1,5 +1,6 @@
 """The headless pipeline with settings.plane_search (the batch script's entry)."""
 from .. import pipeline
+from ..core import settings as settings_table
 from ..core.solve_context import SolveContext
 from .auto import auto, family_planes
 from .nearby import nearby
@@ -9,18 +10,21 @@ from .records import _record, _summary, nearby_reason
 MODES = ("off", "nearby", "auto")
 
 
-def run(vertices, faces, planes, material, settings, progress=None, cancel=None, stock=None):
+def run(vertices, faces, planes, material, settings, progress=None, cancel=None, stock=None, clock=None):
     """The headless pipeline with settings.plane_search: "off" -> pipeline.run; "nearby" -> the
     given planes first, the nearby search when they give no stable design; "auto" -> planes
     from the mesh. The design carries `plane_search` whenever a search ran; when none is found the
     design of the given planes (nearby) or of the first proposal (auto) is returned, not stable,
-    with the reason saying what was tried. `stock`: as pipeline.solve's. Returns (design, planes
-    actually used)."""
+    with the reason saying what was tried. `stock`: as pipeline.solve's. One wall-clock budget,
+    settings.max_solve_seconds, for the whole run, the search and every solve in it included: past
+    it OutOfTime (naming the key and the stage) ends the run. `clock()`: the time it reads (None:
+    time.monotonic; a test's may run fast). Returns (design, planes actually used)."""
     say = progress or (lambda stage, message: None)
-    context = SolveContext(progress, cancel)  # the search's progress and cancel
+    budget = float(settings.get("max_solve_seconds") or settings_table.SETTINGS["max_solve_seconds"][0])
+    context = SolveContext(progress, cancel, budget, clock)  # the run's progress, cancel and one deadline
     mode = settings.get("plane_search", "off")
     if mode == "off":
-        return pipeline.run(vertices, faces, planes, material, settings, progress, cancel, stock), list(planes)
+        return pipeline.run(vertices, faces, planes, material, settings, progress, cancel, stock, context), list(planes)
     if mode == "nearby":
         if not planes:
             raise ValueError('settings.plane_search "nearby" needs planes to start from; give "planes" or use "auto"')
@@ -29,7 +33,7 @@ def run(vertices, faces, planes, material, settings, progress=None, cancel=None,
             best = found[0]
             design = best["design"]
         else:
-            design = pipeline.run(vertices, faces, planes, material, settings, progress, cancel, stock)
+            design = pipeline.run(vertices, faces, planes, material, settings, progress, cancel, stock, context)
             best = None
             if not design["stable"]:
                 design["reason"] = (f"{nearby_reason(s)}. The planes as given: {design['reason']}"
@@ -48,7 +52,7 @@ def run(vertices, faces, planes, material, settings, progress=None, cancel=None,
         else:
             best = None
             used = [p.spec() for p in family_planes(s, (count - count // 2, count // 2, 0))]
-            design = pipeline.run(vertices, faces, used, material, settings, progress, cancel, stock)
+            design = pipeline.run(vertices, faces, used, material, settings, progress, cancel, stock, context)
             if not design["stable"]:
                 design["reason"] += (f"; no proposed set of {count} planes ({s.screened} tried) gives a "
                                      f"stable design")
