@@ -136,7 +136,7 @@ def grow(s, count, frames, min_segment, until):
     limit = began + (until - began) // 4
     bases = []
     for spread, by, counts, axes in itertools.product(SPREADS, ("area", "extent"), splits_of(count - 1), frames):
-        if s.screened >= limit or s.over_time():
+        if s.screened >= limit or s.should_stop():
             break
         placements = family_planes(s, counts, "largest", spread, axes, by)
         ok, _design, probe = s.screen_layered(placements)
@@ -150,7 +150,7 @@ def grow(s, count, frames, min_segment, until):
         names = _family_names(axes)
         for k in range(3):
             for q in GROW_QUANTILES:
-                if s.screened >= limit or s.over_time():
+                if s.screened >= limit or s.should_stop():
                     return sorted(out, key=lambda t: t[:2])
                 added = area_quantile_plane(s, axes[k], q, f"{names[k]}{counts[k]}")
                 ok, design, probe = s.screen_layered(placements + [added])
@@ -210,14 +210,15 @@ def auto(mesh, count, material, settings, want=2, budget=None, context=None, sto
                 batch.append((close_gaps(probe, min_segment), -s.coverage(design), counts, axes, placements, design,
                               ""))
                 clean += batch[-1][0] == 0
-            if clean >= EARLY_SOLVES or s.screened >= limit or (not clean and s.screened >= soft) or s.over_time():
+            if (clean >= EARLY_SOLVES or s.screened >= limit or (not clean and s.screened >= soft)
+                    or s.should_stop()):
                 passed += len(batch)
                 return batch, True
         passed += len(batch)
         return batch, False
 
     more, pool, first, grown = True, [], True, None
-    while more and len(found) < want and not (s.over_time() or s.out_of_work()):
+    while more and len(found) < want and not (s.should_stop() or s.out_of_work()):
         # screening up to half the screens at first (a quarter when no proposal passes without close
         # crossings by then: grow follows), later up to half of what is left; verifying the pool
         # (fewest close gaps first) after each round
@@ -232,7 +233,7 @@ def auto(mesh, count, material, settings, want=2, budget=None, context=None, sto
             # no proposal keeps its crossings apart: sets grown from count - 1 planes, verified first
             grown = grow(s, count, frames, min_segment, screens)
             s.say("plane_search", f"{len(grown)} sets grown from {count - 1} planes pass the screen")
-        while (grown or pool) and len(found) < want and not (s.over_time() or s.out_of_work(("full_solves",))):
+        while (grown or pool) and len(found) < want and not (s.should_stop() or s.out_of_work(("full_solves",))):
             close, cover, counts, axes, placements, design, extra = (grown or pool).pop(0)
             solved = s.solve(copy.deepcopy(design))
             if solved is None or not solved["stable"]:

@@ -48,7 +48,7 @@ def nearby(mesh, planes, material, settings, want=1, budget=BUDGET_SECONDS, cont
 
     def out_of_time():
         """The search's end with work left: its guard, or a count of its limits reached."""
-        return s.over_time() or s.out_of_work()
+        return s.should_stop() or s.out_of_work()
 
     def bar():
         """The cost a candidate must beat to matter: the want-th cheapest found, else infinity."""
@@ -90,7 +90,7 @@ def nearby(mesh, planes, material, settings, want=1, budget=BUDGET_SECONDS, cont
             else:
                 solve(cost, changes, placements, design, probe)
         for k, (cost, changes, placements, design, probe) in enumerate(deferred):
-            if cost >= bar() or s.over_time() or s.out_of_work(("full_solves",)):
+            if cost >= bar() or s.should_stop() or s.out_of_work(("full_solves",)):
                 for _cost, later, _placements, _design, left in deferred[k:]:
                     gap = plane_faults.closest_gap(left)
                     tally.fault(tally.family_of(later), ("near", (gap[1],), gap[2]) if gap else ("unsolved", (), ()),

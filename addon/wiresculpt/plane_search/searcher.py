@@ -30,7 +30,7 @@ COVERAGE_RADIUS = 0.1  # fraction of S
 # context's deadline), after which the run ends with OutOfTime naming the plane search.
 CANDIDATE_HOOK_PATTERNS = 1
 SCREEN_NODES = 5000  # a screen's layering search stops after this many nodes (a search of many contours)
-FINAL_HOOK_PATTERNS = 64  # the final comparison of hook patterns: at most this many (pipeline.HOOK_PATTERNS)
+FINAL_HOOK_PATTERNS = 16  # the final comparison of hook patterns: at most this many (about the 10 s it had)
 FINAL_SECONDS = 120.0  # the final comparison's wall-clock guard (stopped_by "time" when it fires)
 SCREEN_SECONDS = None  # gone: a screen is bounded by SCREEN_NODES (kept for the package's names)
 FINAL_HOOK_SECONDS = None  # gone: the final comparison is bounded by FINAL_HOOK_PATTERNS
@@ -80,6 +80,12 @@ class Searcher:
         if self.clock() > self.guard:
             self.time_stopped = True
         return self.time_stopped
+
+    def should_stop(self):
+        """At a step of the search: OutOfTime past the run's one budget (it comes before the search's
+        own guard), else whether the guard has passed (over_time)."""
+        self._run_out()
+        return self.over_time()
 
     def out_of_work(self, which=("candidates", "full_solves")):
         """Whether a count of the search's limits (`limits`: those named by `which`) is reached:
@@ -337,7 +343,10 @@ class Searcher:
         stop = math.inf if deadline is None else deadline
         try:
             return pipeline.solve(design, self.material, self.settings_for(design),
-                                  cancel=lambda: self.cancel() or self.over_time() or self.clock() > stop,
+                                  # past the run's budget the solve's own OutOfTime (naming its stage)
+                                  # comes before the guard's stop
+                                  cancel=lambda: self.cancel() or ((self.over_time() or self.clock() > stop)
+                                                                   and not self.context.out_of_time()),
                                   stock=self.stock,
                                   hook_patterns=hook_patterns, hook_seconds=hook_seconds, context=self.context)
         except OutOfTime:  # the run's budget: the run ends
