@@ -6,6 +6,9 @@ key and the plane search). The scenes are test_plane_search's spheres, whose pla
 hand; the clocks are the test's (SolveContext's `clock`)."""
 import json
 import math
+import os
+import subprocess
+import sys
 import threading
 import time
 import unittest
@@ -133,6 +136,37 @@ class SameDesignAnyClock(unittest.TestCase):
         self.assertEqual(s.stopped_by(), "time")
         self.assertTrue(s.tally.out_of_time)
         self.assertLess(s.screened, plane_search.NEARBY_SCREENS)
+
+
+# One process's nearby search on HINGE, printing the SHA-256 of its design's bytes without the times.
+ONE_PROCESS = """
+import hashlib, sys
+sys.path[:0] = sys.argv[1:]
+from wiresculpt import plane_search
+from wiresculpt.core.materials import PRESETS
+from helpers import sphere
+import test_plane_search_budgets as t
+V, F = sphere(t.R)
+t.setUpModule()
+design, _ = plane_search.run(V, F, t.HINGE, PRESETS["steel"], t.settings(plane_search="nearby"))
+print(hashlib.sha256(t.as_written(design)).hexdigest())
+"""
+
+
+@unittest.skipUnless(native.available(), native.LOAD_ERROR)
+class SameDesignAnyProcess(unittest.TestCase):
+    def test_string_hashing_does_not_reach_the_design(self):
+        # two processes whose string hashes differ (PYTHONHASHSEED): sets and dicts of wire and plane
+        # names iterate otherwise, and the design's bytes must not show it
+        here = os.path.dirname(os.path.abspath(__file__))
+        path = [os.path.join(os.path.dirname(os.path.dirname(here)), "addon"), os.path.dirname(here), here]
+        digests = set()
+        for seed in ("1", "2"):
+            r = subprocess.run([sys.executable, "-c", ONE_PROCESS, *path], capture_output=True, text=True,
+                               env=dict(os.environ, PYTHONHASHSEED=seed), timeout=600)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            digests.add(r.stdout.strip().splitlines()[-1])
+        self.assertEqual(len(digests), 1)
 
 
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)
