@@ -40,8 +40,7 @@ def slice_and_pick(vertices, faces, planes, material, settings, progress=None):
     return design
 
 
-def solve(design, material, settings, progress=None, cancel=None, stock=None, hook_patterns=None, hook_seconds=None,
-          context=None):
+def solve(design, material, settings, progress=None, cancel=None, stock=None, hook_patterns=None, hook_seconds=None):
     """Runs every stage after slicing on `design` (its wires' contours set), re-layering while the
     target shape cannot realise a hook (relayer). `progress(stage, message)` is called once per
     finished stage; `cancel()` returning True stops at the next safe point with Cancelled.
@@ -50,14 +49,16 @@ def solve(design, material, settings, progress=None, cancel=None, stock=None, ho
     the default profile's). `hook_patterns`: at most this many hook patterns per round in
     hooks_by_forces (None: HOOK_PATTERNS; 1: the layering's own, as Live does); `hook_seconds`: no
     new pattern after this many seconds (None: HOOK_SECONDS; the plane search's final solve). Past settings.max_solve_seconds (wall
-    clock) the solve stops the same way and raises OutOfTime, naming the key and the stage. `context`:
-    the SolveContext of a longer run this solve is part of (the plane search's): the solve keeps
-    its deadline (one budget for the whole run) instead of starting its own (None: its own)."""
-    if context is None:
+    clock) the solve stops the same way and raises OutOfTime, naming the key and the stage.
+    `progress` may instead be the SolveContext of a longer run this solve is part of (the plane
+    search's): the solve then says what it says (nothing, from a quiet view), is cancelled when that
+    run is or by `cancel`, and keeps the run's deadline (one budget for the whole run) instead of
+    starting its own."""
+    if isinstance(progress, SolveContext):
+        context = progress.for_solve(cancel)
+    else:
         budget = float(settings.get("max_solve_seconds") or settings_table.SETTINGS["max_solve_seconds"][0])
         context = SolveContext(progress, cancel, budget)
-    else:
-        context = context.for_solve(progress, cancel)
     design["pending_stages"] = list(ALL_STAGES)
     if len(design["wires"]) < 2:
         design["stable"] = False
@@ -507,7 +508,9 @@ def hooks_by_forces(design, material, settings, context, patterns=None, seconds=
     return design
 
 
-def run(vertices, faces, planes, material, settings, progress=None, cancel=None, stock=None, context=None):
-    """slice_and_pick then solve: the whole pipeline from a mesh and planes (`context`: as solve's)."""
-    design = slice_and_pick(vertices, faces, planes, material, settings, progress)
-    return solve(design, material, settings, progress, cancel, stock, context=context)
+def run(vertices, faces, planes, material, settings, progress=None, cancel=None, stock=None):
+    """slice_and_pick then solve: the whole pipeline from a mesh and planes (`progress`: as solve's,
+    a callback or the SolveContext of the run)."""
+    design = slice_and_pick(vertices, faces, planes, material, settings,
+                            progress.say if isinstance(progress, SolveContext) else progress)
+    return solve(design, material, settings, progress, cancel, stock)

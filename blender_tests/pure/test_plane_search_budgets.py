@@ -119,7 +119,7 @@ class SameDesignAnyClock(unittest.TestCase):
             out = []
             for mode, planes, extra in (("nearby", HINGE, {}), ("auto", [], {"plane_count": 4})):
                 design, used = plane_search.run(self.V, self.F, planes, PRESETS["steel"],
-                                                settings(plane_search=mode, **extra), clock=clock)
+                                                settings(plane_search=mode, **extra), SolveContext(clock=clock))
                 self.assertTrue(design["stable"], design["reason"])
                 self.assertEqual(design["plane_search"]["stopped_by"], "done")
                 out.append((as_written(design), [p.name for p in used]))
@@ -199,7 +199,7 @@ class OneBudgetForTheRun(unittest.TestCase):
             with self.subTest(mode=mode), self.assertRaises(OutOfTime) as raised:
                 plane_search.run(V, F, planes, PRESETS["steel"],
                                  settings(plane_search=mode, plane_count=4, max_solve_seconds=5.0),
-                                 clock=FastClock(1e9))
+                                 SolveContext(clock=FastClock(1e9)))
             self.assertEqual((raised.exception.budget, raised.exception.stage), (5.0, "plane_search"))
             self.assertTrue(str(raised.exception).startswith(
                 "the solve stopped at its time budget, settings.max_solve_seconds = 5 s, during the plane search"))
@@ -217,7 +217,8 @@ class OneBudgetForTheRun(unittest.TestCase):
         searcher.pipeline.solve = late_solve
         try:
             with self.assertRaises(OutOfTime) as raised:
-                plane_search.run(V, F, HINGE, PRESETS["steel"], settings(plane_search="nearby"), clock=clock)
+                plane_search.run(V, F, HINGE, PRESETS["steel"], settings(plane_search="nearby"),
+                                 SolveContext(clock=clock))
         finally:
             searcher.pipeline.solve = real
         self.assertEqual(raised.exception.budget, 600.0)

@@ -11,7 +11,7 @@ Instead of closures passed by position, a stage's caller reads
                                        False when cancelled or past the deadline
     context.checkpoint()               raises Cancelled or OutOfTime at a safe point
     context.quiet()                    the same context, saying nothing (hook patterns after the first)
-    context.for_solve(progress, cancel) a fresh context for one solve inside a longer run (the plane
+    context.for_solve(cancel)          a fresh context for one solve inside a longer run (the plane
                                        search's): its own memos, the run's clock and deadline
 
 and the solve's shared memos: `same_solves` (target-shape solves by exact input, for every
@@ -83,13 +83,14 @@ class SolveContext:
         view._speaks = False
         return view
 
-    def for_solve(self, progress=None, cancel=None):
+    def for_solve(self, cancel=None):
         """A fresh context for one solve inside the run this context times (the plane search's
-        full solves): its own progress, stage and memos, this context's clock, budget and deadline
-        (the run's one budget, not a fresh one per solve), cancelled when this one is or when
-        `cancel()` (None: only then)."""
+        full solves): its own stage and memos, this context's progress (nothing from a quiet
+        view), clock, budget and deadline (the run's one budget, not a fresh one per solve),
+        cancelled when this one is or when `cancel()` (None: only then)."""
         mine = self.cancelled
-        view = SolveContext(progress, mine if cancel is None else (lambda: mine() or cancel()), clock=self.clock)
+        view = SolveContext(self.progress if self._speaks else None,
+                            mine if cancel is None else (lambda: mine() or cancel()), clock=self.clock)
         view.budget, view.deadline = self.budget, self.deadline
         return view
 

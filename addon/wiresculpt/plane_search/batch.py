@@ -10,21 +10,25 @@ from .records import _record, _summary, nearby_reason
 MODES = ("off", "nearby", "auto")
 
 
-def run(vertices, faces, planes, material, settings, progress=None, cancel=None, stock=None, clock=None):
+def run(vertices, faces, planes, material, settings, progress=None, cancel=None, stock=None):
     """The headless pipeline with settings.plane_search: "off" -> pipeline.run; "nearby" -> the
     given planes first, the nearby search when they give no stable design; "auto" -> planes
     from the mesh. The design carries `plane_search` whenever a search ran; when none is found the
     design of the given planes (nearby) or of the first proposal (auto) is returned, not stable,
     with the reason saying what was tried. `stock`: as pipeline.solve's. One wall-clock budget,
     settings.max_solve_seconds, for the whole run, the search and every solve in it included: past
-    it OutOfTime (naming the key and the stage) ends the run. `clock()`: the time it reads (None:
-    time.monotonic; a test's may run fast). Returns (design, planes actually used)."""
+    it OutOfTime (naming the key and the stage) ends the run. `progress`: a callback (stage, message),
+    or a SolveContext whose progress, cancel and clock the run takes (a test's clock may run fast;
+    the budget is still the settings'). Returns (design, planes actually used)."""
+    clock = None
+    if isinstance(progress, SolveContext):
+        progress, cancel, clock = progress.progress, cancel or progress.cancelled, progress.clock
     say = progress or (lambda stage, message: None)
     budget = float(settings.get("max_solve_seconds") or settings_table.SETTINGS["max_solve_seconds"][0])
     context = SolveContext(progress, cancel, budget, clock)  # the run's progress, cancel and one deadline
     mode = settings.get("plane_search", "off")
     if mode == "off":
-        return pipeline.run(vertices, faces, planes, material, settings, progress, cancel, stock, context), list(planes)
+        return pipeline.run(vertices, faces, planes, material, settings, context, None, stock), list(planes)
     if mode == "nearby":
         if not planes:
             raise ValueError('settings.plane_search "nearby" needs planes to start from; give "planes" or use "auto"')
@@ -33,7 +37,7 @@ def run(vertices, faces, planes, material, settings, progress=None, cancel=None,
             best = found[0]
             design = best["design"]
         else:
-            design = pipeline.run(vertices, faces, planes, material, settings, progress, cancel, stock, context)
+            design = pipeline.run(vertices, faces, planes, material, settings, context, None, stock)
             best = None
             if not design["stable"]:
                 design["reason"] = (f"{nearby_reason(s)}. The planes as given: {design['reason']}"
@@ -52,7 +56,7 @@ def run(vertices, faces, planes, material, settings, progress=None, cancel=None,
         else:
             best = None
             used = [p.spec() for p in family_planes(s, (count - count // 2, count // 2, 0))]
-            design = pipeline.run(vertices, faces, used, material, settings, progress, cancel, stock, context)
+            design = pipeline.run(vertices, faces, used, material, settings, context, None, stock)
             if not design["stable"]:
                 design["reason"] += (f"; no proposed set of {count} planes ({s.screened} tried) gives a "
                                      f"stable design")

@@ -342,13 +342,12 @@ class Searcher:
         self._run_out()
         stop = math.inf if deadline is None else deadline
         try:
-            return pipeline.solve(design, self.material, self.settings_for(design),
+            return pipeline.solve(design, self.material, self.settings_for(design), self.context.quiet(),
                                   # past the run's budget the solve's own OutOfTime (naming its stage)
                                   # comes before the guard's stop
                                   cancel=lambda: self.cancel() or ((self.over_time() or self.clock() > stop)
                                                                    and not self.context.out_of_time()),
-                                  stock=self.stock,
-                                  hook_patterns=hook_patterns, hook_seconds=hook_seconds, context=self.context)
+                                  stock=self.stock, hook_patterns=hook_patterns, hook_seconds=hook_seconds)
         except OutOfTime:  # the run's budget: the run ends
             raise
         except (ValueError, RuntimeError):  # a candidate the solver cannot finish (an infeasible LP): no answer
