@@ -6,6 +6,7 @@ import json
 import os
 import sys
 import tempfile
+import time
 import unittest
 
 import numpy as np
@@ -14,6 +15,9 @@ from helpers import BATCH, ROOT, run_blender, wiresculpt_lines
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "pure"))
 import recheck  # noqa: E402
+
+OUTPUTS = ("design.json", "sculpture.blend", "render.png", "assembly", "svg", "dxf", "templates", "gcode", "bends",
+           "bendlist")
 
 GLOBE_OBJ = os.path.join(ROOT, "scripts", "examples", "globe", "globe.obj")
 HINGE = [{"name": "Z1", "origin": [0, 0, 0.7], "normal": [0, 0, 1]},
@@ -103,6 +107,22 @@ class PlaneSearchBatch(unittest.TestCase):
         self.assertEqual(recheck.recheck(d), [])
         self.assertEqual(len(d["plane_search"]["planes_after"]), 4)
         self.assertEqual(len({w["name"].split("/")[0] for w in d["wires"]}), 4)
+
+    def test_max_solve_seconds_bounds_the_whole_search_and_nothing_is_written(self):
+        # one budget for the run, the plane search and its solves included: 12 auto planes on the globe
+        # take far longer than 0.5 s (screens and full solves of seconds), so the run ends at the budget
+        # with one line naming the key, exit 1, and no output file
+        started = time.monotonic()
+        r, d = self.run_scene([], plane_search="auto", plane_count=12, max_solve_seconds=0.5)
+        self.assertEqual(r.returncode, 1, r.stdout + r.stderr)
+        errors = wiresculpt_lines(r.stderr)
+        self.assertEqual(len(errors), 1, r.stderr)
+        self.assertIn("the solve stopped at its time budget, settings.max_solve_seconds = 0.5 s, during the ",
+                      errors[0])
+        self.assertIsNone(d)
+        left = os.listdir(self.out) if os.path.isdir(self.out) else []
+        self.assertEqual([n for n in left if n in OUTPUTS], [])
+        self.assertLess(time.monotonic() - started, 120.0)  # Blender's start and the mesh, not a 12-plane search
 
     def test_bad_mode_is_one_clear_error(self):
         r, _d = self.run_scene(HINGE, plane_search="everywhere")

@@ -116,7 +116,7 @@ def kept_auto(old):
                 result.group(0).replace("Auto (the run before):", "Auto:"))
     run = re.search(r"\((\d{4}-\d\d-\d\d), commit (\w+);", old)
     load = re.search(r"shared: ([\d.]+) at the start, ([\d.]+) at the end", old)
-    budget = re.search(r'`"auto"` \((budget .*?)\)', old, re.S)
+    budget = re.search(r'`"auto"` \(((?:budget|at most) .*?)\)', old, re.S)  # the older header said "budget"
     if not (run and load and budget and result):
         raise SystemExit("plane_search_corpus: the section's header does not say when its auto columns ran "
                          "(date, commit, load, budget, result): run with --counts")
@@ -156,15 +156,16 @@ def section(path, rows, counts, args, load, commit):
     rechecked = sum(1 for r in rows for k in ["nearby"] + [f"auto{n}" for n in counts] if r[k]["stable"])
     failed = sum(1 for r in rows for k in ["nearby"] + [f"auto{n}" for n in counts] if r[k].get("recheck"))
     auto_run = ("" if kept else
-                f', and every mesh with `"auto"` (budget {plane_search.AUTO_SECONDS_PER_PLANE:g} s per plane, then at '
-                f"most {plane_search.FINAL_SECONDS:g} s for the comparison of hook patterns on the returned design)")
+                f', and every mesh with `"auto"` (at most {plane_search.AUTO_SCREENS_PER_PLANE} proposals screened and '
+                f"{plane_search.AUTO_SOLVES_PER_PLANE} solved per plane, then at most {plane_search.FINAL_HOOK_PATTERNS} "
+                "patterns for the comparison of hook patterns on the returned design)")
     counts_arg = args.counts or '""'
     head = [BEGIN, "## Plane assistant on the real-mesh corpus", "",
             f"`scripts/bench planes --size {args.size} --counts {counts_arg} --section docs/performance.md` "
             f"({datetime.date.today().isoformat()}, commit {commit}; `scripts/plane_search_corpus.py`, in-process with "
             "the system Python 3.11 and the built module, no Blender): every `zzxxy5` scene of the corpus at "
-            f"{args.size} m, solved with the planes as given, then with `plane_search: \"nearby\"` (budget "
-            f"{plane_search.BUDGET_SECONDS:g} s){auto_run}. Load average (1 min) of the 2-core "
+            f"{args.size} m, solved with the planes as given, then with `plane_search: \"nearby\"` (at most "
+            f"{plane_search.NEARBY_SCREENS} candidates screened and {plane_search.NEARBY_SOLVES} solved){auto_run}. Load average (1 min) of the 2-core "
             f"machine, shared: {load[0]:.1f} at the start, {load[1]:.1f} at the end. Every stable design of the run is "
             f"re-checked by `blender_tests/pure/recheck.py`: {rechecked} stable, {failed} refused by it."
             + (f" {about}" if about else ""), "",

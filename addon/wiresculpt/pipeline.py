@@ -53,9 +53,16 @@ def solve(design, material, settings, progress=None, cancel=None, stock=None, ho
     the default profile's). `hook_patterns`: at most this many hook patterns per round in
     hooks_by_forces (None: HOOK_PATTERNS; 1: the layering's own, as Live does); `hook_seconds`: no
     new pattern after this many seconds (None: HOOK_SECONDS; the plane search's final solve). Past settings.max_solve_seconds (wall
-    clock) the solve stops the same way and raises OutOfTime, naming the key and the stage."""
-    budget = float(settings.get("max_solve_seconds") or settings_table.SETTINGS["max_solve_seconds"][0])
-    context = SolveContext(progress, cancel, budget)
+    clock) the solve stops the same way and raises OutOfTime, naming the key and the stage.
+    `progress` may instead be the SolveContext of a longer run this solve is part of (the plane
+    search's): the solve then says what it says (nothing, from a quiet view), is cancelled when that
+    run is or by `cancel`, and keeps the run's deadline (one budget for the whole run) instead of
+    starting its own."""
+    if isinstance(progress, SolveContext):
+        context = progress.for_solve(cancel)
+    else:
+        budget = float(settings.get("max_solve_seconds") or settings_table.SETTINGS["max_solve_seconds"][0])
+        context = SolveContext(progress, cancel, budget)
     design["pending_stages"] = list(ALL_STAGES)
     if len(design["wires"]) < 2:
         design["stable"] = False
@@ -502,7 +509,8 @@ def hooks_by_forces(design, material, settings, context, patterns=None, seconds=
     if cut:
         best.setdefault("warnings", []).append(
             f"hooks by forces: {checked} of {total} hook patterns of equal Eq. 2 cost were tried (bounded to "
-            f"{patterns} patterns and {seconds:g} s{' over every re-layering round' if deadline is not None else ''}); "
+            f"{patterns} patterns{f' and {seconds:g} s' if math.isfinite(seconds) else ''}"
+            f"{' over every re-layering round' if deadline is not None else ''}); "
             "a better one may exist")
     if chosen and best_score is not None:
         context.say("forces", f"hooks by forces: pattern {chosen} of {checked} tried (weakest load "
@@ -515,6 +523,8 @@ def hooks_by_forces(design, material, settings, context, patterns=None, seconds=
 
 
 def run(vertices, faces, planes, material, settings, progress=None, cancel=None, stock=None):
-    """slice_and_pick then solve: the whole pipeline from a mesh and planes."""
-    design = slice_and_pick(vertices, faces, planes, material, settings, progress)
+    """slice_and_pick then solve: the whole pipeline from a mesh and planes (`progress`: as solve's,
+    a callback or the SolveContext of the run)."""
+    design = slice_and_pick(vertices, faces, planes, material, settings,
+                            progress.say if isinstance(progress, SolveContext) else progress)
     return solve(design, material, settings, progress, cancel, stock)

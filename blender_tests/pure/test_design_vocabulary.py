@@ -23,7 +23,8 @@ FORMATS = os.path.join(ROOT, "docs", "formats.md")
 BULLETS = {"Top": {"design", "pipeline", "every stage"}, "Slicing": {"slicing"}, "Layering": {"layering"},
            "Target shape": {"target_shape"}, "Forces and rest shape": {"forces"}, "Fabrication": {"fabrication"},
            "Plane search": {"plane_search"}, "Standing in 3D": {"stands_3d"}}
-PREFIX = {"top": "", "wire": "wires[].", "crossing": "crossings[].", "stages": "stages."}
+PREFIX = {"top": "", "wire": "wires[].", "crossing": "crossings[].", "stages": "stages.",
+          "plane_search": "plane_search."}
 
 
 def documented():

@@ -278,13 +278,14 @@ class NoNearbyPlacement(unittest.TestCase):
         self.assertTrue(design["reason"].endswith(f". The planes as given: {given['reason']}"))
         self.assertIn("wire A/0 on wire C/0", design["reason"])
         # the record keeps the keys it had (the FORMATS contract's and the extra ones before), and adds only
-        # not_found: how the search ended, as data beside the reason's words, and the returned candidate's
-        # fidelity and coverage (none here)
+        # not_found (how the search ended, as data beside the reason's words), what bounded the search
+        # (limits, stopped_by, screens_cut) and the returned candidate's fidelity and coverage (none here)
         self.assertEqual(set(design["plane_search"]), {
             "mode", "planes_before", "planes_after", "changes", "candidates", "full_solves", "budget_seconds",
             "solves_stopped", "solves_failed", "final_solve", "seconds", "score", "measure", "not_found",
-            "fidelity", "coverage"})
+            "limits", "stopped_by", "screens_cut", "fidelity", "coverage"})
         self.assertIsNone(design["plane_search"]["fidelity"])
+        self.assertEqual(design["plane_search"]["stopped_by"], "done")  # every candidate screened
         self.assertEqual(design["plane_search"]["planes_after"], [])
         screened = int(re.search(r"; (\d+) placements screened", design["reason"]).group(1))
         self.assertEqual(design["plane_search"]["candidates"], screened)

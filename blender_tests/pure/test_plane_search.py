@@ -190,10 +190,10 @@ class Nearby(unittest.TestCase):
         placements = [plane_search.Placement(p.name, p.origin, p.normal, p.contours) for p in BASE]
         ok, design, _close = s.screen(placements)
         self.assertTrue(ok)  # the base is stable (test_the_scenes_are_what_the_hand_says)
-        s.deadline = 0.0  # long past: the solve stops at its first check
+        s.guard = 0.0  # the search's guard long past: the solve stops at its first check
         self.assertIsNone(s.solve(copy.deepcopy(design)))
         self.assertEqual((s.full_solves, s.timed_out), (1, 1))
-        s.deadline = math.inf
+        s.guard, s.time_stopped = math.inf, False
         self.assertTrue(s.solve(copy.deepcopy(design))["stable"])
         s.cancel = lambda: True
         with self.assertRaises(pipeline.Cancelled):

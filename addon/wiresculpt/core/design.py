@@ -72,6 +72,11 @@ KEYS = {
         "forces": "forces", "rest_shape": "forces", "hook_search": "pipeline", "relayering": "pipeline",
         "stands_3d": "stands_3d",
     },
+    # the plane search's record (`plane_search`, plane_search/records.py)
+    "plane_search": {k: "plane_search" for k in (
+        "mode", "planes_before", "planes_after", "changes", "candidates", "full_solves", "budget_seconds",
+        "solves_stopped", "solves_failed", "final_solve", "seconds", "score", "measure", "not_found",
+        "limits", "stopped_by", "screens_cut")},
 }
 
 # Keys written only in some cases (a stage that ran may leave them out): close crossings, a
@@ -84,6 +89,7 @@ OPTIONAL = {
              "as_built"},
     "crossing": {"pyramid", "carried_force", "carried_weight", "force_3d", "admissible"},
     "stages": {"stands_3d"},
+    "plane_search": {"not_found"},
 }
 
 

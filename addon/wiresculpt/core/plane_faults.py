@@ -480,7 +480,8 @@ class Tally:
         """The sentence a nearby search that found nothing ends with: what it searched, how many
         placements it screened and solved, whether the budget cut it short and how much was left,
         each family's candidates counted by fault (the `shown` commonest, then the rest as one
-        count), and what to change (advice on the commonest faults)."""
+        count), and what to change (advice on the commonest faults). `budget`: the seconds of the
+        budget that ended it, or what ended it in words ("limit of 24 full solves")."""
         fam = self.families
         ending = self.ending(min_segment)
         screened, total, todo = ending["screened"], ending["total"], ending["advice"]
@@ -493,7 +494,8 @@ class Tally:
                f"{screened} placements screened, {solved} fully solved, in {self.seconds:.1f} s"]
         left, left_given, left_singles, left_pairs = self.left()
         if ending["budget_ended"]:
-            out.append(f"the {budget:g} s budget ended the search after {screened} of {total} candidates: "
+            ended = f"{budget:g} s budget" if isinstance(budget, (int, float)) else budget  # or a count, in words
+            out.append(f"the {ended} ended the search after {screened} of {total} candidates: "
                        f"{left} left ({'the planes as given, ' if left_given else ''}{left_singles} one-plane and "
                        f"{left_pairs} two-plane changes)")
         elif left:

@@ -1,7 +1,9 @@
 """The context of one solve: how it reports, when it stops, and what its stages share.
 
 pipeline.solve builds one SolveContext and hands it to the stages' callers (pipeline.relayer,
-shape_and_rest, hooks_by_forces); the plane search holds one for its own progress and cancel.
+shape_and_rest, hooks_by_forces); the plane search holds one for the whole run (its progress,
+cancel and the run's one deadline, settings.max_solve_seconds), and each of its full solves gets a
+for_solve view of it.
 Instead of closures passed by position, a stage's caller reads
 
     context.say(stage, message)        a progress line (and the stage under way, for OutOfTime)
@@ -9,6 +11,8 @@ Instead of closures passed by position, a stage's caller reads
                                        False when cancelled or past the deadline
     context.checkpoint()               raises Cancelled or OutOfTime at a safe point
     context.quiet()                    the same context, saying nothing (hook patterns after the first)
+    context.for_solve(cancel)          a fresh context for one solve inside a longer run (the plane
+                                       search's): its own memos, the run's clock and deadline
 
 and the solve's shared memos: `same_solves` (target-shape solves by exact input, for every
 re-layering round: target_shape.Memo's `same`) and `contour_cache` (core.polylines.ContourArrays).
@@ -47,13 +51,16 @@ class SolveContext:
 
     `progress(stage, message)`: called by say (None: nothing is said); `cancel()`: True stops the
     solve at its next safe point (None: never); `budget`: seconds of wall clock from now after
-    which the solve is out of time (math.inf: never)."""
+    which the solve is out of time (math.inf: never); `clock()`: the seconds it reads the time
+    in (None: time.monotonic; a test's may run fast), for the deadline and for every wall-clock
+    bound of whoever holds the context (the plane search's guard)."""
 
-    def __init__(self, progress=None, cancel=None, budget=math.inf):
+    def __init__(self, progress=None, cancel=None, budget=math.inf, clock=None):
         self.progress = progress or quiet
         self.cancelled = cancel or (lambda: False)
         self.budget = budget
-        self.deadline = time.monotonic() + budget
+        self.clock = clock or time.monotonic
+        self.deadline = self.clock() + budget
         self._at = {"stage": "layering"}  # the stage under way, shared with quiet() views
         self._speaks = True
         self.same_solves = {}
@@ -76,8 +83,19 @@ class SolveContext:
         view._speaks = False
         return view
 
+    def for_solve(self, cancel=None):
+        """A fresh context for one solve inside the run this context times (the plane search's
+        full solves): its own stage and memos, this context's progress (nothing from a quiet
+        view), clock, budget and deadline (the run's one budget, not a fresh one per solve),
+        cancelled when this one is or when `cancel()` (None: only then)."""
+        mine = self.cancelled
+        view = SolveContext(self.progress if self._speaks else None,
+                            mine if cancel is None else (lambda: mine() or cancel()), clock=self.clock)
+        view.budget, view.deadline = self.budget, self.deadline
+        return view
+
     def out_of_time(self):
-        return time.monotonic() > self.deadline
+        return self.clock() > self.deadline
 
     def native_progress(self, stage, _fraction):
         """The native stages' callback: notes the stage, False to stop (cancelled or out of time)."""

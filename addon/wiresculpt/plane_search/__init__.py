@@ -27,8 +27,8 @@ Two searches:
   and, when that fails the screen, the contours of the crossing network's largest connected part
   without hinged wires (Searcher.connected). Screened proposals are verified fewest crossings
   closer than 2 * min_segment along a wire first (close_gaps), then by the fidelity of their
-  contours (highest first); budget
-  auto_budget(count) = AUTO_SECONDS_PER_PLANE * count. When no proposal of the first screening
+  contours (highest first); its work bounded by auto_limits(count) (AUTO_SCREENS_PER_PLANE and
+  AUTO_SOLVES_PER_PLANE per plane). When no proposal of the first screening
   round keeps its crossings 2 * min_segment apart, sets grown from count - 1 planes (grow: a
   family proposal plus one plane at an area quantile along one of its axes) are screened and
   verified first.
@@ -42,9 +42,14 @@ finds the hooks; both without the hooks the target shape cannot realise at cross
 along a wire (Searcher._layer). Only survivors run the full pipeline (pipeline.solve: target shape, forces, rest
 shape, buildability) with the layering's own hooks (CANDIDATE_HOOK_PATTERNS), and a candidate is
 returned only when that says stable (which means buildable, fab/buildability). The returned
-design then gets the comparison of hook patterns by their forces (Searcher.finish), bounded by
-FINAL_HOOK_SECONDS / FINAL_SECONDS; when that does not end stable in time, the verified design
-is kept.
+design then gets the comparison of hook patterns by their forces (Searcher.finish), at most
+FINAL_HOOK_PATTERNS patterns; when that does not end stable, the verified design is kept.
+
+Work, not time: every choice is bounded by counts (candidates screened, full solves, a screen's
+layering nodes SCREEN_NODES, FINAL_HOOK_PATTERNS), so a scene gives the same design on any machine
+and under any load. The clock (the context's, SolveContext.clock) only stops a search that takes
+too long: its guard (BUDGET_SECONDS, auto_budget, FINAL_SECONDS; `stopped_by` "time" in the record)
+and the run's one budget, settings.max_solve_seconds (OutOfTime, which ends the run).
 
 Score of a returned candidate (documented in docs/formats.md, higher is better):
 
@@ -58,12 +63,13 @@ the design as `fidelity`. Every returned candidate of either search also carries
 (the share of the mesh's vertices within 0.1 S of some wire's contour), in its figures
 (Searcher.looks): what the panel shows beside each candidate.
 """
-from .auto import (AUTO_SECONDS_PER_PLANE, EARLY_SOLVES, GROW_BASES, GROW_QUANTILES,  # noqa: F401
+from .auto import (AUTO_SCREENS_PER_PLANE, AUTO_SECONDS_PER_PLANE, AUTO_SOLVES_PER_PLANE, auto_limits,  # noqa: F401
+                   EARLY_SOLVES, GROW_BASES, GROW_QUANTILES,  # noqa: F401
                    SPREADS, area_quantile_plane, auto, auto_budget, family_planes, grow, splits_of)
 from .batch import MODES, run  # noqa: F401
-from .nearby import BUDGET_SECONDS, PAIR_SINGLES, SLICE_AHEAD, nearby  # noqa: F401
+from .nearby import BUDGET_SECONDS, NEARBY_SCREENS, NEARBY_SOLVES, PAIR_SINGLES, SLICE_AHEAD, nearby  # noqa: F401
 from .placements import OFFSETS, RULE_COST, TILTS_DEG, Placement, mesh_frame, single_changes  # noqa: F401
 from .records import nearby_reason  # noqa: F401
-from .searcher import (CANDIDATE_HOOK_PATTERNS, COVERAGE_RADIUS, FINAL_HOOK_SECONDS, FINAL_SECONDS,  # noqa: F401
-                       SCREEN_SECONDS, Searcher)
+from .searcher import (CANDIDATE_HOOK_PATTERNS, COVERAGE_RADIUS, FINAL_HOOK_PATTERNS, FINAL_HOOK_SECONDS,  # noqa: F401
+                       FINAL_SECONDS, SCREEN_NODES, SCREEN_SECONDS, Searcher)
 from ..core.plane_faults import Tally, close_gaps, crossing_gaps  # noqa: F401 (the search's names for them)

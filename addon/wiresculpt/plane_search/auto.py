@@ -12,7 +12,14 @@ from ..core.plane_faults import close_gaps
 from .placements import Placement
 from .searcher import Searcher, _figures
 
-AUTO_SECONDS_PER_PLANE = 6.0  # auto's search budget: this many seconds per plane (24 s for N = 4)
+# auto's work for `count` planes: at most AUTO_SCREENS_PER_PLANE * count proposals screened and
+# AUTO_SOLVES_PER_PLANE * count full solves of proposals (the final comparison of hook patterns not
+# counted): on this project's 2-core machine about the 6 s per plane its wall-clock budget used to
+# be. AUTO_SECONDS_PER_PLANE is only the guard that stops a search that takes too long (stopped_by
+# "time"); it never decides what a search that ends returns.
+AUTO_SCREENS_PER_PLANE = 400
+AUTO_SOLVES_PER_PLANE = 2
+AUTO_SECONDS_PER_PLANE = 30.0
 EARLY_SOLVES = 3  # auto verifies as soon as this many screened proposals have no close gap
 
 
@@ -80,9 +87,15 @@ def _axis_word(axis, k):
 
 
 def auto_budget(count):
-    """auto's search budget in seconds for `count` planes (the final hook comparison comes on top:
-    at most FINAL_SECONDS)."""
+    """auto's wall-clock guard in seconds for `count` planes (the final hook comparison comes on
+    top: at most FINAL_SECONDS)."""
     return AUTO_SECONDS_PER_PLANE * max(int(count), 1)
+
+
+def auto_limits(count):
+    """auto's counts of work for `count` planes: {"candidates": screens, "full_solves": solves}."""
+    n = max(int(count), 1)
+    return {"candidates": AUTO_SCREENS_PER_PLANE * n, "full_solves": AUTO_SOLVES_PER_PLANE * n}
 
 
 def splits_of(count):
@@ -110,18 +123,19 @@ def area_quantile_plane(searcher, axis, q, name):
 def grow(s, count, frames, min_segment, until):
     """Proposals of `count` planes grown from proposals of count - 1 (a designer adds a plane to a
     set that holds): the (count - 1)-plane family proposals (largest contours) screened for up to a
-    quarter of the time left before `until`, the GROW_BASES that pass with the fewest crossings
-    closer than 2 * min_segment along a wire (then the largest closest gap) each extended by one
-    plane along each of its three axes at every area quantile of GROW_QUANTILES (area_quantile_plane)
-    and screened, up to half the time left. Returns the extended sets that pass the screen as auto's
+    quarter of the screens left before `until` (a count of screens), the GROW_BASES that pass with
+    the fewest crossings closer than 2 * min_segment along a wire (then the largest closest gap)
+    each extended by one plane along each of its three axes at every area quantile of
+    GROW_QUANTILES (area_quantile_plane) and screened, up to half the screens left. Returns the
+    extended sets that pass the screen as auto's
     pool entries, fewest close gaps first, then the largest closest gap. The families' evenly spread
     planes often put crossings closer than 2 * min_segment along some wire (man, N = 6: every
     proposal), and planes at uneven places, which no spread gives, keep them apart."""
-    began = time.perf_counter()
-    s.deadline = began + (until - began) / 4
+    began = s.screened
+    limit = began + (until - began) // 4
     bases = []
     for spread, by, counts, axes in itertools.product(SPREADS, ("area", "extent"), splits_of(count - 1), frames):
-        if time.perf_counter() > s.deadline:
+        if s.screened >= limit or s.should_stop():
             break
         placements = family_planes(s, counts, "largest", spread, axes, by)
         ok, _design, probe = s.screen_layered(placements)
@@ -129,13 +143,13 @@ def grow(s, count, frames, min_segment, until):
             gap = plane_faults.closest_gap(probe)
             bases.append((close_gaps(probe, min_segment), -(gap[0] if gap else math.inf), counts, axes, placements))
     bases.sort(key=lambda b: b[:2])
-    s.deadline = began + (until - began) / 2
+    limit = began + (until - began) // 2
     out = []
     for _close, _gap, counts, axes, placements in bases[:GROW_BASES]:
         names = _family_names(axes)
         for k in range(3):
             for q in GROW_QUANTILES:
-                if time.perf_counter() > s.deadline:
+                if s.screened >= limit or s.should_stop():
                     return sorted(out, key=lambda t: t[:2])
                 added = area_quantile_plane(s, axes[k], q, f"{names[k]}{counts[k]}")
                 ok, design, probe = s.screen_layered(placements + [added])
@@ -150,12 +164,13 @@ def grow(s, count, frames, min_segment, until):
 
 def auto(mesh, count, material, settings, want=2, budget=None, context=None, stock=None):
     """Up to `want` stable, buildable plane sets of `count` planes proposed from the mesh alone,
-    best score first (see the module's docstring), and the Searcher. `budget`: seconds (None:
-    auto_budget(count)). Proposals: every split of `count` over three axes using at least two
+    best score first (see the module's docstring), and the Searcher. `budget`: the wall-clock guard
+    in seconds (None: auto_budget(count)); the work is bounded by counts (auto_limits(count)), and
+    every share below is a share of them. Proposals: every split of `count` over three axes using at least two
     (balanced first), every spread of SPREADS, in the principal axes' frame and (when it differs)
     the world's; each with the largest contour of every plane and, when that does not pass the
     screen, with the contours of the network's largest connected part (Searcher.connected).
-    Screening (up to half the budget) keeps the proposals the layering finds stable; they are
+    Screening (up to half the screens) keeps the proposals the layering finds stable; they are
     verified by full solves with the layering's hooks in order of how many crossings come closer
     than 2 * min_segment along a wire (fewest first), then the fidelity of their contours (highest
     first); the stable ones are ranked by the fidelity of their solved wires (the score) and the
@@ -163,18 +178,19 @@ def auto(mesh, count, material, settings, want=2, budget=None, context=None, sto
     s = Searcher(mesh, material, settings, context, stock)
     start = time.perf_counter()
     budget = auto_budget(count) if budget is None else budget
-    s.deadline, s.budget = start + budget / 2, budget  # screening: up to half the budget
+    s.guard, s.budget = s.clock() + budget, budget
+    s.limits = auto_limits(count)
+    screens = s.limits["candidates"]
     frames = [s.axes] + ([np.eye(3)] if np.abs(np.abs(s.axes) - np.eye(3)).max() > 1e-6 else [])
     min_segment = float(settings.get("min_segment") or 0.0)
     proposals = itertools.product(SPREADS, ("area", "extent"), splits_of(count), frames)
     seen, found, passed = set(), [], 0
 
     def screen_some(limit, soft=math.inf):
-        """Screens proposals until `limit` (perf_counter time) or EARLY_SOLVES of them pass with
-        no close gap, or until `soft` when none has passed without one by then; returns the passing
-        ones, and whether proposals remain."""
+        """Screens proposals until `limit` screens in all or EARLY_SOLVES of them pass with no close
+        gap, or until `soft` screens when none has passed without one by then (or the guard);
+        returns the passing ones, and whether proposals remain."""
         nonlocal passed
-        s.deadline = limit
         batch, clean = [], 0
         for spread, by, counts, axes in proposals:
             placements = family_planes(s, counts, "largest", spread, axes, by)
@@ -195,32 +211,30 @@ def auto(mesh, count, material, settings, want=2, budget=None, context=None, sto
                 batch.append((close_gaps(probe, min_segment), -(s.fidelity(design)["share"] or 0.0), counts, axes,
                               placements, design, ""))
                 clean += batch[-1][0] == 0
-            if clean >= EARLY_SOLVES or time.perf_counter() > limit or (not clean and time.perf_counter() > soft):
+            if (clean >= EARLY_SOLVES or s.screened >= limit or (not clean and s.screened >= soft)
+                    or s.should_stop()):
                 passed += len(batch)
                 return batch, True
         passed += len(batch)
         return batch, False
 
     more, pool, first, grown = True, [], True, None
-    while more and len(found) < want and time.perf_counter() - start < budget:
-        # screening up to half the budget at first (a quarter when no proposal passes without close
+    while more and len(found) < want and not (s.should_stop() or s.out_of_work()):
+        # screening up to half the screens at first (a quarter when no proposal passes without close
         # crossings by then: grow follows), later up to half of what is left; verifying the pool
         # (fewest close gaps first) after each round
-        now = time.perf_counter()
-        batch, more = (screen_some(start + budget / 2, start + budget / 4) if first else
-                       screen_some(now + (start + budget - now) / 2))
+        batch, more = (screen_some(screens // 2, screens // 4) if first else
+                       screen_some(s.screened + (screens - s.screened) // 2))
         first = False
-        s.deadline = start + budget
         pool = sorted(pool + batch, key=lambda t: t[:2])
         s.say("plane_search", f"{passed} of {s.screened} proposals pass the screen; "
                               f"{sum(1 for t in pool if t[0] == 0)} to verify without crossings closer than "
                               f"2 x min_segment along a wire")
         if grown is None and count >= 3 and not any(t[0] == 0 for t in pool):
             # no proposal keeps its crossings apart: sets grown from count - 1 planes, verified first
-            grown = grow(s, count, frames, min_segment, start + budget)
-            s.deadline = start + budget
+            grown = grow(s, count, frames, min_segment, screens)
             s.say("plane_search", f"{len(grown)} sets grown from {count - 1} planes pass the screen")
-        while (grown or pool) and len(found) < want and time.perf_counter() - start < budget:
+        while (grown or pool) and len(found) < want and not (s.should_stop() or s.out_of_work(("full_solves",))):
             close, _looks, counts, axes, placements, design, extra = (grown or pool).pop(0)
             solved = s.solve(copy.deepcopy(design))
             if solved is None or not solved["stable"]:

@@ -1,6 +1,7 @@
 """The headless pipeline with settings.plane_search (the batch script's entry)."""
 from .. import pipeline
 from ..core import fidelity
+from ..core import settings as settings_table
 from ..core.solve_context import SolveContext
 from .auto import auto, family_planes
 from .nearby import nearby
@@ -24,13 +25,20 @@ def run(vertices, faces, planes, material, settings, progress=None, cancel=None,
     from the mesh. The design carries `plane_search` whenever a search ran, and `fidelity` whenever it
     has wires (core/fidelity.py); when none is found the
     design of the given planes (nearby) or of the first proposal (auto) is returned, not stable,
-    with the reason saying what was tried. `stock`: as pipeline.solve's. Returns (design, planes
-    actually used)."""
+    with the reason saying what was tried. `stock`: as pipeline.solve's. One wall-clock budget,
+    settings.max_solve_seconds, for the whole run, the search and every solve in it included: past
+    it OutOfTime (naming the key and the stage) ends the run. `progress`: a callback (stage, message),
+    or a SolveContext whose progress, cancel and clock the run takes (a test's clock may run fast;
+    the budget is still the settings'). Returns (design, planes actually used)."""
+    clock = None
+    if isinstance(progress, SolveContext):
+        progress, cancel, clock = progress.progress, cancel or progress.cancelled, progress.clock
     say = progress or (lambda stage, message: None)
-    context = SolveContext(progress, cancel)  # the search's progress and cancel
+    budget = float(settings.get("max_solve_seconds") or settings_table.SETTINGS["max_solve_seconds"][0])
+    context = SolveContext(progress, cancel, budget, clock)  # the run's progress, cancel and one deadline
     mode = settings.get("plane_search", "off")
     if mode == "off":
-        return _looks(pipeline.run(vertices, faces, planes, material, settings, progress, cancel, stock), vertices,
+        return _looks(pipeline.run(vertices, faces, planes, material, settings, context, None, stock), vertices,
                       faces), list(planes)
     if mode == "nearby":
         if not planes:
@@ -40,7 +48,7 @@ def run(vertices, faces, planes, material, settings, progress=None, cancel=None,
             best = found[0]
             design = best["design"]
         else:
-            design = pipeline.run(vertices, faces, planes, material, settings, progress, cancel, stock)
+            design = pipeline.run(vertices, faces, planes, material, settings, context, None, stock)
             best = None
             if not design["stable"]:
                 design["reason"] = (f"{nearby_reason(s)}. The planes as given: {design['reason']}"
@@ -60,7 +68,7 @@ def run(vertices, faces, planes, material, settings, progress=None, cancel=None,
         else:
             best = None
             used = [p.spec() for p in family_planes(s, (count - count // 2, count // 2, 0))]
-            design = pipeline.run(vertices, faces, used, material, settings, progress, cancel, stock)
+            design = pipeline.run(vertices, faces, used, material, settings, context, None, stock)
             if not design["stable"]:
                 design["reason"] += (f"; no proposed set of {count} planes ({s.screened} tried) gives a "
                                      f"stable design")

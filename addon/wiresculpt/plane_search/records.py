@@ -3,6 +3,7 @@ when it found nothing."""
 import time
 
 from .placements import OFFSETS, TILTS_DEG, Placement
+from .searcher import FINAL_HOOK_PATTERNS, SCREEN_NODES
 
 
 def _record(mode, before, candidate, searcher, start):
@@ -13,6 +14,9 @@ def _record(mode, before, candidate, searcher, start):
             "candidates": searcher.screened, "full_solves": searcher.full_solves,
             "budget_seconds": searcher.budget, "solves_stopped": searcher.timed_out,
             "solves_failed": searcher.failed, "final_solve": searcher.final,
+            # what bounded the search: its counts of work, whether one of them or the guard ended it
+            "limits": dict(searcher.limits, screen_nodes=SCREEN_NODES, final_hook_patterns=FINAL_HOOK_PATTERNS),
+            "stopped_by": searcher.stopped_by(), "screens_cut": searcher.screens_cut,
             "seconds": time.perf_counter() - start, "score": candidate["score"] if candidate else None,
             # the returned candidate's looks (Searcher.looks): fidelity (the design's `fidelity` share) and coverage
             "fidelity": (candidate or {}).get("fidelity"), "coverage": (candidate or {}).get("coverage"),
@@ -27,8 +31,18 @@ def nearby_reason(searcher):
     """Why the nearby search `searcher` ran found no stable placement (plane_faults.Tally.report):
     what it searched, how far the budget let it, its candidates counted by fault, what to change."""
     s = searcher
-    return s.tally.report(OFFSETS[-1] * s.size * 1000.0, s.size * 1000.0, TILTS_DEG[-1], s.budget,
+    return s.tally.report(OFFSETS[-1] * s.size * 1000.0, s.size * 1000.0, TILTS_DEG[-1], _ended_by(s),
                           float(s.settings.get("min_segment") or 0.0))
+
+
+def _ended_by(s):
+    """What ended a search with work left, for Tally.report: the guard's seconds (a number), or the
+    count of work reached, in words."""
+    if s.time_stopped or not s.count_stopped:
+        return s.budget
+    if s.screened >= s.limits.get("candidates", float("inf")):
+        return f"limit of {s.limits['candidates']} candidates screened"
+    return f"limit of {s.limits['full_solves']} full solves"
 
 
 def nearby_ending(searcher):

@@ -9,27 +9,40 @@ import numpy as np
 
 from .. import native, pipeline
 from ..core import fidelity, plane_faults
-from ..core.solve_context import SolveContext
+from ..core.solve_context import OutOfTime, SolveContext
 from ..stages import layering, slicing, target_shape
 from .placements import Placement, _unit, mesh_frame
 
 COVERAGE_RADIUS = 0.1  # fraction of S
 # Candidates are verified by full solves with the layering's own hooks (pipeline.solve with
 # hook_patterns=1, as Live does: 0.2-4 s on the corpus); the comparison of hook patterns by their
-# forces (up to 64 patterns, seconds to a minute) runs once, on the returned design, within
-# FINAL_HOOK_SECONDS (no new pattern after it) and stopped at FINAL_SECONDS; when it does not end
-# stable in time, the verified design (stable and buildable with the layering's hooks) is returned.
+# forces (up to FINAL_HOOK_PATTERNS patterns, seconds to a minute) runs once, on the returned
+# design; when it does not end stable, the verified design (stable and buildable with the
+# layering's hooks) is returned.
+#
+# What the search chooses is bounded by counts of work, never by the clock, so that a scene gives
+# the same design on any machine and under any load: candidates screened and full solves (each
+# search's own limits, nearby.py and auto.py), a screen's layering search nodes (SCREEN_NODES: a
+# screen that needs more does not pass, "incomplete") and the final comparison's hook patterns
+# (FINAL_HOOK_PATTERNS). The wall clock only stops a search that takes too long: its guard
+# (`budget_seconds`; FINAL_SECONDS for the final comparison), after which the search returns what
+# it has with `stopped_by` "time", and the run's one budget (settings.max_solve_seconds, the
+# context's deadline), after which the run ends with OutOfTime naming the plane search.
 CANDIDATE_HOOK_PATTERNS = 1
-SCREEN_SECONDS = 2.0  # a screen's layering longer than this does not pass (a search of many contours)
-FINAL_HOOK_SECONDS = 10.0
-FINAL_SECONDS = 20.0
+SCREEN_NODES = 5000  # a screen's layering search stops after this many nodes (a search of many contours)
+FINAL_HOOK_PATTERNS = 16  # the final comparison of hook patterns: at most this many (about the 10 s it had)
+FINAL_SECONDS = 120.0  # the final comparison's wall-clock guard (stopped_by "time" when it fires)
+SCREEN_SECONDS = None  # gone: a screen is bounded by SCREEN_NODES (kept for the package's names)
+FINAL_HOOK_SECONDS = None  # gone: the final comparison is bounded by FINAL_HOOK_PATTERNS
 
 
 class Searcher:
     """Slicing cache, screening and full solves for one mesh, material and settings. `mesh`:
     (vertices, faces); `context`: a core.solve_context.SolveContext, whose say reports the search's
-    progress and whose cancel stops it (None: silent, never cancelled; the search keeps its own
-    deadline); `stock`: (length, profile name) for pipeline.solve's stock-length warnings."""
+    progress and whose cancel stops it, whose deadline is the run's one budget (OutOfTime past it)
+    and whose clock every wall-clock bound reads (None: silent, never cancelled, no deadline);
+    `stock`: (length, profile name) for pipeline.solve's stock-length warnings. The search's own
+    guard (`guard`, a clock time; `budget`, its seconds) is set by the search that holds it."""
 
     def __init__(self, mesh, material, settings, context=None, stock=None):
         self.V, self.F = mesh
@@ -38,6 +51,7 @@ class Searcher:
         self.context = SolveContext() if context is None else context
         self.say = self.context.say
         self.cancel = self.context.cancelled
+        self.clock = self.context.clock
         self.cache = {}  # placement key -> the slicer's contours of the plane
         # repr(placement key) -> the slicer's message refusing the plane (_contours raises it); by
         # repr, as a refused key may hold a NaN, which is not equal to itself
@@ -51,12 +65,46 @@ class Searcher:
         self.tally = None  # the nearby search's account of its candidates (plane_faults.Tally)
         self.surface = None  # (triangle centroids, areas) of the mesh, made by _surface when first needed
         self.outlines = None  # the mesh's three views (core/fidelity.Silhouettes), made by fidelity() when first needed
-        self.deadline = math.inf  # perf_counter() time at which a full solve is stopped (the budget)
-        self.budget = None  # seconds
+        self.guard = math.inf  # clock() time after which the search stops (its wall-clock guard)
+        self.budget = None  # the guard's seconds (`budget_seconds`)
+        self.limits = {}  # the search's counts of work ({"candidates": n, "full_solves": m}), set by it
+        self.verified = 0  # full solves of candidates (the final comparison not counted)
+        self.screens_cut = 0  # screens whose layering SCREEN_NODES stopped
+        self.time_stopped = self.count_stopped = False  # what ended the search before it was done
         self.centre, self.axes, self.size = mesh_frame(self.V, self.F)
         self.sample = np.asarray(self.V, dtype=float)
         if len(self.sample) > 4000:
             self.sample = self.sample[np.linspace(0, len(self.sample) - 1, 4000).astype(int)]
+
+    def over_time(self):
+        """Whether the search's wall-clock guard has passed (it then stops, `stopped_by` "time")."""
+        if self.clock() > self.guard:
+            self.time_stopped = True
+        return self.time_stopped
+
+    def should_stop(self):
+        """At a step of the search: OutOfTime past the run's one budget (it comes before the search's
+        own guard), else whether the guard has passed (over_time)."""
+        self._run_out()
+        return self.over_time()
+
+    def out_of_work(self, which=("candidates", "full_solves")):
+        """Whether a count of the search's limits (`limits`: those named by `which`) is reached:
+        the search then stops, `stopped_by` "count" (the caller asks only when there is more to do)."""
+        done = {"candidates": self.screened, "full_solves": self.verified}
+        if any(done[k] >= self.limits.get(k, math.inf) for k in which):
+            self.count_stopped = True
+            return True
+        return False
+
+    def stopped_by(self):
+        """What ended the search: "time" (its guard), "count" (a limit of `limits`) or "done"."""
+        return "time" if self.time_stopped else "count" if self.count_stopped else "done"
+
+    def _run_out(self):
+        """Raises OutOfTime, naming the plane search, past the run's one budget (the context's)."""
+        if self.context.out_of_time():
+            raise OutOfTime(self.context.budget, "plane_search")
 
     def _contours(self, placement):
         """The slicer's contours of `placement`; ValueError with the slicer's message when it
@@ -171,6 +219,7 @@ class Searcher:
         (passes, the sliced design, the layered design or None)."""
         if self.cancel():
             raise pipeline.Cancelled()
+        self._run_out()
         self.screened += 1
         self.fault = None
         try:
@@ -180,15 +229,17 @@ class Searcher:
                 return False, design, None
             probe = self._probe(design, arrays)
             self._layer(probe, design)
+            self.screens_cut += bool(probe.get("search_incomplete"))
             if not probe["stable"]:
                 self.fault = plane_faults.screen_fault(probe, lambda: self._decided_by_too_close(design, arrays))
             return bool(probe["stable"]), design, probe
         except (ValueError, RuntimeError, native.Cancelled) as exc:
             if self.cancel():
                 raise pipeline.Cancelled() from None
+            self._run_out()
             self.fault = (("slow", (), ()) if isinstance(exc, native.Cancelled) else
                           ("refused", (), (str(exc).split(";", 1)[0][:120],)))
-            return False, None, None  # refused, or its layering ran past the deadline
+            return False, None, None  # refused, or its layering ran past the guard
 
     def _decided_by_too_close(self, design, arrays):
         """Whether the hooks a screen forbade as too close decided its verdict: with every hook the
@@ -200,9 +251,12 @@ class Searcher:
         return bool(every["stable"] or every.get("search_incomplete"))
 
     def _layer(self, probe, design, too_close=True, **settings):
-        """layering.run on `probe`, stopped (native.Cancelled) by a cancel, past the deadline or
-        after SCREEN_SECONDS: a layering search can take many seconds on a network of many small
-        contours (elephant, N = 6: one took the whole screening time), and a screen is to be cheap.
+        """layering.run on `probe`, stopped (native.Cancelled) by a cancel, past the guard or the
+        run's deadline, and its search after SCREEN_NODES nodes (or the settings' max_nodes, when
+        fewer; the probe is then "search_incomplete"): a layering search can take many seconds on a
+        network of many small contours (elephant, N = 6: one took the whole screening time), and a
+        screen is to be cheap; a count of nodes, not seconds, so that the verdict is the same on any
+        machine.
         The hooks that the target shape cannot realise for want of a free bending point between
         two crossings (too_close, the native too_close_hooks) are forbidden: a placement that needs
         them could only fail its full solve (measured on man's nearby search: of the 288
@@ -211,9 +265,10 @@ class Searcher:
         still be stable). The probe's contours come back as arrays (`arrays`): as lists, a list per
         point, the garbage collector's walks over them took 2 of the 5.6 s of man's 6376 screens.
         `too_close=False` allows every hook; `settings` override the search's (max_nodes)."""
-        stop = min(self.deadline, time.perf_counter() + SCREEN_SECONDS)
+        nodes = min(int(layering.knob(self.settings, "max_nodes")), SCREEN_NODES)
+        settings = dict({"max_nodes": nodes}, **settings)
         layering.run(probe, self.material, dict(self.settings_for(design), **settings),
-                     lambda _stage, _fraction: not (self.cancel() or time.perf_counter() > stop),
+                     lambda _stage, _fraction: not (self.cancel() or self.over_time() or self.context.out_of_time()),
                      too_close=target_shape.REALISED_ANGLE if too_close else None, arrays=True)
 
     def connected(self, placements):
@@ -234,6 +289,7 @@ class Searcher:
         except (ValueError, RuntimeError, native.Cancelled):
             if self.cancel():
                 raise pipeline.Cancelled() from None
+            self._run_out()
             return None
         partners = {i: set() for i in range(len(probe["wires"]))}
         for c in probe["crossings"]:
@@ -277,16 +333,24 @@ class Searcher:
 
     def solve(self, design, hook_patterns=CANDIDATE_HOOK_PATTERNS, hook_seconds=None, deadline=None):
         """The full pipeline on a screened design; the solved design (stable means buildable), or
-        None when it fails or runs past the search's deadline (a solve is stopped there, like a
-        cancel, so the budget holds however long one solve would take). `hook_patterns`: as
+        None when it fails or runs past the search's guard (a solve is stopped there, like a
+        cancel, so the guard holds however long one solve would take). The solve keeps the run's
+        one budget (the context's deadline: OutOfTime past it, raised). `hook_patterns`: as
         pipeline.solve's (default: the layering's own hooks, see CANDIDATE_HOOK_PATTERNS);
-        `deadline`: instead of the search's."""
+        `deadline`: a clock time at which it is stopped too (the final comparison's guard)."""
         self.full_solves += 1
-        stop = self.deadline if deadline is None else deadline
+        self.verified += deadline is None
+        self._run_out()
+        stop = math.inf if deadline is None else deadline
         try:
-            return pipeline.solve(design, self.material, self.settings_for(design),
-                                  cancel=lambda: self.cancel() or time.perf_counter() > stop, stock=self.stock,
-                                  hook_patterns=hook_patterns, hook_seconds=hook_seconds)
+            return pipeline.solve(design, self.material, self.settings_for(design), self.context.quiet(),
+                                  # past the run's budget the solve's own OutOfTime (naming its stage)
+                                  # comes before the guard's stop
+                                  cancel=lambda: self.cancel() or ((self.over_time() or self.clock() > stop)
+                                                                   and not self.context.out_of_time()),
+                                  stock=self.stock, hook_patterns=hook_patterns, hook_seconds=hook_seconds)
+        except OutOfTime:  # the run's budget: the run ends
+            raise
         except (ValueError, RuntimeError):  # a candidate the solver cannot finish (an infeasible LP): no answer
             self.failed += 1
             return None
@@ -298,20 +362,24 @@ class Searcher:
 
     def finish(self, candidate):
         """The comparison of hook patterns by their forces (pipeline.solve's default) on a
-        candidate verified with the layering's hooks (its "sliced" design, unsolved): its design
-        is replaced when that solve ends stable within FINAL_SECONDS, else kept. Records
-        self.final: {"hook_search": "by forces" or "the layering's hooks", "seconds", "why"}."""
-        began, stopped = time.perf_counter(), self.timed_out
-        solved = self.solve(copy.deepcopy(candidate["sliced"]), hook_patterns=None, hook_seconds=FINAL_HOOK_SECONDS,
-                            deadline=began + FINAL_SECONDS)
+        candidate verified with the layering's hooks (its "sliced" design, unsolved): at most
+        FINAL_HOOK_PATTERNS patterns, no time bound on them; its design is replaced when that
+        solve ends stable, else kept. Stopped by the search's guard or FINAL_SECONDS, whichever
+        comes first (the search is then "stopped_by" "time"). Records self.final: {"hook_search":
+        "by forces" or "the layering's hooks", "seconds", "why"}."""
+        began, stopped = self.clock(), self.timed_out
+        solved = self.solve(copy.deepcopy(candidate["sliced"]), hook_patterns=FINAL_HOOK_PATTERNS,
+                            hook_seconds=math.inf, deadline=began + FINAL_SECONDS)
         if solved is not None and solved["stable"]:
             candidate["design"], candidate["figures"] = solved, _figures(solved)
             self.looks(candidate)
-            self.final = {"hook_search": "by forces", "seconds": time.perf_counter() - began}
+            self.final = {"hook_search": "by forces", "seconds": self.clock() - began}
         else:
-            why = (f"stopped at {FINAL_SECONDS:g} s" if self.timed_out > stopped else
+            if self.timed_out > stopped:
+                self.time_stopped = True
+            why = (f"stopped at {min(FINAL_SECONDS, self.budget or math.inf):g} s" if self.timed_out > stopped else
                    "the solver could not finish it" if solved is None else f"not stable: {solved['reason']}")
-            self.final = {"hook_search": "the layering's hooks", "seconds": time.perf_counter() - began, "why": why}
+            self.final = {"hook_search": "the layering's hooks", "seconds": self.clock() - began, "why": why}
         return candidate
 
     def coverage(self, design):
