@@ -377,3 +377,25 @@ class SceneSettings(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class StandsFirst(unittest.TestCase):
+    """Both searches rank a candidate whose assembled sculpture stands in the 3D check before any
+    that does not (searcher.stands_first), from the figures _figures takes from its design."""
+
+    def design(self, record):
+        d = {"wires": [{"target_max_distance": 0.001, "closure_gap": 0.0}], "load_capacity": {"+x": 2.0}}
+        if record is not None:
+            d["stands_3d"] = record
+        return d
+
+    def test_the_figures_and_the_key(self):
+        from wiresculpt.plane_search.searcher import _figures, stands_first
+        stands = _figures(self.design({"stands": True, "cause": "stands", "max_sag": 0.0004}))
+        slips = _figures(self.design({"stands": False, "cause": "slips", "max_sag": 0.0002}))
+        unchecked = _figures(self.design(None))
+        self.assertEqual((stands["stands_3d"], stands["cause_3d"], stands["sag"]), (True, "stands", 0.0004))
+        self.assertEqual((unchecked["stands_3d"], unchecked["sag"]), (None, None))
+        found = [{"figures": slips, "cost": 0.1}, {"figures": unchecked, "cost": 0.0}, {"figures": stands, "cost": 0.3}]
+        found.sort(key=lambda c: (stands_first(c), c["cost"]))  # nearby's order
+        self.assertEqual([c["cost"] for c in found], [0.3, 0.0, 0.1])

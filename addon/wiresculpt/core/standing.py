@@ -17,6 +17,9 @@ NO_EQUILIBRIUM = "no_equilibrium"  # no equilibrium found (the native's cause is
 SLIPS = "slips"  # a crossing's force outside its pyramid
 SAGS = "sags"  # a wire further than the sag limit from its target
 CAUSES = (STANDS, NO_EQUILIBRIUM, SLIPS, SAGS)
+# A plane-assistant candidate's 3D verdict in the panel's line ("..., stands in 3D (sag 0.4 mm)")
+CANDIDATE_WORDS = {STANDS: "stands", NO_EQUILIBRIUM: "finds no balance", SLIPS: "slips at a crossing",
+                   SAGS: "sags"}
 
 
 def sag_limit(design):

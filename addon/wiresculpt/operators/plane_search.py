@@ -35,7 +35,7 @@ from ..blend.view import redraw_3d_views
 from ..core import session
 from ..core.jobs import WorkerJob
 from ..core.scene import PlaneSpec
-from ..core import mesh_faults
+from ..core import mesh_faults, standing
 from ..core.sizes import mesh_size
 from ..core.solve_context import SolveContext
 from ..props import material_of, solver_settings
@@ -85,8 +85,13 @@ def describe(candidate):
     """The candidate's figures as one line for the panel."""
     f = candidate["figures"]
     load = "n/a" if f["load_capacity"] is None else f"{f['load_capacity']:.1f}x weight"
-    return (f"holds {load}, deviation {f['max_deviation'] * 1000:.1f} mm, "
+    line = (f"holds {load}, deviation {f['max_deviation'] * 1000:.1f} mm, "
             f"closure gap {f['closure_gap'] * 1000:.1f} mm")
+    if f.get("cause_3d") == standing.NO_EQUILIBRIUM:
+        line += f", {standing.CANDIDATE_WORDS[f['cause_3d']]} in 3D"
+    elif f.get("cause_3d") is not None:
+        line += f", {standing.CANDIDATE_WORDS[f['cause_3d']]} in 3D (sag {f['sag'] * 1000:.1f} mm)"
+    return line
 
 
 def looks(candidate):

@@ -10,7 +10,7 @@ import numpy as np
 from ..core import plane_faults
 from ..core.plane_faults import close_gaps
 from .placements import Placement
-from .searcher import Searcher, _figures
+from .searcher import Searcher, _figures, stands_first
 
 # auto's work for `count` planes: at most AUTO_SCREENS_PER_PLANE * count proposals screened and
 # AUTO_SOLVES_PER_PLANE * count full solves of proposals (the final comparison of hook patterns not
@@ -247,8 +247,9 @@ def auto(mesh, count, material, settings, want=2, budget=None, context=None, sto
             # --- end of fidelity ---
             s.say("plane_search", f"candidate {len(found)}: {found[-1]['changes'][0]} (score {score:.3f})")
     # a design whose assembly needs two wires placed at once (two_hand_steps) comes after every
-    # design that can be built one wire at a time, whatever its score
-    found.sort(key=lambda c: (bool(c["design"].get("two_hand_steps")), -c["score"]))
+    # design that can be built one wire at a time, then one that does not stand in 3D after every one
+    # that does, whatever its score
+    found.sort(key=lambda c: (bool(c["design"].get("two_hand_steps")), stands_first(c), -c["score"]))
     if found:
         s.finish(found[0])
     return found, s, start

@@ -7,7 +7,7 @@ import time
 from ..core import plane_faults
 from ..core.plane_faults import Tally
 from .placements import Placement, _unit, single_changes
-from .searcher import Searcher, _figures
+from .searcher import Searcher, _figures, stands_first
 
 # A nearby search's work: at most NEARBY_SCREENS candidates screened and NEARBY_SOLVES full solves
 # of candidates (the final comparison of hook patterns not counted), which on this project's 2-core
@@ -103,7 +103,7 @@ def nearby(mesh, planes, material, settings, want=1, budget=BUDGET_SECONDS, cont
         phase(tally.pair_order(pairs))
     tally.seconds = time.perf_counter() - start
     tally.out_of_time = s.time_stopped or s.count_stopped
-    found.sort(key=lambda c: c["cost"])
+    found.sort(key=lambda c: (stands_first(c), c["cost"]))  # what stands in 3D first, then the least change
     if found:
         s.finish(found[0])
     for candidate in found[:want]:  # fidelity and coverage, shown with each candidate (after the budget)

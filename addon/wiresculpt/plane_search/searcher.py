@@ -417,9 +417,20 @@ class Searcher:
 
 def _figures(design):
     """The stability figures a candidate shows: load capacity (least multiple of its weight over
-    the six directions), max deviation and largest closure gap."""
+    the six directions), max deviation and largest closure gap, and the 3D check's verdict:
+    `stands_3d` (true when the assembled sculpture stands, stages/stands3d.py; None when the check
+    did not run), its `cause` and `sag` (m, the largest distance of a wire from its target)."""
     cap = design.get("load_capacity") or {}
     multiples = [v for k, v in cap.items() if k in ("+x", "-x", "+y", "-y", "+z", "-z") and isinstance(v, (int, float))]
+    record = design.get("stands_3d") or {}
     return {"load_capacity": min(multiples) if multiples else None,
             "max_deviation": max((w.get("target_max_distance", 0.0) for w in design["wires"]), default=0.0),
-            "closure_gap": max((w.get("closure_gap", 0.0) for w in design["wires"]), default=0.0)}
+            "closure_gap": max((w.get("closure_gap", 0.0) for w in design["wires"]), default=0.0),
+            "stands_3d": record.get("stands"), "cause_3d": record.get("cause"), "sag": record.get("max_sag")}
+
+
+def stands_first(candidate):
+    """0 for a candidate whose assembled sculpture stands in the 3D check, 1 otherwise: the key
+    both searches rank by before their own score (a design that stands as the planar model says
+    before one that slips or sags)."""
+    return 0 if candidate["figures"].get("stands_3d") else 1
