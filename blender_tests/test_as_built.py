@@ -87,7 +87,8 @@ class Ramp(Case):
 
     def test_legend_in_mm(self):
         legend = as_built_view.legend(small_design())
-        self.assertEqual([label for _x, _c, label in legend["stops"]], ["0 mm", "1.00 mm", "2.00 mm sag limit"])
+        self.assertEqual([label for _x, _c, label in legend["stops"]], ["0 mm", "1.00 mm", "2.00 mm"])
+        self.assertIn("red: at the 2.00 mm sag limit or past it", legend["notes"])
         self.assertEqual([x for x, _c, _l in legend["stops"]], [0.0, 0.5, 1.0])
         self.assertIn("largest 4.00 mm (A/0)", legend["notes"])
         self.assertIn("+ marks: crossing 0 slips", legend["notes"])

@@ -109,5 +109,6 @@ def legend_words(record, limit, scale, slipping):
     if slipping:
         notes.append(f"+ marks: crossing{'s' if len(slipping) > 1 else ''} {', '.join(map(str, slipping))} "
                      f"slip{'' if len(slipping) > 1 else 's'}")
+    notes.insert(0, f"red: at the {sag_text(limit)} sag limit or past it")
     return {"title": "As built: distance from target",
-            "stops": ["0 mm", sag_text(limit / 2), f"{sag_text(limit)} sag limit"], "notes": notes}
+            "stops": ["0 mm", sag_text(limit / 2), sag_text(limit)], "notes": notes}

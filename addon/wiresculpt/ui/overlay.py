@@ -185,7 +185,7 @@ def draw_as_built(ghosts):
 
 
 LEGEND_MARGIN = 20  # px from the view's lower left corner
-LEGEND_BAR = (160, 12)  # px: the ramp's bar
+LEGEND_BAR = (240, 12)  # px: the ramp's bar
 LEGEND_TEXT = 11  # px
 
 
