@@ -15,6 +15,7 @@ from wiresculpt.blend import results as scene_results
 from wiresculpt.core import as_built_view, standing
 from wiresculpt.live import engine as live
 from wiresculpt.live.state import STATE
+from wiresculpt.operators import optimize
 from wiresculpt.ui import overlay, panel
 from wiresculpt.ui import results as results_ui
 
@@ -212,6 +213,14 @@ class Globe(Case):
             self.assertIn(f"sag {w['sag'] * 1000:.2f} mm", shown)
         self.assertNotIn("out of plane", shown)
         self.assertIn(f"within {record['max_sag'] * 1000:.1f} mm of their targets", shown)  # the 3D sentence
+
+    def test_optimize_reports_the_3d_verdict(self):
+        record = self.design["stands_3d"]
+        kind, sentence = optimize.summary(self.design)
+        self.assertEqual(kind, {'INFO'})
+        self.assertTrue(sentence.startswith("Stable: 3 wires, 6 crossings; assemble "), sentence)
+        self.assertTrue(sentence.endswith(f". 3D: stands, sag at most {record['max_sag'] * 1000:.2f} mm "
+                                          f"(limit {record['sag_limit'] * 1000:.2f} mm)"), sentence)
 
     def test_result_panel_has_the_toggle(self):
         shown = [a[1] for n, a, _k in draw(results_ui.VIEW3D_PT_wiresculpt_display, bpy.context) if n == "prop"]
