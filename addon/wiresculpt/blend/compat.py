@@ -63,6 +63,17 @@ def smooth_colour_shader():
         return gpu.shader.from_builtin('3D_SMOOTH_COLOR')
 
 
+def font_size(font, size):
+    """blf.size of `font` in pixels: without the dpi argument where Blender dropped it (4.0 on),
+    with 72 dpi where it is still asked for."""
+    import blf
+
+    try:
+        blf.size(font, size)
+    except TypeError:
+        blf.size(font, size, 72)
+
+
 # --- the sidebar's active tab: Region.active_panel_category is writable from 4.x on (read-only
 # or missing before). ---
 

@@ -198,14 +198,13 @@ def draw_legend():
     scale = bpy.context.preferences.system.ui_scale
     x0, bar_w, bar_h, text = (int(v * scale) for v in (LEGEND_MARGIN, LEGEND_BAR[0], LEGEND_BAR[1], LEGEND_TEXT))
     line = int(1.5 * text)
-    y = x0 + line * len(legend["notes"])
     font = 0
-    compat_size(font, text)
+    compat.font_size(font, text)
     blf.color(font, 1.0, 1.0, 1.0, 1.0)
     for k, note in enumerate(legend["notes"]):
         blf.position(font, x0, x0 + line * (len(legend["notes"]) - 1 - k), 0)
         blf.draw(font, note)
-    label_y = y
+    label_y = x0 + line * len(legend["notes"])  # the stops' labels above the notes, the bar above them
     bar_y = label_y + line
     stops = legend["stops"]
     pos, col = [], []
@@ -225,14 +224,6 @@ def draw_legend():
     blf.position(font, x0, bar_y + bar_h + line - text, 0)
     blf.draw(font, legend["title"])
     gpu.state.blend_set('NONE')
-
-
-def compat_size(font, size):
-    """blf.size without its dpi argument where Blender dropped it (4.0), with it before."""
-    try:
-        blf.size(font, size)
-    except TypeError:
-        blf.size(font, size, 72)
 
 
 def draw():
