@@ -222,6 +222,16 @@ class Globe(Case):
         self.assertTrue(sentence.endswith(f". 3D: stands, sag at most {record['max_sag'] * 1000:.2f} mm "
                                           f"(limit {record['sag_limit'] * 1000:.2f} mm)"), sentence)
 
+    def test_slipping_crossing_marker_is_magenta(self):
+        design = scene_results.stored_design()
+        design = {**design, "crossings": [dict(c) for c in design["crossings"]]}
+        design["crossings"][2]["admissible"] = False
+        scene_results.write_results(bpy.context.scene, design)
+        markers = {o[scene_results.CROSSING_KEY]: o for o in bpy.context.scene.objects if scene_results.CROSSING_KEY in o}
+        colour = lambda c: tuple(round(x, 6) for x in markers[c].material_slots[0].material.diffuse_color)
+        self.assertEqual(colour(2), (1.0, 0.0, 1.0, 1.0))
+        self.assertEqual(colour(0), (0.1, 0.85, 0.2, 1.0))  # hooked and holding: green
+
     def test_result_panel_has_the_toggle(self):
         shown = [a[1] for n, a, _k in draw(results_ui.VIEW3D_PT_wiresculpt_display, bpy.context) if n == "prop"]
         self.assertIn("show_as_built", shown)

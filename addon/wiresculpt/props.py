@@ -299,7 +299,7 @@ class WiresculptSettings(bpy.types.PropertyGroup):
                     "(when the design has forces)")
     show_markers: BoolProperty(
         name="Crossing Markers", default=True,
-        description="Show the crossing markers (green: hooked, grey: null)",
+        description="Show the crossing markers (green: hooked, grey: null, magenta: slips in the 3D check)",
         update=_assembly_step_changed)
     show_as_built: BoolProperty(
         name="Show As Built", default=False,
