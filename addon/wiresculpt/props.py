@@ -15,6 +15,7 @@ from .blend import results as scene_results
 from .blend.calibration import MATERIAL_NAME_KEY, config_folder
 from .blend.handles import is_handle
 from .blend.registration import classes_factory
+from .blend import view
 from .core import calibration as cal
 from .core import materials, settings as settings_table
 from .fab import streaming
@@ -174,6 +175,14 @@ def _assembly_step_changed(settings, context):
     scene_results.apply_assembly_step(context.scene)
 
 
+def _redraw_views(_settings, context):
+    """A display toggle changed: the overlay draws it at the 3D views' next redraw."""
+    try:
+        view.redraw_3d_views()
+    except (AttributeError, ReferenceError):  # no window (background)
+        pass
+
+
 def _port_suggestions(_settings, _context, _text):
     """Serial ports libserialport lists, offered while typing the port (any path may be typed:
     a pseudo-terminal, a udev symlink)."""
@@ -290,8 +299,18 @@ class WiresculptSettings(bpy.types.PropertyGroup):
                     "(when the design has forces)")
     show_markers: BoolProperty(
         name="Crossing Markers", default=True,
-        description="Show the crossing markers (green: hooked, grey: null)",
+        description="Show the crossing markers (green: hooked, grey: null, magenta: slips in the 3D check)",
         update=_assembly_step_changed)
+    show_as_built: BoolProperty(
+        name="Show As Built", default=False,
+        description="Draw each wire as the 3D check finds it standing (its as-built shape), coloured by "
+                    "each point's distance from the target, and mark the crossings that slip",
+        update=_redraw_views)
+    as_built_scale: FloatProperty(
+        name="Exaggerate", default=1.0, min=1.0, soft_max=100.0, max=10000.0,
+        description="Draw the as-built shape's change from the target this many times larger "
+                    "(1: as it is); the colours keep the true distances",
+        update=_redraw_views)
     assembly_step: IntProperty(
         name="Show After Step", default=0, min=0, soft_max=50,
         description="Show only the wires added up to this assembly step (0: the whole sculpture)",

@@ -20,6 +20,11 @@ sidebar and a strip of the viewport: the globe with five slicing planes of which
 blender_tests/test_plane_assistant.py), optimized (not stable); Find Stable Planes (run inline);
 Preview of candidate 1 (its wires and moved plane drawn over the scene, which is unchanged);
 Apply candidate 1 (the moved plane selected, the stable verdict in the panel).
+
+With SHOTS=as_built (screen "-screen 0 1600x1400x24") it makes docs/images/panel-as-built.png: the
+globe optimized, Show As Built on with the shape change drawn 100 times (the globe sags 0.15 mm at
+most), the ghosts in their distance colours beside the wires, the legend in the view's corner, and
+the Stability box with each wire's sag.
 """
 import math
 import os
@@ -32,6 +37,7 @@ import wiresculpt
 MODE = os.environ.get("SHOTS", "")
 FABRICATION = MODE == "fabrication"
 PLANES = MODE == "planes"
+AS_BUILT = MODE == "as_built"
 if PLANES:  # the Plane Assistant open, the long Result and Fabrication panels shut
     from wiresculpt.ui import fabrication as fabrication_ui, plane_search as planes_ui, results as results_ui
     planes_ui.VIEW3D_PT_wiresculpt_planes.bl_options = set()
@@ -48,7 +54,7 @@ R = 0.125
 target.scale = (R,) * 3
 bpy.context.view_layer.update()
 ws = bpy.context.scene.wiresculpt
-ws.target = target
+ws.model = target
 if PLANES:  # Slice A/B at z = +-0.7 R, C at x = -0.3 R, D at y = 0, E at x = 0.8 R (the hinge)
     PLANE_SET = ((None, (0, 0, 0), (0, 0, 0.7 * R)), (None, (0, 0, 0), (0, 0, -0.7 * R)),
                  (None, (0, math.pi / 2, 0), (-0.3 * R, 0, 0)), (None, (math.pi / 2, 0, 0), (0, 0, 0)),
@@ -68,6 +74,10 @@ bpy.ops.wiresculpt.optimize()
 if PLANES:
     from wiresculpt.blend import results as scene_results
     assert not scene_results.stored_design()["stable"], "the hinged scene is stable: no loop to show"
+if AS_BUILT:
+    ws.show_as_built = True
+    ws.as_built_scale = 100.0
+    ws.show_forces = False  # the arrows would cross the ghosts
 if FABRICATION:
     import tempfile
     from wiresculpt.blend import calibration as calibration_store
@@ -138,6 +148,8 @@ def apply_first():
 VIEW = 560  # the viewport strip the planes shots keep, the sculpture framed at its top
 if FABRICATION:
     shots = [("panel-fabrication.png", 0, None, None)]
+elif AS_BUILT:
+    shots = [("panel-as-built.png", 0, None, (ui.x - area.x, 0))]  # the 3D view and its sidebar
 elif PLANES:
     shots = [("panel-planes-1-not-stable.png", 0, None, (VIEW, 1230)),
              ("panel-planes-2-candidates.png", 0, find_planes, (VIEW, 1850)),

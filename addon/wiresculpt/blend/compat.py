@@ -52,6 +52,28 @@ def uniform_colour_shader():
         return gpu.shader.from_builtin('3D_UNIFORM_COLOR')
 
 
+def smooth_colour_shader():
+    """The built-in per-vertex colour shader ('SMOOTH_COLOR'; '3D_SMOOTH_COLOR' where only that
+    name is known), as uniform_colour_shader."""
+    import gpu
+
+    try:
+        return gpu.shader.from_builtin('SMOOTH_COLOR')
+    except (ValueError, TypeError):
+        return gpu.shader.from_builtin('3D_SMOOTH_COLOR')
+
+
+def font_size(font, size):
+    """blf.size of `font` in pixels: without the dpi argument where Blender dropped it (4.0 on),
+    with 72 dpi where it is still asked for."""
+    import blf
+
+    try:
+        blf.size(font, size)
+    except TypeError:
+        blf.size(font, size, 72)
+
+
 # --- the sidebar's active tab: Region.active_panel_category is writable from 4.x on (read-only
 # or missing before). ---
 

@@ -36,7 +36,8 @@ PALETTE = [
     (0.80, 0.22, 0.10), (0.10, 0.36, 0.80), (0.15, 0.60, 0.20), (0.85, 0.60, 0.05),
     (0.55, 0.20, 0.70), (0.05, 0.62, 0.65), (0.75, 0.15, 0.45), (0.45, 0.40, 0.30),
 ]
-MARKER_COLOURS = {"hooked": (0.1, 0.85, 0.2, 1.0), "null": (0.55, 0.55, 0.55, 1.0)}
+# a hooked crossing the 3D check finds slipping (`admissible` false): magenta, as the as-built ghosts' mark
+MARKER_COLOURS = {"hooked": (0.1, 0.85, 0.2, 1.0), "null": (0.55, 0.55, 0.55, 1.0), "slips": (1.0, 0.0, 1.0, 1.0)}
 
 
 def wire_colour(wire_id):
@@ -273,6 +274,7 @@ def write_results(scene, design, inputs=None):
     mesh = _marker_mesh()
     hooked = _material("wiresculpt crossing hooked", MARKER_COLOURS["hooked"])
     null = _material("wiresculpt crossing null", MARKER_COLOURS["null"])
+    slips = _material("wiresculpt crossing slips", MARKER_COLOURS["slips"])
     for c in design.get("crossings", []):
         obj = markers.pop(c["id"], None)
         if obj is None:
@@ -281,7 +283,8 @@ def write_results(scene, design, inputs=None):
             obj[CROSSING_KEY] = c["id"]
             crossings_coll.objects.link(obj)
         obj.material_slots[0].link = 'OBJECT'
-        obj.material_slots[0].material = hooked if c.get("hook") else null
+        obj.material_slots[0].material = (slips if c.get("admissible") is False else hooked if c.get("hook")
+                                          else null)
         obj.location = c["point"]
         obj.scale = (MARKER_SIZE * radius,) * 3
         obj.hide_render = True

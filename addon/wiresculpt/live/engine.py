@@ -47,6 +47,7 @@ from ..blend.registration import handlers_factory
 from ..blend.handles import contour_plane_name, handles, model_name, model_problem, ticked_planes
 from ..blend.view import redraw_3d_views
 from ..core.jobs import WorkerJob
+from ..core import standing
 from ..core.limits import limit_records
 from ..core.live_verdict import CANNOT_SOLVE, ERROR, SOLVING, of_design, shortened, verdict
 from ..props import LIVE_HOOKS, material_of, solve_inputs, solver_settings
@@ -113,6 +114,7 @@ def _show(kind, text="", limits=()):
     """Sets the verdict of `kind` (core/live_verdict) with its reason, problem or error `text`, and
     the codes of the `limits` it breaks (stable, over its limits)."""
     STATE.verdict, STATE.reason, STATE.kind, STATE.limits = verdict(kind, text), text, kind, tuple(limits)
+    STATE.standing = ""  # a solved job's _step sets it after
 
 
 def whole_reason():
@@ -174,6 +176,12 @@ class LiveJob(WorkerJob):
             return (ERROR if self.unexpected else CANNOT_SOLVE), self.error
         return of_design(self.design, *(self.stock[:1] if self.stock else ()))
 
+    def standing(self):
+        """The design's 3D check in one line (core/standing.summary), "" when it did not run (an
+        error, or a design the planar stages call not stable)."""
+        record = standing.checked(self.design) if self.error is None and self.design else None
+        return standing.summary(record) if record is not None else ""
+
     def limit_codes(self):
         """The codes of the limits the design breaks when it is stable (core/limits.limit_records,
         the phrases verdict() says), () otherwise."""
@@ -230,6 +238,7 @@ def _step():
         STATE.job = None
         if job.key == key and not job.cancelled and not job.cancel_event.is_set():
             _show(*job.verdict(), limits=job.limit_codes())
+            STATE.standing = job.standing()
             STATE.solved = job.key
             STATE.preview = job.preview if job.error is None else []
             STATE.preview_ids, STATE.preview_steps = job.preview_ids, job.preview_steps
@@ -322,6 +331,12 @@ def stop():
 def line():
     """The panel's line, or "" when Live is off."""
     return f"Live: {STATE.verdict}" if STATE.running else ""
+
+
+def standing_shown():
+    """The shown verdict's 3D check in one line (core/standing.summary), "" when it did not run or
+    Live is off."""
+    return STATE.standing if STATE.running else ""
 
 
 def verdict_shown():

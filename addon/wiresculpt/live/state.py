@@ -23,6 +23,7 @@ class LiveState:
         self.reason = ""  # the whole text behind `verdict` (its reason, problem or error), "" for a word alone
         self.kind = ""  # the kind of `verdict` (core/live_verdict: STABLE, NOT_STABLE, ...), "" before the first
         self.limits = ()  # the codes of the limits a stable verdict breaks (core/limits.limit_records)
+        self.standing = ""  # the shown verdict's 3D check in one line (core/standing.summary), "" when it did not run
         self.preview = []  # [(RGBA, (2k, 3) float32 segment end points)], one per wire of the shown verdict
         # the wire id of each preview entry and the verdict's assembly_steps: the slider's filter
         # (core/assembly_view.shown_lines, ui/overlay)
@@ -52,12 +53,12 @@ class LiveRecord:
 STATE = LiveState()
 
 # what observed() shows of the run state, besides the whole record
-_SHOWN = ("running", "verdict", "reason", "kind", "limits", "preview", "preview_steps", "job", "solved", "geometry")
+_SHOWN = ("running", "verdict", "reason", "kind", "limits", "standing", "preview", "preview_steps", "job", "solved", "geometry")
 
 
 def observed(state=STATE):
     """A read-only view of Live now, for the tests and the bench: the run state's running, verdict,
-    reason, kind, limits, preview, preview_steps, job, solved and geometry, and the record's
+    reason, kind, limits, standing, preview, preview_steps, job, solved and geometry, and the record's
     durations, results, shown_at, drawn_at, job_seconds and drawn (a copy: writing to it changes
     nothing)."""
     record = state.record

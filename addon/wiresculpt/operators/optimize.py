@@ -25,6 +25,7 @@ from ..blend.machine import chosen_stock
 from ..blend.view import redraw_3d_views
 from ..blend.registration import classes_factory
 from ..core.jobs import WorkerJob
+from ..core import standing
 from ..core.limits import OVER_LIMITS, STOCK_LENGTH, recorded_stock
 from ..core.live_verdict import STABLE, of_design
 from ..props import material_of, solver_settings
@@ -85,7 +86,8 @@ def summary(design, stock_length=STOCK_LENGTH):
     counts = f"{len(design['wires'])} wires, {len(design.get('crossings', []))} crossings; assemble {', '.join(names)}"
     if kind == OVER_LIMITS:
         return {'WARNING'}, f"{OVER_LIMITS.capitalize()}: {text}; {counts}"
-    return {'INFO'}, f"Stable: {counts}"
+    record = standing.checked(design)  # the 3D check's figures beside a plain "Stable"
+    return {'INFO'}, f"Stable: {counts}" + (f". {standing.summary(record)}" if record is not None else "")
 
 
 def run_optimize(context, progress=None, cancel=None):

@@ -8,16 +8,22 @@ on. The longest arrow is ARROW_SHARE of the sculpture's size; each arrow starts 
 and shows the force on wires[0] (docs/formats.md `force`). A wire with `out_of_plane_deflection` gets a
 whisker at the target vertex where it deflects most, along its plane normal, DEFLECTION_SCALE times
 the deflection long (so 1 mm shows as 1 cm), red when over the limit (DEFLECTION_LIMIT, the
-solver's default 2 mm), else blue.
+solver's default 2 mm), else blue; not where the 3D check ran (its as-built ghosts show the sag).
+
+With scene.wiresculpt.show_as_built, each wire of the 3D check as it would stand (core/as_built_view:
+`as_built`, the shape change drawn as_built_scale times), every point in the colour of its distance
+from its target, the slipping crossings marked, and a legend in the view's lower left corner.
+The assembly slider hides what belongs to later wires: their arrows, whiskers, ghosts and marks.
 """
 
+import blf
 import bpy
 import gpu
 import numpy as np
 from gpu_extras.batch import batch_for_shader
 
 from ..blend import compat, results
-from ..core import assembly_view
+from ..core import as_built_view, assembly_view, standing
 from ..core.limits import DEFLECTION_LIMIT
 from ..live import engine as live
 from ..operators import plane_search
@@ -29,7 +35,10 @@ DEFLECTION_SCALE = 10.0
 DEFLECTION_COLOURS = {False: (0.2, 0.45, 1.0, 1.0), True: (1.0, 0.1, 0.1, 1.0)}
 
 _handle = None
+_legend_handle = None
 _shader = None
+_smooth = None
+_ghosts = {"design": None, "key": None, "shown": None}  # the last as-built ghosts drawn
 _arrows = {"design": None, "step": None, "lines": None, "whiskers": None}  # the last design drawn
 
 
@@ -39,6 +48,34 @@ def uniform_colour_shader():
     if _shader is None:
         _shader = compat.uniform_colour_shader()
     return _shader
+
+
+def smooth_colour_shader():
+    """The built-in per-vertex colour shader (blend.compat)."""
+    global _smooth
+    if _smooth is None:
+        _smooth = compat.smooth_colour_shader()
+    return _smooth
+
+
+def as_built_shown(scene, design=None):
+    """What the overlay draws of the as-built ghosts in `scene`: {"lines": {wire id: (segment end
+    points, their colours)}, "marks": the slipping crossings' marks or None, "legend":
+    core/as_built_view.legend}, for the wires shown after the assembly slider's step; None when
+    show_as_built is off or the stored design (or `design`) has no as-built shapes."""
+    design = results.stored_design() if design is None else design
+    if scene is None or design is None or not scene.wiresculpt.show_as_built or not as_built_view.has_as_built(design):
+        return None
+    ws = scene.wiresculpt
+    step, scale = ws.assembly_step, float(ws.as_built_scale)
+    key = (step, scale)
+    if _ghosts["design"] is not design or _ghosts["key"] != key:  # stored_design(): the same dict until it changes
+        shown = results.visible_wires(design, step) if step else None
+        _ghosts.update(design=design, key=key, shown={
+            "lines": as_built_view.ghost_lines(design, shown, scale),
+            "marks": as_built_view.slip_marks(design, shown, scale),
+            "legend": as_built_view.legend(design, scale)})
+    return _ghosts["shown"]
 
 
 def force_arrows(design, shown=None):
@@ -78,6 +115,8 @@ def deflection_whiskers(design, shown=None):
     `out_of_plane_deflection`, from its target point of largest deflection along the plane normal,
     DEFLECTION_SCALE x the deflection long. `shown` as force_arrows."""
     out = {False: [], True: []}
+    if standing.checked(design) is not None and as_built_view.has_as_built(design):
+        return {}  # the 3D check's as-built shapes replace each wire's own figure
     for w in design.get("wires", []):
         if "out_of_plane_deflection" not in w or (shown is not None and w["id"] not in shown):
             continue
@@ -127,6 +166,66 @@ def draw_candidate(preview):
     plane_search.DRAWN[0] += 1
 
 
+def draw_as_built(ghosts):
+    """The as-built ghosts in their distance colours and the slipping crossings' marks, over
+    everything (they lie within a wire's thickness of the wires when the sag is small)."""
+    gpu.state.depth_test_set('NONE')
+    gpu.state.line_width_set(3.0)
+    shader = smooth_colour_shader()
+    shader.bind()
+    for lines, colours in ghosts["lines"].values():
+        if len(lines):
+            batch_for_shader(shader, 'LINES', {"pos": lines, "color": colours}).draw(shader)
+    if ghosts["marks"] is not None:
+        flat = uniform_colour_shader()
+        flat.bind()
+        flat.uniform_float("color", as_built_view.SLIP_COLOUR)
+        batch_for_shader(flat, 'LINES', {"pos": ghosts["marks"]}).draw(flat)
+    gpu.state.line_width_set(1.0)
+
+
+LEGEND_MARGIN = 20  # px from the view's lower left corner
+LEGEND_BAR = (240, 12)  # px: the ramp's bar
+LEGEND_TEXT = 11  # px
+
+
+def draw_legend():
+    """The as-built legend (POST_PIXEL): the title, the ramp as a bar with its stops' labels, the notes."""
+    ghosts = as_built_shown(bpy.context.scene)
+    if ghosts is None or ghosts["legend"] is None:
+        return
+    legend = ghosts["legend"]
+    scale = bpy.context.preferences.system.ui_scale
+    x0, bar_w, bar_h, text = (int(v * scale) for v in (LEGEND_MARGIN, LEGEND_BAR[0], LEGEND_BAR[1], LEGEND_TEXT))
+    line = int(1.5 * text)
+    font = 0
+    compat.font_size(font, text)
+    blf.color(font, 1.0, 1.0, 1.0, 1.0)
+    for k, note in enumerate(legend["notes"]):
+        blf.position(font, x0, x0 + line * (len(legend["notes"]) - 1 - k), 0)
+        blf.draw(font, note)
+    label_y = x0 + line * len(legend["notes"])  # the stops' labels above the notes, the bar above them
+    bar_y = label_y + line
+    stops = legend["stops"]
+    pos, col = [], []
+    for (xa, ca, _la), (xb, cb, _lb) in zip(stops, stops[1:]):
+        a, b = x0 + xa * bar_w, x0 + xb * bar_w
+        pos += [(a, bar_y, 0), (b, bar_y, 0), (b, bar_y + bar_h, 0), (a, bar_y, 0), (b, bar_y + bar_h, 0), (a, bar_y + bar_h, 0)]
+        col += [ca, cb, cb, ca, cb, ca]
+    gpu.state.blend_set('ALPHA')
+    shader = smooth_colour_shader()
+    shader.bind()
+    batch_for_shader(shader, 'TRIS', {"pos": pos, "color": col}).draw(shader)
+    for x, _colour, label in stops:
+        width = blf.dimensions(font, label)[0]
+        left = x0 + x * bar_w - (0 if x == 0 else width if x == 1 else width / 2)
+        blf.position(font, left, label_y, 0)
+        blf.draw(font, label)
+    blf.position(font, x0, bar_y + bar_h + line - text, 0)
+    blf.draw(font, legend["title"])
+    gpu.state.blend_set('NONE')
+
+
 def draw():
     if live.preview_shown():
         draw_live()
@@ -134,6 +233,9 @@ def draw():
     if preview is not None and plane_search.previewed(bpy.context) is not None:
         draw_candidate(preview)
     scene = bpy.context.scene
+    ghosts = as_built_shown(scene)
+    if ghosts is not None:
+        draw_as_built(ghosts)
     if scene is None or not scene.wiresculpt.show_forces:
         return
     design = results.stored_design()
@@ -158,15 +260,21 @@ def draw():
 
 
 def register():
-    global _handle
+    global _handle, _legend_handle
     if _handle is None:
         _handle = bpy.types.SpaceView3D.draw_handler_add(draw, (), 'WINDOW', 'POST_VIEW')
+    if _legend_handle is None:
+        _legend_handle = bpy.types.SpaceView3D.draw_handler_add(draw_legend, (), 'WINDOW', 'POST_PIXEL')
 
 
 def unregister():
-    global _handle, _shader
+    global _handle, _legend_handle, _shader, _smooth
     if _handle is not None:
         bpy.types.SpaceView3D.draw_handler_remove(_handle, 'WINDOW')
         _handle = None
-    _shader = None
+    if _legend_handle is not None:
+        bpy.types.SpaceView3D.draw_handler_remove(_legend_handle, 'WINDOW')
+        _legend_handle = None
+    _shader = _smooth = None
+    _ghosts.update(design=None, key=None, shown=None)
     _arrows.update(design=None, step=None, lines=None, whiskers=None)

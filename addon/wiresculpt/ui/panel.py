@@ -102,6 +102,8 @@ def draw_live(layout, context):
     col = layout.column()
     col.alert = alert
     wrap_labels(col, context, live.line(), icon=icon)
+    if live.standing_shown():  # the 3D check of the live design (core/standing.summary)
+        wrap_labels(col, context, live.standing_shown(), icon='BLANK1')
     hint = live_hint(context, live.kind_shown(), live.limits_shown())
     if hint:  # Live keeps the layering's own hooks; a current Optimize that says otherwise wins
         wrap_labels(layout, context, hint, icon='INFO')

@@ -8,10 +8,10 @@ import bpy
 from .. import native, props
 from ..blend import results as scene_results
 from ..blend.registration import classes_factory
-from ..core import closure, mesh_faults, stale
+from ..core import as_built_view, closure, mesh_faults, stale, standing
 from ..core.design import setup_problem
 from ..core.figures import mass_text
-from ..core.limits import OVER_LIMITS
+from ..core.limits import DEFLECTION_LIMIT, OVER_LIMITS
 from .stale import design_limits, report, report_changes  # noqa: F401 (report_changes: read here by the tests)
 from ..operators import optimize
 from ..operators.results import WIRESCULPT_OT_assembly_guide, WIRESCULPT_OT_clear_results
@@ -60,18 +60,38 @@ def load_capacity_rows(design):
 
 
 def wire_rows(design, names=None):
-    """[(wire name, closure gap text or None, out-of-plane deflection text or None)] per wire that
-    has either figure: the gap in mm and % of the wire's length (core/closure.py), the deflection
-    in mm (the 3D check, `out_of_plane_deflection`). names: core/stale.current_names, for the wires
-    of renamed planes (core/stale.renamed_wire)."""
+    """[(wire name, closure gap text or None, sag or out-of-plane text or None)] per wire that has
+    either figure: the gap in mm and % of the wire's length (core/closure.py); where the 3D check
+    ran, the wire's sag in the assembled sculpture (`sag`, core/standing.sag_text), else its
+    out-of-plane deflection loaded alone (`out_of_plane_deflection`, mm), as standing.wire_heading
+    says. names: core/stale.current_names, for the wires of renamed planes (core/stale.renamed_wire)."""
+    in_3d = standing.has_sag(design)
     rows = []
     for w in design.get("wires", []):
         gap = closure.closure_text(w)
-        bend = w.get("out_of_plane_deflection")
+        if in_3d:
+            bend = standing.sag_text(w["sag"]) if "sag" in w else None
+        else:
+            bend = w.get("out_of_plane_deflection")
+            bend = f"{bend * 1000:.2f} mm" if bend is not None else None
         if gap is not None or bend is not None:
-            rows.append((stale.renamed_wire(w["name"], names), gap,
-                         f"{bend * 1000:.2f} mm" if bend is not None else None))
+            rows.append((stale.renamed_wire(w["name"], names), gap, bend))
     return rows
+
+
+def standing_line(design):
+    """The 3D check's sentence under a plain "Stable" (core/standing.words), or None when the check
+    did not run or failed (then the box's limits say it)."""
+    record = standing.checked(design)
+    return standing.words(record) if record is not None and record.get("stands") else None
+
+
+def deflection_note(design):
+    """Whether the warnings need standing.DEFLECTION_NOTE: the 3D check ran and some wire loaded
+    alone bends past the limit (the forces stage's warning for it is among the warnings)."""
+    return standing.checked(design) is not None and any(
+        isinstance(w.get("out_of_plane_deflection"), (int, float)) and w["out_of_plane_deflection"] > DEFLECTION_LIMIT
+        for w in design.get("wires", []))
 
 
 def torque_text(design):
@@ -200,6 +220,9 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
                 box.label(text="Was stable", icon='BLANK1')
             else:
                 box.label(text="Stable", icon='CHECKMARK')
+            line = standing_line(design)
+            if line:
+                _wrap(box, context, line[0].upper() + line[1:], icon='BLANK1')
         elif setup_problem(design):  # fewer than two wires: something to set up, as Live's "cannot solve"
             box.label(text="Could not solve" if said else "Cannot solve", icon='INFO')
             _wrap(box, context, design["reason"])
@@ -227,12 +250,13 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
             _wrap(layout, context, torque)
         wires = wire_rows(design, names)
         if wires:
-            # per wire: how far its rest shape's ends stand apart before assembly, and how far its
-            # contact forces bend it out of its plane
+            # per wire: how far its rest shape's ends stand apart before assembly, and how far it
+            # sags in the assembled sculpture (the 3D check), or bends out of its plane loaded alone
             col = layout.column(align=True)
-            _wrap(col, context, "Per wire: closure gap, out of plane")
+            _wrap(col, context, standing.wire_heading(design))
+            word = standing.sag_column(design)
             for name, gap, bend in wires:
-                _wrap(col, context, f"{name}: gap {gap or '-'}, out of plane {bend or '-'}", icon='DOT')
+                _wrap(col, context, f"{name}: gap {gap or '-'}, {word} {bend or '-'}", icon='DOT')
             if any(w.get("closed") and "closure_gap" in w for w in design["wires"]):
                 layout.label(text="Cuts: drag a sphere", icon='INFO')
         capacity = load_capacity_rows(design)
@@ -259,6 +283,8 @@ class VIEW3D_PT_wiresculpt_report(_Child, bpy.types.Panel):
         warnings = [w for w in warnings if w not in crossing]
         if warnings:
             col = layout.column(align=True)
+            if deflection_note(design):
+                _wrap(col, context, standing.DEFLECTION_NOTE[0].upper() + standing.DEFLECTION_NOTE[1:] + ":", icon='INFO')
             for warning in warnings[:3]:
                 _wrap(col, context, warning, icon='ERROR')
             if len(warnings) > 3:
@@ -278,6 +304,12 @@ class VIEW3D_PT_wiresculpt_display(_Child, bpy.types.Panel):
         design = scene_results.stored_design()
         if any("force" in c for c in design.get("crossings", [])):
             layout.prop(ws, "show_forces")
+        if as_built_view.has_as_built(design):
+            row = layout.row(align=True)
+            row.prop(ws, "show_as_built")
+            sub = row.row(align=True)
+            sub.active = ws.show_as_built
+            sub.prop(ws, "as_built_scale")
         layout.prop(ws, "show_markers")
         steps = design.get("assembly_steps") or []
         if steps:
