@@ -233,8 +233,11 @@ class SuggestPlanes(Case):
             line = (f"traces {f['fidelity']:.0%} of the outline (front {f['views']['front']:.0%}, side "
                     f"{f['views']['side']:.0%}, top {f['views']['top']:.0%}), covers {f['coverage']:.0%} of the mesh")
             self.assertIn(line, " ".join(texts))  # wrapped over labels
-        self.assertEqual([c["score"] for c in candidates],
-                         sorted((c["score"] for c in candidates), reverse=True))
+        # ranked: those that stand in the 3D check first, each group by fidelity (the score)
+        order = [(not c["figures"]["stands_3d"], -c["score"]) for c in candidates]
+        self.assertEqual(order, sorted(order))
+        for c in candidates:  # the panel line carries the 3D verdict beside the load capacity
+            self.assertEqual(c["figures"]["stands_3d"], c["design"]["stands_3d"]["stands"])
         # the preview of a suggestion outlines every plane it would add, and adds none
         self.assertEqual(bpy.ops.wiresculpt.preview_planes(index=0), {'FINISHED'})
         self.assertEqual(handles(bpy.context.scene), [])
