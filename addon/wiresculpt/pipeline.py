@@ -12,9 +12,9 @@ from .core import mesh_faults
 from .core import settings as settings_table
 from .core.design import (NO_WIRES_CAUSE, ONE_WIRE_CAUSE, RELAYER_INCOMPLETE, RELAYER_NO_ASSEMBLY, RELAYER_NOTHING_NEW,
                           RELAYER_ROUNDS, RELAYER_STABLE, SETUP_WORDS, TOO_CLOSE, new_design)
-from .core.sizes import mesh_size, size_warnings
+from .core.sizes import STOCK_LENGTH, mesh_size, size_warnings
 from .core.solve_context import Cancelled, OutOfTime, SolveContext, quiet  # noqa: F401 (the pipeline's names)
-from .fab import buildability
+from .fab import buildability, pieces
 from .stages import forces, layering, slicing, stands3d, target_shape
 
 ALL_STAGES = ["layering", "target_shape", "forces", "rest_shape"]
@@ -70,6 +70,8 @@ def solve(design, material, settings, progress=None, cancel=None, stock=None, ho
         if solved["stable"]:  # the planar verdict holds: does the assembled sculpture stand in 3D?
             context.checkpoint()
             context.say("stands_3d", stands3d.run(solved, material, context.native_progress))
+        if any("rest" in w for w in solved["wires"]):  # wires longer than the stock: in pieces, or why not
+            pieces.apply(solved, (stock or (STOCK_LENGTH,))[0])
         # the warnings the design keeps: the solved wires' lengths, the figures its files give
         solved.setdefault("warnings", []).extend(size_warnings(solved, *(stock or ())))
         mesh_faults.explain(solved)  # a mesh of several parts or with holes: its faults lead the reason

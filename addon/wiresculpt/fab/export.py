@@ -20,7 +20,7 @@ import re
 import numpy as np
 
 from .. import native
-from . import bendlist, tiles
+from . import bendlist, pieces, tiles
 from ..core.calibration import closed_overlap, machine_dict
 from ..core.design import setup_problem
 from ..core import sizes
@@ -126,6 +126,32 @@ def with_overlap(rest, closed, overlap):
     return out
 
 
+def made_of(design, wire, plan, overlap):
+    """What the machine bends for `wire`: one item, the whole rest shape, or one per piece when
+    `plan` (fab/pieces.wire_plan) splits it. Each {"rest" (with a closed wire's overlap on its last
+    item), "own" (without it), "closed", "name", "stem", "crossing_points" (indices into "rest"),
+    "overlap"}; a piece's also "piece", "pieces", "from" and "to" (m from the cut)."""
+    closed = bool(wire.get("closed"))
+    if not plan or "pieces" not in plan:
+        return [{"rest": with_overlap(wire["rest"], closed, overlap), "own": wire["rest"], "closed": closed,
+                 "name": wire["name"], "stem": file_stem(wire), "crossing_points": crossing_indices(design, wire),
+                 "overlap": overlap if closed else 0.0}]
+    rest = np.asarray(wire["rest"], dtype=np.float64)
+    s = pieces.arc_lengths(rest)
+    at = [float(s[i]) for i in crossing_indices(design, wire)]
+    out, count = [], len(plan["pieces"])
+    for k, piece in enumerate(plan["pieces"]):
+        line = pieces.piece_polyline(rest, s, piece["from"], piece["to"])
+        last = closed and k + 1 == count
+        ps = pieces.arc_lengths(line) + piece["from"]
+        points = [int(np.argmin(np.abs(ps - a))) for a in at if piece["from"] < a < piece["to"]]
+        out.append({"rest": with_overlap(line, last, overlap), "own": line, "closed": False,
+                    "name": pieces.piece_name(wire, k + 1, count), "stem": f"{file_stem(wire)}-piece-{k + 1}-of-{count}",
+                    "crossing_points": points, "overlap": overlap if last else 0.0, "piece": k + 1, "pieces": count,
+                    "from": piece["from"], "to": piece["to"]})
+    return out
+
+
 def preview_model(native_profile):
     """The words for a spring-back line: "measured = a x commanded + b deg (name)"."""
     return (f"measured = {float(native_profile['springback_a']):.4f} × commanded "
@@ -151,51 +177,57 @@ def export(design, out_dir, profile=None, paper=None, machine=None):
     paper = paper or (profile or {}).get("paper") or "A4"
     tiles.layout(1.0, 1.0, paper)  # an unknown paper is refused before anything is written
     overlap = closed_overlap(profile)  # refused before anything is written
-    stock_notes = stock_warnings(design, *sizes.stock(profile or {}))
+    stock_length, stock_name = sizes.stock(profile or {})
+    profile_in = profile
     profile, notes = machine_profile(design, profile)  # and a missing module (RuntimeError)
     made_by = profile if machine is None else machine_profile(design, machine)[0]
     native.validate_machine_profile(made_by)  # a bad model is one message before anything is written
-    notes += stock_notes
+    split = pieces.plans(design, stock_length, overlap, profile_in)
+    planned = {**design, "wires": [{**{k: v for k, v in w.items() if k not in pieces.KEYS}, **(split.get(w["id"]) or {})}
+                                   for w in design["wires"]]}
+    notes += stock_warnings(planned, stock_length, stock_name)  # a split wire: its pieces; else why not
     clear(out_dir)
     material = design["material"].get("name", "")
     files, summaries, errors, templates = [], [], [], []
     wires = [x for x in design["wires"] if "rest" in x]
     for wire in wires:
-        rest = with_overlap(wire["rest"], wire.get("closed"), overlap)
-        try:
-            program = native.make_bend_program(rest, profile, made_by)
-        except ValueError as exc:
-            errors.append(f"wire {wire['name']}: {exc}")
-            continue
-        stem = file_stem(wire)
-        template = {"name": wire["name"], "points": rest, "bend_points": list(program["bend_vertices"]),
-                    "crossing_points": crossing_indices(design, wire),
-                    "preview": program["predicted"], "preview_distance": program["preview_distance"],
-                    "overlap": overlap if wire.get("closed") else 0.0}
-        crosses = self_crossings(np.asarray(wire["rest"], dtype=np.float64), wire["closed"])  # not the overlap
-        if crosses:  # marked on the template: the wire must pass over itself there
-            template["self_crossings"] = np.array([c[2] for c in crosses], dtype=np.float64)
-        templates.append(template)
-        for folder, name, write in (
-            ("svg", f"{stem}.svg", lambda p: native.write_machine_svg(p, {"name": wire["name"], "points": rest})),
-            ("dxf", f"{stem}.dxf", lambda p: native.write_dxf(p, [template], layout="start_at_origin")),
-            ("templates", f"{stem}.svg", lambda p: native.write_svg(p, [template], False)),
-            ("gcode", f"{stem}.gcode", lambda p: native.write_gcode(p, rest, profile, wire["name"], material)),
-            ("bends", f"{stem}.csv", lambda p: native.write_bend_table(p, rest, profile)),
-            ("bendlist", f"{stem}.txt",
-             lambda p: bendlist.write_bend_list(p, program, bool(profile.get("left_is_positive", True)))),
-        ):
-            path = os.path.join(out_dir, folder, name)
-            os.makedirs(os.path.dirname(path), exist_ok=True)
-            text = write(path)
-            files.append(path)
-            if folder == "templates":
-                files += tiles.write_pages(text, os.path.join(out_dir, "templates", "pages"), stem, wire["name"], paper)
-        summaries.append({"id": wire["id"], "name": wire["name"], "bend_count": program["bend_count"],
-                          "wire_length": program["wire_length"], "machine_seconds": program["machine_seconds"],
-                          "shape_error": program["shape_error"], "predicted": np.asarray(program["predicted"]),
-                          "preview_distance": program["preview_distance"],
-                          "overlap": overlap if wire.get("closed") else 0.0})
+        for item in made_of(design, wire, split.get(wire["id"]), overlap):
+            rest, name, stem = item["rest"], item["name"], item["stem"]
+            try:
+                program = native.make_bend_program(rest, profile, made_by)
+            except ValueError as exc:
+                errors.append(f"wire {name}: {exc}")
+                continue
+            template = {"name": name, "points": rest, "bend_points": list(program["bend_vertices"]),
+                        "crossing_points": item["crossing_points"],
+                        "preview": program["predicted"], "preview_distance": program["preview_distance"],
+                        "overlap": item["overlap"]}
+            crosses = self_crossings(np.asarray(item["own"], dtype=np.float64), item["closed"])  # not the overlap
+            if crosses:  # marked on the template: the wire must pass over itself there
+                template["self_crossings"] = np.array([c[2] for c in crosses], dtype=np.float64)
+            templates.append(template)
+            for folder, file_name, write in (
+                ("svg", f"{stem}.svg", lambda p: native.write_machine_svg(p, {"name": name, "points": rest})),
+                ("dxf", f"{stem}.dxf", lambda p: native.write_dxf(p, [template], layout="start_at_origin")),
+                ("templates", f"{stem}.svg", lambda p: native.write_svg(p, [template], False)),
+                ("gcode", f"{stem}.gcode", lambda p: native.write_gcode(p, rest, profile, name, material)),
+                ("bends", f"{stem}.csv", lambda p: native.write_bend_table(p, rest, profile)),
+                ("bendlist", f"{stem}.txt",
+                 lambda p: bendlist.write_bend_list(p, program, bool(profile.get("left_is_positive", True)))),
+            ):
+                path = os.path.join(out_dir, folder, file_name)
+                os.makedirs(os.path.dirname(path), exist_ok=True)
+                text = write(path)
+                files.append(path)
+                if folder == "templates":
+                    files += tiles.write_pages(text, os.path.join(out_dir, "templates", "pages"), stem, name, paper)
+            summary = {"id": wire["id"], "name": name, "bend_count": program["bend_count"],
+                       "wire_length": program["wire_length"], "machine_seconds": program["machine_seconds"],
+                       "shape_error": program["shape_error"], "predicted": np.asarray(program["predicted"]),
+                       "preview_distance": program["preview_distance"], "overlap": item["overlap"]}
+            if item.get("piece"):
+                summary.update(piece=item["piece"], pieces=item["pieces"], **{"from": item["from"], "to": item["to"]})
+            summaries.append(summary)
     if templates:
         for folder, name, write in (("templates", "sheet.svg", lambda p: native.write_svg(p, templates, True)),
                                     ("dxf", "sculpture.dxf",
@@ -204,7 +236,7 @@ def export(design, out_dir, profile=None, paper=None, machine=None):
             os.makedirs(os.path.dirname(path), exist_ok=True)
             write(path)
             files.append(path)
-    return {"files": files, "wires": summaries, "errors": errors, "notes": notes,
+    return {"files": files, "wires": summaries, "errors": errors, "notes": notes, "pieces": split,
             "empty_reason": "" if wires else no_rest_reason(design), "preview_model": preview_model(made_by),
             "preview_springback": (float(made_by["springback_a"]), float(made_by["springback_b_deg"]))}
 
