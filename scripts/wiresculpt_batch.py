@@ -177,7 +177,7 @@ def write_fabrication(design, out, say, profile=None, machine=None):
         return  # no folders: the earlier run's are removed with the rest of its set
     start = time.perf_counter()
     # wires longer than the profile's stock: the pieces the files are made of (fab/pieces.py)
-    pieces.apply(design, sizes.stock(profile or {})[0], closed_overlap(profile), profile)
+    pieces.apply(design, sizes.stock(profile or {})[0], closed_overlap(profile), export.machine_profile(design, profile)[0])
     result = export.export(design, out, profile, machine=machine)
     # the predicted polylines stay in the templates; the design keeps each wire's preview distance (m)
     design["fabrication"] = {"wires": [{k: v for k, v in w.items() if k != "predicted"} for w in result["wires"]],

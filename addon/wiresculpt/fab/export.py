@@ -11,6 +11,9 @@
     bends/NN-name.csv      the bend table
     bendlist/NN-name.txt   the bend list for a DIWire-class machine (FabMo Bend List app; fab/bendlist.py)
 
+A wire longer than the profile's stock_length is bent in pieces (fab/pieces.py): each piece gets
+these files under NN-name-piece-K-of-N instead of the wire's.
+
 Free of bpy: the batch run and the add-on's Export operator both call it. Every file is written
 atomically by the native writers.
 """
@@ -21,6 +24,7 @@ import numpy as np
 
 from .. import native
 from . import bendlist, pieces, tiles
+from .pieces import with_overlap  # noqa: F401 (export's name for it)
 from ..core.calibration import closed_overlap, machine_dict
 from ..core.design import setup_problem
 from ..core import sizes
@@ -112,20 +116,6 @@ def no_rest_reason(design):
     return "no wire has a rest shape yet: optimize until the rest shape stage has run"
 
 
-def with_overlap(rest, closed, overlap):
-    """The polyline the machine bends: a closed wire's rest shape with its last segment fed on
-    straight by `overlap` m past the cut (the profile's closed_overlap), so the loop's ends
-    overlap; an open wire, or no allowance, unchanged. Moving the last point keeps the program's
-    bends and lengthens its final feed by exactly `overlap`."""
-    rest = np.asarray(rest, dtype=np.float64)
-    if not closed or overlap <= 0 or len(rest) < 2:
-        return rest
-    d = rest[-1] - rest[-2]
-    out = rest.copy()
-    out[-1] = rest[-1] + overlap * d / np.linalg.norm(d)
-    return out
-
-
 def made_of(design, wire, plan, overlap):
     """What the machine bends for `wire`: one item, the whole rest shape, or one per piece when
     `plan` (fab/pieces.wire_plan) splits it. Each {"rest" (with a closed wire's overlap on its last
@@ -178,11 +168,10 @@ def export(design, out_dir, profile=None, paper=None, machine=None):
     tiles.layout(1.0, 1.0, paper)  # an unknown paper is refused before anything is written
     overlap = closed_overlap(profile)  # refused before anything is written
     stock_length, stock_name = sizes.stock(profile or {})
-    profile_in = profile
     profile, notes = machine_profile(design, profile)  # and a missing module (RuntimeError)
     made_by = profile if machine is None else machine_profile(design, machine)[0]
     native.validate_machine_profile(made_by)  # a bad model is one message before anything is written
-    split = pieces.plans(design, stock_length, overlap, profile_in)
+    split = pieces.plans(design, stock_length, overlap, profile)
     planned = {**design, "wires": [{**{k: v for k, v in w.items() if k not in pieces.KEYS}, **(split.get(w["id"]) or {})}
                                    for w in design["wires"]]}
     notes += stock_warnings(planned, stock_length, stock_name)  # a split wire: its pieces; else why not

@@ -241,6 +241,20 @@ def piece_polyline(points, s, a, b):
     return np.array([at(a)] + [p[i] for i in inner] + [at(b)])
 
 
+def with_overlap(rest, closed, overlap):
+    """The polyline the machine bends: a closed wire's rest shape with its last segment fed on
+    straight by `overlap` m past the cut (the profile's closed_overlap), so the loop's ends
+    overlap; an open wire, or no allowance, unchanged. Moving the last point keeps the program's
+    bends and lengthens its final feed by exactly `overlap`."""
+    rest = np.asarray(rest, dtype=np.float64)
+    if not closed or overlap <= 0 or len(rest) < 2:
+        return rest
+    d = rest[-1] - rest[-2]
+    out = rest.copy()
+    out[-1] = rest[-1] + overlap * d / np.linalg.norm(d)
+    return out
+
+
 def piece_name(wire, number, count):
     """"X0/0 piece 1 of 2": the name a piece's files and messages give."""
     return f"{wire['name']} piece {number} of {count}"
@@ -273,7 +287,6 @@ def wire_plan(design, wire, stock_length, closed_overlap, machine, joint=JOINT_L
         piece["name"] = piece_name(wire, k + 1, count)
         line = piece_polyline(rest, s, piece["from"], piece["to"])
         if k + 1 == count and allowance > 0:
-            from .export import with_overlap
             line = with_overlap(line, True, allowance)
         problems = native.bend_program_problems(line, machine)
         if problems:
@@ -286,12 +299,20 @@ def wire_plan(design, wire, stock_length, closed_overlap, machine, joint=JOINT_L
     return out
 
 
-def plans(design, stock_length=sizes.STOCK_LENGTH, closed_overlap=0.0, profile=None, joint=JOINT_LENGTH):
-    """{wire id: wire_plan} of every wire with a rest shape longer than the stock; `profile` a
-    machine profile as for export.export (None: the default, with the design's limits)."""
-    from .export import machine_profile
+def design_machine(design):
+    """The native profile the pipeline checks wires with: the default machine with the design's
+    limits (as fab/export.machine_profile gives it without a profile)."""
+    out = dict(native.default_machine_profile())
+    out.update({k: float(design["machine"][k]) for k in LIMIT_KEYS if k in design.get("machine", {})})
+    return out
 
-    machine = None
+
+LIMIT_KEYS = ("min_segment", "max_bend_deg", "min_bend_deg")
+
+
+def plans(design, stock_length=sizes.STOCK_LENGTH, closed_overlap=0.0, machine=None, joint=JOINT_LENGTH):
+    """{wire id: wire_plan} of every wire with a rest shape longer than the stock; `machine` a
+    native profile as fab/export.machine_profile makes it (None: design_machine)."""
     out = {}
     for wire in design.get("wires", []):
         if "rest" not in wire or len(wire["rest"]) < 2:
@@ -300,7 +321,7 @@ def plans(design, stock_length=sizes.STOCK_LENGTH, closed_overlap=0.0, profile=N
         if length <= stock_length * (1 + RELATIVE):
             continue
         if machine is None:
-            machine = machine_profile(design, profile)[0]
+            machine = design_machine(design)
         out[wire["id"]] = wire_plan(design, wire, stock_length, closed_overlap, machine, joint)
     return out
 
@@ -308,11 +329,11 @@ def plans(design, stock_length=sizes.STOCK_LENGTH, closed_overlap=0.0, profile=N
 KEYS = ("pieces", "joints", "split_fault")  # the per-wire keys written here
 
 
-def apply(design, stock_length=sizes.STOCK_LENGTH, closed_overlap=0.0, profile=None, joint=JOINT_LENGTH):
+def apply(design, stock_length=sizes.STOCK_LENGTH, closed_overlap=0.0, machine=None, joint=JOINT_LENGTH):
     """plans() into the design: each split wire's `pieces` and `joints`, each wire that cannot be
     split its `split_fault`; earlier ones removed; `stages.pieces` with the stock, the joint's
     length, the allowance and the counts. Returns the plans."""
-    found = plans(design, stock_length, closed_overlap, profile, joint)
+    found = plans(design, stock_length, closed_overlap, machine, joint)
     for wire in design.get("wires", []):
         for key in KEYS:
             wire.pop(key, None)
