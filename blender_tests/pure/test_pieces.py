@@ -8,6 +8,7 @@ import math
 import os
 import tempfile
 import unittest
+import xml.etree.ElementTree as ET
 
 import numpy as np
 
@@ -200,6 +201,32 @@ class Globe(unittest.TestCase):
                 for folder, ext in (("svg", "svg"), ("dxf", "dxf"), ("templates", "svg"), ("bendlist", "txt")):
                     self.assertTrue(os.path.isfile(os.path.join(self.tmp.name, folder, f"{stem}.{ext}")))
             self.assertFalse(os.path.exists(os.path.join(self.tmp.name, "gcode", export.file_stem(w) + ".gcode")))
+
+    def test_the_templates_mark_each_pieces_crossings(self):
+        total = 0
+        for w in self.design["wires"]:
+            s = pieces.arc_lengths(w["rest"])
+            at = [float(s[i]) for i in export.crossing_indices(self.design, w)]
+            for k, piece in enumerate(w["pieces"]):
+                stem = f"{export.file_stem(w)}-piece-{k + 1}-of-{len(w['pieces'])}"
+                root = ET.parse(os.path.join(self.tmp.name, "templates", stem + ".svg")).getroot()
+                rings = [e for e in root.iter() if e.get("class") == "crossing"]
+                self.assertEqual(len(rings), sum(1 for a in at if piece["from"] < a < piece["to"]))
+                total += len(rings)
+        self.assertEqual(total, 2 * len(self.design["crossings"]))  # none inside a joint: each on one piece of each wire
+
+    def test_a_closed_wires_last_piece_carries_the_closing_overlap(self):
+        profile = dict(self.profile, closed_overlap=0.02)
+        with tempfile.TemporaryDirectory() as tmp:
+            result = export.export(self.design, tmp, profile)
+            for w in self.design["wires"]:
+                plan = result["pieces"][w["id"]]
+                last = plan["pieces"][-1]
+                self.assertEqual(last["allowance"], 0.02)
+                self.assertLessEqual(last["length"] + 0.02, 0.5 * (1 + 1e-9))
+                made = [s for s in result["wires"] if s["id"] == w["id"]]
+                self.assertAlmostEqual(made[-1]["wire_length"], last["length"] + 0.02, places=9)  # fed 20 mm past the cut
+                self.assertAlmostEqual(made[0]["wire_length"], plan["pieces"][0]["length"], places=9)
 
     def test_the_batch_writes_the_pieces_files_and_keys(self):
         spec = importlib.util.spec_from_file_location("wiresculpt_batch", BATCH)
