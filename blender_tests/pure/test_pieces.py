@@ -213,6 +213,17 @@ class Globe(unittest.TestCase):
                 rings = [e for e in root.iter() if e.get("class") == "crossing"]
                 self.assertEqual(len(rings), sum(1 for a in at if piece["from"] < a < piece["to"]))
                 total += len(rings)
+                # the joints: a band over the first 30 mm (a joint at its start) and the last 30 mm (at its end)
+                wire_path = next(e for e in root.iter() if e.get("class") == "wire-path")
+                q = np.array([[float(v) for v in p.split(",")] for p in wire_path.get("points").split()])
+                bands = [e for e in root.iter() if e.get("class") == "joint"]
+                ends = [q[0]] * (k > 0) + [q[-1]] * (k + 1 < len(w["pieces"]))
+                self.assertEqual(len(bands), len(ends))
+                for band, end in zip(bands, ends):
+                    line = next(iter(band))
+                    b = np.array([[float(v) for v in p.split(",")] for p in line.get("points").split()])
+                    self.assertAlmostEqual(float(pieces.arc_lengths(b)[-1]), 30.0, places=3)
+                    self.assertTrue(np.allclose(end, b[0], atol=1e-3) or np.allclose(end, b[-1], atol=1e-3))
         self.assertEqual(total, 2 * len(self.design["crossings"]))  # none inside a joint: each on one piece of each wire
 
     def test_a_closed_wires_last_piece_carries_the_closing_overlap(self):

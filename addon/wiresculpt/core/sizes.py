@@ -157,7 +157,8 @@ def joint_sentence(wire, joint, diameter):
     length = joint["length"]
     head = (f"join {name} piece {a} of {count} and piece {b} of {count} {where} before the wire goes in: "
             f"their ends overlap by {_mm(length)}, each running {_mm(length / 2)} past the joint's centre "
-            f"(the last {_mm(length)} of piece {a} lies along the first {_mm(length)} of piece {b})")
+            f"(the last {_mm(length)} of piece {a} lies along the first {_mm(length)} of piece {b}, "
+            "an orange band on both templates)")
     if joint["kind"] == JOINT_SLEEVE:
         return (head + f"; slide a {_mm(length)} sleeve whose bore takes two {diameter * 1000:g} mm wires onto the end "
                 f"of piece {a}, push the start of piece {b} in beside it and crimp or solder the sleeve")

@@ -19,6 +19,7 @@ atomically by the native writers.
 """
 import os
 import re
+import xml.etree.ElementTree as ET
 
 import numpy as np
 
@@ -27,6 +28,7 @@ from . import bendlist, pieces, tiles
 from .pieces import with_overlap  # noqa: F401 (export's name for it)
 from ..core.calibration import closed_overlap, machine_dict
 from ..core.design import setup_problem
+from ..core.files import write_atomic
 from ..core import sizes
 from ..core.sizes import stock_warnings
 from ..core.polylines import self_crossings
@@ -135,11 +137,55 @@ def made_of(design, wire, plan, overlap):
         last = closed and k + 1 == count
         ps = pieces.arc_lengths(line) + piece["from"]
         points = [int(np.argmin(np.abs(ps - a))) for a in at if piece["from"] < a < piece["to"]]
-        out.append({"rest": with_overlap(line, last, overlap), "own": line, "closed": False,
+        marks = []  # (from, to) mm along the piece where it overlaps its neighbour at a joint
+        length_mm = 1000.0 * (piece["to"] - piece["from"])
+        for joint in plan.get("joints") or []:
+            if joint["pieces"][1] == k + 1:  # the joint at its start
+                marks.append((0.0, 1000.0 * (joint["to"] - piece["from"]), joint["pieces"][0], joint["kind"]))
+            if joint["pieces"][0] == k + 1:  # at its end
+                marks.append((1000.0 * (joint["from"] - piece["from"]), length_mm, joint["pieces"][1], joint["kind"]))
+        out.append({"rest": with_overlap(line, last, overlap), "own": line, "closed": False, "joints": marks,
                     "name": pieces.piece_name(wire, k + 1, count), "stem": f"{file_stem(wire)}-piece-{k + 1}-of-{count}",
                     "crossing_points": points, "overlap": overlap if last else 0.0, "piece": k + 1, "pieces": count,
                     "from": piece["from"], "to": piece["to"]})
     return out
+
+
+JOINT_COLOUR = "#c06000"  # the joint bands on a piece's template
+
+
+def mark_joints(path, svg, marks):
+    """The template SVG text `svg` with, on each wire group named in `marks` ({piece name:
+    ([(from mm, to mm, other piece, kind)], piece count)}), a wide band over each stretch where the
+    piece overlaps its neighbour at a joint, labelled; written atomically to `path` (None: not
+    written). Returns the text."""
+    root = ET.fromstring(svg, parser=ET.XMLParser(target=ET.TreeBuilder(insert_comments=True)))
+    ns = "{http://www.w3.org/2000/svg}"
+    groups = [g for g in root.iter(f"{ns}g") if g.get("class") == "wire" and g.get("data-name") in marks]
+    if not groups:  # nothing to mark: the native's text as it is
+        if path is not None:
+            write_atomic(path, svg)
+        return svg
+    for group in groups:
+        stretches, count = marks[group.get("data-name")]
+        path_el = next(e for e in group if e.get("class") == "wire-path")
+        q = np.array([[float(v) for v in pair.split(",")] for pair in path_el.get("points").split()])
+        s = pieces.arc_lengths(q)
+        for a, b, other, kind in stretches:
+            band = pieces.piece_polyline(q, s, max(a, 0.0), min(b, float(s[-1])))
+            mark = ET.SubElement(group, f"{ns}g", {"class": "joint", "data-mm": f"{b - a:.4f}", "data-kind": kind,
+                                                     "data-other": str(other)})
+            ET.SubElement(mark, f"{ns}polyline", {
+                "fill": "none", "stroke": JOINT_COLOUR, "stroke-opacity": "0.45", "stroke-width": "2.0000",
+                "stroke-linecap": "butt", "points": " ".join(f"{x:.4f},{y:.4f}" for x, y in band)})
+            label = ET.SubElement(mark, f"{ns}text", {"x": f"{band[0][0] + 1.5:.4f}", "y": f"{band[0][1] - 1.5:.4f}",
+                                                      "font-family": "sans-serif", "font-size": "2.4000",
+                                                      "fill": JOINT_COLOUR})
+            label.text = f"joint ({kind}): overlaps piece {other} of {count} by {b - a:.1f} mm"
+    text = '<?xml version="1.0" encoding="UTF-8" standalone="no"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+    if path is not None:
+        write_atomic(path, text)
+    return text
 
 
 def preview_model(native_profile):
@@ -178,6 +224,7 @@ def export(design, out_dir, profile=None, paper=None, machine=None):
     clear(out_dir)
     material = design["material"].get("name", "")
     files, summaries, errors, templates = [], [], [], []
+    joint_marks = {}  # piece name: its joints' stretches, marked on the templates
     wires = [x for x in design["wires"] if "rest" in x]
     for wire in wires:
         for item in made_of(design, wire, split.get(wire["id"]), overlap):
@@ -195,10 +242,13 @@ def export(design, out_dir, profile=None, paper=None, machine=None):
             if crosses:  # marked on the template: the wire must pass over itself there
                 template["self_crossings"] = np.array([c[2] for c in crosses], dtype=np.float64)
             templates.append(template)
+            if item.get("joints"):
+                joint_marks[name] = (item["joints"], item["pieces"])
             for folder, file_name, write in (
                 ("svg", f"{stem}.svg", lambda p: native.write_machine_svg(p, {"name": name, "points": rest})),
                 ("dxf", f"{stem}.dxf", lambda p: native.write_dxf(p, [template], layout="start_at_origin")),
-                ("templates", f"{stem}.svg", lambda p: native.write_svg(p, [template], False)),
+                ("templates", f"{stem}.svg", lambda p: mark_joints(p, native.write_svg(None, [template], False),
+                                                                   joint_marks)),
                 ("gcode", f"{stem}.gcode", lambda p: native.write_gcode(p, rest, profile, name, material)),
                 ("bends", f"{stem}.csv", lambda p: native.write_bend_table(p, rest, profile)),
                 ("bendlist", f"{stem}.txt",
@@ -218,7 +268,8 @@ def export(design, out_dir, profile=None, paper=None, machine=None):
                 summary.update(piece=item["piece"], pieces=item["pieces"], **{"from": item["from"], "to": item["to"]})
             summaries.append(summary)
     if templates:
-        for folder, name, write in (("templates", "sheet.svg", lambda p: native.write_svg(p, templates, True)),
+        for folder, name, write in (("templates", "sheet.svg",
+                                     lambda p: mark_joints(p, native.write_svg(None, templates, True), joint_marks)),
                                     ("dxf", "sculpture.dxf",
                                      lambda p: native.write_dxf(p, templates, layout="side_by_side"))):
             path = os.path.join(out_dir, folder, name)
