@@ -49,8 +49,8 @@ def solve(design, material, settings, progress=None, cancel=None, stock=None, ho
     target shape cannot realise a hook (relayer). `progress(stage, message)` is called once per
     finished stage; `cancel()` returning True stops at the next safe point with Cancelled.
     `pending_stages` names the stages that did not run. `stock`: (length in m, profile name) of
-    the machine profile in use, for the stock-length warnings said before the long work (None:
-    the default profile's). `hook_patterns`: at most this many hook patterns per round in
+    the machine profile in use, for the stock-length warnings said before the long work and the
+    pieces of the wires longer than it (fab/pieces.py; None: the default profile's). `hook_patterns`: at most this many hook patterns per round in
     hooks_by_forces (None: HOOK_PATTERNS; 1: the layering's own, as Live does); `hook_seconds`: no
     new pattern after this many seconds (None: HOOK_SECONDS; the plane search's final solve). Past settings.max_solve_seconds (wall
     clock) the solve stops the same way and raises OutOfTime, naming the key and the stage."""

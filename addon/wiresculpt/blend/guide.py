@@ -235,7 +235,9 @@ def pieces_html(wire, diameter):
     parts = wire.get("pieces") or []
     if len(parts) < 2:
         return ""
-    lengths = ", ".join(f"piece {k + 1} {p['length'] * 1000:.0f} mm" for k, p in enumerate(parts))
+    lengths = ", ".join(f"piece {k + 1} {p['length'] * 1000:.0f} mm"
+                        + (f" and {p['allowance'] * 1000:.0f} mm fed past the cut" if p.get("allowance") else "")
+                        for k, p in enumerate(parts))
     joints = "".join(f"<li>{html.escape(s[0].upper() + s[1:])}.</li>"
                      for s in (sizes.joint_sentence(wire, j, diameter) for j in wire.get("joints") or []))
     return f"; made in {len(parts)} pieces ({lengths}), each with its own bend program and template:<ul>{joints}</ul>"
