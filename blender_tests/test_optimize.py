@@ -263,27 +263,39 @@ class OptimizeGlobe(Case):
 
     def test_the_chosen_machine_profiles_stock_is_the_limit(self):
         """The globe's wires are 0.815 m: within the default 1 m stock; a profile of 0.5 m stock chosen
-        in the Fabrication panel makes them over it, in the report, the box and the design's warnings."""
+        in the Fabrication panel makes them longer than it, so each is made in two pieces (fab/pieces.py)
+        and the design is within it; on a 50 mm stock no piece can carry a 30 mm joint and 15 mm feeds
+        (joints 45 mm apart, pieces at most 50 mm), so they are over it, in the report, the box and the
+        design's warnings."""
         from wiresculpt.core import calibration as cal
 
         globe()
         result, reports = run(optimize.WIRESCULPT_OT_optimize)
         self.assertEqual(reports[-1][0], {'INFO'})
-        with tempfile.TemporaryDirectory() as folder:
-            path = cal.save_profile(dict(cal.default_profile(), stock_length=0.5, name="short stock"),
-                                    os.path.join(folder, "short.json"))
-            bpy.context.scene.wiresculpt.machine_profile = path
-            self.addCleanup(setattr, bpy.context.scene.wiresculpt, "machine_profile", "")
-            result, reports = run(optimize.WIRESCULPT_OT_optimize)
-        design = scene_results.stored_design()
-        longest = max(w["length"] for w in design["wires"])
-        self.assertGreater(longest, 0.5)
-        self.assertEqual(reports[-1][0], {'WARNING'})
-        self.assertIn("3 wires are longer than the 500 mm stock", reports[-1][1])
-        self.assertTrue(any("stock of short stock" in w for w in design["warnings"]), design["warnings"])
-        shown = " ".join(labels(draw(results_ui.VIEW3D_PT_wiresculpt_report)))
-        self.assertIn("Stable, over its limits", shown)
-        self.assertIn("longer than the 500 mm stock", shown)
+        for stock in (0.5, 0.05):
+            with tempfile.TemporaryDirectory() as folder:
+                path = cal.save_profile(dict(cal.default_profile(), stock_length=stock, name="short stock"),
+                                        os.path.join(folder, "short.json"))
+                bpy.context.scene.wiresculpt.machine_profile = path
+                self.addCleanup(setattr, bpy.context.scene.wiresculpt, "machine_profile", "")
+                result, reports = run(optimize.WIRESCULPT_OT_optimize)
+            design = scene_results.stored_design()
+            longest = max(w["length"] for w in design["wires"])
+            self.assertGreater(longest, 0.5)
+            self.assertTrue(any("stock of short stock" in w for w in design["warnings"]), design["warnings"])
+            shown = " ".join(labels(draw(results_ui.VIEW3D_PT_wiresculpt_report)))
+            if stock == 0.5:
+                self.assertEqual([len(w["pieces"]) for w in design["wires"]], [2, 2, 2])
+                self.assertEqual(reports[-1][0], {'INFO'})
+                self.assertTrue(any("made in 2 pieces" in w for w in design["warnings"]), design["warnings"])
+                self.assertNotIn("over its limits", shown)
+            else:
+                self.assertTrue(all("split_fault" in w for w in design["wires"]))
+                self.assertEqual(reports[-1][0], {'WARNING'})
+                self.assertIn("3 wires are longer than the 50 mm stock", reports[-1][1])
+                self.assertIn("cannot be split", reports[-1][1])
+                self.assertIn("Stable, over its limits", shown)
+                self.assertIn("longer than the 50 mm stock", shown)
 
     def test_no_green_stable_beside_a_broken_limit(self):
         globe()

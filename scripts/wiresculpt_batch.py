@@ -169,11 +169,15 @@ def machine_model(args, say):
 def write_fabrication(design, out, say, profile=None, machine=None):
     """svg/, dxf/, templates/, gcode/, bends/ and bendlist/ in `out` for every wire with a rest shape; the programs'
     summary goes into the design as `fabrication`."""
-    from wiresculpt.fab import export
+    from wiresculpt.core import sizes
+    from wiresculpt.core.calibration import closed_overlap
+    from wiresculpt.fab import export, pieces
 
     if not any("rest" in w for w in design["wires"]):
         return  # no folders: the earlier run's are removed with the rest of its set
     start = time.perf_counter()
+    # wires longer than the profile's stock: the pieces the files are made of (fab/pieces.py)
+    pieces.apply(design, sizes.stock(profile or {})[0], closed_overlap(profile), export.machine_profile(design, profile)[0])
     result = export.export(design, out, profile, machine=machine)
     # the predicted polylines stay in the templates; the design keeps each wire's preview distance (m)
     design["fabrication"] = {"wires": [{k: v for k, v in w.items() if k != "predicted"} for w in result["wires"]],

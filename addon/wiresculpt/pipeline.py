@@ -12,9 +12,9 @@ from .core import mesh_faults
 from .core import settings as settings_table
 from .core.design import (NO_WIRES_CAUSE, ONE_WIRE_CAUSE, RELAYER_INCOMPLETE, RELAYER_NO_ASSEMBLY, RELAYER_NOTHING_NEW,
                           RELAYER_ROUNDS, RELAYER_STABLE, SETUP_WORDS, TOO_CLOSE, new_design)
-from .core.sizes import mesh_size, size_warnings
+from .core.sizes import STOCK_LENGTH, mesh_size, size_warnings
 from .core.solve_context import Cancelled, OutOfTime, SolveContext, quiet  # noqa: F401 (the pipeline's names)
-from .fab import buildability
+from .fab import buildability, pieces
 from .stages import forces, layering, slicing, stands3d, target_shape
 
 ALL_STAGES = ["layering", "target_shape", "forces", "rest_shape"]
@@ -49,8 +49,8 @@ def solve(design, material, settings, progress=None, cancel=None, stock=None, ho
     target shape cannot realise a hook (relayer). `progress(stage, message)` is called once per
     finished stage; `cancel()` returning True stops at the next safe point with Cancelled.
     `pending_stages` names the stages that did not run. `stock`: (length in m, profile name) of
-    the machine profile in use, for the stock-length warnings said before the long work (None:
-    the default profile's). `hook_patterns`: at most this many hook patterns per round in
+    the machine profile in use, for the stock-length warnings said before the long work and the
+    pieces of the wires longer than it (fab/pieces.py; None: the default profile's). `hook_patterns`: at most this many hook patterns per round in
     hooks_by_forces (None: HOOK_PATTERNS; 1: the layering's own, as Live does); `hook_seconds`: no
     new pattern after this many seconds (None: HOOK_SECONDS; the plane search's final solve). Past settings.max_solve_seconds (wall
     clock) the solve stops the same way and raises OutOfTime, naming the key and the stage.
@@ -77,6 +77,8 @@ def solve(design, material, settings, progress=None, cancel=None, stock=None, ho
         if solved["stable"]:  # the planar verdict holds: does the assembled sculpture stand in 3D?
             context.checkpoint()
             context.say("stands_3d", stands3d.run(solved, material, context.native_progress))
+        if any("rest" in w for w in solved["wires"]):  # wires longer than the stock: in pieces, or why not
+            pieces.apply(solved, (stock or (STOCK_LENGTH,))[0])
         # the warnings the design keeps: the solved wires' lengths, the figures its files give
         solved.setdefault("warnings", []).extend(size_warnings(solved, *(stock or ())))
         mesh_faults.explain(solved)  # a mesh of several parts or with holes: its faults lead the reason

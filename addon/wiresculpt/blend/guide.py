@@ -13,7 +13,7 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
-from ..core import closure
+from ..core import closure, sizes
 from ..core.design import crossing_direction
 from ..core.files import write_atomic
 from ..core.limits import OVER_LIMITS, broken_limits, recorded_stock
@@ -229,6 +229,20 @@ def _wire_html(design, wire_id):
             f"<b>{html.escape(w['name'])}</b>")
 
 
+def pieces_html(wire, diameter):
+    """A split wire's pieces and how to join them (fab/pieces.py; words: core/sizes.joint_sentence),
+    as HTML after the wire's line; "" for a wire of one piece."""
+    parts = wire.get("pieces") or []
+    if len(parts) < 2:
+        return ""
+    lengths = ", ".join(f"piece {k + 1} {p['length'] * 1000:.0f} mm"
+                        + (f" and {p['allowance'] * 1000:.0f} mm fed past the cut" if p.get("allowance") else "")
+                        for k, p in enumerate(parts))
+    joints = "".join(f"<li>{html.escape(s[0].upper() + s[1:])}.</li>"
+                     for s in (sizes.joint_sentence(wire, j, diameter) for j in wire.get("joints") or []))
+    return f"; made in {len(parts)} pieces ({lengths}), each with its own bend program and template:<ul>{joints}</ul>"
+
+
 def page_html(design, pictures, overlap=0.0):
     """The guide page; `pictures` [file name per step]."""
     parts = ["<!DOCTYPE html>", '<html><head><meta charset="utf-8"><title>wiresculpt assembly guide</title>',
@@ -255,6 +269,7 @@ def page_html(design, pictures, overlap=0.0):
             advice = closure.closure_advice(w, mat["wire_diameter"], overlap)
             if advice is not None:
                 text += f" with {'a sleeve' if advice[0] == 'sleeve' else 'an overlap'}: {html.escape(advice[1])}"
+        text += pieces_html(w, mat["wire_diameter"])
         items.append(f"<li>{text}</li>")
     parts.append("<p>Wires:</p><ul>" + "".join(items) + "</ul>")
     for k, picture in enumerate(pictures):

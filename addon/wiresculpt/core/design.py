@@ -59,6 +59,7 @@ KEYS = {
         "out_of_plane_deflection": "forces", "out_of_plane_deflection_vertex": "forces",
         "cut_override": "user", "cut_point": "user",
         "sag": "stands_3d", "as_built": "stands_3d",
+        "pieces": "pipeline", "joints": "pipeline", "split_fault": "pipeline",
     },
     "crossing": {
         "id": "layering", "wires": "layering", "contour_vertices": "layering", "point": "layering",
@@ -70,7 +71,7 @@ KEYS = {
     "stages": {
         "slicing": "slicing", "layering": "layering", "target_shape": "target_shape",
         "forces": "forces", "rest_shape": "forces", "hook_search": "pipeline", "relayering": "pipeline",
-        "stands_3d": "stands_3d",
+        "stands_3d": "stands_3d", "pieces": "pipeline",
     },
     # the plane search's record (`plane_search`, plane_search/records.py)
     "plane_search": {k: "plane_search" for k in (
@@ -86,9 +87,9 @@ OPTIONAL = {
             "buildability", "search_incomplete", "plane_search", "reason_causes", "model_size", "mesh_faults",
             "mesh_closing", "stands_3d", "what_moves", "fidelity"},
     "wire": {"cut_override", "cut_point", "out_of_plane_deflection", "out_of_plane_deflection_vertex", "sag",
-             "as_built"},
+             "as_built", "pieces", "joints", "split_fault"},
     "crossing": {"pyramid", "carried_force", "carried_weight", "force_3d", "admissible"},
-    "stages": {"stands_3d"},
+    "stages": {"stands_3d", "pieces"},
     "plane_search": {"not_found"},
 }
 

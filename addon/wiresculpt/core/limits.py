@@ -11,7 +11,7 @@ import math
 from . import standing
 from .figures import versus
 # STOCK_LENGTH: the default stock, which callers take from here too
-from .sizes import LARGEST_MODEL, MEASURED_WIRE, OVER_STOCK, STOCK_LENGTH, TOO_LARGE, size_facts
+from .sizes import LARGEST_MODEL, MEASURED_WIRE, OVER_STOCK, STOCK_LENGTH, TOO_LARGE, size_facts, split_sentence
 
 # m: the forces stage's deflection_limit (native forces_and_rest; the add-on never sets another):
 # a wire predicted to bend further out of its plane under its contact forces is warned about.
@@ -25,7 +25,7 @@ LOAD_FACTOR = "load_factor"  # the load factor asked for not reached
 # wires bending out of their planes past DEFLECTION_LIMIT, each loaded alone (forces stage): said
 # only where the coupled 3D check did not run, whose sag it overstates
 DEFLECTION = "deflection"
-STOCK = "stock"  # wires longer than the machine's stock
+STOCK = "stock"  # wires longer than the machine's stock and not made in pieces that fit it (fab/pieces.py)
 SIZE = "size"  # a model over LARGEST_MODEL
 # the limits another hook pattern may keep (the pre-stress follows the hooks): not the stock or the size
 HOOK_LIMITS = (STANDS_3D, LOAD_FACTOR, DEFLECTION)
@@ -81,11 +81,15 @@ def limit_figures(design, stock_length=STOCK_LENGTH):
     ok = isinstance(stock_length, (int, float)) and math.isfinite(stock_length) and stock_length > 0
     stock_length = stock_length if ok else STOCK_LENGTH  # as recorded_stock: the default profile's
     facts = size_facts({"wires": wires, "model_size": design.get("model_size")}, stock_length) if wires else []
-    long = [(f["length"], f["wire"]) for f in facts if f["cause"] == OVER_STOCK and f["measured"] == MEASURED_WIRE
-            and _over(f["length"], stock_length)]
+    # a wire made in pieces that each fit the stock (fab/pieces.py) is within it; one that cannot be
+    # split says why (its split_fault)
+    long = [(f["length"], f["wire"], f["split_fault"]) for f in facts
+            if f["cause"] == OVER_STOCK and f["measured"] == MEASURED_WIRE and _over(f["length"], stock_length)
+            and not f["pieces"]]
     if long:
-        worst, name = max(long)
-        out.append((STOCK, {"worst": worst, "name": name, "count": len(long), "stock_length": stock_length}))
+        worst, name, fault = max(long, key=lambda item: (item[0], item[1]))
+        out.append((STOCK, {"worst": worst, "name": name, "count": len(long), "stock_length": stock_length,
+                            "fault": fault}))
     for f in facts:
         if f["cause"] == TOO_LARGE and _over(f["size"], LARGEST_MODEL):
             out.append((SIZE, {"size": f["size"]}))
@@ -107,8 +111,10 @@ def phrase(code, **figures):
                      f"(limit {limit} mm)")
     if code == STOCK:
         shown, limit = versus(figures["worst"] * 1000, figures["stock_length"] * 1000, 0)
-        return (f"wire {figures['name']} is {shown} mm long, over the {limit} mm stock" if figures["count"] == 1
-                else f"{figures['count']} wires are longer than the {limit} mm stock, {figures['name']} {shown} mm")
+        fault = figures.get("fault")
+        why = f" ({split_sentence(fault)})" if fault else ""
+        return (f"wire {figures['name']} is {shown} mm long, over the {limit} mm stock{why}" if figures["count"] == 1
+                else f"{figures['count']} wires are longer than the {limit} mm stock, {figures['name']} {shown} mm{why}")
     if code == SIZE:
         shown, limit = versus(figures["size"], LARGEST_MODEL, 2)
         return f"{shown} m across, over {limit} m"

@@ -19,6 +19,20 @@ def stock(profile):
     return float(profile.get("stock_length", STOCK_LENGTH)), profile.get("name") or "the machine profile"
 
 
+# A wire longer than the stock is split into pieces joined over JOINT_LENGTH (fab/pieces.py): the
+# two pieces overlap there, each running half of it past the joint's centre. A joint on a straight
+# stretch of the rest shape is a sleeve (a tube over both ends), one over bends an overlap (the ends,
+# bent alike, laid side by side and bound or soldered).
+JOINT_LENGTH = 0.03  # m
+JOINT_SLEEVE, JOINT_OVERLAP = "sleeve", "overlap"
+# Why a wire longer than the stock cannot be split (wires[].split_fault["cause"]; split_sentence
+# makes their words), each with the figures length, stock, allowance, joint_length, min_segment and
+# least_stock (m: the shortest stock that would do):
+NO_JOINT_POINT = "no_joint_point"          # no point of the wire can hold a joint (crossings, bends)
+PIECE_TOO_LONG = "piece_too_long"          # the points that can leave a piece longer than the stock
+PIECE_NOT_BENDABLE = "piece_not_bendable"  # a piece's own bend program is refused: piece, message
+SPLIT_CAUSES = (NO_JOINT_POINT, PIECE_TOO_LONG, PIECE_NOT_BENDABLE)
+
 # Causes of the size warnings (codes; size_sentence makes their words)
 OVER_STOCK = "over_stock"        # a wire longer than the machine's stock: wire, length, stock, profile, measured
 TOO_LARGE = "model_too_large"    # a model over LARGEST_MODEL: size, limit
@@ -84,8 +98,72 @@ def size_facts(design, stock_length=STOCK_LENGTH, profile_name="the default mach
         length = wire_length(w)
         if length > stock_length:
             out.append({"cause": OVER_STOCK, "wire": w["name"], "length": length, "stock": float(stock_length),
-                        "profile": profile_name, "measured": measured_on(w)})
+                        "profile": profile_name, "measured": measured_on(w), "pieces": fitting_pieces(w, stock_length),
+                        "split_fault": split_fault(w)})
     return out
+
+
+def fitting_pieces(wire, stock_length):
+    """The number of pieces the wire is made of (its `pieces`, fab/pieces.py) when every piece,
+    with its allowance, fits `stock_length` (m); 0 when it is not split so."""
+    pieces = wire.get("pieces")
+    if not isinstance(pieces, list) or len(pieces) < 2:
+        return 0
+    ok = all(isinstance(p, dict) and isinstance(p.get("length"), (int, float))
+             and p["length"] + float(p.get("allowance", 0.0)) <= stock_length * (1 + 1e-9) for p in pieces)
+    return len(pieces) if ok else 0
+
+
+def split_fault(wire):
+    """The wire's `split_fault` (why it cannot be split, fab/pieces.py) when it has a known cause, else None."""
+    fault = wire.get("split_fault")
+    return fault if isinstance(fault, dict) and fault.get("cause") in SPLIT_CAUSES else None
+
+
+def _mm(metres):
+    return f"{metres * 1000:.0f} mm"
+
+
+def split_sentence(fault):
+    """Why a wire cannot be split into pieces of the stock, and what to change: the words of a
+    `split_fault` (SPLIT_CAUSES with their figures), the one place they are made."""
+    cause = fault["cause"]
+    joint, least = fault["joint_length"], fault["least_stock"]
+    if cause == NO_JOINT_POINT:
+        why = (f"no point of it can take a {_mm(joint)} joint clear of its crossings by {_mm(fault['min_segment'])} "
+               f"with a feed of at least {_mm(fault['min_segment'])} to the next bend on both pieces")
+    elif cause == PIECE_TOO_LONG:
+        shown, stock = versus(least * 1000, fault["stock"] * 1000, 0)
+        why = (f"the points that can take a {_mm(joint)} joint leave a piece of at least {shown} mm"
+               + (f" (with its {_mm(fault['allowance'])} closing overlap)" if fault.get("allowance") else "")
+               + f", over the {stock} mm stock")
+    else:
+        why = f"the bend program refuses piece {fault['piece']}: {fault['message']}"
+    factor = fault["stock"] / least if least > 0 else 1.0
+    change = (f"use a stock of at least {math.ceil(round(least * 1000, 2)):.0f} mm"
+              + (f" or scale the model down to {math.floor(factor * 100) / 100:.2f} of its size or less"
+                 if factor < 1 else ""))
+    return f"it cannot be split into pieces of the stock: {why}; {change}"
+
+
+def joint_sentence(wire, joint, diameter):
+    """How to join two pieces of a split wire (the assembly guide): which piece ends meet, where,
+    and the sleeve or the overlap (fab/pieces.py)."""
+    name = wire["name"]
+    a, b = joint["pieces"]
+    count = len(wire.get("pieces") or ())
+    mm = ", ".join(f"{'xyz'[k]} {round(1000 * joint['point'][k]) or 0}" for k in range(3)) if joint.get("point") else ""
+    where = (f"{joint['at'] * 1000:.0f} mm from the cut" + (f", at ({mm} mm)" if mm else ""))
+    length = joint["length"]
+    head = (f"join {name} piece {a} of {count} and piece {b} of {count} {where} before the wire goes in: "
+            f"their ends overlap by {_mm(length)}, each running {_mm(length / 2)} past the joint's centre "
+            f"(the last {_mm(length)} of piece {a} lies along the first {_mm(length)} of piece {b}, "
+            "an orange band on both templates)")
+    if joint["kind"] == JOINT_SLEEVE:
+        return (head + f"; slide a {_mm(length)} sleeve whose bore takes two {diameter * 1000:g} mm wires onto the end "
+                f"of piece {a}, push the start of piece {b} in beside it and crimp or solder the sleeve")
+    return (head + "; the overlap has bends, made alike on both pieces: lay the two ends side by side and bind or "
+            "solder them along the whole overlap")
 
 
 def size_sentence(fact):
@@ -96,8 +174,12 @@ def size_sentence(fact):
                 f"the scene's size (a wire sculpture this large sags and needs very long wires)")
     shown, stock_mm = versus(fact["length"] * 1000, fact["stock"] * 1000, 0)
     measured = " (its sliced contour; the solve sets the wire's length)" if fact["measured"] == MEASURED_CONTOUR else ""
-    return (f"wire {fact['wire']} is {shown} mm long{measured}, longer than the {stock_mm} mm "
-            f"stock of {fact['profile']}: it needs a longer stock or a joint")
+    head = f"wire {fact['wire']} is {shown} mm long{measured}, longer than the {stock_mm} mm stock of {fact['profile']}"
+    if fact.get("pieces"):
+        return f"{head}: it is made in {fact['pieces']} pieces joined at low-stress points (see the assembly guide)"
+    if fact.get("split_fault"):
+        return f"{head}: {split_sentence(fact['split_fault'])}"
+    return f"{head}: it needs a longer stock or a joint"
 
 
 def size_warnings(design, stock_length=STOCK_LENGTH, profile_name="the default machine profile"):

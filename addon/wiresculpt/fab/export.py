@@ -11,18 +11,24 @@
     bends/NN-name.csv      the bend table
     bendlist/NN-name.txt   the bend list for a DIWire-class machine (FabMo Bend List app; fab/bendlist.py)
 
+A wire longer than the profile's stock_length is bent in pieces (fab/pieces.py): each piece gets
+these files under NN-name-piece-K-of-N instead of the wire's.
+
 Free of bpy: the batch run and the add-on's Export operator both call it. Every file is written
 atomically by the native writers.
 """
 import os
 import re
+import xml.etree.ElementTree as ET
 
 import numpy as np
 
 from .. import native
-from . import bendlist, tiles
+from . import bendlist, pieces, tiles
+from .pieces import with_overlap  # noqa: F401 (export's name for it)
 from ..core.calibration import closed_overlap, machine_dict
 from ..core.design import setup_problem
+from ..core.files import write_atomic
 from ..core import sizes
 from ..core.sizes import stock_warnings
 from ..core.polylines import self_crossings
@@ -112,18 +118,74 @@ def no_rest_reason(design):
     return "no wire has a rest shape yet: optimize until the rest shape stage has run"
 
 
-def with_overlap(rest, closed, overlap):
-    """The polyline the machine bends: a closed wire's rest shape with its last segment fed on
-    straight by `overlap` m past the cut (the profile's closed_overlap), so the loop's ends
-    overlap; an open wire, or no allowance, unchanged. Moving the last point keeps the program's
-    bends and lengthens its final feed by exactly `overlap`."""
-    rest = np.asarray(rest, dtype=np.float64)
-    if not closed or overlap <= 0 or len(rest) < 2:
-        return rest
-    d = rest[-1] - rest[-2]
-    out = rest.copy()
-    out[-1] = rest[-1] + overlap * d / np.linalg.norm(d)
+def made_of(design, wire, plan, overlap):
+    """What the machine bends for `wire`: one item, the whole rest shape, or one per piece when
+    `plan` (fab/pieces.wire_plan) splits it. Each {"rest" (with a closed wire's overlap on its last
+    item), "own" (without it), "closed", "name", "stem", "crossing_points" (indices into "rest"),
+    "overlap"}; a piece's also "piece", "pieces", "from" and "to" (m from the cut)."""
+    closed = bool(wire.get("closed"))
+    if not plan or "pieces" not in plan:
+        return [{"rest": with_overlap(wire["rest"], closed, overlap), "own": wire["rest"], "closed": closed,
+                 "name": wire["name"], "stem": file_stem(wire), "crossing_points": crossing_indices(design, wire),
+                 "overlap": overlap if closed else 0.0}]
+    rest = np.asarray(wire["rest"], dtype=np.float64)
+    s = pieces.arc_lengths(rest)
+    at = [float(s[i]) for i in crossing_indices(design, wire)]
+    out, count = [], len(plan["pieces"])
+    for k, piece in enumerate(plan["pieces"]):
+        line = pieces.piece_polyline(rest, s, piece["from"], piece["to"])
+        last = closed and k + 1 == count
+        ps = pieces.arc_lengths(line) + piece["from"]
+        points = [int(np.argmin(np.abs(ps - a))) for a in at if piece["from"] < a < piece["to"]]
+        marks = []  # (from, to) mm along the piece where it overlaps its neighbour at a joint
+        length_mm = 1000.0 * (piece["to"] - piece["from"])
+        for joint in plan.get("joints") or []:
+            if joint["pieces"][1] == k + 1:  # the joint at its start
+                marks.append((0.0, 1000.0 * (joint["to"] - piece["from"]), joint["pieces"][0], joint["kind"]))
+            if joint["pieces"][0] == k + 1:  # at its end
+                marks.append((1000.0 * (joint["from"] - piece["from"]), length_mm, joint["pieces"][1], joint["kind"]))
+        out.append({"rest": with_overlap(line, last, overlap), "own": line, "closed": False, "joints": marks,
+                    "name": pieces.piece_name(wire, k + 1, count), "stem": f"{file_stem(wire)}-piece-{k + 1}-of-{count}",
+                    "crossing_points": points, "overlap": overlap if last else 0.0, "piece": k + 1, "pieces": count,
+                    "from": piece["from"], "to": piece["to"]})
     return out
+
+
+JOINT_COLOUR = "#c06000"  # the joint bands on a piece's template
+
+
+def mark_joints(path, svg, marks):
+    """The template SVG text `svg` with, on each wire group named in `marks` ({piece name:
+    ([(from mm, to mm, other piece, kind)], piece count)}), a wide band over each stretch where the
+    piece overlaps its neighbour at a joint, labelled; written atomically to `path` (None: not
+    written). Returns the text."""
+    root = ET.fromstring(svg, parser=ET.XMLParser(target=ET.TreeBuilder(insert_comments=True)))
+    ns = "{http://www.w3.org/2000/svg}"
+    groups = [g for g in root.iter(f"{ns}g") if g.get("class") == "wire" and g.get("data-name") in marks]
+    if not groups:  # nothing to mark: the native's text as it is
+        if path is not None:
+            write_atomic(path, svg)
+        return svg
+    for group in groups:
+        stretches, count = marks[group.get("data-name")]
+        path_el = next(e for e in group if e.get("class") == "wire-path")
+        q = np.array([[float(v) for v in pair.split(",")] for pair in path_el.get("points").split()])
+        s = pieces.arc_lengths(q)
+        for a, b, other, kind in stretches:
+            band = pieces.piece_polyline(q, s, max(a, 0.0), min(b, float(s[-1])))
+            mark = ET.SubElement(group, f"{ns}g", {"class": "joint", "data-mm": f"{b - a:.4f}", "data-kind": kind,
+                                                     "data-other": str(other)})
+            ET.SubElement(mark, f"{ns}polyline", {
+                "fill": "none", "stroke": JOINT_COLOUR, "stroke-opacity": "0.45", "stroke-width": "2.0000",
+                "stroke-linecap": "butt", "points": " ".join(f"{x:.4f},{y:.4f}" for x, y in band)})
+            label = ET.SubElement(mark, f"{ns}text", {"x": f"{band[0][0] + 1.5:.4f}", "y": f"{band[0][1] - 1.5:.4f}",
+                                                      "font-family": "sans-serif", "font-size": "2.4000",
+                                                      "fill": JOINT_COLOUR})
+            label.text = f"joint ({kind}): overlaps piece {other} of {count} by {b - a:.1f} mm"
+    text = '<?xml version="1.0" encoding="UTF-8" standalone="no"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+    if path is not None:
+        write_atomic(path, text)
+    return text
 
 
 def preview_model(native_profile):
@@ -151,60 +213,70 @@ def export(design, out_dir, profile=None, paper=None, machine=None):
     paper = paper or (profile or {}).get("paper") or "A4"
     tiles.layout(1.0, 1.0, paper)  # an unknown paper is refused before anything is written
     overlap = closed_overlap(profile)  # refused before anything is written
-    stock_notes = stock_warnings(design, *sizes.stock(profile or {}))
+    stock_length, stock_name = sizes.stock(profile or {})
     profile, notes = machine_profile(design, profile)  # and a missing module (RuntimeError)
     made_by = profile if machine is None else machine_profile(design, machine)[0]
     native.validate_machine_profile(made_by)  # a bad model is one message before anything is written
-    notes += stock_notes
+    split = pieces.plans(design, stock_length, overlap, profile)
+    planned = {**design, "wires": [{**{k: v for k, v in w.items() if k not in pieces.KEYS}, **(split.get(w["id"]) or {})}
+                                   for w in design["wires"]]}
+    notes += stock_warnings(planned, stock_length, stock_name)  # a split wire: its pieces; else why not
     clear(out_dir)
     material = design["material"].get("name", "")
     files, summaries, errors, templates = [], [], [], []
+    joint_marks = {}  # piece name: its joints' stretches, marked on the templates
     wires = [x for x in design["wires"] if "rest" in x]
     for wire in wires:
-        rest = with_overlap(wire["rest"], wire.get("closed"), overlap)
-        try:
-            program = native.make_bend_program(rest, profile, made_by)
-        except ValueError as exc:
-            errors.append(f"wire {wire['name']}: {exc}")
-            continue
-        stem = file_stem(wire)
-        template = {"name": wire["name"], "points": rest, "bend_points": list(program["bend_vertices"]),
-                    "crossing_points": crossing_indices(design, wire),
-                    "preview": program["predicted"], "preview_distance": program["preview_distance"],
-                    "overlap": overlap if wire.get("closed") else 0.0}
-        crosses = self_crossings(np.asarray(wire["rest"], dtype=np.float64), wire["closed"])  # not the overlap
-        if crosses:  # marked on the template: the wire must pass over itself there
-            template["self_crossings"] = np.array([c[2] for c in crosses], dtype=np.float64)
-        templates.append(template)
-        for folder, name, write in (
-            ("svg", f"{stem}.svg", lambda p: native.write_machine_svg(p, {"name": wire["name"], "points": rest})),
-            ("dxf", f"{stem}.dxf", lambda p: native.write_dxf(p, [template], layout="start_at_origin")),
-            ("templates", f"{stem}.svg", lambda p: native.write_svg(p, [template], False)),
-            ("gcode", f"{stem}.gcode", lambda p: native.write_gcode(p, rest, profile, wire["name"], material)),
-            ("bends", f"{stem}.csv", lambda p: native.write_bend_table(p, rest, profile)),
-            ("bendlist", f"{stem}.txt",
-             lambda p: bendlist.write_bend_list(p, program, bool(profile.get("left_is_positive", True)))),
-        ):
-            path = os.path.join(out_dir, folder, name)
-            os.makedirs(os.path.dirname(path), exist_ok=True)
-            text = write(path)
-            files.append(path)
-            if folder == "templates":
-                files += tiles.write_pages(text, os.path.join(out_dir, "templates", "pages"), stem, wire["name"], paper)
-        summaries.append({"id": wire["id"], "name": wire["name"], "bend_count": program["bend_count"],
-                          "wire_length": program["wire_length"], "machine_seconds": program["machine_seconds"],
-                          "shape_error": program["shape_error"], "predicted": np.asarray(program["predicted"]),
-                          "preview_distance": program["preview_distance"],
-                          "overlap": overlap if wire.get("closed") else 0.0})
+        for item in made_of(design, wire, split.get(wire["id"]), overlap):
+            rest, name, stem = item["rest"], item["name"], item["stem"]
+            try:
+                program = native.make_bend_program(rest, profile, made_by)
+            except ValueError as exc:
+                errors.append(f"wire {name}: {exc}")
+                continue
+            template = {"name": name, "points": rest, "bend_points": list(program["bend_vertices"]),
+                        "crossing_points": item["crossing_points"],
+                        "preview": program["predicted"], "preview_distance": program["preview_distance"],
+                        "overlap": item["overlap"]}
+            crosses = self_crossings(np.asarray(item["own"], dtype=np.float64), item["closed"])  # not the overlap
+            if crosses:  # marked on the template: the wire must pass over itself there
+                template["self_crossings"] = np.array([c[2] for c in crosses], dtype=np.float64)
+            templates.append(template)
+            if item.get("joints"):
+                joint_marks[name] = (item["joints"], item["pieces"])
+            for folder, file_name, write in (
+                ("svg", f"{stem}.svg", lambda p: native.write_machine_svg(p, {"name": name, "points": rest})),
+                ("dxf", f"{stem}.dxf", lambda p: native.write_dxf(p, [template], layout="start_at_origin")),
+                ("templates", f"{stem}.svg", lambda p: mark_joints(p, native.write_svg(None, [template], False),
+                                                                   joint_marks)),
+                ("gcode", f"{stem}.gcode", lambda p: native.write_gcode(p, rest, profile, name, material)),
+                ("bends", f"{stem}.csv", lambda p: native.write_bend_table(p, rest, profile)),
+                ("bendlist", f"{stem}.txt",
+                 lambda p: bendlist.write_bend_list(p, program, bool(profile.get("left_is_positive", True)))),
+            ):
+                path = os.path.join(out_dir, folder, file_name)
+                os.makedirs(os.path.dirname(path), exist_ok=True)
+                text = write(path)
+                files.append(path)
+                if folder == "templates":
+                    files += tiles.write_pages(text, os.path.join(out_dir, "templates", "pages"), stem, name, paper)
+            summary = {"id": wire["id"], "name": name, "bend_count": program["bend_count"],
+                       "wire_length": program["wire_length"], "machine_seconds": program["machine_seconds"],
+                       "shape_error": program["shape_error"], "predicted": np.asarray(program["predicted"]),
+                       "preview_distance": program["preview_distance"], "overlap": item["overlap"]}
+            if item.get("piece"):
+                summary.update(piece=item["piece"], pieces=item["pieces"], **{"from": item["from"], "to": item["to"]})
+            summaries.append(summary)
     if templates:
-        for folder, name, write in (("templates", "sheet.svg", lambda p: native.write_svg(p, templates, True)),
+        for folder, name, write in (("templates", "sheet.svg",
+                                     lambda p: mark_joints(p, native.write_svg(None, templates, True), joint_marks)),
                                     ("dxf", "sculpture.dxf",
                                      lambda p: native.write_dxf(p, templates, layout="side_by_side"))):
             path = os.path.join(out_dir, folder, name)
             os.makedirs(os.path.dirname(path), exist_ok=True)
             write(path)
             files.append(path)
-    return {"files": files, "wires": summaries, "errors": errors, "notes": notes,
+    return {"files": files, "wires": summaries, "errors": errors, "notes": notes, "pieces": split,
             "empty_reason": "" if wires else no_rest_reason(design), "preview_model": preview_model(made_by),
             "preview_springback": (float(made_by["springback_a"]), float(made_by["springback_b_deg"]))}
 
