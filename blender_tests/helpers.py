@@ -453,6 +453,26 @@ def _planes():
 PLANES = _planes()  # three great circles through the origin
 
 
+def settings(**kw):
+    """The default settings with no cuts (core/settings.defaults()), updated by `kw`."""
+    from wiresculpt.core.settings import defaults
+
+    s = defaults()
+    s["cuts"] = {}
+    s.update(kw)
+    return s
+
+
+def sphere_design(material, run_settings=None):
+    """The design pipeline.run makes of sphere() (radius 0.125 m) cut by PLANES, three great
+    circles, with `material` and `run_settings` (the defaults when None)."""
+    from wiresculpt import pipeline
+    from wiresculpt.core.settings import defaults
+
+    V, F = sphere()
+    return pipeline.run(V, F, PLANES, material, defaults() if run_settings is None else run_settings)
+
+
 # --- inside Blender (bpy is imported where it is used, so the bpy-free suites can import this) ---
 
 GLOBE_OBJ = os.path.join(ROOT, "scripts", "examples", "globe", "globe.obj")

@@ -8,12 +8,12 @@ import unittest
 
 import numpy as np
 
-from wiresculpt import native, pipeline
+from wiresculpt import native
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.settings import defaults
 from wiresculpt.stages import stands3d
 
-from helpers import PLANES, sphere
+from helpers import sphere_design
 
 MARGIN, SHARE = 0.2, 0.25  # the forces stage's carried_margin and carried_share (their defaults)
 
@@ -32,11 +32,9 @@ def common_line(design, c):
 class Carried(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        V, F = sphere()
         cls.material = dict(PRESETS["steel"])
-        cls.design = pipeline.run(V, F, PLANES, cls.material, defaults())
-        planar = dict(defaults(), carried_3d=False)
-        cls.planar = pipeline.run(V, F, PLANES, copy.deepcopy(cls.material), planar)
+        cls.design = sphere_design(cls.material)
+        cls.planar = sphere_design(copy.deepcopy(cls.material), dict(defaults(), carried_3d=False))
 
     def test_the_rows_held_and_every_carried_force_lies_in_its_shrunk_pyramid(self):
         from scipy.optimize import nnls
