@@ -522,6 +522,20 @@ def save_and_reload(name="sculpture.blend"):
         bpy.ops.wm.open_mainfile(filepath=path)
 
 
+def mesh_model(name, V, F):
+    """A mesh object `name` of vertices V (n, 3) and triangles F (t, 3), linked into the scene and
+    set as the model."""
+    import bpy
+
+    me = bpy.data.meshes.new(name)
+    me.from_pydata(V.tolist(), [], F.tolist())
+    obj = bpy.data.objects.new(name, me)
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.update()
+    bpy.context.scene.wiresculpt.model = obj
+    return obj
+
+
 def globe_target():
     """globe.obj at radius GLOBE_RADIUS as the model, no slicing plane yet."""
     import bpy
@@ -597,3 +611,32 @@ class BlenderCase(unittest.TestCase):
 
     def setUp(self):
         clear_scene()
+
+
+class DesignSuite(unittest.TestCase):
+    """A suite inside Blender on one solved design: the add-on registered, cls.design (made by
+    cls.make_design()) stored in the scene, cls.tmp a temporary folder; after the suite the stored
+    design's text and the folder are removed (the add-on stays registered)."""
+
+    @classmethod
+    def make_design(cls):
+        raise NotImplementedError
+
+    @classmethod
+    def setUpClass(cls):
+        from wiresculpt.blend import results
+
+        register_addon()
+        cls.design = cls.make_design()
+        results.store_design(cls.design)
+        cls.tmp = tempfile.TemporaryDirectory()
+
+    @classmethod
+    def tearDownClass(cls):
+        import bpy
+        from wiresculpt.blend import results
+
+        text = bpy.data.texts.get(results.DESIGN_TEXT)
+        if text is not None:
+            bpy.data.texts.remove(text)
+        cls.tmp.cleanup()
