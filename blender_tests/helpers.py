@@ -463,14 +463,15 @@ def settings(**kw):
     return s
 
 
-def sphere_design(material, run_settings=None):
+def sphere_design(run_settings=None):
     """The design pipeline.run makes of sphere() (radius 0.125 m) cut by PLANES, three great
-    circles, with `material` and `run_settings` (the defaults when None)."""
+    circles, in steel wire (a copy of its preset), with `run_settings` (the defaults when None)."""
     from wiresculpt import pipeline
+    from wiresculpt.core.materials import PRESETS
     from wiresculpt.core.settings import defaults
 
     V, F = sphere()
-    return pipeline.run(V, F, PLANES, material, defaults() if run_settings is None else run_settings)
+    return pipeline.run(V, F, PLANES, dict(PRESETS["steel"]), defaults() if run_settings is None else run_settings)
 
 
 # --- inside Blender (bpy is imported where it is used, so the bpy-free suites can import this) ---

@@ -10,7 +10,6 @@ import numpy as np
 
 from wiresculpt import native
 from wiresculpt.core import standing
-from wiresculpt.core.materials import PRESETS
 from wiresculpt.stages import stands3d
 
 from helpers import sphere_design
@@ -76,8 +75,7 @@ class Words(unittest.TestCase):
 class RealDesign(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.material = dict(PRESETS["steel"])
-        cls.design = sphere_design(cls.material)
+        cls.design = sphere_design()
 
     def test_the_record_is_written(self):
         d = self.design
