@@ -453,6 +453,27 @@ def _planes():
 PLANES = _planes()  # three great circles through the origin
 
 
+def settings(**kw):
+    """The default settings with no cuts (core/settings.defaults()), updated by `kw`."""
+    from wiresculpt.core.settings import defaults
+
+    s = defaults()
+    s["cuts"] = {}
+    s.update(kw)
+    return s
+
+
+def sphere_design(run_settings=None):
+    """The design pipeline.run makes of sphere() (radius 0.125 m) cut by PLANES, three great
+    circles, in steel wire (a copy of its preset), with `run_settings` (the defaults when None)."""
+    from wiresculpt import pipeline
+    from wiresculpt.core.materials import PRESETS
+    from wiresculpt.core.settings import defaults
+
+    V, F = sphere()
+    return pipeline.run(V, F, PLANES, dict(PRESETS["steel"]), defaults() if run_settings is None else run_settings)
+
+
 # --- inside Blender (bpy is imported where it is used, so the bpy-free suites can import this) ---
 
 GLOBE_OBJ = os.path.join(ROOT, "scripts", "examples", "globe", "globe.obj")
@@ -500,6 +521,20 @@ def save_and_reload(name="sculpture.blend"):
         bpy.ops.wm.save_as_mainfile(filepath=path)
         bpy.ops.wm.read_homefile(use_empty=True)
         bpy.ops.wm.open_mainfile(filepath=path)
+
+
+def mesh_model(name, V, F):
+    """A mesh object `name` of vertices V (n, 3) and triangles F (t, 3), linked into the scene and
+    set as the model."""
+    import bpy
+
+    me = bpy.data.meshes.new(name)
+    me.from_pydata(V.tolist(), [], F.tolist())
+    obj = bpy.data.objects.new(name, me)
+    bpy.context.scene.collection.objects.link(obj)
+    bpy.context.view_layer.update()
+    bpy.context.scene.wiresculpt.model = obj
+    return obj
 
 
 def globe_target():
@@ -577,3 +612,32 @@ class BlenderCase(unittest.TestCase):
 
     def setUp(self):
         clear_scene()
+
+
+class DesignSuite(unittest.TestCase):
+    """A suite inside Blender on one solved design: the add-on registered, cls.design (made by
+    cls.make_design()) stored in the scene, cls.tmp a temporary folder; after the suite the stored
+    design's text and the folder are removed (the add-on stays registered)."""
+
+    @classmethod
+    def make_design(cls):
+        raise NotImplementedError
+
+    @classmethod
+    def setUpClass(cls):
+        from wiresculpt.blend import results
+
+        register_addon()
+        cls.design = cls.make_design()
+        results.store_design(cls.design)
+        cls.tmp = tempfile.TemporaryDirectory()
+
+    @classmethod
+    def tearDownClass(cls):
+        import bpy
+        from wiresculpt.blend import results
+
+        text = bpy.data.texts.get(results.DESIGN_TEXT)
+        if text is not None:
+            bpy.data.texts.remove(text)
+        cls.tmp.cleanup()

@@ -14,7 +14,7 @@ import numpy as np
 
 import bpy
 
-import wiresculpt
+from helpers import register_addon
 from wiresculpt import native
 from wiresculpt.core import calibration as cal
 from wiresculpt.core import materials
@@ -193,9 +193,7 @@ class FilesTest(unittest.TestCase):
 class OperatorTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        if wiresculpt._modules:
-            wiresculpt.unregister()
-        wiresculpt.register()
+        register_addon()
         from wiresculpt.operators import calibration as ops
         from wiresculpt.ui import calibration as ui
         cls.own = not hasattr(bpy.types.Scene, "wiresculpt_calibration")

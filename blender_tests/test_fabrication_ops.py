@@ -11,15 +11,13 @@ import glob
 import math
 import os
 import shutil
-import tempfile
 import threading
 import time
 import unittest
 
 import bpy
 
-import wiresculpt
-from helpers import ROOT, GrblEmulator, gcode_lines, run_under_xvfb, step_start
+from helpers import ROOT, DesignSuite, GrblEmulator, gcode_lines, run_under_xvfb, step_start
 from wiresculpt import native, pipeline
 from wiresculpt.blend import results as scene_results
 from wiresculpt.fab import export, streaming
@@ -50,15 +48,14 @@ def read_rows(path):
 
 
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)
-class FabricationOperators(unittest.TestCase):
+class FabricationOperators(DesignSuite):
+    @classmethod
+    def make_design(cls):
+        return globe_design()
+
     @classmethod
     def setUpClass(cls):
-        if wiresculpt._modules:
-            wiresculpt.unregister()
-        wiresculpt.register()
-        cls.design = globe_design()
-        scene_results.store_design(cls.design)
-        cls.tmp = tempfile.TemporaryDirectory()
+        super().setUpClass()
         fit = {"springback_a": SPRINGBACK_A, "springback_b_deg": SPRINGBACK_B, "rms_deg": 0.1,
                "max_residual_deg": 0.2, "samples": 5}
         cls.profile_path = cal.save_profile(cal.with_springback(cal.default_profile(), fit, "bench.csv"),
@@ -67,13 +64,10 @@ class FabricationOperators(unittest.TestCase):
 
     @classmethod
     def tearDownClass(cls):
-        text = bpy.data.texts.get(scene_results.DESIGN_TEXT)
-        if text is not None:
-            bpy.data.texts.remove(text)
+        super().tearDownClass()
         bpy.context.scene.wiresculpt.property_unset("machine_profile")
         streaming.PENDING.clear()
         streaming.LAST.clear()
-        cls.tmp.cleanup()
 
     def setUp(self):
         bpy.context.scene.wiresculpt.machine_profile = ""

@@ -10,17 +10,14 @@ X 12.5; rows measured = 0.9 x commanded - 1 fit a = 0.9, b = -1.
 """
 import math
 import os
-import tempfile
 import time
 import unittest
 
 import bpy
 
-import wiresculpt
-from helpers import GrblEmulator, draw, gcode_lines, step_start
+from helpers import DesignSuite, GrblEmulator, draw, gcode_lines, step_start
 from wiresculpt import native
 from wiresculpt.blend import calibration as scene_calibration
-from wiresculpt.blend import results as scene_results
 from wiresculpt.core import machine_words as words
 from wiresculpt.fab import export, grbl, streaming
 from wiresculpt.ui import calibration as calibration_ui
@@ -60,23 +57,15 @@ def operators(log):
 
 
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)
-class MachinePanel(unittest.TestCase):
+class MachinePanel(DesignSuite):
     @classmethod
-    def setUpClass(cls):
-        if wiresculpt._modules:
-            wiresculpt.unregister()
-        wiresculpt.register()
-        cls.design = ring_design()
-        scene_results.store_design(cls.design)
-        cls.tmp = tempfile.TemporaryDirectory()
+    def make_design(cls):
+        return ring_design()
 
     @classmethod
     def tearDownClass(cls):
         grbl.disconnect()
-        text = bpy.data.texts.get(scene_results.DESIGN_TEXT)
-        if text is not None:
-            bpy.data.texts.remove(text)
-        cls.tmp.cleanup()
+        super().tearDownClass()
 
     def setUp(self):
         streaming.forget()

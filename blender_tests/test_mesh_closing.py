@@ -13,7 +13,7 @@ import unittest
 import bpy
 import numpy as np
 
-from helpers import BATCH, BlenderCase, add_handle, box_faces, box_vertices, draw, run_blender, sphere, write_obj
+from helpers import BATCH, BlenderCase, add_handle, box_faces, box_vertices, draw, mesh_model, run_blender, sphere, write_obj
 from wiresculpt import native
 from wiresculpt.blend import mesh
 from wiresculpt.blend import results as scene_results
@@ -160,12 +160,8 @@ class Closing(BlenderCase):
 
     def test_slice_says_what_it_did_and_leaves_the_mesh_object_alone(self):
         V, _F, punched = punched_sphere()
-        me = bpy.data.meshes.new("punched")
-        me.from_pydata(V.tolist(), [], punched.tolist())
-        obj = bpy.data.objects.new("punched", me)
-        bpy.context.scene.collection.objects.link(obj)
-        bpy.context.view_layer.update()
-        bpy.context.scene.wiresculpt.model = obj
+        obj = mesh_model("punched", V, punched)
+        me = obj.data
         for rotation in ((0, 0, 0), (0, np.pi / 2, 0)):
             add_handle(rotation, location=(0.0, 0.0, 0.1))
         before = np.empty(3 * len(me.vertices))

@@ -10,7 +10,7 @@ from unittest import mock
 import bpy
 import numpy as np
 
-from helpers import BlenderCase, add_handle, sphere
+from helpers import BlenderCase, add_handle, mesh_model, sphere
 from wiresculpt import native, plane_search
 from wiresculpt.blend import results as scene_results
 from wiresculpt.core import mesh_faults
@@ -24,12 +24,7 @@ def two_spheres_target():
     V, F = sphere(RADIUS)
     V = np.concatenate([V, V + [2 * RADIUS + GAP, 0.0, 0.0]])
     F = np.concatenate([F, F + len(V) // 2])
-    me = bpy.data.meshes.new("two spheres")
-    me.from_pydata(V.tolist(), [], F.tolist())
-    obj = bpy.data.objects.new("two spheres", me)
-    bpy.context.scene.collection.objects.link(obj)
-    bpy.context.view_layer.update()
-    bpy.context.scene.wiresculpt.model = obj
+    mesh_model("two spheres", V, F)
     for rotation in ((0, 0, 0), (0, np.pi / 2, 0), (np.pi / 2, 0, 0)):  # z = 0 and y = 0 cut both spheres
         add_handle(rotation)
     assert bpy.ops.wiresculpt.slice() == {'FINISHED'}

@@ -3,17 +3,15 @@ great circles of a sphere), re-checked here apart from the solver: each carried 
 shrunk pyramid by scipy's NNLS and its normal force against the mean, both from the design's own
 pyramids and planes, and the carried forces against the nonlinear 3D check's (stages/stands3d.py,
 Newton on the assembled rods with the weight on a table: another computation). bpy-free."""
-import copy
 import unittest
 
 import numpy as np
 
-from wiresculpt import native, pipeline
-from wiresculpt.core.materials import PRESETS
+from wiresculpt import native
 from wiresculpt.core.settings import defaults
 from wiresculpt.stages import stands3d
 
-from helpers import PLANES, sphere
+from helpers import sphere_design
 
 MARGIN, SHARE = 0.2, 0.25  # the forces stage's carried_margin and carried_share (their defaults)
 
@@ -32,11 +30,8 @@ def common_line(design, c):
 class Carried(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        V, F = sphere()
-        cls.material = dict(PRESETS["steel"])
-        cls.design = pipeline.run(V, F, PLANES, cls.material, defaults())
-        planar = dict(defaults(), carried_3d=False)
-        cls.planar = pipeline.run(V, F, PLANES, copy.deepcopy(cls.material), planar)
+        cls.design = sphere_design()
+        cls.planar = sphere_design(dict(defaults(), carried_3d=False))
 
     def test_the_rows_held_and_every_carried_force_lies_in_its_shrunk_pyramid(self):
         from scipy.optimize import nnls

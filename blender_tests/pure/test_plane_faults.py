@@ -27,20 +27,12 @@ from wiresculpt.core import plane_faults
 from wiresculpt.core.design import TOO_CLOSE
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.scene import PlaneSpec
-from wiresculpt.core.settings import defaults
 
-from helpers import sphere
+from helpers import settings, sphere
 
 R = 0.125
 CANDIDATES = 1 + 3 * 25 + 3 * 25 * 25
 HINGES = ("hinge", ("A/0", "B/0"), ("C/0", "C/0"))
-
-
-def settings(**kw):
-    s = defaults()
-    s["cuts"] = {}
-    s.update(kw)
-    return s
 
 
 def P(name, origin, normal):

@@ -16,10 +16,9 @@ from wiresculpt.core import design as vocabulary
 from wiresculpt.core import sizes
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.scene import PlaneSpec, parse_scene
-from wiresculpt.core.settings import defaults
 from wiresculpt.stages import layering, slicing, target_shape
 
-from helpers import ROOT, sphere
+from helpers import ROOT, settings, sphere
 import recheck
 
 R = 0.125  # the sphere's radius (m); its size S is 0.25 m
@@ -49,13 +48,6 @@ def torus(major=0.1, minor=0.04, n=64, m=24):
             a, b, c, d = i * m + j, ((i + 1) % n) * m + j, ((i + 1) % n) * m + (j + 1) % m, i * m + (j + 1) % m
             F += [(a, b, c), (a, c, d)]
     return np.array(V), np.array(F)
-
-
-def settings(**kw):
-    s = defaults()
-    s["cuts"] = {}
-    s.update(kw)
-    return s
 
 
 def round_trip(design):

@@ -23,21 +23,13 @@ import numpy as np
 from wiresculpt import native, plane_search
 from wiresculpt.plane_search import searcher
 from wiresculpt.core.materials import PRESETS
-from wiresculpt.core.settings import defaults
 
-from helpers import sphere
+from helpers import settings, sphere
 import recheck
 
 import json
 
 R = 0.125
-
-
-def settings(**kw):
-    s = defaults()
-    s["cuts"] = {}
-    s.update(kw)
-    return s
 
 
 def place(name, origin, normal, contours="largest"):

@@ -14,18 +14,10 @@ from wiresculpt import native, plane_search
 from wiresculpt.core import fidelity
 from wiresculpt.core.materials import PRESETS
 from wiresculpt.core.scene import PlaneSpec
-from wiresculpt.core.settings import defaults
 
-from helpers import PLANES, sphere
+from helpers import PLANES, settings, sphere
 
 R = 0.125
-
-
-def settings(**kw):
-    s = defaults()
-    s["cuts"] = {}
-    s.update(kw)
-    return s
 
 
 @unittest.skipUnless(native.available(), native.LOAD_ERROR)

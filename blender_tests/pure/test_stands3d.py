@@ -8,13 +8,11 @@ import unittest
 
 import numpy as np
 
-from wiresculpt import native, pipeline
+from wiresculpt import native
 from wiresculpt.core import standing
-from wiresculpt.core.materials import PRESETS
-from wiresculpt.core.settings import defaults
 from wiresculpt.stages import stands3d
 
-from helpers import PLANES, sphere
+from helpers import sphere_design
 
 
 def turned_by(R):
@@ -77,9 +75,7 @@ class Words(unittest.TestCase):
 class RealDesign(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        V, F = sphere()
-        cls.material = dict(PRESETS["steel"])
-        cls.design = pipeline.run(V, F, PLANES, cls.material, defaults())
+        cls.design = sphere_design()
 
     def test_the_record_is_written(self):
         d = self.design

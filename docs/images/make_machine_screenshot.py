@@ -15,7 +15,7 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
-sys.path[:0] = [os.path.join(ROOT, "addon"), os.path.join(ROOT, "blender_tests")]
+sys.path[:0] = [os.path.join(ROOT, "addon"), os.path.join(ROOT, "blender_tests"), HERE]
 import bpy  # noqa: E402
 
 from wiresculpt.ui import calibration as calibration_ui  # noqa: E402
@@ -27,6 +27,7 @@ import wiresculpt  # noqa: E402
 
 wiresculpt.register()
 from helpers import GrblEmulator  # noqa: E402
+from sidebar_events import click_tab, close_splash  # noqa: E402
 from wiresculpt.fab import grbl  # noqa: E402
 
 OUT = os.environ.get("SHOT_DIR", HERE)
@@ -38,22 +39,6 @@ area = max((a for a in win.screen.areas if a.type == 'VIEW_3D'), key=lambda a: a
 area.spaces.active.show_region_ui = True
 ui = next(r for r in area.regions if r.type == 'UI')
 bpy.context.preferences.view.show_splash = False
-
-
-def close_splash():
-    x, y = win.width // 2, 40
-    win.event_simulate(type='MOUSEMOVE', value='NOTHING', x=x, y=y)
-    win.event_simulate(type='ESC', value='PRESS', x=x, y=y)
-    win.event_simulate(type='ESC', value='RELEASE', x=x, y=y)
-
-
-def click_tab():
-    # Blender 3.4 has no API for the sidebar's active tab: click "Wire" (the 4th tab)
-    x, y = ui.x + ui.width - 10, ui.y + ui.height - int(os.environ.get("TAB_OFFSET", "157"))
-    win.event_simulate(type='MOUSEMOVE', value='NOTHING', x=x, y=y)
-    win.event_simulate(type='LEFTMOUSE', value='PRESS', x=x, y=y)
-    win.event_simulate(type='LEFTMOUSE', value='RELEASE', x=x, y=y)
-    win.event_simulate(type='MOUSEMOVE', value='NOTHING', x=x - 600, y=y)
 
 
 def drive():
@@ -117,7 +102,7 @@ def take_stop():
     bpy.ops.wm.quit_blender()
 
 
-bpy.app.timers.register(lambda: close_splash(), first_interval=0.7)
-bpy.app.timers.register(lambda: click_tab(), first_interval=1.0)
+bpy.app.timers.register(lambda: close_splash(win), first_interval=0.7)
+bpy.app.timers.register(lambda: click_tab(win, ui), first_interval=1.0)
 bpy.app.timers.register(lambda: drive(), first_interval=1.5)
 bpy.app.timers.register(take, first_interval=3.5)

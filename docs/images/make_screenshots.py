@@ -31,9 +31,10 @@ import os
 import sys
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
-sys.path.insert(0, os.path.join(ROOT, 'addon'))
+sys.path[:0] = [os.path.join(ROOT, 'addon'), HERE]
 import bpy
 import wiresculpt
+from sidebar_events import click_tab, close_splash
 MODE = os.environ.get("SHOTS", "")
 FABRICATION = MODE == "fabrication"
 PLANES = MODE == "planes"
@@ -202,24 +203,6 @@ def crop(path, box):
     bpy.data.images.remove(image)
     bpy.data.images.remove(out)
 
-def close_splash():
-    x, y = win.width // 2, 40
-    win.event_simulate(type='MOUSEMOVE', value='NOTHING', x=x, y=y)
-    win.event_simulate(type='ESC', value='PRESS', x=x, y=y)
-    win.event_simulate(type='ESC', value='RELEASE', x=x, y=y)
-    return None
-
-
-def click_tab():
-    # Blender 3.4 has no API for the sidebar's active tab: click "Wire" (the 4th tab)
-    x, y = ui.x + ui.width - 10, ui.y + ui.height - int(os.environ.get("TAB_OFFSET", "157"))
-    win.event_simulate(type='MOUSEMOVE', value='NOTHING', x=x, y=y)
-    win.event_simulate(type='LEFTMOUSE', value='PRESS', x=x, y=y)
-    win.event_simulate(type='LEFTMOUSE', value='RELEASE', x=x, y=y)
-    win.event_simulate(type='MOUSEMOVE', value='NOTHING', x=x - 600, y=y)
-    return None
-
-
 def shoot():
     name, step, action, box = shots.pop(0)
     ws.assembly_step = step
@@ -241,6 +224,6 @@ def shoot():
     bpy.app.timers.register(take, first_interval=1.5)
     return None
 
-bpy.app.timers.register(close_splash, first_interval=0.7)
-bpy.app.timers.register(click_tab, first_interval=1.0)
+bpy.app.timers.register(lambda: close_splash(win), first_interval=0.7)
+bpy.app.timers.register(lambda: click_tab(win, ui), first_interval=1.0)
 bpy.app.timers.register(shoot, first_interval=3.0)

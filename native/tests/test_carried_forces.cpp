@@ -6,6 +6,7 @@
 #include <random>
 #include <vector>
 
+#include "structure3d_fixtures.hpp"
 #include "wire_fixtures.hpp"
 #include "wiresculpt/carried_forces.hpp"
 #include "wiresculpt/error.hpp"
@@ -14,24 +15,8 @@
 #include "wiresculpt/structure3d.hpp"
 
 using namespace wiresculpt;
-
-namespace {
-
-Structure3dWire straight(const std::string& name, const Vec3& from, const Vec3& step, int n) {
-  Structure3dWire w;
-  w.name = name, w.normal = Vec3::UnitZ();
-  for (int k = 0; k < n; ++k) w.start.push_back(from + k * step);
-  w.rest = w.start;
-  return w;
-}
-
-Structure3dOptions weightless() {
-  Structure3dOptions o;
-  o.linear_density = 0.0;
-  return o;
-}
-
-}  // namespace
+using fixtures::straight;
+using fixtures::weightless;
 
 TEST_CASE("tie response: a rod between a tie and a pin passes half its middle load", "[carried]") {
   // A cantilever A along x (clamped at its root) and a straight rod B along y from A's tip (tied

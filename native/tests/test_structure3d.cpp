@@ -6,11 +6,13 @@
 #include <random>
 #include <vector>
 
+#include "structure3d_fixtures.hpp"
 #include "structure3d_model.hpp"
 #include "wiresculpt/error.hpp"
 #include "wiresculpt/structure3d.hpp"
 
 using namespace wiresculpt;
+using fixtures::weightless;
 
 namespace {
 
@@ -55,12 +57,6 @@ std::pair<double, double> elastica_tip(double alpha, double length) {
   }
   shoot(0.5 * (lo + hi), down, along);
   return {down, length - along};
-}
-
-Structure3dOptions weightless() {
-  Structure3dOptions o;
-  o.linear_density = 0.0;
-  return o;
 }
 
 }  // namespace

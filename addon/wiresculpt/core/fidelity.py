@@ -70,16 +70,8 @@ def rasterise(points, triangles, shape):
     for p, q in ((a, b), (b, c), (c, a)):
         u, v = -(q[:, 1] - p[:, 1]), q[:, 0] - p[:, 0]
         edges.append((u, v, -(u * p[:, 0] + v * p[:, 1])))
-    counts = nx * ny
-    ends = np.cumsum(counts)
-    start = 0
-    while start < len(counts):
-        # triangles start..stop-1 hold at most CHUNK candidate pixels (one triangle at least)
-        base = ends[start - 1] if start else 0
-        stop = max(int(np.searchsorted(ends, base + CHUNK, side="right")), start + 1)
-        n = counts[start:stop]
-        tri = np.repeat(np.arange(start, stop), n)
-        local = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+    # triangle by triangle, each of the nx * ny candidate pixels of its bounding box
+    for _start, _stop, tri, local in _chunks(nx * ny):
         px = x0[tri] + local % nx[tri]
         py = y0[tri] + local // nx[tri]
         cx, cy = px + 0.5, py + 0.5
@@ -87,8 +79,28 @@ def rasterise(points, triangles, shape):
         for u, v, w in edges:
             inside &= u[tri] * cx + v[tri] * cy + w[tri] >= -1e-9
         mask[py[inside], px[inside]] = True
-        start = stop
     return mask
+
+
+def _spread(counts, first=0):
+    """(row, local) of the items of rows holding `counts` items each: for every item its row
+    (numbered from `first`) and its index within its row."""
+    row = np.repeat(np.arange(first, first + len(counts)), counts)
+    local = np.arange(int(counts.sum())) - np.repeat(np.cumsum(counts) - counts, counts)
+    return row, local
+
+
+def _chunks(counts):
+    """The rows holding `counts` items each, in runs of at most CHUNK items (one row at least):
+    yields (start, stop, row, local) for rows start..stop-1, with _spread's row and local of
+    their items."""
+    ends = np.cumsum(counts)
+    start = 0
+    while start < len(counts):
+        base = ends[start - 1] if start else 0
+        stop = max(int(np.searchsorted(ends, base + CHUNK, side="right")), start + 1)
+        yield (start, stop) + _spread(counts[start:stop], start)
+        start = stop
 
 
 def cracks(mask):
@@ -142,9 +154,7 @@ def near(points, polylines, tolerance):
     lo, hi = lo - origin, hi - origin
     span = hi.max(axis=0) + 1
     nx, ny = hi[:, 0] - lo[:, 0] + 1, hi[:, 1] - lo[:, 1] + 1
-    n = nx * ny
-    seg = np.repeat(np.arange(len(A)), n)
-    local = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+    seg, local = _spread(nx * ny)
     cells = (lo[seg, 0] + local % nx[seg]) * span[1] + (lo[seg, 1] + local // nx[seg])
     order = np.argsort(cells, kind="stable")
     cells, seg = cells[order], seg[order]
@@ -155,15 +165,8 @@ def near(points, polylines, tolerance):
     first = np.searchsorted(cells, key, side="left")
     last = np.searchsorted(cells, key, side="right")
     m = last - first
-    ends = np.cumsum(m)
-    start = 0
-    while start < len(which):
-        base = ends[start - 1] if start else 0
-        stop = max(int(np.searchsorted(ends, base + CHUNK, side="right")), start + 1)
-        k = m[start:stop]
-        pt = np.repeat(np.arange(start, stop), k)
-        local = np.arange(int(k.sum())) - np.repeat(np.cumsum(k) - k, k)
-        s = seg[np.repeat(first[start:stop], k) + local]
+    for start, stop, pt, local in _chunks(m):  # point by point, the segments of its cell
+        s = seg[np.repeat(first[start:stop], m[start:stop]) + local]
         p = P[which[pt]]
         a, d = A[s], B[s] - A[s]
         length2 = (d * d).sum(axis=1)
@@ -172,7 +175,6 @@ def near(points, polylines, tolerance):
         gap = p - (a + t[:, None] * d)
         hit = (gap * gap).sum(axis=1) <= tolerance * tolerance
         out[which[np.unique(pt[hit])]] = True
-        start = stop
     return out
 
 

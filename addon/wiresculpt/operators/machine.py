@@ -127,17 +127,23 @@ REALTIME = (("HOLD", "Hold", "Feed hold (!): the machine stops its moves, decele
 BYTES = {"HOLD": b"!", "RESUME": b"~", "STATUS": b"?"}
 
 
-class WIRESCULPT_OT_machine_realtime(bpy.types.Operator):
+class _CommandDescribed:
+    """An operator whose `command` is one of CHOICES: its tooltip is the chosen item's description."""
+    CHOICES = ()
+
+    @classmethod
+    def description(cls, context, properties):
+        return dict((k, d) for k, _n, d in cls.CHOICES)[properties.command]
+
+
+class WIRESCULPT_OT_machine_realtime(_CommandDescribed, bpy.types.Operator):
     """Feed hold, resume or a status query: sent at once, also while a wire is being sent"""
     bl_idname = "wiresculpt.machine_realtime"
     bl_label = "Machine Command"
     bl_options = {'REGISTER'}
 
+    CHOICES = REALTIME
     command: EnumProperty(name="Command", items=REALTIME, default="STATUS")
-
-    @classmethod
-    def description(cls, context, properties):
-        return dict((k, d) for k, _n, d in REALTIME)[properties.command]
 
     def execute(self, context):
         job = streaming.JOB
@@ -169,17 +175,14 @@ LINES = (("HOME", "Home", "Home the machine ($H): the axes run to their switches
 COMMAND_LINES = {"HOME": "$H", "UNLOCK": "$X"}
 
 
-class WIRESCULPT_OT_machine_command(bpy.types.Operator):
+class WIRESCULPT_OT_machine_command(_CommandDescribed, bpy.types.Operator):
     """Home ($H) or unlock ($X) the machine"""
     bl_idname = "wiresculpt.machine_command"
     bl_label = "Machine Command"
     bl_options = {'REGISTER'}
 
+    CHOICES = LINES
     command: EnumProperty(name="Command", items=LINES, default="HOME")
-
-    @classmethod
-    def description(cls, context, properties):
-        return dict((k, d) for k, _n, d in LINES)[properties.command]
 
     def execute(self, context):
         session = _session(self)
