@@ -48,7 +48,7 @@ R = 0.125
 target.scale = (R,) * 3
 bpy.context.view_layer.update()
 ws = bpy.context.scene.wiresculpt
-ws.target = target
+ws.model = target
 if PLANES:  # Slice A/B at z = +-0.7 R, C at x = -0.3 R, D at y = 0, E at x = 0.8 R (the hinge)
     PLANE_SET = ((None, (0, 0, 0), (0, 0, 0.7 * R)), (None, (0, 0, 0), (0, 0, -0.7 * R)),
                  (None, (0, math.pi / 2, 0), (-0.3 * R, 0, 0)), (None, (math.pi / 2, 0, 0), (0, 0, 0)),
