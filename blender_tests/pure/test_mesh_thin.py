@@ -21,9 +21,10 @@ RINGS = 11
 MIN_SEGMENT = 0.015
 
 
-def rod(r, x0=0.05, x1=0.2):
-    """A closed prism of N sides and RINGS rings from x0 to x1 about the x axis, capped by fans,
+def rod(r, x0=0.05, x1=0.2, rings=RINGS):
+    """A closed prism of N sides and `rings` rings from x0 to x1 about the x axis, capped by fans,
     its faces wound outwards."""
+    RINGS = rings  # noqa: N806
     a = 2 * math.pi * np.arange(N) / N
     rings = [np.column_stack([np.full(N, x), r * np.cos(a), r * np.sin(a)]) for x in np.linspace(x0, x1, RINGS)]
     V = np.concatenate(rings + [[[x0, 0, 0], [x1, 0, 0]]])
@@ -75,6 +76,16 @@ class ThinParts(unittest.TestCase):
         self.assertIn(f"scale the model up at least {factor:.2f} times (largest side 0.3 m -> {0.3 * factor:.4g} m)",
                       words)
         self.assertIn("expect no wire there", words)
+
+    def test_two_thin_rods_are_two_places_the_larger_one_named(self):
+        # a second, shorter rod of 0.002 m out of the -x side: 6 rings from -0.2 to -0.05
+        V, F = joined(box_with_rod(0.003), rod(0.002, -0.2, -0.05, rings=6))
+        (fault,) = mesh_faults.thin(V, F, MIN_SEGMENT)
+        self.assertEqual(fault["places"], 2)
+        np.testing.assert_allclose(fault["at"], [0.125, 0.0, 0.0], atol=1e-3)  # the rod of 11 rings
+        self.assertAlmostEqual(fault["thinnest"], 0.003 * (1 + math.cos(math.pi / N)), places=9)
+        self.assertIn("in 2 places", mesh_faults.sentence(fault))
+        self.assertIn("the largest around (125, 0, 0) mm", mesh_faults.sentence(fault))
 
     def test_faces_wound_inwards_give_the_same_answer(self):
         V, F = box_with_rod(0.003)

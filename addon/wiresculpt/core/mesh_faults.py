@@ -28,9 +28,10 @@ Faults (each a dict with "cause" and its figures):
 
 Thin parts (thin(vertices, faces, min_segment), apart from check(): a thin part is no reason to
 close the mesh, and its threshold depends on the wire):
-- THIN: "share" of the vertices where the model is thinner than "limit" (m), "thinnest" (m) the
-  least thickness found, "at" the centre of those vertices' bounding box (m), "size" the model's
-  size (m, for the scale advice). A vertex's local thickness is the distance from it, inwards
+- THIN: "share" of the vertices where the model is thinner than "limit" (m), "places" how many
+  separate places they make (thin vertices in neighbouring cells of the limit's size, or joined
+  by an edge of the mesh, are one place), of the place with the most of them "thinnest" (m) its least thickness and "at" the
+  centre of its bounding box (m); "size" the model's size (m, for the scale advice). A vertex's local thickness is the distance from it, inwards
   along its normal (area-weighted, flipped when the faces wind inwards), to the first face the ray
   leaves the solid through (numpy, faces found through a grid of cells of the limit's size; at
   most THIN_RAYS vertices, evenly spread over the mesh's vertex list). The limit is THIN_SEGMENTS
@@ -252,7 +253,8 @@ def _expand(first, last):
 
 def local_thickness(P, F, reach, rays):
     """m: for each vertex in `rays` (indices into the welded mesh P, F), the distance inwards along
-    its normal to the first face the ray leaves the solid through, when within `reach`; inf
+    its normal to the first face the ray leaves the solid through (not one touching the vertex or
+    a neighbour of it), when within `reach`; inf
     otherwise (or for a vertex without a normal); nan for a ray left out (THIN_PAIRS)."""
     normals, cross = _vertex_normals(P, F)
     out = np.full(len(rays), np.inf)
@@ -273,6 +275,10 @@ def local_thickness(P, F, reach, rays):
         c = cell + 1  # a cell at -1 (a ray's end below the origin) keeps a non-negative key
         return (c[:, 0] * dims[1] + c[:, 1]) * dims[2] + c[:, 2]
 
+    # vertex pairs (a * len(P) + b) of each vertex with itself and with its neighbours
+    edges = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
+    ring = np.unique(np.concatenate([edges[:, 0] * len(P) + edges[:, 1], edges[:, 1] * len(P) + edges[:, 0],
+                                     np.arange(len(P)) * (len(P) + 1)]))
     face_key = key(face_cell)
     order = np.argsort(face_key, kind="stable")
     face_key, face_of = face_key[order], face_of[order]
@@ -300,8 +306,10 @@ def local_thickness(P, F, reach, rays):
         face = face_of[at]
         pair = np.unique(ray * len(F) + face)
         ray, face = np.divmod(pair, len(F))
-        own = (F[face] == rays[ray][:, None]).any(axis=1)  # the faces at the ray's own vertex
-        ray, face = ray[~own], face[~own]
+        # the faces touching the ray's vertex or its neighbours: a ray grazes them on a curved or
+        # creased surface (a hit at about no distance), and no part is as thin as its own faces
+        near = np.isin(rays[ray][:, None] * len(P) + F[face], ring).any(axis=1)
+        ray, face = ray[~near], face[~near]
         exits = np.einsum("ij,ij->i", cross[face], d[ray]) > 0  # leaving the solid: the face looks along the ray
         ray, face = ray[exits], face[exits]
         A = P[F[face, 0]]
@@ -354,9 +362,33 @@ def _thin(V, F, min_segment):
     share = float(thin_rays.sum() / max(measured.sum(), 1))
     if share <= THIN_SHARE:
         return []
-    where = P[rays[thin_rays]]
-    return [{"cause": THIN, "share": share, "thinnest": float(t[thin_rays].min()), "limit": float(limit),
-             "at": [float(c) for c in (where.min(axis=0) + where.max(axis=0)) / 2], "size": float(size)}]
+    where, depth = P[rays[thin_rays]], t[thin_rays]
+    # the thin places: thin vertices in the same or neighbouring cells of the limit's size are one
+    cell = np.floor((where - where.min(axis=0)) / limit).astype(np.int64)
+    cells, of = np.unique(cell, axis=0, return_inverse=True)
+    of = of.reshape(-1)
+    span = cells.max(axis=0) + 2
+    keys = (cells[:, 0] * span[1] + cells[:, 1]) * span[2] + cells[:, 2]  # sorted, as cells are
+    pairs = []
+    for dx, dy, dz in _OFFSETS:
+        other = np.searchsorted(keys, keys + (dx * span[1] + dy) * span[2] + dz)
+        found = (other < len(keys)) & (keys[np.minimum(other, len(keys) - 1)] == keys + (dx * span[1] + dy) * span[2] + dz)
+        ok = found & ((cells[np.minimum(other, len(keys) - 1)] - cells)[:, [1, 2]] <= 1).all(axis=1) \
+            & ((cells[np.minimum(other, len(keys) - 1)] - cells)[:, [1, 2]] >= -1).all(axis=1)
+        pairs.append(np.column_stack([np.nonzero(ok)[0], other[ok]]))
+    # and thin vertices joined by an edge of the mesh (a coarse mesh's edges are longer than a cell)
+    thin_index = np.full(len(P), -1)
+    thin_index[rays[thin_rays]] = np.arange(len(where))
+    ends = thin_index[np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])]
+    ends = ends[(ends >= 0).all(axis=1)]
+    pairs.append(np.column_stack([of[ends[:, 0]], of[ends[:, 1]]]))
+    label, places = _components(len(cells), np.concatenate(pairs))
+    part = label[of]
+    largest = int(np.argmax(np.bincount(part, minlength=places)))
+    mine = part == largest
+    at = (where[mine].min(axis=0) + where[mine].max(axis=0)) / 2
+    return [{"cause": THIN, "share": share, "places": int(places), "thinnest": float(depth[mine].min()),
+             "limit": float(limit), "at": [float(c) for c in at], "size": float(size)}]
 
 
 def _mm(metres):
@@ -369,11 +401,13 @@ def sentence(fault):
         return obstacle_sentence(fault)
     if fault["cause"] == THIN:
         at = ", ".join(f"{1000 * c:.0f}" for c in fault["at"])
-        return (f"parts of the model are thinner than a wire can go round: {100 * fault['share']:.0f} % of its "
-                f"vertices, around ({at}) mm, as thin as {_mm(fault['thinnest'])}, under the {_mm(fault['limit'])} "
-                f"a closed wire of straight pieces of at least the minimum segment needs: "
-                f"{scale_words(fault['size'], fault['limit'] / fault['thinnest'])}, thicken them, or expect no "
-                f"wire there")
+        places = fault.get("places", 1)
+        where = (f"in {places} places, {100 * fault['share']:.0f} % of its vertices; the largest around ({at}) mm"
+                 if places > 1 else f"{100 * fault['share']:.0f} % of its vertices, around ({at}) mm")
+        return (f"parts of the model are thinner than a wire can go round: {where}, as thin as "
+                f"{_mm(fault['thinnest'])}, under the {_mm(fault['limit'])} a closed wire of straight pieces of at "
+                f"least the minimum segment needs: {scale_words(fault['size'], fault['limit'] / fault['thinnest'])}, "
+                f"thicken them, or expect no wire there")
     if fault["cause"] == NONMANIFOLD:
         return (f"the mesh has {fault['edges']} non-manifold edge{'s' if fault['edges'] != 1 else ''} (shared by "
                 f"more than two faces), where a plane's contour can branch: merge or separate the faces there")
