@@ -37,6 +37,9 @@ def slice_and_pick(vertices, faces, planes, material, settings, progress=None):
     design = new_design(material, settings)
     design["model_size"] = mesh_size(vertices)  # the model's size, one figure for every message (core/sizes)
     design["mesh_faults"] = mesh_faults.check(vertices, faces)  # said in the verdict when it fails (explain)
+    thin = mesh_faults.thin(vertices, faces, settings["min_segment"])  # parts no closed wire goes round
+    design["mesh_faults"] += thin
+    design.setdefault("warnings", []).extend(mesh_faults.sentence(f) for f in thin)
     closing = mesh_faults.closing_of(vertices, faces)  # a mesh closed for slicing (blend/mesh.py): what was done
     if closing is not None:
         design["mesh_closing"] = closing

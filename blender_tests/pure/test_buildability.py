@@ -59,15 +59,23 @@ class Verdict(unittest.TestCase):
 
     def test_a_too_short_straight_piece_between_crossings_asks_for_a_scale_up(self):
         # 20 mm, then 5 mm between the crossings at rest points 1 and 2 (both bent 30 deg), then 20 mm:
-        # 15 / 5 = 3 times, the 0.1 m model to 0.3 m.
+        # room for a free bending point between the two crossings, 2 x 15 / 5 = 6 times, the 0.1 m
+        # model to 0.6 m.
         design = design_of(walk([0.02, 0.005, 0.02], [30.0, 30.0]), crossing_vertices=(1, 2))
         buildability.apply(design)
         self.assertFalse(design["stable"])
         self.assertIn("wire T/0: step 2 feeds 5.000 mm (between bends 1 and 2, 20.0 mm from the cut)",
                       design["reason"])
         self.assertIn("crossings 0 and 1", design["reason"])
-        self.assertIn("scale the model up at least 3.00 times (largest side 0.1 m -> 0.3 m)", design["reason"])
+        self.assertIn("scale the model up at least 6.00 times (largest side 0.1 m -> 0.6 m)", design["reason"])
         self.assertEqual(design["buildability"]["problems"][0]["crossings"], [0, 1])
+
+    def test_a_too_short_feed_with_no_crossings_at_its_ends_asks_for_that_feed_only(self):
+        # the same 5 mm feed with no crossing at its ends: one straight piece, 15 / 5 = 3 times
+        design = design_of(walk([0.02, 0.005, 0.02], [30.0, 30.0]))
+        buildability.apply(design)
+        self.assertFalse(design["stable"])
+        self.assertIn("scale the model up at least 3.00 times (largest side 0.1 m -> 0.3 m)", design["reason"])
 
     def test_a_rest_shape_the_bend_program_cannot_read_is_a_reason_not_a_crash(self):
         rest = walk([0.02, 0.02, 0.02], [30.0, 30.0])

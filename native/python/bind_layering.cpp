@@ -149,7 +149,8 @@ py::dict layering_py(const py::object& wire_list, const py::object& settings, co
 
   py::list warnings;
   for (const auto& w : net.warnings) warnings.append(w);
-  for (const auto& g : net.close_crossings) warnings.append(g.message);
+  // the close crossings go in network.close_crossings with their figures; the add-on words them
+  // (core/sizes.close_crossing_sentence), with the model's own size
   for (const auto& w : r.warnings) warnings.append(w);
   py::dict out(
       py::arg("network") = network_dict(net, r.hooks, r.metric, options.contact, forbidden.contour_arrays), py::arg("hook") = r.hooks, py::arg("metric") = r.metric,

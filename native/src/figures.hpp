@@ -33,4 +33,18 @@ inline std::pair<std::string, std::string> versus(double value, double limit, in
   return {figure(value, d, style), figure(limit, d, style)};
 }
 
+/// The one scale rule (docs/user-guide.md, "Scale advice"): two crossings `arc` metres apart along a
+/// wire need room for a free bending point between them, two straight pieces of at least
+/// `min_segment` each, so the model must grow by 2 min_segment / arc (1e300 for arc <= 0). The
+/// network's close crossings and the target shape's too-close ones both say this factor.
+inline double gap_scale(double arc, double min_segment) { return arc > 0 ? 2.0 * min_segment / arc : 1e300; }
+
+/// The words of a scale advice, as the add-on's core/sizes.scale_advice makes them: "scale the model
+/// up at least 2.51 times (largest side 0.214 m -> 0.538 m)"; without the sizes when `size` <= 0.
+inline std::string scale_words(double factor, double size) {
+  std::string out = "scale the model up at least " + figure(factor, 2) + " times";
+  if (size > 0) out += " (largest side " + figure(size, 4, 'g') + " m -> " + figure(size * factor, 4, 'g') + " m)";
+  return out;
+}
+
 }  // namespace wiresculpt::detail

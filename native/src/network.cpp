@@ -18,12 +18,6 @@ std::string fmt_point(const Vec3& p) {
   return buf;
 }
 
-std::string fmt_len(double metres) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.4g m", metres);
-  return buf;
-}
-
 std::string quoted(const std::string& name) { return "'" + name + "'"; }
 
 // Validates one wire, projects it onto its plane and merges duplicate points.
@@ -371,14 +365,11 @@ void size_and_close_crossings(Network& net, const NetworkOptions& options) {
       g.wire = w;
       g.crossings = {ca, cb};
       g.distance = dist;
-      g.scale = dist > 0 ? options.min_segment / dist : 1e300;
-      char buf[64];
-      std::snprintf(buf, sizeof buf, "%.2f", g.scale);
+      g.scale = detail::gap_scale(dist, options.min_segment);
       const auto [apart, least] = detail::versus(dist, options.min_segment, 4, 'g');
       g.message = "wire " + quoted(wire.name) + ": crossings " + std::to_string(ca) + " and " + std::to_string(cb) +
                   " are " + apart + " m apart along the wire, less than the machine's minimum segment " + least +
-                  " m; scale the model up at least " + buf + " times (largest side " +
-                  fmt_len(net.size) + " -> " + fmt_len(net.size * g.scale) + ")";
+                  " m; a free bending point between them needs twice that: " + detail::scale_words(g.scale, net.size);
       net.min_scale = std::max(net.min_scale, g.scale);
       net.close_crossings.push_back(g);
     }

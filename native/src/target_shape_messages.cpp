@@ -26,11 +26,12 @@ std::string fitting_contact_angle(const CrossingFigures& f) {
 }
 
 // Two crossings with no room for a free bending point between them, and the scale that makes room.
-std::string gap_sentence(const std::string& wire, const CrossingFigures& f) {
+// `what`: a clause on the piece between them, after a comma, or empty.
+std::string gap_sentence(const std::string& wire, const CrossingFigures& f, const std::string& what = {}) {
   std::string msg = "crossings " + std::to_string(f.first) + " and " + std::to_string(f.second) + " on wire " + wire +
-                    " are " + mm(f.length) + " apart along the wire; a free bending point between them needs " +
-                    mm(2.0 * f.limit) + ": scale the model up by " + fmt(f.scale) + "x";
-  if (f.model_size > 0.0) msg += ", to at least " + fmt(f.model_size * f.scale) + " m";
+                    " are " + mm(f.length) + " apart along the wire" + (what.empty() ? "" : ", " + what) +
+                    "; a free bending point between them needs " +
+                    mm(2.0 * f.limit) + ": " + scale_words(f.scale, f.model_size);
   return msg;
 }
 }  // namespace
@@ -102,7 +103,7 @@ CrossingSentence crossing_sentence(int crossing, const std::string& wire, Crossi
                        ") but the machine bends at most " + deg(f.limit) + fitting_contact_angle(f));
     case CrossingCause::short_piece: {
       // the direct segment is too short to bend: a fabrication problem whatever the hooks
-      const std::string msg = gap_sentence(wire, f) + " (the straight piece is shorter than the minimum segment)";
+      const std::string msg = gap_sentence(wire, f, "the straight piece between them shorter than the minimum segment");
       return {msg, msg};
     }
     case CrossingCause::fixed_edge: {

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "figures.hpp"
 #include "target_shape_messages.hpp"
 #include "target_shape_parts.hpp"
 #include "target_shape_sqp.hpp"
@@ -376,7 +377,7 @@ void TargetShapeProblem::check_crossings(const std::vector<Gap>& gaps) {
     f.second = g.b;
     f.length = g.arc;
     f.limit = lmin;
-    f.scale = 2.0 * lmin / std::max(g.arc, 1e-300);
+    f.scale = detail::gap_scale(g.arc, lmin);
     f.model_size = o.model_size;
     if (g.chord < lmin) {
       // The direct segment is too short to bend: a fabrication problem whatever the hooks.

@@ -1,4 +1,5 @@
 // Crossings of wires whose meeting points are known by hand: circles of one sphere.
+#include <cstdio>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <numbers>
@@ -154,6 +155,7 @@ TEST_CASE("network: three wires through one point are an input error naming the 
 }
 
 TEST_CASE("network: crossings closer than the minimum segment are reported with the scale needed") {
+  // The scale gives room for a free bending point between them: twice 15 mm along the wire.
   // Great circle G (x = 0) and a small circle near the pole (z = h, radius rho = 4 mm): they meet
   // at (0, ±rho, h), 2 R asin(rho / R) apart along G and pi rho apart (both ways) along the
   // small circle; both less than 15 mm.
@@ -168,8 +170,11 @@ TEST_CASE("network: crossings closer than the minimum segment are reported with 
     if (g.wire == 0) {
       ++on_g;
       CHECK(g.distance == Approx(along_g).epsilon(1e-4));
-      CHECK(g.scale == Approx(0.015 / along_g).epsilon(1e-4));
-      CHECK_THAT(g.message, Contains("'G'") && Contains("crossings") && Contains("scale the model up"));
+      CHECK(g.scale == Approx(0.030 / along_g).epsilon(1e-4));
+      char advice[96];  // 0.03 / 0.0080000 = 3.75: the size 0.2 m of both circles' box grows to 0.75 m
+      std::snprintf(advice, sizeof advice, "scale the model up at least %.2f times (largest side 0.2 m -> %.4g m)",
+                    0.030 / along_g, 0.2 * 0.030 / along_g);
+      CHECK_THAT(g.message, Contains("'G'") && Contains("crossings") && Contains(advice));
     } else {
       ++on_cap;
       CHECK(g.distance == Approx(along_cap).epsilon(1e-3));
@@ -177,7 +182,7 @@ TEST_CASE("network: crossings closer than the minimum segment are reported with 
   }
   CHECK(on_g == 1);   // the long way round G is far more than 15 mm
   CHECK(on_cap == 2); // both ways round the cap are short
-  CHECK(net.min_scale == Approx(0.015 / along_g).epsilon(1e-4));
+  CHECK(net.min_scale == Approx(0.030 / along_g).epsilon(1e-4));
   CHECK(net.size == Approx(2 * R).epsilon(1e-6));
   CHECK(net.required_size == Approx(net.size * net.min_scale));
 

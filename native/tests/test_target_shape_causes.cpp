@@ -146,8 +146,9 @@ TEST_CASE("target shape causes: each cause's sentence from its figures", "[targe
     f.model_size = 0.093;
     const auto s = sentence(CrossingCause::short_piece);
     CHECK(s.message ==
-          "crossings 3 and 4 on wire A/0 are 9 mm apart along the wire; a free bending point between them needs 30 mm: "
-          "scale the model up by 3.33x, to at least 0.31 m (the straight piece is shorter than the minimum segment)");
+          "crossings 3 and 4 on wire A/0 are 9 mm apart along the wire, the straight piece between them shorter than the "
+          "minimum segment; a free bending point between them needs 30 mm: scale the model up at least 3.33 times "
+          "(largest side 0.093 m -> 0.31 m)");
     CHECK(s.words == s.message);
   }
   SECTION("every cause has its own name") {

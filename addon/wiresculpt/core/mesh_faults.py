@@ -26,6 +26,22 @@ Faults (each a dict with "cause" and its figures):
   size that closes them (VOXEL_SHARE of the model's size).
 - NONMANIFOLD: "edges" edges shared by more than two faces (after welding).
 
+Thin parts (thin(vertices, faces, min_segment), apart from check(): a thin part is no reason to
+close the mesh, and its threshold depends on the wire):
+- THIN: "share" of the vertices where the model is thinner than "limit" (m), "places" how many
+  separate places they make (thin vertices in neighbouring cells of the limit's size, or joined
+  by an edge of the mesh, are one place), of the place with the most of them "thinnest" (m) its least thickness and "at" the
+  centre of its bounding box (m); "size" the model's size (m, for the scale advice). A vertex's local thickness is the distance from it, inwards
+  along its normal (area-weighted, flipped when the faces wind inwards), to the first face the ray
+  leaves the solid through (numpy, faces found through a grid of cells of the limit's size; at
+  most THIN_RAYS vertices, evenly spread over the mesh's vertex list). The limit is THIN_SEGMENTS
+  of min_segment (l_min): a closed wire around a part is a polygon of at least three straight
+  pieces of at least l_min each, a perimeter of at least 3 l_min, and a section of width t has a
+  perimeter of about pi t, so a part narrower than 3 / pi l_min (about one l_min) holds no closed
+  wire around it; a plane through it gives a contour the wire can only cut across. Reported when
+  more than THIN_SHARE of the vertices are that thin; what to do: scale the model up (by limit /
+  thinnest), thicken the part, or expect no wire there.
+
 Closing for slicing (blend/mesh.py does it, in Blender, on a temporary copy: the user's mesh object
 is never changed): every hole is capped (its boundary loop filled) and the capped mesh remeshed by
 voxels, which fuses overlapping or touching parts into one surface and mends non-manifold edges.
@@ -48,7 +64,7 @@ import hashlib
 import numpy as np
 
 from .design import setup_problem
-from .sizes import mesh_size
+from .sizes import mesh_size, scale_words
 
 SHELLS = "mesh_shells"  # the mesh is several separate parts
 OPEN = "mesh_open"      # the mesh has boundary edges (holes)
@@ -58,6 +74,7 @@ CLOSED = "mesh_closed"  # what was done: the mesh closed for slicing (closing)
 # the obstacle a closed mesh can hold beyond check()'s faults of it (parts the remesh could not join
 # stay SHELLS), said when the design fails (explain adds it to reason_causes)
 THIN_LOST = "mesh_thin_lost"    # parts thinner than the voxel vanished in the remesh
+THIN = "mesh_thin"              # parts thinner than a closed wire around them can be (thin)
 
 WELD = 1e-9              # of the model's size: vertices closer than this are one
 VOXEL_SHARE = 0.015      # of the model's size: a remesh that closes small holes and keeps the shape
@@ -67,8 +84,14 @@ CLOSE_SHARE = 0.01       # of the model's size: the closing voxel at most (keeps
 CLOSE_SEGMENTS = 0.25    # of min_segment (l_min): the closing voxel at most (below what a wire shows)
 CLOSE_CELLS = 256        # cells along the model's largest side at most: the closing voxel at least
 LOST_SHARE = 0.005       # of the original vertices: more than this far from the closed surface is a part lost
+THIN_SEGMENTS = 3 / np.pi  # of min_segment (l_min): the thinnest part a closed wire goes round (module doc)
+THIN_SHARE = 0.005       # of the vertices (rays cast): more than this thin is a thin part
+THIN_RAYS = 20000        # vertices whose thickness is measured at most
+THIN_CELLS = 4_000_000   # (face, cell) entries of the grid at most: beyond, its cells grow
+THIN_PAIRS = 5_000_000   # (ray, face) pairs tested at most (about a second): beyond, fewer rays
 
 _closed = {}  # the last closed mesh: "V", "F", "digest", "record" (remember, closing_of)
+_thin_memo = {}  # the last thin() answer: "key" (digest, min_segment), "faults"
 _memo = {}  # the last mesh: "V", "F" (the arrays asked about), "digest", "faults" (Live slices it again and again)
 
 
@@ -199,6 +222,176 @@ def check(vertices, faces):
     return faults
 
 
+def _vertex_normals(P, F):
+    """Unit area-weighted vertex normals of the welded mesh (P, F), turned outwards when the faces
+    wind inwards (negative signed volume); zero for a vertex of no face."""
+    A, B, C = P[F[:, 0]], P[F[:, 1]], P[F[:, 2]]
+    cross = np.cross(B - A, C - A)  # twice the area times the face's normal
+    if np.einsum("ij,ij->", A, cross) < 0:  # six times the signed volume
+        cross = -cross
+    N = np.zeros_like(P)
+    for k in range(3):
+        np.add.at(N, F[:, k], cross)
+    length = np.linalg.norm(N, axis=1)
+    return np.divide(N, length[:, None], out=np.zeros_like(N), where=length[:, None] > 0), cross
+
+
+def _cells(lo, hi, h, origin):
+    """Integer cell ranges (first, last) of boxes lo..hi ((n, 3)) on a grid of side h."""
+    return (np.floor((lo - origin) / h).astype(np.int64), np.floor((hi - origin) / h).astype(np.int64))
+
+
+def _expand(first, last):
+    """(owner, cell (m, 3)): every cell of every box first..last (inclusive ranges, (n, 3))."""
+    span = last - first + 1
+    count = span.prod(axis=1)
+    owner = np.repeat(np.arange(len(first)), count)
+    k = np.arange(len(owner)) - np.repeat(np.cumsum(count) - count, count)  # index inside the box
+    s = span[owner]
+    offset = np.column_stack([k // (s[:, 1] * s[:, 2]), (k // s[:, 2]) % s[:, 1], k % s[:, 2]])
+    return owner, first[owner] + offset
+
+
+def local_thickness(P, F, reach, rays):
+    """m: for each vertex in `rays` (indices into the welded mesh P, F), the distance inwards along
+    its normal to the first face the ray leaves the solid through (not one touching the vertex or
+    a neighbour of it), when within `reach`; inf
+    otherwise (or for a vertex without a normal); nan for a ray left out (THIN_PAIRS)."""
+    normals, cross = _vertex_normals(P, F)
+    out = np.full(len(rays), np.inf)
+    if not len(rays) or not len(F):
+        return out
+    origin = P.min(axis=0)
+    corner = P[F]
+    h = reach
+    while True:  # the grid's cells: faces much larger than the reach would fill too many
+        f_first, f_last = _cells(corner.min(axis=1), corner.max(axis=1), h, origin)
+        if (f_last - f_first + 1).prod(axis=1).sum() <= THIN_CELLS:
+            break
+        h *= 2
+    face_of, face_cell = _expand(f_first, f_last)
+    dims = np.maximum(f_last.max(axis=0), np.floor((P.max(axis=0) + reach - origin) / h).astype(np.int64)) + 3
+
+    def key(cell):
+        c = cell + 1  # a cell at -1 (a ray's end below the origin) keeps a non-negative key
+        return (c[:, 0] * dims[1] + c[:, 1]) * dims[2] + c[:, 2]
+
+    # vertex pairs (a * len(P) + b) of each vertex with itself and with its neighbours
+    edges = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
+    ring = np.unique(np.concatenate([edges[:, 0] * len(P) + edges[:, 1], edges[:, 1] * len(P) + edges[:, 0],
+                                     np.arange(len(P)) * (len(P) + 1)]))
+    face_key = key(face_cell)
+    order = np.argsort(face_key, kind="stable")
+    face_key, face_of = face_key[order], face_of[order]
+    o = P[rays]
+    d = -normals[rays]
+    end = o + reach * d
+    r_first, r_last = _cells(np.minimum(o, end), np.maximum(o, end), h, origin)
+    ray_of, ray_cell = _expand(r_first, r_last)
+    k = key(ray_cell)
+    lo, hi = np.searchsorted(face_key, k, "left"), np.searchsorted(face_key, k, "right")
+    per_ray = np.bincount(ray_of, weights=hi - lo, minlength=len(rays))
+    # a small dense part puts many faces in each cell: beyond THIN_PAIRS (ray, face) pairs in all,
+    # every so-many-th ray only (the others stay inf)
+    step = max(1, int(np.ceil(per_ray.sum() / THIN_PAIRS)))
+    keep = (ray_of % step) == 0
+    ray_of, lo, hi = ray_of[keep], lo[keep], hi[keep]
+    out[np.arange(len(rays)) % step != 0] = np.nan
+    bounds = np.searchsorted(np.cumsum(hi - lo), np.arange(1, int((hi - lo).sum() // 1_000_000) + 1) * 1_000_000)
+    for part in np.split(np.arange(len(ray_of)), np.unique(bounds)):  # about a million pairs at a time
+        if not len(part):
+            continue
+        n = hi[part] - lo[part]
+        ray = np.repeat(ray_of[part], n)
+        at = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n) + np.repeat(lo[part], n)
+        face = face_of[at]
+        pair = np.unique(ray * len(F) + face)
+        ray, face = np.divmod(pair, len(F))
+        # the faces touching the ray's vertex or its neighbours: a ray grazes them on a curved or
+        # creased surface (a hit at about no distance), and no part is as thin as its own faces
+        near = np.isin(rays[ray][:, None] * len(P) + F[face], ring).any(axis=1)
+        ray, face = ray[~near], face[~near]
+        exits = np.einsum("ij,ij->i", cross[face], d[ray]) > 0  # leaving the solid: the face looks along the ray
+        ray, face = ray[exits], face[exits]
+        A = P[F[face, 0]]
+        e1, e2 = P[F[face, 1]] - A, P[F[face, 2]] - A
+        dr = d[ray]
+        p = np.cross(dr, e2)
+        det = np.einsum("ij,ij->i", e1, p)
+        ok = np.abs(det) > 1e-300
+        inv = np.divide(1.0, det, out=np.zeros_like(det), where=ok)
+        sv = o[ray] - A
+        u = np.einsum("ij,ij->i", sv, p) * inv
+        q = np.cross(sv, e1)
+        v = np.einsum("ij,ij->i", dr, q) * inv
+        t = np.einsum("ij,ij->i", e2, q) * inv
+        hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 0) & (t <= reach)
+        np.minimum.at(out, ray[hit], t[hit])
+    out[~(np.linalg.norm(normals[rays], axis=1) > 0) & ~np.isnan(out)] = np.inf
+    return out
+
+
+def thin(vertices, faces, min_segment):
+    """[THIN fault] when more than THIN_SHARE of the mesh's vertices lie where it is thinner than
+    THIN_SEGMENTS * min_segment (module doc), else []."""
+    V = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
+    F = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    if not len(V) or not len(F) or not min_segment > 0:
+        return []
+    memo_key = (_digest(V, F), float(min_segment))  # Live slices the same mesh again and again
+    if _thin_memo.get("key") == memo_key:
+        return [dict(f) for f in _thin_memo["faults"]]
+    faults = _thin(V, F, min_segment)
+    _thin_memo.update(key=memo_key, faults=[dict(f) for f in faults])
+    return faults
+
+
+def _thin(V, F, min_segment):
+    size = mesh_size(V)
+    index, count = _weld(V, size)
+    F = index[F]
+    F = F[(F[:, 0] != F[:, 1]) & (F[:, 1] != F[:, 2]) & (F[:, 2] != F[:, 0])]
+    P = np.zeros((count, 3))
+    P[index] = V
+    used = np.unique(F)
+    rays = used[np.linspace(0, len(used) - 1, min(len(used), THIN_RAYS)).round().astype(np.int64)] \
+        if len(used) > THIN_RAYS else used
+    limit = THIN_SEGMENTS * min_segment
+    t = local_thickness(P, F, limit, rays)
+    measured = ~np.isnan(t)
+    thin_rays = measured & (t < limit)
+    share = float(thin_rays.sum() / max(measured.sum(), 1))
+    if share <= THIN_SHARE:
+        return []
+    where, depth = P[rays[thin_rays]], t[thin_rays]
+    # the thin places: thin vertices in the same or neighbouring cells of the limit's size are one
+    cell = np.floor((where - where.min(axis=0)) / limit).astype(np.int64)
+    cells, of = np.unique(cell, axis=0, return_inverse=True)
+    of = of.reshape(-1)
+    span = cells.max(axis=0) + 2
+    keys = (cells[:, 0] * span[1] + cells[:, 1]) * span[2] + cells[:, 2]  # sorted, as cells are
+    pairs = []
+    for dx, dy, dz in _OFFSETS:
+        other = np.searchsorted(keys, keys + (dx * span[1] + dy) * span[2] + dz)
+        found = (other < len(keys)) & (keys[np.minimum(other, len(keys) - 1)] == keys + (dx * span[1] + dy) * span[2] + dz)
+        ok = found & ((cells[np.minimum(other, len(keys) - 1)] - cells)[:, [1, 2]] <= 1).all(axis=1) \
+            & ((cells[np.minimum(other, len(keys) - 1)] - cells)[:, [1, 2]] >= -1).all(axis=1)
+        pairs.append(np.column_stack([np.nonzero(ok)[0], other[ok]]))
+    # and thin vertices joined by an edge of the mesh (a coarse mesh's edges are longer than a cell)
+    thin_index = np.full(len(P), -1)
+    thin_index[rays[thin_rays]] = np.arange(len(where))
+    ends = thin_index[np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])]
+    ends = ends[(ends >= 0).all(axis=1)]
+    pairs.append(np.column_stack([of[ends[:, 0]], of[ends[:, 1]]]))
+    label, places = _components(len(cells), np.concatenate(pairs))
+    part = label[of]
+    largest = int(np.argmax(np.bincount(part, minlength=places)))
+    mine = part == largest
+    at = (where[mine].min(axis=0) + where[mine].max(axis=0)) / 2
+    return [{"cause": THIN, "share": share, "places": int(places), "thinnest": float(depth[mine].min()),
+             "limit": float(limit), "at": [float(c) for c in at], "size": float(size)}]
+
+
 def _mm(metres):
     return f"{metres * 1000:.0f} mm" if metres >= 0.0015 else f"{metres * 1000:.1f} mm"
 
@@ -207,6 +400,15 @@ def sentence(fault):
     """The words of one fault of check() or obstacle of obstacles(), with its figures and what to do."""
     if fault["cause"] == THIN_LOST:
         return obstacle_sentence(fault)
+    if fault["cause"] == THIN:
+        at = ", ".join(f"{1000 * c:.0f}" for c in fault["at"])
+        places = fault.get("places", 1)
+        where = (f"in {places} places, {100 * fault['share']:.0f} % of its vertices; the largest around ({at}) mm"
+                 if places > 1 else f"{100 * fault['share']:.0f} % of its vertices, around ({at}) mm")
+        return (f"parts of the model are thinner than a wire can go round: {where}, as thin as "
+                f"{_mm(fault['thinnest'])}, under the {_mm(fault['limit'])} a closed wire of straight pieces of at "
+                f"least the minimum segment needs: {scale_words(fault['size'], fault['limit'] / fault['thinnest'])}, "
+                f"thicken them, or expect no wire there")
     if fault["cause"] == NONMANIFOLD:
         return (f"the mesh has {fault['edges']} non-manifold edge{'s' if fault['edges'] != 1 else ''} (shared by "
                 f"more than two faces), where a plane's contour can branch: merge or separate the faces there")

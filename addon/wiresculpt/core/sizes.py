@@ -77,12 +77,52 @@ def model_size(design):
     return max(max(map(itemgetter(k), points)) - min(map(itemgetter(k), points)) for k in range(3))
 
 
+def gap_scale(arc, min_segment):
+    """The one scale rule: two crossings `arc` m apart along a wire need room for a free bending
+    point between them, two straight pieces of at least `min_segment` each, so the model must grow
+    by 2 min_segment / arc (math.inf for arc <= 0). The native network and target shape compute
+    the same (native/src/figures.hpp gap_scale), and hand it over as each gap's `scale`; this is
+    the rule for the add-on's own gaps (a short feed between two crossings). Why twice: scaled by
+    min_segment / arc only, the two crossings would be one straight piece apart, a fixed edge both
+    kinks share, which the target shape still refuses unless the contour happens to lie in both
+    contact cones, and the user would be told to scale up a second time."""
+    return 2.0 * min_segment / arc if arc > 0 else math.inf
+
+
+def feed_scale(feed, min_segment):
+    """The factor by which a lone straight feed of `feed` m must grow to be `min_segment` long (one
+    piece, no crossing at both its ends: min_segment / feed)."""
+    return min_segment / feed if feed > 0 else math.inf
+
+
 def scale_advice(design, factor):
     """The words of "scale the model up by `factor`", with the model's size (model_size) before and
-    after: every scale advice the add-on makes says its figures this way."""
-    size = model_size(design)
-    return (f"scale the model up at least {factor:.2f} times (largest side {size:.4g} m -> "
-            f"{size * factor:.4g} m)")
+    after: every scale advice the add-on makes says its figures this way, as the native's
+    (native/src/figures.hpp scale_words) do."""
+    return scale_words(model_size(design), factor)
+
+
+def scale_words(size, factor):
+    """scale_advice's words for a model `size` m across (without the sizes when `size` <= 0)."""
+    if not size > 0:
+        return f"scale the model up at least {factor:.2f} times"
+    return f"scale the model up at least {factor:.2f} times (largest side {size:.4g} m -> {size * factor:.4g} m)"
+
+
+def required_size(design, factor):
+    """m: the model's size (model_size) once scaled up by `factor`: the design's `required_size`,
+    the figure after the arrow of scale_advice."""
+    return model_size(design) * factor
+
+
+def close_crossing_sentence(design, gap, min_segment):
+    """The words of one of the network's close crossings (`gap`: wire, crossings, distance, scale,
+    as native.layering hands them over), with the model's size (scale_advice)."""
+    shown, least = versus(gap["distance"] * 1000, min_segment * 1000, 1)
+    a, b = gap["crossings"]
+    return (f"wire {design['wires'][gap['wire']]['name']}: crossings {a} and {b} are {shown} mm apart along the "
+            f"wire, less than the machine's minimum segment {least} mm; a free bending point between them needs "
+            f"twice that: " + scale_advice(design, gap["scale"]))
 
 
 def size_facts(design, stock_length=STOCK_LENGTH, profile_name="the default machine profile"):

@@ -16,7 +16,7 @@ import numpy as np
 
 from .. import native
 from ..core.design import NOT_BUILDABLE
-from ..core.sizes import scale_advice
+from ..core.sizes import feed_scale, gap_scale, scale_advice
 from ..core.polylines import self_crossings
 from .export import machine_profile
 
@@ -48,8 +48,10 @@ def between_bends(bend_points, edge):
 
 
 def _scale_advice(design, feed, limit, ends):
-    """How to lengthen a short feed: scale the model (every length grows with it)."""
-    scale = scale_advice(design, limit / feed)
+    """How to lengthen a short feed: scale the model (every length grows with it); between two
+    crossings by the one rule for crossings (core/sizes.gap_scale: room for a free bending point),
+    else until the feed is `limit` long (feed_scale)."""
+    scale = scale_advice(design, gap_scale(feed, limit) if len(ends) == 2 else feed_scale(feed, limit))
     if len(ends) == 2:
         return (f"its ends are crossings {ends[0]} and {ends[1]}, fixed points of the wire: {scale} or move the "
                 "planes so that they lie farther apart")

@@ -5,6 +5,7 @@ from .. import native
 from ..core import settings as settings_table
 from ..core.design import UNREALISED
 from ..core.polylines import point_array
+from ..core.sizes import close_crossing_sentence, required_size
 
 
 def knob(settings, key):
@@ -76,9 +77,11 @@ def run(design, material, settings, native_progress=None, forbidden=(), too_clos
     if not result["complete_search"] and not design["stable"]:
         design["search_incomplete"] = True  # max_nodes stopped it: a stable design may still exist
     design.setdefault("warnings", []).extend(result["warnings"])
-    if net["close_crossings"]:
-        design["close_crossings"] = [g["message"] for g in net["close_crossings"]]
-        design["required_size"] = net["required_size"]
+    if net["close_crossings"]:  # worded here, with the model's size (core/sizes), warnings and design alike
+        close = [close_crossing_sentence(design, g, settings["min_segment"]) for g in net["close_crossings"]]
+        design["warnings"].extend(close)
+        design["close_crossings"] = close
+        design["required_size"] = required_size(design, max(g["scale"] for g in net["close_crossings"]))
     if too_close is not None:  # for the screen (plane_faults.screen_fault) and relayer, never in a design.json
         design["too_close_forbidden"] = [list(p) for p in result["too_close_forbidden"]]
     stats = result["stats"]

@@ -50,7 +50,7 @@ struct CrossingGap {
   int wire = -1;
   std::array<int, 2> crossings{-1, -1};  ///< crossing ids, in the wire's direction
   double distance = 0.0;                 ///< metres, along the wire
-  double scale = 1.0;                    ///< min_segment / distance: the model must grow this much
+  double scale = 1.0;                    ///< 2 min_segment / distance (detail::gap_scale): the model must grow this much
   std::string message;                   ///< a sentence naming the wire, crossings and sizes
 };
 
@@ -60,7 +60,7 @@ struct Network {
   std::vector<std::string> warnings;    ///< e.g. a wire touching another without crossing it
   std::vector<CrossingGap> close_crossings;  ///< empty when every gap is >= min_segment
   /// >= 1: the factor by which the model must be scaled up so that no two crossings are closer
-  /// than min_segment along a wire (1 when close_crossings is empty).
+  /// than 2 min_segment along a wire, the largest close_crossings' scale (1 when it is empty).
   double min_scale = 1.0;
   /// Metres: the largest side of the bounding box of all wires, now and after scaling by
   /// min_scale.
