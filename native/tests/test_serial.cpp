@@ -635,3 +635,48 @@ TEST_CASE("serial: a controller restart seen before the next line is sent stops 
   CHECK_THAT(r.message, Contains("restarted") && Contains("step 1") && Contains("from line 4"));
   CHECK(state.next_line == 3);  // step 1's queued feed and bend are lost: the resume makes it again
 }
+
+TEST_CASE("serial: the Windows stage's five streams give its outcomes on this build's back end", "[fab][serial]") {
+  // blender_tests/windows/test_windows.py's cases and expected outcomes (globe_design.SERIAL_PROGRAM),
+  // here on the back end of this binary: libserialport's pty path, or the posix one (macOS's).
+  const std::vector<std::string> program{"G21", "G91", "G1 X1 F100", "G4 P0", "G1 Y-2 F100", "G4 P0", "M2"};
+  const MachineProfile profile;
+  {
+    GrblEmulator grbl(GrblEmulator::Mode::normal);
+    StreamState state;
+    const auto r = stream_program(grbl.path(), program, profile, state, quick());
+    CHECK(r.status == StreamStatus::completed);
+    CHECK((r.sent == 7 && r.acknowledged == 7 && r.failed_line == -1));
+    CHECK((state.next_line == 7 && state.confirmed == 7));
+    CHECK(grbl.received() == program);
+  }
+  {
+    GrblEmulator grbl(GrblEmulator::Mode::error_at, 2);  // error:20 to the 3rd line
+    StreamState state;
+    const auto r = stream_program(grbl.path(), program, profile, state, quick());
+    CHECK(r.status == StreamStatus::error);
+    CHECK((r.code == 20 && r.failed_line == 2 && r.acknowledged == 2));
+    CHECK(state.next_line == 2);
+    CHECK(grbl.received() == std::vector<std::string>{"G21", "G91", "G1 X1 F100"});
+  }
+  {
+    GrblEmulator grbl(GrblEmulator::Mode::drop_at, 2);  // the cable goes with the 3rd line in flight
+    StreamState state;
+    const auto r = stream_program(grbl.path(), program, profile, state, quick());
+    CHECK(r.status == StreamStatus::disconnected);
+    CHECK((r.failed_line == 2 && r.acknowledged == 2));
+    CHECK((state.next_line == 2 && state.confirmed == 2));
+    CHECK(grbl.received() == std::vector<std::string>{"G21", "G91", "G1 X1 F100"});
+  }
+  {
+    GrblEmulator grbl(GrblEmulator::Mode::normal);
+    SerialPort holder(grbl.path(), profile.serial);
+    StreamState state;
+    CHECK_THROWS_WITH(stream_program(grbl.path(), program, profile, state, quick()),
+                      Contains("serial port '" + grbl.path() + "' is in use by "));
+    CHECK(grbl.received().empty());
+  }
+  StreamState state;
+  CHECK_THROWS_WITH(stream_program("/dev/ttyUSB-wiresculpt-absent", program, profile, state, quick()),
+                    Contains("could not open serial port '/dev/ttyUSB-wiresculpt-absent': no such port"));
+}
