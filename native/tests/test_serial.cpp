@@ -379,7 +379,7 @@ TEST_CASE("serial: dry run, bad programs and bad ports", "[fab][serial]") {
   CHECK_NOTHROW(list_ports());
 }
 
-TEST_CASE("serial: 'ok ok' to one line is a protocol error before the next line; the resume sends that line",
+TEST_CASE("serial: 'ok ok' to one line is a protocol error before the next line: the resume sends that line",
           "[fab][serial][robustness]") {
   // Before strict accounting, the second "ok" acknowledged line k+1 the moment it was sent: a
   // resume after any later stop would have skipped it (a bend never made).
@@ -465,7 +465,7 @@ TEST_CASE("serial: timeouts and settle outside their ranges are refused on entry
                     "write_timeout must be more than 0 and at most 600 seconds, got 0");
 }
 
-TEST_CASE("serial: parse_answer classifies GRBL's lines; device bytes become printable text", "[fab][serial]") {
+TEST_CASE("serial: parse_answer classifies GRBL's lines: device bytes become printable text", "[fab][serial]") {
   using K = GrblAnswer::Kind;
   CHECK(parse_answer("ok").kind == K::ok);
   CHECK(parse_answer("ok\r").kind == K::ok);
@@ -493,7 +493,7 @@ std::vector<std::size_t> sync_lines(const std::vector<std::string>& lines) {
 
 }  // namespace
 
-TEST_CASE("serial: a link dropped while a step's G4 P0 waits names the step in doubt; the resume sends the whole "
+TEST_CASE("serial: a link dropped while a step's G4 P0 waits names the step in doubt: the resume sends the whole "
           "step again", "[fab][serial][robustness]") {
   // GRBL answers "ok" when a line is queued: step 2's feed and bend lines were all acknowledged at
   // once, and only its G4 P0 waits for the moves. Reopening the port resets the controller in the
