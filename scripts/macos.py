@@ -10,7 +10,9 @@ uses), the headers (a Linux Python's with cmake/macos-pyconfig.h as pyconfig.h, 
 against a real interpreter), and the modules by a hash of the native sources. The module links
 with `-undefined dynamic_lookup` (Python's symbols come from the interpreter that loads it),
 libc++ static; macos.dylibs() reads its load commands (llvm-objdump) and module() refuses one
-that needs anything but the system's libSystem. Built without libserialport (no source here).
+that needs anything but the system's libSystem. Serial ports through the termios back end
+(WIRESCULPT_SERIAL_BACKEND=posix, native/src/fab/serial_posix.cpp: libserialport's source is not
+here); it is tested on Linux's ptys (ctest posix-backend/...), not on a Mac.
 """
 import glob
 import hashlib
@@ -30,7 +32,7 @@ ARCHS = ("aarch64", "x86_64")
 MINOS = "11.0"  # the oldest macOS Blender 4.2+ runs on
 WHEEL_TAG = {"aarch64": "macosx_11_0_arm64", "x86_64": "macosx_11_0_x86_64"}
 SYSTEM = ("/usr/lib/libSystem.B.dylib",)
-BUILD_KEY = "1"
+BUILD_KEY = "2"  # 2: serial ports through the posix back end
 
 
 def zig_bin():
@@ -144,7 +146,8 @@ def module(arch, minor):
                  f"-DWIRESCULPT_DEPS_PREFIX={prefix}", f"-DNLopt_DIR={prefix}/lib/cmake/nlopt",
                  # named, not searched: a build folder keeps what find_library found for another prefix
                  f"-DGLPK_LIBRARY={prefix}/lib/libglpk.a", f"-DGLPK_INCLUDE_DIR={prefix}/include",
-                 "-DEigen3_DIR=/usr/share/eigen3/cmake", "-DWIRESCULPT_SERIAL_PORT=OFF", "-DWIRESCULPT_BUILD_TESTS=OFF",
+                 "-DEigen3_DIR=/usr/share/eigen3/cmake", "-DWIRESCULPT_SERIAL_PORT=ON", "-DWIRESCULPT_SERIAL_BACKEND=posix",
+                 "-DWIRESCULPT_BUILD_TESTS=OFF",
                  f"-DWIRESCULPT_PYTHON_INCLUDE_DIR={headers(minor)}", "-DWIRESCULPT_PYTHON_LIBRARY=",
                  f"-DWIRESCULPT_PYBIND11_INCLUDE_DIR={windows.pybind11_include()}",
                  f"-DWIRESCULPT_MODULE_SUFFIX=.cpython-{tag[2:]}-darwin.so", f"-DWIRESCULPT_MODULE_DIR={out}"]

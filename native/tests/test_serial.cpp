@@ -379,7 +379,7 @@ TEST_CASE("serial: dry run, bad programs and bad ports", "[fab][serial]") {
   CHECK_NOTHROW(list_ports());
 }
 
-TEST_CASE("serial: 'ok ok' to one line is a protocol error before the next line; the resume sends that line",
+TEST_CASE("serial: 'ok ok' to one line is a protocol error before the next line: the resume sends that line",
           "[fab][serial][robustness]") {
   // Before strict accounting, the second "ok" acknowledged line k+1 the moment it was sent: a
   // resume after any later stop would have skipped it (a bend never made).
@@ -465,7 +465,7 @@ TEST_CASE("serial: timeouts and settle outside their ranges are refused on entry
                     "write_timeout must be more than 0 and at most 600 seconds, got 0");
 }
 
-TEST_CASE("serial: parse_answer classifies GRBL's lines; device bytes become printable text", "[fab][serial]") {
+TEST_CASE("serial: parse_answer classifies GRBL's lines: device bytes become printable text", "[fab][serial]") {
   using K = GrblAnswer::Kind;
   CHECK(parse_answer("ok").kind == K::ok);
   CHECK(parse_answer("ok\r").kind == K::ok);
@@ -493,7 +493,7 @@ std::vector<std::size_t> sync_lines(const std::vector<std::string>& lines) {
 
 }  // namespace
 
-TEST_CASE("serial: a link dropped while a step's G4 P0 waits names the step in doubt; the resume sends the whole "
+TEST_CASE("serial: a link dropped while a step's G4 P0 waits names the step in doubt: the resume sends the whole "
           "step again", "[fab][serial][robustness]") {
   // GRBL answers "ok" when a line is queued: step 2's feed and bend lines were all acknowledged at
   // once, and only its G4 P0 waits for the moves. Reopening the port resets the controller in the
@@ -634,4 +634,49 @@ TEST_CASE("serial: a controller restart seen before the next line is sent stops 
   CHECK(grbl.received().size() == k + 1);  // line k+1 was never sent
   CHECK_THAT(r.message, Contains("restarted") && Contains("step 1") && Contains("from line 4"));
   CHECK(state.next_line == 3);  // step 1's queued feed and bend are lost: the resume makes it again
+}
+
+TEST_CASE("serial: the Windows stage's five streams give its outcomes on this build's back end", "[fab][serial]") {
+  // blender_tests/windows/test_windows.py's cases and expected outcomes (globe_design.SERIAL_PROGRAM),
+  // here on the back end of this binary: libserialport's pty path, or the posix one (macOS's).
+  const std::vector<std::string> program{"G21", "G91", "G1 X1 F100", "G4 P0", "G1 Y-2 F100", "G4 P0", "M2"};
+  const MachineProfile profile;
+  {
+    GrblEmulator grbl(GrblEmulator::Mode::normal);
+    StreamState state;
+    const auto r = stream_program(grbl.path(), program, profile, state, quick());
+    CHECK(r.status == StreamStatus::completed);
+    CHECK((r.sent == 7 && r.acknowledged == 7 && r.failed_line == -1));
+    CHECK((state.next_line == 7 && state.confirmed == 7));
+    CHECK(grbl.received() == program);
+  }
+  {
+    GrblEmulator grbl(GrblEmulator::Mode::error_at, 2);  // error:20 to the 3rd line
+    StreamState state;
+    const auto r = stream_program(grbl.path(), program, profile, state, quick());
+    CHECK(r.status == StreamStatus::error);
+    CHECK((r.code == 20 && r.failed_line == 2 && r.acknowledged == 2));
+    CHECK(state.next_line == 2);
+    CHECK(grbl.received() == std::vector<std::string>{"G21", "G91", "G1 X1 F100"});
+  }
+  {
+    GrblEmulator grbl(GrblEmulator::Mode::drop_at, 2);  // the cable goes with the 3rd line in flight
+    StreamState state;
+    const auto r = stream_program(grbl.path(), program, profile, state, quick());
+    CHECK(r.status == StreamStatus::disconnected);
+    CHECK((r.failed_line == 2 && r.acknowledged == 2));
+    CHECK((state.next_line == 2 && state.confirmed == 2));
+    CHECK(grbl.received() == std::vector<std::string>{"G21", "G91", "G1 X1 F100"});
+  }
+  {
+    GrblEmulator grbl(GrblEmulator::Mode::normal);
+    SerialPort holder(grbl.path(), profile.serial);
+    StreamState state;
+    CHECK_THROWS_WITH(stream_program(grbl.path(), program, profile, state, quick()),
+                      Contains("serial port '" + grbl.path() + "' is in use by "));
+    CHECK(grbl.received().empty());
+  }
+  StreamState state;
+  CHECK_THROWS_WITH(stream_program("/dev/ttyUSB-wiresculpt-absent", program, profile, state, quick()),
+                    Contains("could not open serial port '/dev/ttyUSB-wiresculpt-absent': no such port"));
 }

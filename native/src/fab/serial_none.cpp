@@ -1,10 +1,9 @@
-// The serial port in a build without serial ports (WIRESCULPT_SERIAL_PORT=OFF: the macOS cross
-// build, whose libserialport source is not among the packages reached here; Windows has its own
-// back end, serial_win32.cpp). The protocol
+// The serial port in a build without serial ports (WIRESCULPT_SERIAL_BACKEND=none, or
+// WIRESCULPT_SERIAL_PORT=OFF). The protocol
 // (grbl_protocol.cpp) and the streamer are built as always (validation, dry runs, parse_answer);
 // no port is listed, and opening one throws an InputError that says why, which reaches the user
 // as the stream's message.
-#ifdef WIRESCULPT_NO_SERIAL_PORT
+#ifdef WIRESCULPT_SERIAL_BACKEND_NONE
 #include <string>
 #include <vector>
 
@@ -12,6 +11,8 @@
 #include "wiresculpt/fab/serial.hpp"
 
 namespace wiresculpt::fab {
+
+const char* serial_backend() { return "none"; }
 
 std::vector<PortInfo> list_ports() { return {}; }
 
@@ -22,7 +23,7 @@ struct SerialPort::Impl {
 SerialPort::SerialPort(const std::string& name, const SerialSettings& /*settings*/) : impl_(std::make_unique<Impl>()) {
   impl_->name = name;
   throw InputError("could not open serial port '" + name + "': this build of the solver has no serial ports "
-                   "(it is made without libserialport); export the G-code files and send them "
+                   "(it is made without a serial back end); export the G-code files and send them "
                    "with the machine's own sender");
 }
 
@@ -37,4 +38,4 @@ int SerialPort::read(char* /*buffer*/, int /*size*/, int /*timeout_ms*/) { retur
 void SerialPort::drain_input(int /*timeout_ms*/) {}
 
 }  // namespace wiresculpt::fab
-#endif  // WIRESCULPT_NO_SERIAL_PORT
+#endif  // WIRESCULPT_SERIAL_BACKEND_NONE

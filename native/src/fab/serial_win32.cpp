@@ -4,9 +4,9 @@
 // is bounded by SetCommTimeouts, so nothing here can hang. Windows opens a COM port for one
 // program at a time (share mode 0); a named kernel object per port ("Local\wiresculpt-serial-
 // COMn", gone with the process) keeps two wiresculpt streams off one port where the system does
-// not (Wine lets a second handle open a COM port), as the POSIX back end's lock file does.
+// not (Wine lets a second handle open a COM port), as the POSIX back ends' lock file does.
 // The ports listed are those Windows records under HKLM\HARDWARE\DEVICEMAP\SERIALCOMM.
-#if defined(_WIN32) && !defined(WIRESCULPT_NO_SERIAL_PORT)
+#ifdef WIRESCULPT_SERIAL_BACKEND_WIN32
 #ifndef WIN32_LEAN_AND_MEAN
 #define WIN32_LEAN_AND_MEAN
 #endif
@@ -116,6 +116,8 @@ std::string system_message(DWORD code) {
 }
 
 }  // namespace
+
+const char* serial_backend() { return "win32"; }
 
 std::vector<PortInfo> list_ports() {
   std::vector<PortInfo> out;
@@ -265,4 +267,4 @@ void SerialPort::drain_input(int timeout_ms) {
 
 }  // namespace wiresculpt::fab
 
-#endif  // _WIN32 && !WIRESCULPT_NO_SERIAL_PORT
+#endif  // WIRESCULPT_SERIAL_BACKEND_WIN32

@@ -1,5 +1,5 @@
 #pragma once
-// Streaming a program to a GRBL-based bender over a serial port (libserialport), with GRBL's
+// Streaming a program to a GRBL-based bender over a serial port (serial_backend()), with GRBL's
 // send-response protocol: one line is sent, then nothing more until GRBL answers that line with
 // "ok" (accepted) or "error:N" (rejected, not executed). "ALARM:N" at any time stops the stream.
 // Every read and write has a timeout, so nothing here can hang; the full protocol, the resume
@@ -30,12 +30,18 @@ struct PortInfo {
   std::string description;  ///< from the system, e.g. "USB2.0-Serial"
 };
 
-/// Serial ports the system reports (libserialport). Pseudo-terminals are not listed.
+/// The serial back end this build has: "libserialport" (Linux), "posix" (termios alone: macOS),
+/// "win32" (Windows' own API) or "none" (opening a port throws; WIRESCULPT_SERIAL_BACKEND).
+const char* serial_backend();
+
+/// Serial ports the system reports: libserialport's list; the posix back end's /dev/cu.* (macOS)
+/// or /dev/ttyUSB*, /dev/ttyACM*; Windows' SERIALCOMM. Pseudo-terminals are not listed.
 std::vector<PortInfo> list_ports();
 
-/// An open serial link with timeouts. Opens through libserialport; a device libserialport does
-/// not know (a pseudo-terminal such as a socat or emulator port) is opened as a plain POSIX tty
-/// with the same settings.
+/// An open serial link with timeouts. Opens through the build's back end (serial_backend()); the
+/// libserialport one opens a device libserialport does not know (a pseudo-terminal such as a
+/// socat or emulator port) as a plain POSIX tty with the same settings, as the posix one opens
+/// every port.
 class SerialPort {
  public:
   /// Throws InputError naming the port when it cannot be opened or configured.
@@ -53,7 +59,7 @@ class SerialPort {
   /// Discards pending input, reading for at most timeout_ms.
   void drain_input(int timeout_ms);
 
-  struct Impl;  // opaque: libserialport handle or POSIX descriptor
+  struct Impl;  // opaque: the back end's handle (libserialport, POSIX descriptor, Windows HANDLE)
 
  private:
   std::unique_ptr<Impl> impl_;
