@@ -77,7 +77,7 @@ TEST_CASE("deflection: quarter ring under an end torque (Castigliano)", "[deflec
   CHECK(stiff.displacement.back().z() == Approx(T * R * R * (std::numbers::pi / (4 * EI) + (std::numbers::pi / 4 - 1) / (10 * GJ))).epsilon(0.01));
 }
 
-TEST_CASE("deflection: a closed ring is clamped at its cut; bad input names the wire", "[deflection]") {
+TEST_CASE("deflection: a closed ring is clamped at its cut, and bad input names the wire", "[deflection]") {
   // A closed ring cut at vertex 0 under self-equilibrated out-of-plane forces (±F at 45°, 225° and
   // 135°, 315°: no net force, no net moment): the walk has the cut at both ends, the clamped
   // first node does not move and a load on the clamp moves nothing.

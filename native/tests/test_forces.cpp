@@ -154,7 +154,7 @@ TEST_CASE("forces: the symmetric three-circle sphere has symmetric forces", "[fo
   }
 }
 
-TEST_CASE("forces: LP and SLSQP agree; the assembly term trades little G_stb", "[forces]") {
+TEST_CASE("forces: LP and SLSQP agree, and the assembly term trades little G_stb", "[forces]") {
   const Sphere s = hooked_sphere();
   const auto cuts = choose_cuts(s.net);
   ForceOptions o;
@@ -219,7 +219,7 @@ TEST_CASE("forces: the torque bound is active and G_stb drops with the torque fr
   }
 }
 
-TEST_CASE("forces: null crossings carry no force; M a = 0 at the optimum", "[forces]") {
+TEST_CASE("forces: null crossings carry no force, and M a = 0 at the optimum", "[forces]") {
   Sphere s = hooked_sphere();
   s.hooks[1] = 0;
   const auto cuts = choose_cuts(s.net);

@@ -288,7 +288,7 @@ TEST_CASE("load: two threads give the serial capacities direction by direction, 
   CHECK(tested >= 5);
 }
 
-TEST_CASE("load: cancelling with two threads throws Cancelled on the calling thread; threads 0 or 3 is an input error",
+TEST_CASE("load: cancelling with two threads throws Cancelled on the calling thread, and threads 0 or 3 is an input error",
           "[load][threads]") {
   const Network net = gallows();
   const std::vector<int> hooks{1};

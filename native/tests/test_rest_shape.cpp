@@ -245,7 +245,7 @@ TEST_CASE("rest: rest bends beyond the machine's limit are reported", "[rest]") 
   for (std::size_t i = 0; i < r.over_bend.size(); ++i) CHECK(std::abs(r.over_bend_angle[i]) > pi / 6);
 }
 
-TEST_CASE("rest: an unloaded bend at the limit is not an over-bend; one past the tolerance is", "[rest]") {
+TEST_CASE("rest: an unloaded bend at the limit is not an over-bend, and one past the tolerance is", "[rest]") {
   // An open rod with one target bend of exactly max_bend (+ rounding) at vertex 2 and no load:
   // the rest angle is the target angle. Built by hand: edges along x, then turned by the angle.
   auto rod = [](double turn) {
