@@ -12,8 +12,11 @@ def write_atomic(path, data):
     mode = "wb" if isinstance(data, (bytes, bytearray)) else "w"
     fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", suffix=".tmp", dir=folder)
     try:
-        os.fchmod(fd, 0o644)  # mkstemp makes 0600: results are for others to read too
+        # the file object owns the descriptor at once: closed on any error before the unlink below,
+        # which Windows refuses while it is open (a sharing violation)
         with os.fdopen(fd, mode, **({} if mode == "wb" else {"encoding": "utf-8", "newline": "\n"})) as f:
+            if hasattr(os, "fchmod"):  # not on Windows before Python 3.13, whose files have no such bits
+                os.fchmod(f.fileno(), 0o644)  # mkstemp makes 0600: results are for others to read too
             f.write(data)
             f.flush()
             os.fsync(f.fileno())
